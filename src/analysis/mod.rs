@@ -1,0 +1,1 @@
+//! Periodicity, harmonics, model-vs-measurement comparison, diagnosis.

@@ -1,0 +1,13 @@
+//! `rotorsim verify` (issue #3).
+use clap::Args;
+
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// Arguments of a command that is not available yet.
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    pub rest: Vec<String>,
+}
+
+pub fn run(_args: VerifyArgs) -> anyhow::Result<()> {
+    anyhow::bail!("`rotorsim verify` is not available yet (tracked in issue #3)")
+}

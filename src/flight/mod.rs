@@ -1,0 +1,1 @@
+//! Flight records (CSV triple and MCAP), unit conversion at the edges, airload replay.

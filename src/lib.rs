@@ -1,0 +1,13 @@
+//! rotorsim: rotor-blade aeroelastic loads with physics-based hydraulic devices.
+//!
+//! Reference: O. A. Bauchau and H. Liu, "On the Modeling of Hydraulic Components in Rotorcraft
+//! Systems" (equation numbers in doc comments, "Eq. N", refer to that paper).
+pub mod analysis;
+pub mod cli;
+pub mod flight;
+pub mod hydraulics;
+pub mod io;
+pub mod report;
+pub mod rotor;
+pub mod solver;
+pub mod structure;

@@ -1,0 +1,2 @@
+//! Reports: plots, HTML, MCAP out.
+pub mod plot;

@@ -1,0 +1,1 @@
+//! Rotor deck -> multibody model.

@@ -1,0 +1,1 @@
+//! Assembly, Newton iterations, generalized-alpha time integration, static and modal analyses.

@@ -1,0 +1,1 @@
+//! Structural elements: rotations, geometrically exact beams, rigid bodies, joints, forces.
