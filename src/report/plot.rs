@@ -57,6 +57,9 @@ pub enum PlotError {
     Output(#[from] crate::io::OutputError),
 }
 
+/// A closed interval (lo, hi).
+type Range = (f64, f64);
+
 const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -113,7 +116,7 @@ impl Plot {
         self
     }
 
-    fn ranges(&self) -> Result<((f64, f64), (f64, f64)), PlotError> {
+    fn ranges(&self) -> Result<(Range, Range), PlotError> {
         let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
         let mut yr = xr;
         for s in &self.series {
