@@ -1,1 +1,4 @@
 //! Periodicity, harmonics, model-vs-measurement comparison, diagnosis.
+pub mod compare;
+pub mod harmonics;
+pub mod periodicity;
