@@ -1,2 +1,3 @@
 //! Reports: plots, HTML, MCAP out.
+pub mod html;
 pub mod plot;

@@ -1,0 +1,132 @@
+//! Self-contained HTML reports: inline SVG figures, tables and text, no external resources.
+use std::fmt::Write as _;
+
+/// Escapes text for HTML element content and attribute values.
+pub fn escape(s: &str) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => o.push_str("&amp;"),
+            '<' => o.push_str("&lt;"),
+            '>' => o.push_str("&gt;"),
+            '"' => o.push_str("&quot;"),
+            '\'' => o.push_str("&#39;"),
+            _ => o.push(c),
+        }
+    }
+    o
+}
+
+/// A report built section by section.
+#[derive(Debug, Clone)]
+pub struct HtmlReport {
+    title: String,
+    body: String,
+}
+
+impl HtmlReport {
+    pub fn new(title: &str) -> Self {
+        Self {
+            title: title.into(),
+            body: String::new(),
+        }
+    }
+
+    pub fn heading(&mut self, level: u8, text: &str) -> &mut Self {
+        let l = level.clamp(1, 6);
+        let _ = writeln!(self.body, "<h{l}>{}</h{l}>", escape(text));
+        self
+    }
+
+    pub fn paragraph(&mut self, text: &str) -> &mut Self {
+        let _ = writeln!(self.body, "<p>{}</p>", escape(text));
+        self
+    }
+
+    /// A highlighted notice (e.g. "synthetic data", "not converged").
+    pub fn notice(&mut self, text: &str) -> &mut Self {
+        let _ = writeln!(self.body, "<p class=\"notice\">{}</p>", escape(text));
+        self
+    }
+
+    pub fn list(&mut self, items: &[String]) -> &mut Self {
+        self.body.push_str("<ul>\n");
+        for i in items {
+            let _ = writeln!(self.body, "<li>{}</li>", escape(i));
+        }
+        self.body.push_str("</ul>\n");
+        self
+    }
+
+    /// Inlines an SVG document produced by [`crate::report::plot`] (trusted, not escaped).
+    pub fn svg(&mut self, caption: &str, svg: &str) -> &mut Self {
+        let start = svg.find("<svg").unwrap_or(0);
+        let _ = writeln!(
+            self.body,
+            "<figure>{}<figcaption>{}</figcaption></figure>",
+            &svg[start..],
+            escape(caption)
+        );
+        self
+    }
+
+    pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) -> &mut Self {
+        self.body.push_str("<table>\n<tr>");
+        for h in header {
+            let _ = write!(self.body, "<th>{}</th>", escape(h));
+        }
+        self.body.push_str("</tr>\n");
+        for r in rows {
+            self.body.push_str("<tr>");
+            for c in r {
+                let _ = write!(self.body, "<td>{}</td>", escape(c));
+            }
+            self.body.push_str("</tr>\n");
+        }
+        self.body.push_str("</table>\n");
+        self
+    }
+
+    /// Preformatted text (commands, JSON excerpts).
+    pub fn pre(&mut self, text: &str) -> &mut Self {
+        let _ = writeln!(self.body, "<pre>{}</pre>", escape(text));
+        self
+    }
+
+    pub fn finish(&self) -> String {
+        format!(
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title>\n<style>\
+body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}\
+table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}\
+th{{background:#eee}}figure{{margin:1em 0}}figcaption{{font-size:90%;color:#555}}\
+.notice{{background:#fff3cd;border:1px solid #e0c060;padding:6px 10px}}pre{{background:#f6f6f6;padding:8px}}\
+</style></head><body>\n<h1>{t}</h1>\n{b}</body></html>\n",
+            t = escape(&self.title),
+            b = self.body
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_text_and_inlines_svg() {
+        let mut r = HtmlReport::new("a<b");
+        r.paragraph("x & y")
+            .notice("SYNTHETIC data")
+            .table(
+                &["model", "rms_N"],
+                &[vec!["<linear>".into(), "1.5".into()]],
+            )
+            .svg("fig", "<?xml version=\"1.0\"?><svg width=\"1\"></svg>");
+        let h = r.finish();
+        assert!(h.contains("<title>a&lt;b</title>"));
+        assert!(h.contains("x &amp; y"));
+        assert!(h.contains("&lt;linear&gt;"));
+        assert!(h.contains("<figure><svg width=\"1\"></svg>"));
+        assert!(!h.contains("<?xml"));
+        assert!(!h.contains("http"), "self-contained");
+    }
+}
