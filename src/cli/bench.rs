@@ -66,7 +66,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     };
     let models: Vec<DamperModel> = match args.damper.as_deref() {
         None => vec![deck.model],
-        Some("all") => vec![DamperModel::Physical, DamperModel::Linear, DamperModel::Nonlinear],
+        Some("all") => vec![
+            DamperModel::Physical,
+            DamperModel::Linear,
+            DamperModel::Nonlinear,
+        ],
         Some(s) => vec![s.parse().map_err(anyhow::Error::msg)?],
     };
     // Build every device first so that a deck error leaves no output at all.
@@ -79,10 +83,21 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     }
     let factor = velocity_factor(&args.velocity_unit)?;
     if !(args.omega > 0.0 && args.omega.is_finite()) {
-        bail!("--omega must be a positive number of rad/s (got {})", args.omega);
+        bail!(
+            "--omega must be a positive number of rad/s (got {})",
+            args.omega
+        );
     }
-    if args.peak_velocity.is_empty() || args.peak_velocity.iter().any(|v| !(*v > 0.0 && v.is_finite())) {
-        bail!("--peak-velocity must be positive numbers (got {:?})", args.peak_velocity);
+    if args.peak_velocity.is_empty()
+        || args
+            .peak_velocity
+            .iter()
+            .any(|v| !(*v > 0.0 && v.is_finite()))
+    {
+        bail!(
+            "--peak-velocity must be positive numbers (got {:?})",
+            args.peak_velocity
+        );
     }
     let sweep = SweepOptions {
         omega_rad_s: args.omega,
@@ -97,7 +112,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             let _ = out.mark_incomplete(&format!("{} model failed: {e}", model.name()));
             anyhow::anyhow!("{} model: {e}", model.name())
         })?;
-        let sub = if devices.len() > 1 { format!("{}/", model.name()) } else { String::new() };
+        let sub = if devices.len() > 1 {
+            format!("{}/", model.name())
+        } else {
+            String::new()
+        };
         write_sweep(&out, &sub, &deck, *model, &runs, &args, factor)?;
         print_table(*model, &runs, &args, factor, opts);
         all.push((*model, runs));
@@ -106,7 +125,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let cap = 3200.0 * LB_TO_N;
     let vmax = args.peak_velocity.iter().cloned().fold(0.0, f64::max);
     let mut p = Plot::new(
-        &format!("Peak force vs peak velocity, omega = {} rad/s ({})", args.omega, deck.source),
+        &format!(
+            "Peak force vs peak velocity, omega = {} rad/s ({})",
+            args.omega, deck.source
+        ),
         &format!("peak velocity [{}]", args.velocity_unit),
         "peak force [N]",
     );
@@ -114,11 +136,17 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let x: Vec<f64> = runs.iter().map(|r| r.peak_velocity_m_s / factor).collect();
         let pos: Vec<f64> = runs.iter().map(|r| r.peak_force_pos_n).collect();
         let neg: Vec<f64> = runs.iter().map(|r| -r.peak_force_neg_n).collect();
-        p = p
-            .line(&format!("{} +peak", model.name()), &x, &pos)
-            .dashed(&format!("{} -peak (magnitude)", model.name()), &x, &neg);
+        p = p.line(&format!("{} +peak", model.name()), &x, &pos).dashed(
+            &format!("{} -peak (magnitude)", model.name()),
+            &x,
+            &neg,
+        );
     }
-    p = p.dashed("paper: relief cap 3200 lb (Fig. 16)", &[0.0, vmax], &[cap, cap]);
+    p = p.dashed(
+        "paper: relief cap 3200 lb (Fig. 16)",
+        &[0.0, vmax],
+        &[cap, cap],
+    );
     out.write("peak_force_vs_velocity.svg", p.to_svg(800, 480)?.as_bytes())?;
     out.finish()?;
     println!("wrote {}", args.out.display());
@@ -134,7 +162,10 @@ fn history_csv(h: &History) -> String {
 }
 
 fn channel<'a>(h: &'a History, name: &str) -> Option<&'a [f64]> {
-    h.channel_names.iter().position(|n| *n == name).map(|i| h.channels[i].as_slice())
+    h.channel_names
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| h.channels[i].as_slice())
 }
 
 fn write_sweep(
@@ -146,20 +177,34 @@ fn write_sweep(
     args: &BenchArgs,
     factor: f64,
 ) -> anyhow::Result<()> {
-    let rows: Vec<[f64; 3]> = runs.iter().map(|r| [r.peak_velocity_m_s, r.peak_force_pos_n, r.peak_force_neg_n]).collect();
+    let rows: Vec<[f64; 3]> = runs
+        .iter()
+        .map(|r| [r.peak_velocity_m_s, r.peak_force_pos_n, r.peak_force_neg_n])
+        .collect();
     out.write(
         &format!("{sub}peaks.csv"),
-        crate::io::csv_string(&["peak_velocity_m_s", "peak_force_pos_N", "peak_force_neg_N"], &rows).as_bytes(),
+        crate::io::csv_string(
+            &["peak_velocity_m_s", "peak_force_pos_N", "peak_force_neg_N"],
+            &rows,
+        )
+        .as_bytes(),
     )?;
     for (k, r) in runs.iter().enumerate() {
-        out.write(&format!("{sub}history_{k}.csv"), history_csv(&r.history).as_bytes())?;
+        out.write(
+            &format!("{sub}history_{k}.csv"),
+            history_csv(&r.history).as_bytes(),
+        )?;
     }
     // Time history at the amplitude closest to 2 in/s (paper Fig. 14), last two cycles.
     let target = 2.0 * IN_TO_M;
     let (k, r) = runs
         .iter()
         .enumerate()
-        .min_by(|a, b| (a.1.peak_velocity_m_s - target).abs().total_cmp(&(b.1.peak_velocity_m_s - target).abs()))
+        .min_by(|a, b| {
+            (a.1.peak_velocity_m_s - target)
+                .abs()
+                .total_cmp(&(b.1.peak_velocity_m_s - target).abs())
+        })
         .context("no runs")?;
     let h = &r.history;
     let from = h.time_s.len().saturating_sub(2 * args.steps_per_cycle + 1);
@@ -171,7 +216,8 @@ fn write_sweep(
         args.velocity_unit,
         deck.source
     );
-    let mut plots = vec![Plot::new(&title, "time [s]", "force [N]").line("force", t, &h.force_n[from..])];
+    let mut plots =
+        vec![Plot::new(&title, "time [s]", "force [N]").line("force", t, &h.force_n[from..])];
     if let (Some(p0), Some(p1)) = (channel(h, "p0_Pa"), channel(h, "p1_Pa")) {
         plots.push(
             Plot::new("chamber pressures", "time [s]", "pressure [Pa]")
@@ -188,11 +234,20 @@ fn write_sweep(
     }
     let sv: Vec<f64> = h.stroke_m[from..].to_vec();
     plots.push(Plot::new("stroke", "time [s]", "stroke [m]").line("stroke", t, &sv));
-    out.write(&format!("{sub}time_history.svg"), stacked_svg(&plots, 800, 300)?.as_bytes())?;
+    out.write(
+        &format!("{sub}time_history.svg"),
+        stacked_svg(&plots, 800, 300)?.as_bytes(),
+    )?;
     Ok(())
 }
 
-fn print_table(model: DamperModel, runs: &[HarmonicRun], args: &BenchArgs, factor: f64, opts: IntegratorOptions) {
+fn print_table(
+    model: DamperModel,
+    runs: &[HarmonicRun],
+    args: &BenchArgs,
+    factor: f64,
+    opts: IntegratorOptions,
+) {
     println!(
         "{} model, omega {} rad/s, {} cycles x {} steps, {:?} x {} substeps; peaks over the last cycle",
         model.name(),
@@ -237,7 +292,11 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
         for test in &tests {
             let r = bench::replay(dev.as_ref(), test).map_err(|e| {
                 let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
-                anyhow::anyhow!("replay of {} with the {} model: {e}", test.name, model.name())
+                anyhow::anyhow!(
+                    "replay of {} with the {} model: {e}",
+                    test.name,
+                    model.name()
+                )
             })?;
             let h = &r.history;
             let stem = format!("{}_{}", test.name, model.name());
@@ -249,9 +308,16 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
             }
             header.extend(h.channel_names.iter().copied());
             cols.extend(h.channels.iter().map(|c| c.as_slice()));
-            out.write(&format!("replay_{stem}.csv"), csv_from_columns(&header, &cols).as_bytes())?;
+            out.write(
+                &format!("replay_{stem}.csv"),
+                csv_from_columns(&header, &cols).as_bytes(),
+            )?;
             let mut p = Plot::new(
-                &format!("{}: force vs stroke, {} model over measurement", test.name, model.name()),
+                &format!(
+                    "{}: force vs stroke, {} model over measurement",
+                    test.name,
+                    model.name()
+                ),
                 "stroke [m]",
                 "force [N]",
             );
@@ -261,10 +327,26 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
             p = p.line(&format!("{} model", model.name()), &h.stroke_m, &h.force_n);
             out.write(&format!("loop_{stem}.svg"), p.to_svg(800, 480)?.as_bytes())?;
             let rms = r.rms_error_n.map_or("".to_string(), |v| v.to_string());
-            summary.push_str(&format!("{},{},{},{}\n", test.name, model.name(), test.time_s.len(), rms));
+            summary.push_str(&format!(
+                "{},{},{},{}\n",
+                test.name,
+                model.name(),
+                test.time_s.len(),
+                rms
+            ));
             match r.rms_error_n {
-                Some(v) => println!("{} ({} model): RMS error {:.1} N over {} samples", test.name, model.name(), v, test.time_s.len()),
-                None => println!("{} ({} model): no measured force, model force written", test.name, model.name()),
+                Some(v) => println!(
+                    "{} ({} model): RMS error {:.1} N over {} samples",
+                    test.name,
+                    model.name(),
+                    v,
+                    test.time_s.len()
+                ),
+                None => println!(
+                    "{} ({} model): no measured force, model force written",
+                    test.name,
+                    model.name()
+                ),
             }
         }
     }

@@ -104,7 +104,15 @@ pub fn harmonic_run(
     let mut buf = vec![0.0; hist.channel_names.len()];
     let f0 = 0.0;
     if keep_history {
-        hist.push(dev.as_ref(), &mut buf, 0.0, 0.0, peak_velocity, f0, f64::NAN);
+        hist.push(
+            dev.as_ref(),
+            &mut buf,
+            0.0,
+            0.0,
+            peak_velocity,
+            f0,
+            f64::NAN,
+        );
     }
     let (mut fmax, mut fmin, mut work) = (f64::NEG_INFINITY, f64::INFINITY, 0.0);
     let last_start = n - steps_per_cycle;
@@ -121,7 +129,15 @@ pub fn harmonic_run(
         }
         if keep_history {
             let t = t_i + dt;
-            hist.push(dev.as_ref(), &mut buf, t, d_f, peak_velocity * (omega * t).cos(), sf.force_end, sf.force_mean);
+            hist.push(
+                dev.as_ref(),
+                &mut buf,
+                t,
+                d_f,
+                peak_velocity * (omega * t).cos(),
+                sf.force_end,
+                sf.force_mean,
+            );
         }
     }
     Ok(HarmonicRun {
@@ -134,10 +150,23 @@ pub fn harmonic_run(
 }
 
 /// Runs the sweep: one fresh harmonic run per peak velocity.
-pub fn harmonic_sweep(device: &dyn Device, opts: &SweepOptions, keep_history: bool) -> Result<Vec<HarmonicRun>, HydraulicError> {
+pub fn harmonic_sweep(
+    device: &dyn Device,
+    opts: &SweepOptions,
+    keep_history: bool,
+) -> Result<Vec<HarmonicRun>, HydraulicError> {
     opts.peak_velocities_m_s
         .iter()
-        .map(|&v| harmonic_run(device, opts.omega_rad_s, v, opts.cycles, opts.steps_per_cycle, keep_history))
+        .map(|&v| {
+            harmonic_run(
+                device,
+                opts.omega_rad_s,
+                v,
+                opts.cycles,
+                opts.steps_per_cycle,
+                keep_history,
+            )
+        })
         .collect()
 }
 
@@ -183,7 +212,10 @@ const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
     ("time", &[("time_s", 1.0)]),
     ("stroke", &[("stroke_m", 1.0), ("stroke_in", IN_TO_M)]),
     ("force", &[("force_N", 1.0), ("force_lb", LB_TO_N)]),
-    ("velocity", &[("velocity_m_s", 1.0), ("velocity_in_s", IN_TO_M)]),
+    (
+        "velocity",
+        &[("velocity_m_s", 1.0), ("velocity_in_s", IN_TO_M)],
+    ),
 ];
 
 /// Reads a bench CSV file (FORMATS.md): `time_s`, `stroke_m` required, `force_N`,
@@ -194,13 +226,18 @@ pub fn read_bench_csv(path: &Path) -> Result<BenchTest, BenchCsvError> {
         file: file.clone(),
         message: e.to_string(),
     })?;
-    let name = path.file_stem().map_or_else(|| "test".to_string(), |s| s.to_string_lossy().into_owned());
+    let name = path
+        .file_stem()
+        .map_or_else(|| "test".to_string(), |s| s.to_string_lossy().into_owned());
     parse_bench_csv(&text, &file, &name)
 }
 
 /// Parses bench CSV text; `file` names it in errors.
 pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, BenchCsvError> {
-    let mut rdr = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(text.as_bytes());
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
     let header: Vec<String> = rdr
         .headers()
         .map_err(|e| BenchCsvError::Read {
@@ -214,7 +251,10 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
     // Column index and SI factor per quantity.
     let mut cols: [Option<(usize, f64)>; 4] = [None; 4];
     for (ci, h) in header.iter().enumerate() {
-        let Some(qi) = QUANTITIES.iter().position(|(q, _)| h.starts_with(&format!("{q}_")) || h == q) else {
+        let Some(qi) = QUANTITIES
+            .iter()
+            .position(|(q, _)| h.starts_with(&format!("{q}_")) || h == q)
+        else {
             continue; // other columns are allowed and ignored
         };
         let (q, alts) = QUANTITIES[qi];
@@ -251,7 +291,9 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
             message: e.to_string(),
         })?;
         for qi in 0..4 {
-            let Some((ci, factor)) = cols[qi] else { continue };
+            let Some((ci, factor)) = cols[qi] else {
+                continue;
+            };
             let cell = rec.get(ci).unwrap_or("");
             let x: f64 = cell.parse().map_err(|_| BenchCsvError::Line {
                 file: file.into(),
@@ -272,7 +314,11 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
             return Err(BenchCsvError::Line {
                 file: file.into(),
                 line,
-                message: format!("time {} s does not increase (previous {} s)", t[t.len() - 1], t[t.len() - 2]),
+                message: format!(
+                    "time {} s does not increase (previous {} s)",
+                    t[t.len() - 1],
+                    t[t.len() - 2]
+                ),
             });
         }
     }
@@ -312,18 +358,37 @@ pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, Hydraulic
     let mut buf = vec![0.0; hist.channel_names.len()];
     let mut force = Vec::with_capacity(n);
     // Velocity column: measured if given, else central differences of the stroke.
-    let vel = test.velocity_m_s.clone().unwrap_or_else(|| differentiate(&test.time_s, &test.stroke_m));
+    let vel = test
+        .velocity_m_s
+        .clone()
+        .unwrap_or_else(|| differentiate(&test.time_s, &test.stroke_m));
     // First sample: the device's force with no step taken yet is its initial (static) force.
     let first = dev.trial_step(test.time_s[0], 1e-9, test.stroke_m[0], test.stroke_m[0])?;
     dev.reset();
     force.push(first.force_end);
-    hist.push(dev.as_ref(), &mut buf, test.time_s[0], test.stroke_m[0], vel[0], first.force_end, f64::NAN);
+    hist.push(
+        dev.as_ref(),
+        &mut buf,
+        test.time_s[0],
+        test.stroke_m[0],
+        vel[0],
+        first.force_end,
+        f64::NAN,
+    );
     for k in 0..n - 1 {
         let dt = test.time_s[k + 1] - test.time_s[k];
         let sf = dev.trial_step(test.time_s[k], dt, test.stroke_m[k], test.stroke_m[k + 1])?;
         dev.commit();
         force.push(sf.force_end);
-        hist.push(dev.as_ref(), &mut buf, test.time_s[k + 1], test.stroke_m[k + 1], vel[k + 1], sf.force_end, sf.force_mean);
+        hist.push(
+            dev.as_ref(),
+            &mut buf,
+            test.time_s[k + 1],
+            test.stroke_m[k + 1],
+            vel[k + 1],
+            sf.force_end,
+            sf.force_mean,
+        );
     }
     let rms = test.force_n.as_ref().map(|m| {
         let s: f64 = m.iter().zip(&force).map(|(a, b)| (a - b) * (a - b)).sum();

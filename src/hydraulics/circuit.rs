@@ -205,7 +205,7 @@ impl CircuitParams {
     pub fn static_stiffness(&self, y: &State, d: f64) -> f64 {
         let mut k = 0.0;
         for (i, c) in self.chambers.iter().enumerate() {
-            let (b, _) = self.fluid.bulk_eff(y[i]);
+            let (b, _) = self.fluid.bulk(y[i]);
             k += b * c.area * c.area / c.volume(d);
         }
         k
@@ -221,6 +221,9 @@ impl CircuitParams {
 
     /// Right-hand side (and, when `JAC`, its Jacobian) with the flows, at time t, stroke d,
     /// stroke rate d_dot. Chamber pressures: Eq. (1); flows: Eqs. (4), (6)-(7); poppets: Eq. (5).
+    /// `contact`: `None` decides seat contact from `y` ([`ReliefValve::poppet_rate`]);
+    /// `Some(held)` imposes it (valve k held on its seat iff `held[k]`), as the implicit scheme does
+    /// over a sub-step.
     #[inline]
     pub fn evaluate<const JAC: bool>(
         &self,
@@ -228,6 +231,7 @@ impl CircuitParams {
         d: f64,
         d_dot: f64,
         y: &State,
+        contact: Option<[bool; 2]>,
     ) -> Result<(State, Jacobian, Flows), HydraulicError> {
         let law = self.law();
         let (p0, p1) = (y[IP0], y[IP1]);
@@ -275,7 +279,10 @@ impl CircuitParams {
             dq[1 - k][ifr] += dqp;
             dq[1 - k][ibk] -= dqp;
             dq[1 - k][ix] += dqx;
-            let pr = rv.poppet_rate(pf, pb, x, v);
+            let pr = match contact {
+                None => rv.poppet_rate(pf, pb, x, v),
+                Some(held) => rv.poppet_rate_with(pf, pb, x, v, held[k]),
+            };
             f[ix] = pr.x_dot;
             f[iv] = pr.v_dot;
             if JAC && !pr.held {
@@ -332,23 +339,46 @@ pub struct StepSystem<'a> {
     pub t_i: f64,
     pub d_i: f64,
     pub d_dot: f64,
+    /// Seat contact frozen over the current implicit sub-step.
+    pub contact: Option<[bool; 2]>,
 }
 
 impl OdeSystem<NS> for StepSystem<'_> {
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> Result<State, HydraulicError> {
         let d = self.d_i + self.d_dot * (t - self.t_i);
-        Ok(self.params.evaluate::<false>(t, d, self.d_dot, y)?.0)
+        Ok(self
+            .params
+            .evaluate::<false>(t, d, self.d_dot, y, self.contact)?
+            .0)
     }
     fn jacobian(&self, t: f64, y: &State) -> Result<Jacobian, HydraulicError> {
         let d = self.d_i + self.d_dot * (t - self.t_i);
-        Ok(self.params.evaluate::<true>(t, d, self.d_dot, y)?.1)
+        Ok(self
+            .params
+            .evaluate::<true>(t, d, self.d_dot, y, self.contact)?
+            .1)
     }
     fn weights(&self, y: &State) -> State {
         const RTOL: f64 = 1e-8;
         const ATOL: [f64; NS] = [0.1, 0.1, 1e-10, 1e-7, 1e-10, 1e-7, 1e-6];
         State::from_fn(|i, _| ATOL[i] + RTOL * y[i].abs())
     }
+    /// Implicit scheme: the seat contact of each poppet is decided at the start of the sub-step
+    /// and held fixed over it (a fixed active set keeps Newton on a smooth problem).
+    fn begin_implicit_substep(&mut self, _t: f64, y: &State) {
+        let mut held = [false; 2];
+        for (k, (ix, iv, ifr, ibk)) in [(IX0, IV0, IP0, IP1), (IX1, IV1, IP1, IP0)]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(rv) = &self.params.relief[k] {
+                held[k] = rv.poppet_rate(y[ifr], y[ibk], y[ix], y[iv]).held;
+            }
+        }
+        self.contact = Some(held);
+    }
+
     /// Seat contact: a poppet found below its seat after a sub-step is put back on it and its
     /// closing velocity removed (perfectly inelastic impact).
     fn project(&self, y: &mut State) {
@@ -444,7 +474,13 @@ impl CircuitDevice {
     /// Flows at the committed state.
     pub fn flows(&self) -> Flows {
         self.params
-            .evaluate::<false>(self.committed_t, self.committed_d, 0.0, &self.committed)
+            .evaluate::<false>(
+                self.committed_t,
+                self.committed_d,
+                0.0,
+                &self.committed,
+                None,
+            )
             .map(|r| r.2)
             .unwrap_or_default()
     }
@@ -459,15 +495,16 @@ impl Device for CircuitDevice {
         d_f: f64,
     ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
-        let sys = StepSystem {
+        let mut sys = StepSystem {
             params: &self.params,
             t_i,
             d_i,
             d_dot: (d_f - d_i) / dt,
+            contact: None,
         };
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
-        let y = integrate(&self.opts, &sys, t_i, dt, &y0)?;
+        let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
         let out = StepForce {
             force_mean: y[IIMP] / dt,
             dforce_dstroke: -0.5 * self.params.static_stiffness(&y, d_f),

@@ -25,7 +25,13 @@ impl LinearDashpot {
 }
 
 impl Device for LinearDashpot {
-    fn trial_step(&mut self, t_i: f64, dt: f64, d_i: f64, d_f: f64) -> Result<StepForce, HydraulicError> {
+    fn trial_step(
+        &mut self,
+        t_i: f64,
+        dt: f64,
+        d_i: f64,
+        d_f: f64,
+    ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
         let v = (d_f - d_i) / dt;
         self.trial_v = Some(v);
@@ -82,12 +88,20 @@ impl MonotoneTable {
             return Err("table must start at velocity 0 with force 0".into());
         }
         if let Some(i) = x.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(format!("velocities not strictly increasing at entry {}", i + 1));
+            return Err(format!(
+                "velocities not strictly increasing at entry {}",
+                i + 1
+            ));
         }
         if let Some(i) = y.windows(2).position(|w| w[1] < w[0]) {
-            return Err(format!("forces decrease at entry {} (the table must be monotone)", i + 1));
+            return Err(format!(
+                "forces decrease at entry {} (the table must be monotone)",
+                i + 1
+            ));
         }
-        let delta: Vec<f64> = (0..n - 1).map(|i| (y[i + 1] - y[i]) / (x[i + 1] - x[i])).collect();
+        let delta: Vec<f64> = (0..n - 1)
+            .map(|i| (y[i + 1] - y[i]) / (x[i + 1] - x[i]))
+            .collect();
         let mut m = vec![0.0; n];
         m[0] = delta[0];
         m[n - 1] = delta[n - 2];
@@ -131,12 +145,14 @@ impl MonotoneTable {
         let h10 = t3 - 2.0 * t2 + t;
         let h01 = -2.0 * t3 + 3.0 * t2;
         let h11 = t3 - t2;
-        let f = h00 * self.y[i] + h10 * h * self.m[i] + h01 * self.y[i + 1] + h11 * h * self.m[i + 1];
+        let f =
+            h00 * self.y[i] + h10 * h * self.m[i] + h01 * self.y[i + 1] + h11 * h * self.m[i + 1];
         let d00 = 6.0 * t2 - 6.0 * t;
         let d10 = 3.0 * t2 - 4.0 * t + 1.0;
         let d01 = -6.0 * t2 + 6.0 * t;
         let d11 = 3.0 * t2 - 2.0 * t;
-        let df = (d00 * self.y[i] + d01 * self.y[i + 1]) / h + d10 * self.m[i] + d11 * self.m[i + 1];
+        let df =
+            (d00 * self.y[i] + d01 * self.y[i + 1]) / h + d10 * self.m[i] + d11 * self.m[i + 1];
         (f, df)
     }
 }
@@ -166,7 +182,13 @@ impl NonlinearDashpot {
 }
 
 impl Device for NonlinearDashpot {
-    fn trial_step(&mut self, t_i: f64, dt: f64, d_i: f64, d_f: f64) -> Result<StepForce, HydraulicError> {
+    fn trial_step(
+        &mut self,
+        t_i: f64,
+        dt: f64,
+        d_i: f64,
+        d_f: f64,
+    ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
         let v = (d_f - d_i) / dt;
         self.trial_v = Some(v);
@@ -219,7 +241,10 @@ mod tests {
             if v > 1e-3 && (0..5).all(|k| (v - [0.0, 0.05, 0.1, 0.2, 0.4][k]).abs() > 1e-5) {
                 let e = 1e-7;
                 let fd = (t.eval(v + e).0 - t.eval(v - e).0) / (2.0 * e);
-                assert!((fd - df).abs() < 1e-4 * df.abs().max(1.0), "v {v}: {fd} vs {df}");
+                assert!(
+                    (fd - df).abs() < 1e-4 * df.abs().max(1.0),
+                    "v {v}: {fd} vs {df}"
+                );
             }
         }
     }

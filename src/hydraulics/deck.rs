@@ -96,7 +96,12 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn table<'t>(&self, parent: &'t Table, path: &str, name: &str) -> Result<Option<&'t Table>, DeckError> {
+    fn table<'t>(
+        &self,
+        parent: &'t Table,
+        path: &str,
+        name: &str,
+    ) -> Result<Option<&'t Table>, DeckError> {
         match parent.get(name) {
             None => Ok(None),
             Some(Value::Table(t)) => Ok(Some(t)),
@@ -151,10 +156,21 @@ impl Ctx<'_> {
     }
 
     /// Number satisfying `ok`, e.g. positive.
-    fn num_where(&self, t: &Table, path: &str, key: &str, expected: &str, ok: fn(f64) -> bool) -> Result<f64, DeckError> {
+    fn num_where(
+        &self,
+        t: &Table,
+        path: &str,
+        key: &str,
+        expected: &str,
+        ok: fn(f64) -> bool,
+    ) -> Result<f64, DeckError> {
         let x = self.num(t, path, key, expected)?;
         if !ok(x) {
-            return Err(self.bad(&format!("{path}.{key}"), &t[key], &format!("expected {expected}")));
+            return Err(self.bad(
+                &format!("{path}.{key}"),
+                &t[key],
+                &format!("expected {expected}"),
+            ));
         }
         Ok(x)
     }
@@ -167,7 +183,10 @@ impl Ctx<'_> {
                 key: full,
                 expected: "an array of numbers".into(),
             }),
-            Some(Value::Array(a)) => a.iter().map(|v| self.as_num(v, &full, "array of numbers")).collect(),
+            Some(Value::Array(a)) => a
+                .iter()
+                .map(|v| self.as_num(v, &full, "array of numbers"))
+                .collect(),
             Some(v) => Err(self.bad(&full, v, "expected an array of numbers")),
         }
     }
@@ -197,7 +216,16 @@ const PHYSICAL_KEYS: &[&str] = &[
     "relief_valve_0",
     "relief_valve_1",
 ];
-const VALVE_KEYS: &[&str] = &["m_kg", "c_N_s_per_m", "k_N_per_m", "F_p_N", "A_front_m2", "A_back_m2", "a_m", "b"];
+const VALVE_KEYS: &[&str] = &[
+    "m_kg",
+    "c_N_s_per_m",
+    "k_N_per_m",
+    "F_p_N",
+    "A_front_m2",
+    "A_back_m2",
+    "a_m",
+    "b",
+];
 
 impl DamperDeck {
     /// Reads a deck file.
@@ -213,15 +241,23 @@ impl DamperDeck {
     /// Parses deck text; `source_name` names it in errors.
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, DeckError> {
         let cx = Ctx { file: source_name };
-        let root: Table = text.parse().map_err(|e: toml::de::Error| DeckError::Parse {
-            file: source_name.into(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
-        let damper = cx.table(&root, "", "damper")?.ok_or_else(|| DeckError::MissingTable {
-            file: source_name.into(),
-            table: "damper".into(),
-        })?;
-        cx.known(damper, "damper", &["model", "linear", "nonlinear", "physical"])?;
+        let root: Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| DeckError::Parse {
+                file: source_name.into(),
+                message: e.to_string().trim_end().to_string(),
+            })?;
+        let damper = cx
+            .table(&root, "", "damper")?
+            .ok_or_else(|| DeckError::MissingTable {
+                file: source_name.into(),
+                table: "damper".into(),
+            })?;
+        cx.known(
+            damper,
+            "damper",
+            &["model", "linear", "nonlinear", "physical"],
+        )?;
         let model = match damper.get("model") {
             None => {
                 return Err(DeckError::MissingKey {
@@ -230,15 +266,29 @@ impl DamperDeck {
                     expected: "physical, linear or nonlinear".into(),
                 })
             }
-            Some(Value::String(s)) => s.parse::<DamperModel>().map_err(|e| cx.bad("damper.model", &damper["model"], &e))?,
-            Some(v) => return Err(cx.bad("damper.model", v, "expected a string: physical, linear or nonlinear")),
+            Some(Value::String(s)) => s
+                .parse::<DamperModel>()
+                .map_err(|e| cx.bad("damper.model", &damper["model"], &e))?,
+            Some(v) => {
+                return Err(cx.bad(
+                    "damper.model",
+                    v,
+                    "expected a string: physical, linear or nonlinear",
+                ))
+            }
         };
 
         let linear = match cx.table(damper, "damper", "linear")? {
             None => None,
             Some(t) => {
                 cx.known(t, "damper.linear", &["c_N_s_per_m"])?;
-                Some(cx.num_where(t, "damper.linear", "c_N_s_per_m", "a positive damping coefficient", positive)?)
+                Some(cx.num_where(
+                    t,
+                    "damper.linear",
+                    "c_N_s_per_m",
+                    "a positive damping coefficient",
+                    positive,
+                )?)
             }
         };
 
@@ -286,38 +336,108 @@ impl DamperDeck {
         let v0 = vol("V0_m3")?;
         let v1 = vol("V1_m3")?;
         let rho = cx.num_where(t, p, "rho_kg_m3", "a positive density in kg/m^3", positive)?;
-        let alpha = cx.num_where(t, p, "bulk_alpha_per_Pa", "a positive alpha in 1/Pa (Eq. 3)", positive)?;
-        let beta = cx.num_where(t, p, "bulk_beta_per_Pa2", "a non-negative beta in 1/Pa^2 (Eq. 3)", non_negative)?;
-        let a_orf = cx.num_where(t, p, "A_orf_m2", "a non-negative orifice area in m^2", non_negative)?;
-        let cd = cx.num_where(t, p, "Cd", "a discharge coefficient in (0, 1]", |x| x > 0.0 && x <= 1.0)?;
-        let p_s = cx.num_where(t, p, "p_s_Pa", "a non-negative background pressure in Pa", non_negative)?;
+        let alpha = cx.num_where(
+            t,
+            p,
+            "bulk_alpha_per_Pa",
+            "a positive alpha in 1/Pa (Eq. 3)",
+            positive,
+        )?;
+        let beta = cx.num_where(
+            t,
+            p,
+            "bulk_beta_per_Pa2",
+            "a non-negative beta in 1/Pa^2 (Eq. 3)",
+            non_negative,
+        )?;
+        let a_orf = cx.num_where(
+            t,
+            p,
+            "A_orf_m2",
+            "a non-negative orifice area in m^2",
+            non_negative,
+        )?;
+        let cd = cx.num_where(t, p, "Cd", "a discharge coefficient in (0, 1]", |x| {
+            x > 0.0 && x <= 1.0
+        })?;
+        let p_s = cx.num_where(
+            t,
+            p,
+            "p_s_Pa",
+            "a non-negative background pressure in Pa",
+            non_negative,
+        )?;
         let dp_l = if t.contains_key("dp_laminar_Pa") {
             cx.num_where(t, p, "dp_laminar_Pa", "a positive pressure in Pa", positive)?
         } else {
             DEFAULT_DP_LAMINAR_PA
         };
         let p_cav = if t.contains_key("p_cav_Pa") {
-            cx.num_where(t, p, "p_cav_Pa", "a non-negative pressure in Pa (0 disables)", non_negative)?
+            cx.num_where(
+                t,
+                p,
+                "p_cav_Pa",
+                "a non-negative pressure in Pa (0 disables)",
+                non_negative,
+            )?
         } else {
             DEFAULT_P_CAV_PA
         };
-        let cva = cx.num_where(t, p, "check_valve_area_m2", "a non-negative area in m^2 (0 disables)", non_negative)?;
+        let cva = cx.num_where(
+            t,
+            p,
+            "check_valve_area_m2",
+            "a non-negative area in m^2 (0 disables)",
+            non_negative,
+        )?;
         let mut relief = [None, None];
         for (k, r) in relief.iter_mut().enumerate() {
             let name = format!("relief_valve_{k}");
-            let Some(vt) = cx.table(t, p, &name)? else { continue };
+            let Some(vt) = cx.table(t, p, &name)? else {
+                continue;
+            };
             let vp = format!("{p}.{name}");
             cx.known(vt, &vp, VALVE_KEYS)?;
             let pos = |key: &str, what: &str| cx.num_where(vt, &vp, key, what, positive);
             *r = Some(ReliefValve {
                 m: pos("m_kg", "a positive poppet mass in kg")?,
-                c: cx.num_where(vt, &vp, "c_N_s_per_m", "a non-negative poppet damping in N s/m", non_negative)?,
+                c: cx.num_where(
+                    vt,
+                    &vp,
+                    "c_N_s_per_m",
+                    "a non-negative poppet damping in N s/m",
+                    non_negative,
+                )?,
                 k: pos("k_N_per_m", "a positive spring constant in N/m")?,
-                f_p: cx.num_where(vt, &vp, "F_p_N", "a non-negative preload in N", non_negative)?,
+                f_p: cx.num_where(
+                    vt,
+                    &vp,
+                    "F_p_N",
+                    "a non-negative preload in N",
+                    non_negative,
+                )?,
                 a_front: pos("A_front_m2", "a positive area in m^2")?,
-                a_back: cx.num_where(vt, &vp, "A_back_m2", "a non-negative area in m^2", non_negative)?,
-                a: cx.num_where(vt, &vp, "a_m", "a non-negative coefficient in m (Eq. 7)", non_negative)?,
-                b: cx.num_where(vt, &vp, "b", "a non-negative coefficient (Eq. 7)", non_negative)?,
+                a_back: cx.num_where(
+                    vt,
+                    &vp,
+                    "A_back_m2",
+                    "a non-negative area in m^2",
+                    non_negative,
+                )?,
+                a: cx.num_where(
+                    vt,
+                    &vp,
+                    "a_m",
+                    "a non-negative coefficient in m (Eq. 7)",
+                    non_negative,
+                )?,
+                b: cx.num_where(
+                    vt,
+                    &vp,
+                    "b",
+                    "a non-negative coefficient (Eq. 7)",
+                    non_negative,
+                )?,
                 cd,
             });
         }
@@ -368,11 +488,17 @@ impl DamperDeck {
     }
 
     /// Builds a device of the given model (errors when the deck lacks that model's table).
-    pub fn build(&self, model: DamperModel, opts: IntegratorOptions) -> Result<Box<dyn Device>, DeckError> {
+    pub fn build(
+        &self,
+        model: DamperModel,
+        opts: IntegratorOptions,
+    ) -> Result<Box<dyn Device>, DeckError> {
         self.require(model)?;
         Ok(match model {
             DamperModel::Physical => Box::new(self.physical_device(opts)?),
-            DamperModel::Linear => Box::new(LinearDashpot::new(self.linear_c_n_s_per_m.unwrap_or_default())),
+            DamperModel::Linear => Box::new(LinearDashpot::new(
+                self.linear_c_n_s_per_m.unwrap_or_default(),
+            )),
             DamperModel::Nonlinear => {
                 let (v, f) = self.nonlinear.clone().unwrap_or_default();
                 let table = MonotoneTable::new(v, f).map_err(|e| DeckError::BadValue {
@@ -389,10 +515,13 @@ impl DamperDeck {
     /// The physical model as a concrete device (for access to its parameters and state).
     pub fn physical_device(&self, opts: IntegratorOptions) -> Result<CircuitDevice, DeckError> {
         self.require(DamperModel::Physical)?;
-        let params = self.physical.clone().ok_or_else(|| DeckError::MissingTable {
-            file: self.source.clone(),
-            table: "damper.physical".into(),
-        })?;
+        let params = self
+            .physical
+            .clone()
+            .ok_or_else(|| DeckError::MissingTable {
+                file: self.source.clone(),
+                table: "damper.physical".into(),
+            })?;
         Ok(CircuitDevice::new(params, opts))
     }
 }

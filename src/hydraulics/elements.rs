@@ -21,12 +21,27 @@ impl Chamber {
         self.volume0 + self.area * self.lambda * d
     }
 
-    /// Eq. (1): `p_dot = B/V (Q - A lambda d_dot)` and its partials (dp_dot/dp, dp_dot/dQ).
+    /// Eq. (1): `p_dot = B/V (Q - A lambda d_dot)`, with B of Eq. (3), and its partials
+    /// (dp_dot/dp, dp_dot/dQ). Cavitation: when the net volume rate is an outflow the rate is
+    /// scaled by the fluid's cavitation factor `s(p)`, so the pressure cannot be driven below
+    /// zero; an inflow always raises the pressure at the full rate (refilling).
     #[inline]
-    pub fn pressure_rate(&self, fluid: &Fluid, p: f64, v: f64, q: f64, d_dot: f64) -> (f64, f64, f64) {
-        let (b, db) = fluid.bulk_eff(p);
+    pub fn pressure_rate(
+        &self,
+        fluid: &Fluid,
+        p: f64,
+        v: f64,
+        q: f64,
+        d_dot: f64,
+    ) -> (f64, f64, f64) {
+        let (b, db) = fluid.bulk(p);
         let net = q - self.area * self.lambda * d_dot;
-        (b / v * net, db / v * net, b / v)
+        if net < 0.0 {
+            let (s, ds) = fluid.cavitation_factor(p);
+            (b * s / v * net, (db * s + b * ds) / v * net, b * s / v)
+        } else {
+            (b / v * net, db / v * net, b / v)
+        }
     }
 }
 
@@ -41,6 +56,25 @@ pub struct FlowLaw {
 }
 
 impl FlowLaw {
+    /// One-sided law of a check valve that opens progressively: 0 for dp <= 0,
+    /// `u_l (5 r^2 - 3 r^3)/2` on (0, dp_l), Eq. (4) beyond; C1 everywhere (also at dp = 0, where
+    /// a plain `max(dp, 0)` would kink and stall Newton).
+    #[inline]
+    pub fn one_sided_flow(&self, dp: f64) -> (f64, f64) {
+        if dp <= 0.0 {
+            (0.0, 0.0)
+        } else if dp >= self.dp_laminar {
+            self.unit_flow(dp)
+        } else {
+            let u_l = (2.0 * self.dp_laminar / self.rho).sqrt();
+            let r = dp / self.dp_laminar;
+            (
+                u_l * (5.0 * r * r - 3.0 * r * r * r) * 0.5,
+                u_l * (10.0 * r - 9.0 * r * r) * 0.5 / self.dp_laminar,
+            )
+        }
+    }
+
     /// u(dp) and du/d(dp).
     #[inline]
     pub fn unit_flow(&self, dp: f64) -> (f64, f64) {
@@ -134,6 +168,33 @@ impl ReliefValve {
         }
     }
 
+    /// Eq. (5) with the contact decided by the caller: `held` keeps the poppet still on its
+    /// seat; otherwise the free Eq. (5) applies (also slightly below the seat; the integrator
+    /// projects back after the sub-step).
+    #[inline]
+    pub fn poppet_rate_with(
+        &self,
+        p_front: f64,
+        p_back: f64,
+        x: f64,
+        v: f64,
+        held: bool,
+    ) -> PoppetRate {
+        if held {
+            return PoppetRate {
+                x_dot: 0.0,
+                v_dot: 0.0,
+                held: true,
+            };
+        }
+        let f = self.opening_force(p_front, p_back);
+        PoppetRate {
+            x_dot: v,
+            v_dot: (f - self.k * x - self.c * v) / self.m,
+            held: false,
+        }
+    }
+
     /// Eq. (7): flow area and its derivative in x; zero for x <= 0.
     #[inline]
     pub fn flow_area(&self, x: f64) -> (f64, f64) {
@@ -162,7 +223,8 @@ impl ReliefValve {
 }
 
 /// Check valve from the background (plenum) pressure p_s into a chamber: it conducts only when
-/// the chamber pressure is below p_s, with the orifice law of Eq. (4) (laminar near zero).
+/// the chamber pressure is below p_s, with the orifice law of Eq. (4) beyond `dp_l` and a
+/// progressive C1 opening below ([`FlowLaw::one_sided_flow`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckValve {
     /// Open flow area [m^2].
@@ -175,11 +237,7 @@ impl CheckValve {
     /// Inflow from the plenum at `p_s` into a chamber at `p`, and dQ/dp.
     #[inline]
     pub fn inflow(&self, law: &FlowLaw, p_s: f64, p: f64) -> (f64, f64) {
-        let dp = p_s - p;
-        if dp <= 0.0 || self.area == 0.0 {
-            return (0.0, 0.0);
-        }
-        let (u, du) = law.unit_flow(dp);
+        let (u, du) = law.one_sided_flow(p_s - p);
         (self.cd * self.area * u, -self.cd * self.area * du)
     }
 }
@@ -205,6 +263,10 @@ mod tests {
         let (hi, dhi) = law.unit_flow(law.dp_laminar + e);
         assert!((lo - hi).abs() < 1e-9 * hi, "value jump {lo} {hi}");
         assert!((dlo - dhi).abs() < 1e-6 * dhi, "slope jump {dlo} {dhi}");
+        let (lo, dlo) = law.one_sided_flow(law.dp_laminar - e);
+        assert!((lo - hi).abs() < 1e-9 * hi && (dlo - dhi).abs() < 1e-6 * dhi);
+        assert_eq!(law.one_sided_flow(0.0), (0.0, 0.0));
+        assert_eq!(law.one_sided_flow(-5.0), (0.0, 0.0));
         // Beyond the transition it is Eq. (4) exactly.
         let (u, _) = law.unit_flow(2.0e6);
         assert_eq!(u, (2.0 * 2.0e6 / 850.0f64).sqrt());

@@ -9,8 +9,9 @@ pub struct Fluid {
     pub alpha: f64,
     /// beta of Eq. (3) [1/Pa^2].
     pub beta: f64,
-    /// Cavitation band [Pa]: the effective bulk modulus is scaled by `1 - exp(-p/p_cav)`, so a
-    /// chamber pressure cannot be driven below zero (0 disables; see docs/hydraulics.md).
+    /// Cavitation band [Pa]: a chamber losing volume has its pressure rate scaled by
+    /// `1 - exp(-p/p_cav)`, so its pressure cannot be driven below zero (0 disables; see
+    /// docs/hydraulics.md).
     pub p_cav: f64,
 }
 
@@ -33,14 +34,6 @@ impl Fluid {
         let b = num / den;
         // d/dp (num/den) = 1 - 2 beta num / den^2
         (b, 1.0 - 2.0 * self.beta * num / (den * den))
-    }
-
-    /// Effective bulk modulus with the cavitation factor, and its derivative.
-    #[inline]
-    pub fn bulk_eff(&self, p: f64) -> (f64, f64) {
-        let (b, db) = self.bulk(p);
-        let (s, ds) = self.cavitation_factor(p);
-        (b * s, db * s + b * ds)
     }
 
     /// `s(p) = 1 - exp(-p/p_cav)` for p >= 0, continued linearly (C1) below zero.

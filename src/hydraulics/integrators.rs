@@ -21,7 +21,9 @@ impl std::str::FromStr for Scheme {
         match s {
             "rk4" => Ok(Self::Rk4),
             "implicit" | "sdirk3" => Ok(Self::Implicit),
-            _ => Err(format!("unknown integrator '{s}' (expected rk4 or implicit)")),
+            _ => Err(format!(
+                "unknown integrator '{s}' (expected rk4 or implicit)"
+            )),
         }
     }
 }
@@ -54,6 +56,9 @@ pub trait OdeSystem<const N: usize> {
     fn weights(&self, y: &SVector<f64, N>) -> SVector<f64, N>;
     /// Project onto the admissible set (default: nothing).
     fn project(&self, _y: &mut SVector<f64, N>) {}
+    /// Called at the start of every sub-step of an implicit scheme with its initial state, e.g.
+    /// to freeze contact conditions over the sub-step (default: nothing).
+    fn begin_implicit_substep(&mut self, _t: f64, _y: &SVector<f64, N>) {}
 }
 
 /// Explicit Runge-Kutta tableau (strictly lower triangular `a`).
@@ -213,17 +218,34 @@ pub fn sdirk_step<const N: usize, const S: usize>(
             base += k[j] * (h * tab.a[i][j]);
         }
         let mut yi = guess;
+        let residual = |y: &SVector<f64, N>| -> Result<SVector<f64, N>, HydraulicError> {
+            Ok(y - base - sys.rhs(ti, y)? * hg)
+        };
+        let mut g = residual(&yi)?;
         let mut converged = false;
         let mut last = f64::INFINITY;
         for it in 1..=newton.max_iter {
-            let f = sys.rhs(ti, &yi)?;
-            let g = yi - base - f * hg;
             let jac = sys.jacobian(ti, &yi)?;
             let m = SMatrix::<f64, N, N>::identity() - jac * hg;
-            let dy = solve_dense(m, -g).ok_or(HydraulicError::SingularJacobian { t: ti, stage: i })?;
-            yi += dy;
+            let dy =
+                solve_dense(m, -g).ok_or(HydraulicError::SingularJacobian { t: ti, stage: i })?;
             let w = sys.weights(&yi);
-            last = wrms(&dy, &w);
+            let g_norm = wrms(&g, &w);
+            // Backtracking on the weighted residual: the element laws have kinks (seat, check
+            // valve opening, cavitation band) where full Newton steps can cycle.
+            let mut lambda = 1.0;
+            let (mut y_try, mut g_try);
+            loop {
+                y_try = yi + dy * lambda;
+                g_try = residual(&y_try)?;
+                if wrms(&g_try, &w) <= (1.0 - 1e-4 * lambda) * g_norm || lambda < 1.0 / 64.0 {
+                    break;
+                }
+                lambda *= 0.5;
+            }
+            yi = y_try;
+            g = g_try;
+            last = wrms(&(dy * lambda), &sys.weights(&yi));
             if !last.is_finite() {
                 return Err(HydraulicError::NewtonDiverged {
                     t: ti,
@@ -259,7 +281,7 @@ pub fn sdirk_step<const N: usize, const S: usize>(
 /// Integrate over [t0, t0 + dt] with `n` fixed sub-steps, projecting after each.
 pub fn integrate<const N: usize>(
     opts: &IntegratorOptions,
-    sys: &impl OdeSystem<N>,
+    sys: &mut impl OdeSystem<N>,
     t0: f64,
     dt: f64,
     y0: &SVector<f64, N>,
@@ -272,7 +294,10 @@ pub fn integrate<const N: usize>(
         let t = t0 + s as f64 * h;
         y = match opts.scheme {
             Scheme::Rk4 => explicit_step(&RK4, sys, t, &y, h)?,
-            Scheme::Implicit => sdirk_step(&SDIRK3, sys, t, &y, h, &newton)?,
+            Scheme::Implicit => {
+                sys.begin_implicit_substep(t, &y);
+                sdirk_step(&SDIRK3, sys, t, &y, h, &newton)?
+            }
         };
         sys.project(&mut y);
         if let Some(c) = y.iter().position(|v| !v.is_finite()) {
@@ -295,7 +320,9 @@ mod tests {
     }
     impl OdeSystem<1> for Prothero {
         fn rhs(&self, t: f64, y: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HydraulicError> {
-            Ok(SVector::<f64, 1>::new(-self.lambda * (y[0] - t.cos()) - t.sin()))
+            Ok(SVector::<f64, 1>::new(
+                -self.lambda * (y[0] - t.cos()) - t.sin(),
+            ))
         }
         fn jacobian(
             &self,
@@ -310,13 +337,13 @@ mod tests {
     }
 
     fn err(scheme: Scheme, n: usize, lambda: f64) -> f64 {
-        let sys = Prothero { lambda };
+        let mut sys = Prothero { lambda };
         let y0 = SVector::<f64, 1>::new(1.0);
         let o = IntegratorOptions {
             scheme,
             substeps: n,
         };
-        match integrate(&o, &sys, 0.0, 1.0, &y0) {
+        match integrate(&o, &mut sys, 0.0, 1.0, &y0) {
             Ok(y) => (y[0] - 1.0f64.cos()).abs(),
             Err(_) => f64::INFINITY,
         }
