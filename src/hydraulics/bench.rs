@@ -57,6 +57,7 @@ impl History {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn push(&mut self, dev: &dyn Device, buf: &mut [f64], t: f64, d: f64, v: f64, f: f64, fm: f64) {
         self.time_s.push(t);
         self.stroke_m.push(d);
@@ -102,7 +103,7 @@ pub fn harmonic_run(
     let stroke = |k: usize| amp * (omega * k as f64 * dt).sin();
     let mut hist = History::new(dev.as_ref(), if keep_history { n + 1 } else { 0 });
     let mut buf = vec![0.0; hist.channel_names.len()];
-    let f0 = 0.0;
+    let f0 = dev.committed_force();
     if keep_history {
         hist.push(
             dev.as_ref(),
@@ -342,7 +343,7 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replay {
     /// Model force at each sample (force_end of the step ending there; the initial state's force
-    /// relative to the background pressure at the first sample).
+    /// at the first sample).
     pub force_model_n: Vec<f64>,
     /// RMS of model - measured [N] over all samples (None without a measured force).
     pub rms_error_n: Option<f64>,

@@ -551,6 +551,10 @@ impl Device for CircuitDevice {
         }
     }
 
+    fn committed_force(&self) -> f64 {
+        self.params.force(&self.committed)
+    }
+
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }

@@ -52,6 +52,9 @@ impl Device for LinearDashpot {
     fn channels(&self, out: &mut [f64]) {
         out[0] = self.committed_v;
     }
+    fn committed_force(&self) -> f64 {
+        -self.c * self.committed_v
+    }
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }
@@ -209,6 +212,9 @@ impl Device for NonlinearDashpot {
     }
     fn channels(&self, out: &mut [f64]) {
         out[0] = self.committed_v;
+    }
+    fn committed_force(&self) -> f64 {
+        self.force(self.committed_v).0
     }
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())

@@ -2,6 +2,8 @@
 //! tableau (classical RK4, the paper's scheme, Ref. 12) and a singly diagonally implicit tableau
 //! (Alexander's 3-stage SDIRK, order 3, L-stable, stiffly accurate) solved by Newton on the
 //! small state with the system's analytic Jacobian. Everything lives on the stack.
+// Tableau sums read best as index loops over (i, j).
+#![allow(clippy::needless_range_loop)]
 use super::HydraulicError;
 use nalgebra::{SMatrix, SVector};
 
@@ -90,7 +92,7 @@ pub struct SdirkTableau<const S: usize> {
     pub gamma: f64,
 }
 
-const G: f64 = 0.435_866_521_508_458_999_416;
+const G: f64 = 0.435_866_521_508_459;
 const T2: f64 = (1.0 + G) / 2.0;
 const B1: f64 = -(6.0 * G * G - 16.0 * G + 1.0) / 4.0;
 const B2: f64 = (6.0 * G * G - 20.0 * G + 5.0) / 4.0;
@@ -381,6 +383,6 @@ mod tests {
         // h * lambda = 1e4 / 10 = 1000: far outside RK4's stability interval.
         assert!(err(Scheme::Implicit, 10, 1.0e4) < 1e-4);
         let e = err(Scheme::Rk4, 10, 1.0e4);
-        assert!(!(e < 1.0), "RK4 should blow up, error {e}");
+        assert!(e >= 1.0 || e.is_nan(), "RK4 should blow up, error {e}");
     }
 }

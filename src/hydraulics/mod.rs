@@ -81,6 +81,8 @@ pub trait Device: Send + Sync + std::fmt::Debug {
     fn channel_names(&self) -> &'static [&'static str];
     /// Values of the channels at the committed state; `out.len() == channel_names().len()`.
     fn channels(&self, out: &mut [f64]);
+    /// Device force at the committed state [N] (Eq. 8 for the hydraulic devices).
+    fn committed_force(&self) -> f64;
     /// Deep copy (parameters are shared copy-on-write, so this is cheap).
     fn clone_device(&self) -> Box<dyn Device>;
     /// Back to the initial state (start of a new test).
