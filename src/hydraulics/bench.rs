@@ -94,6 +94,18 @@ pub fn harmonic_run(
     steps_per_cycle: usize,
     keep_history: bool,
 ) -> Result<HarmonicRun, HydraulicError> {
+    if cycles == 0
+        || steps_per_cycle == 0
+        || !(omega > 0.0 && omega.is_finite())
+        || !peak_velocity.is_finite()
+    {
+        return Err(HydraulicError::BadStep {
+            t: 0.0,
+            reason: format!(
+                "harmonic run needs cycles >= 1 ({cycles}), steps per cycle >= 1 ({steps_per_cycle}), omega > 0 ({omega} rad/s) and a finite peak velocity ({peak_velocity} m/s)"
+            ),
+        });
+    }
     let mut dev = device.clone_device();
     dev.reset();
     let period = 2.0 * std::f64::consts::PI / omega;

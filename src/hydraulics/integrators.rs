@@ -378,6 +378,54 @@ mod tests {
         assert!((r.log2() - 3.0).abs() < 0.3, "sdirk order {}", r.log2());
     }
 
+    /// y' = -k y^3: nonlinear, so one Newton iteration cannot meet a tight tolerance.
+    struct Cubic;
+    impl OdeSystem<1> for Cubic {
+        fn rhs(&self, _t: f64, y: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HydraulicError> {
+            Ok(SVector::<f64, 1>::new(-1e3 * y[0].powi(3)))
+        }
+        fn jacobian(
+            &self,
+            _t: f64,
+            y: &SVector<f64, 1>,
+        ) -> Result<SMatrix<f64, 1, 1>, HydraulicError> {
+            Ok(SMatrix::<f64, 1, 1>::new(-3e3 * y[0] * y[0]))
+        }
+        fn weights(&self, _y: &SVector<f64, 1>) -> SVector<f64, 1> {
+            SVector::<f64, 1>::new(1e-14)
+        }
+    }
+
+    #[test]
+    fn newton_failure_names_time_iteration_and_residual() {
+        let y0 = SVector::<f64, 1>::new(1.0);
+        let opts = NewtonOptions {
+            max_iter: 2,
+            tol: 1.0,
+        };
+        let e = sdirk_step(&SDIRK3, &Cubic, 0.25, &y0, 0.1, &opts).unwrap_err();
+        match &e {
+            HydraulicError::NewtonDiverged {
+                t,
+                iteration,
+                residual,
+                ..
+            } => {
+                assert!(*t > 0.25 && *iteration == 2 && *residual > 1.0, "{e:?}");
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        let msg = e.to_string();
+        assert!(
+            msg.contains("t = ") && msg.contains("iteration 2") && msg.contains("residual"),
+            "{msg}"
+        );
+        // With the default settings it converges and matches the exact solution closely.
+        let y = sdirk_step(&SDIRK3, &Cubic, 0.0, &y0, 1e-4, &NewtonOptions::default()).unwrap();
+        let exact = 1.0 / (1.0f64 + 2.0 * 1e3 * 1e-4).sqrt();
+        assert!((y[0] - exact).abs() < 1e-4, "{} vs {exact}", y[0]);
+    }
+
     #[test]
     fn implicit_is_stable_where_rk4_is_not() {
         // h * lambda = 1e4 / 10 = 1000: far outside RK4's stability interval.
