@@ -352,3 +352,63 @@ fn actuator_chambers_settle_at_the_entrance_pressures() {
     dev.commit();
     assert!(dev.state()[IP1] > p_before);
 }
+
+#[test]
+fn finite_difference_tangent_includes_the_orifice_relaxation() {
+    // At a flowing state the true dF_m/dd_f is below the Eq. (16) static value in magnitude
+    // (the orifice relieves part of the compression within the step); the FD tangent must
+    // match an external difference of force_mean and have the same (negative) sign.
+    let d = deck();
+    let mut dev = d.physical_device(IntegratorOptions::default()).unwrap();
+    let dt = 9.08e-4;
+    for k in 0..60 {
+        let s = |k: usize| 3.0e-3 * (27.02 * k as f64 * dt).sin();
+        dev.trial_step(k as f64 * dt, dt, s(k), s(k + 1)).unwrap();
+        dev.commit();
+    }
+    let (t, di, df) = (60.0 * dt, 1.0e-3, 1.05e-3);
+    let eq16 = dev.trial_step(t, dt, di, df).unwrap();
+    dev.set_tangent(Tangent::FiniteDifference);
+    let fd = dev.trial_step(t, dt, di, df).unwrap();
+    assert_eq!(eq16.force_mean, fd.force_mean);
+    eprintln!(
+        "tangent: eq16 {} fd {}",
+        eq16.dforce_dstroke, fd.dforce_dstroke
+    );
+    let h = 1e-6;
+    let up = dev.trial_step(t, dt, di, df + h).unwrap();
+    let dn = dev.trial_step(t, dt, di, df - h).unwrap();
+    let central = (up.force_mean - dn.force_mean) / (2.0 * h);
+    assert!(fd.dforce_dstroke < 0.0 && eq16.dforce_dstroke < 0.0);
+    assert!(
+        (fd.dforce_dstroke - central).abs() < 1e-3 * central.abs(),
+        "{} vs {central}",
+        fd.dforce_dstroke
+    );
+    assert!(
+        fd.dforce_dstroke.abs() <= eq16.dforce_dstroke.abs() * 1.001,
+        "{} vs {}",
+        fd.dforce_dstroke,
+        eq16.dforce_dstroke
+    );
+}
+
+#[test]
+fn actuator_table_matches_paper_table1_and_rejects_unknown_keys() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/rotors/paper_table1_actuator.toml"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    assert_eq!(
+        actuator_from_toml_str(&text, path).unwrap(),
+        ActuatorParams::paper_table1()
+    );
+    let e = actuator_from_toml_str(&text.replace("B_Pa", "B_MPa"), "act.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("act.toml") && e.contains("actuator.B_MPa"),
+        "{e}"
+    );
+}

@@ -391,11 +391,23 @@ impl OdeSystem<NS> for StepSystem<'_> {
     }
 }
 
+/// How a circuit device estimates `dF_m/dd_f`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tangent {
+    /// Eq. (16) static stiffness, `-(1/2)(B A0^2/V0 + B A1^2/V1)` (the paper's choice; cheap).
+    #[default]
+    Eq16,
+    /// Forward difference of `F_m` in `d_f` (one extra integration of the step, step size
+    /// 1e-7 of the chamber length scale `V0/A0`): the true derivative including the flows.
+    FiniteDifference,
+}
+
 /// A two-chamber hydraulic device (damper, damper with relief valves, actuator).
 #[derive(Debug, Clone)]
 pub struct CircuitDevice {
     params: Arc<CircuitParams>,
     opts: IntegratorOptions,
+    tangent: Tangent,
     committed: State,
     committed_t: f64,
     committed_d: f64,
@@ -434,6 +446,7 @@ impl CircuitDevice {
         Self {
             params: Arc::new(params),
             opts,
+            tangent: Tangent::Eq16,
             committed: y0,
             committed_t: 0.0,
             committed_d: 0.0,
@@ -448,6 +461,11 @@ impl CircuitDevice {
     /// Mutable parameters (copy-on-write when shared with clones).
     pub fn params_mut(&mut self) -> &mut CircuitParams {
         Arc::make_mut(&mut self.params)
+    }
+
+    /// Selects the estimate of `dforce_dstroke`.
+    pub fn set_tangent(&mut self, tangent: Tangent) {
+        self.tangent = tangent;
     }
 
     pub fn options(&self) -> IntegratorOptions {
@@ -505,9 +523,21 @@ impl Device for CircuitDevice {
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
         let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
+        let force_mean = y[IIMP] / dt;
+        let dforce_dstroke = match self.tangent {
+            Tangent::Eq16 => -0.5 * self.params.static_stiffness(&y, d_f),
+            Tangent::FiniteDifference => {
+                let c = &self.params.chambers[0];
+                let h = 1e-7 * c.volume0 / c.area;
+                sys.d_dot = (d_f + h - d_i) / dt;
+                sys.contact = None;
+                let yh = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
+                (yh[IIMP] / dt - force_mean) / h
+            }
+        };
         let out = StepForce {
-            force_mean: y[IIMP] / dt,
-            dforce_dstroke: -0.5 * self.params.static_stiffness(&y, d_f),
+            force_mean,
+            dforce_dstroke,
             force_end: self.params.force(&y),
         };
         self.trial = Some((y, t_i + dt, d_f));

@@ -1,6 +1,6 @@
 //! The damper deck of FORMATS.md: the `[damper]` table of any TOML file (other top-level tables
 //! are ignored; unknown keys inside `[damper...]` tables are errors).
-use super::circuit::{CircuitDevice, CircuitParams};
+use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
 use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
 use super::fluid::Fluid;
@@ -524,4 +524,80 @@ impl DamperDeck {
             })?;
         Ok(CircuitDevice::new(params, opts))
     }
+}
+
+pub const ACTUATOR_KEYS: &[&str] = &[
+    "A0_m2",
+    "A1_m2",
+    "V0_m3",
+    "V1_m3",
+    "p_E0_Pa",
+    "p_E1_Pa",
+    "A_orf0_m2",
+    "A_orf1_m2",
+    "Cd0",
+    "Cd1",
+    "p_s_Pa",
+    "B_Pa",
+    "rho_kg_m3",
+    "check_valve_area_m2",
+    "dp_laminar_Pa",
+];
+
+/// Reads the linear actuator of an `[actuator]` table (keys: [`ACTUATOR_KEYS`]; paper Table 1
+/// names with units; `dp_laminar_Pa` optional). Other top-level tables are ignored.
+pub fn actuator_from_toml_str(text: &str, source_name: &str) -> Result<ActuatorParams, DeckError> {
+    let cx = Ctx { file: source_name };
+    let root: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| DeckError::Parse {
+            file: source_name.into(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+    let p = "actuator";
+    let t = cx
+        .table(&root, "", p)?
+        .ok_or_else(|| DeckError::MissingTable {
+            file: source_name.into(),
+            table: p.into(),
+        })?;
+    cx.known(t, p, ACTUATOR_KEYS)?;
+    let pos = |k: &str, what: &str| cx.num_where(t, p, k, what, positive);
+    let nonneg = |k: &str, what: &str| cx.num_where(t, p, k, what, non_negative);
+    let cd = |k: &str| {
+        cx.num_where(t, p, k, "a discharge coefficient in (0, 1]", |x| {
+            x > 0.0 && x <= 1.0
+        })
+    };
+    Ok(ActuatorParams {
+        area_m2: [
+            pos("A0_m2", "a positive area in m^2")?,
+            pos("A1_m2", "a positive area in m^2")?,
+        ],
+        volume0_m3: [
+            pos("V0_m3", "a positive volume in m^3")?,
+            pos("V1_m3", "a positive volume in m^3")?,
+        ],
+        p_entrance_pa: [
+            nonneg("p_E0_Pa", "a non-negative pressure in Pa")?,
+            nonneg("p_E1_Pa", "a non-negative pressure in Pa")?,
+        ],
+        orifice_area_m2: [
+            nonneg("A_orf0_m2", "a non-negative area in m^2")?,
+            nonneg("A_orf1_m2", "a non-negative area in m^2")?,
+        ],
+        cd: [cd("Cd0")?, cd("Cd1")?],
+        p_s_pa: nonneg("p_s_Pa", "a non-negative pressure in Pa")?,
+        bulk_modulus_pa: pos("B_Pa", "a positive bulk modulus in Pa")?,
+        rho_kg_m3: pos("rho_kg_m3", "a positive density in kg/m^3")?,
+        check_valve_area_m2: nonneg(
+            "check_valve_area_m2",
+            "a non-negative area in m^2 (0 disables)",
+        )?,
+        dp_laminar_pa: if t.contains_key("dp_laminar_Pa") {
+            pos("dp_laminar_Pa", "a positive pressure in Pa")?
+        } else {
+            DEFAULT_DP_LAMINAR_PA
+        },
+    })
 }

@@ -14,10 +14,10 @@ pub mod fluid;
 pub mod integrators;
 
 pub use circuit::{
-    ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear,
+    ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear, Tangent,
 };
 pub use dashpot::{LinearDashpot, NonlinearDashpot};
-pub use deck::{DamperDeck, DamperModel, DeckError};
+pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError};
 pub use elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
