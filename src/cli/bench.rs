@@ -108,10 +108,27 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let out = OutDir::create(&args.out)?;
     let mut all = Vec::new();
     for (model, dev) in &devices {
-        let runs = bench::harmonic_sweep(dev.as_ref(), &sweep, true).map_err(|e| {
-            let _ = out.mark_incomplete(&format!("{} model failed: {e}", model.name()));
-            anyhow::anyhow!("{} model: {e}", model.name())
-        })?;
+        let mut runs = Vec::with_capacity(sweep.peak_velocities_m_s.len());
+        for &v in &sweep.peak_velocities_m_s {
+            let r = bench::harmonic_run(
+                dev.as_ref(),
+                sweep.omega_rad_s,
+                v,
+                sweep.cycles,
+                sweep.steps_per_cycle,
+                true,
+            );
+            runs.push(r.map_err(|e| {
+                let msg = format!(
+                    "{} model at peak velocity {} {} ({v} m/s): {e}",
+                    model.name(),
+                    v / factor,
+                    args.velocity_unit
+                );
+                let _ = out.mark_incomplete(&msg);
+                anyhow::anyhow!(msg)
+            })?);
+        }
         let sub = if devices.len() > 1 {
             format!("{}/", model.name())
         } else {

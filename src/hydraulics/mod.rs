@@ -38,7 +38,7 @@ pub struct StepForce {
 /// Errors of the hydraulic models, with the time at which they occurred.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HydraulicError {
-    #[error("non-finite hydraulic state at t = {t} s (component {component})")]
+    #[error("non-finite hydraulic state at t = {t} s (component {component}); with RK4 this is usually the explicit stability limit: more sub-steps or the implicit scheme")]
     NonFinite { t: f64, component: usize },
     #[error("chamber {chamber} volume {volume_m3} m^3 is not positive at stroke {stroke_m} m (t = {t} s): stroke beyond the device's travel")]
     ChamberVolume {
