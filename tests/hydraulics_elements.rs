@@ -412,3 +412,26 @@ fn actuator_table_matches_paper_table1_and_rejects_unknown_keys() {
         "{e}"
     );
 }
+
+#[test]
+fn simple_damper_matches_the_incompressible_orifice_law_at_low_frequency() {
+    // Chambers + orifice only (the paper's simple damper). Slow stroking: the oil is nearly
+    // incompressible, so Q = A d' and F = -A dp with dp = (rho/2) (A d'/(C_d A_orf))^2 (Eq. 4).
+    let phys = deck().physical.unwrap();
+    let mut params = sealed(phys.fluid, 5.0e6);
+    params.orifice = phys.orifice;
+    params.dp_laminar = phys.dp_laminar;
+    let o = phys.orifice.unwrap();
+    let (omega, v) = (2.0, 0.05);
+    let dev = CircuitDevice::new(params.clone(), IntegratorOptions::default());
+    let r = harmonic_run(&dev, omega, v, 2, 512, false).unwrap();
+    let a = params.chambers[0].area;
+    let dp = 0.5 * params.fluid.rho * (a * v / (o.cd * o.area)).powi(2);
+    let analytic = a * dp;
+    for peak in [r.peak_force_pos_n, -r.peak_force_neg_n] {
+        assert!(
+            (peak - analytic).abs() < 2e-3 * analytic,
+            "peak {peak} vs {analytic}"
+        );
+    }
+}
