@@ -227,7 +227,7 @@ fn write_sweep(
     let from = h.time_s.len().saturating_sub(2 * args.steps_per_cycle + 1);
     let t = &h.time_s[from..];
     let title = format!(
-        "{} model, peak velocity {} {} (history_{k}.csv), {}",
+        "{} model, peak velocity {} {} (cf. paper Fig. 14; history_{k}.csv), {}",
         model.name(),
         r.peak_velocity_m_s / factor,
         args.velocity_unit,
