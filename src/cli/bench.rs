@@ -143,7 +143,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let vmax = args.peak_velocity.iter().cloned().fold(0.0, f64::max);
     let mut p = Plot::new(
         &format!(
-            "Peak force vs peak velocity, omega = {} rad/s ({})",
+            "Peak force vs peak velocity (cf. paper Fig. 13), omega = {} rad/s ({})",
             args.omega, deck.source
         ),
         &format!("peak velocity [{}]", args.velocity_unit),
