@@ -1,2 +1,112 @@
 //! Hydraulic elements on pressure states (chamber, orifice, relief valve, check valve), composed
-//! into devices (actuator, dampers, dashpots), with sub-stepping integrators. Paper Eqs. (1)-(8).
+//! into devices (actuator, dampers, dashpots), with sub-stepping integrators. Paper Eqs. (1)-(8),
+//! coupling quantities of Eqs. (13) and (16).
+//!
+//! Every device implements [`Device`]: the structure hands it the strokes at the ends of a
+//! structural step, the device integrates its internal (hydraulic) state over the step with
+//! `N` sub-steps and returns the step-averaged force `F_m` of Eq. (13) and its derivative.
+pub mod bench;
+pub mod circuit;
+pub mod dashpot;
+pub mod deck;
+pub mod elements;
+pub mod fluid;
+pub mod integrators;
+
+pub use circuit::{
+    ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear, Tangent,
+};
+pub use dashpot::{LinearDashpot, NonlinearDashpot};
+pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError};
+pub use elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
+pub use fluid::Fluid;
+pub use integrators::{IntegratorOptions, Scheme};
+
+/// Result of one trial step of a device.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepForce {
+    /// Time average of the device force over the step [N]: the `F_m` of Eq. (13).
+    pub force_mean: f64,
+    /// Signed derivative `dF_m/dd_f` [N/m] with respect to the end-of-step stroke. For the
+    /// physical devices it is the Eq. (16) static-stiffness estimate, `-(1/2)(B A0^2/V0 + B A1^2/V1)`:
+    /// negative (a longer damper pushes less) and halved because `d_m = (d_i + d_f)/2`.
+    pub dforce_dstroke: f64,
+    /// Device force at the end of the step [N] (Eq. 8).
+    pub force_end: f64,
+}
+
+/// Errors of the hydraulic models, with the time at which they occurred.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HydraulicError {
+    #[error("non-finite hydraulic state at t = {t} s (component {component}); with RK4 this is usually the explicit stability limit: more sub-steps or the implicit scheme")]
+    NonFinite { t: f64, component: usize },
+    #[error("chamber {chamber} volume {volume_m3} m^3 is not positive at stroke {stroke_m} m (t = {t} s): stroke beyond the device's travel")]
+    ChamberVolume {
+        chamber: usize,
+        volume_m3: f64,
+        stroke_m: f64,
+        t: f64,
+    },
+    #[error("implicit sub-step did not converge at t = {t} s: stage {stage}, iteration {iteration}, scaled residual {residual:.3e}")]
+    NewtonDiverged {
+        t: f64,
+        stage: usize,
+        iteration: usize,
+        residual: f64,
+    },
+    #[error("singular Newton matrix at t = {t} s, stage {stage}")]
+    SingularJacobian { t: f64, stage: usize },
+    #[error("invalid step at t = {t} s: {reason}")]
+    BadStep { t: f64, reason: String },
+}
+
+/// A hydraulic (or dashpot) device connecting two structural points, as seen by the structure.
+///
+/// Protocol: `trial_step` advances from the committed state and keeps the result as a trial
+/// state; calling it again restarts from the committed state (structural Newton iterations);
+/// `commit` accepts the last trial state.
+pub trait Device: Send + Sync + std::fmt::Debug {
+    /// Advance from the committed state at `t_i` over `dt`, the stroke moving linearly from
+    /// `d_i` to `d_f` (constant rate). The result is kept as the trial state.
+    fn trial_step(
+        &mut self,
+        t_i: f64,
+        dt: f64,
+        d_i: f64,
+        d_f: f64,
+    ) -> Result<StepForce, HydraulicError>;
+    /// Accept the last trial state (no-op when there is none).
+    fn commit(&mut self);
+    /// Names (with units) of the internal channels, e.g. `p0_Pa`.
+    fn channel_names(&self) -> &'static [&'static str];
+    /// Values of the channels at the committed state; `out.len() == channel_names().len()`.
+    fn channels(&self, out: &mut [f64]);
+    /// Device force at the committed state [N] (Eq. 8 for the hydraulic devices).
+    fn committed_force(&self) -> f64;
+    /// Deep copy (parameters are shared copy-on-write, so this is cheap).
+    fn clone_device(&self) -> Box<dyn Device>;
+    /// Back to the initial state (start of a new test).
+    fn reset(&mut self);
+}
+
+impl Clone for Box<dyn Device> {
+    fn clone(&self) -> Self {
+        self.clone_device()
+    }
+}
+
+pub(crate) fn check_step(t_i: f64, dt: f64, d_i: f64, d_f: f64) -> Result<(), HydraulicError> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(HydraulicError::BadStep {
+            t: t_i,
+            reason: format!("time step {dt} s must be positive and finite"),
+        });
+    }
+    if !(d_i.is_finite() && d_f.is_finite() && t_i.is_finite()) {
+        return Err(HydraulicError::BadStep {
+            t: t_i,
+            reason: format!("non-finite stroke ({d_i}, {d_f}) m or time"),
+        });
+    }
+    Ok(())
+}

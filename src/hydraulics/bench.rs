@@ -1,0 +1,426 @@
+//! Virtual test bench: harmonic stroking sweeps (paper Figs. 13-14) and replay of measured bench
+//! tests (bench CSV of FORMATS.md).
+use super::{Device, HydraulicError};
+use std::path::Path;
+
+/// Inches to metres.
+pub const IN_TO_M: f64 = 0.0254;
+/// Pounds-force to newtons.
+pub const LB_TO_N: f64 = 4.448_221_615_260_5;
+
+/// Harmonic sweep settings: `d(t) = (v/omega) sin(omega t)` for each peak velocity `v`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepOptions {
+    pub omega_rad_s: f64,
+    pub peak_velocities_m_s: Vec<f64>,
+    pub cycles: usize,
+    pub steps_per_cycle: usize,
+}
+
+impl Default for SweepOptions {
+    /// The paper's bench: omega = 27.02 rad/s, 0.5 ... 10 in/s, 10 cycles, 256 steps per cycle.
+    fn default() -> Self {
+        Self {
+            omega_rad_s: 27.02,
+            peak_velocities_m_s: [0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0]
+                .iter()
+                .map(|v| v * IN_TO_M)
+                .collect(),
+            cycles: 10,
+            steps_per_cycle: 256,
+        }
+    }
+}
+
+/// Time history of one bench run, one row per step end (and the initial instant).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct History {
+    pub time_s: Vec<f64>,
+    pub stroke_m: Vec<f64>,
+    pub velocity_m_s: Vec<f64>,
+    /// Device force at the sample instant (Eq. 8), i.e. `force_end` of the step ending there.
+    pub force_n: Vec<f64>,
+    /// Step-averaged force of the step ending at the sample (NaN at t = 0).
+    pub force_mean_n: Vec<f64>,
+    pub channel_names: Vec<&'static str>,
+    /// channels[c][sample]
+    pub channels: Vec<Vec<f64>>,
+}
+
+impl History {
+    fn new(dev: &dyn Device, cap: usize) -> Self {
+        let names = dev.channel_names().to_vec();
+        Self {
+            channels: vec![Vec::with_capacity(cap); names.len()],
+            channel_names: names,
+            ..Default::default()
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn push(&mut self, dev: &dyn Device, buf: &mut [f64], t: f64, d: f64, v: f64, f: f64, fm: f64) {
+        self.time_s.push(t);
+        self.stroke_m.push(d);
+        self.velocity_m_s.push(v);
+        self.force_n.push(f);
+        self.force_mean_n.push(fm);
+        dev.channels(buf);
+        for (c, x) in self.channels.iter_mut().zip(buf.iter()) {
+            c.push(*x);
+        }
+    }
+}
+
+/// Result of one harmonic run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HarmonicRun {
+    pub peak_velocity_m_s: f64,
+    /// Largest force over the last cycle [N].
+    pub peak_force_pos_n: f64,
+    /// Smallest (most negative) force over the last cycle [N].
+    pub peak_force_neg_n: f64,
+    /// Energy dissipated in the last cycle, `-int F d_dot dt` [J] (positive for a damper).
+    pub dissipated_last_cycle_j: f64,
+    pub history: History,
+}
+
+/// Runs one harmonic test on a fresh copy of `device` (reset to its initial state).
+/// `keep_history` false skips recording the channels (benchmarks).
+pub fn harmonic_run(
+    device: &dyn Device,
+    omega: f64,
+    peak_velocity: f64,
+    cycles: usize,
+    steps_per_cycle: usize,
+    keep_history: bool,
+) -> Result<HarmonicRun, HydraulicError> {
+    if cycles == 0
+        || steps_per_cycle == 0
+        || !(omega > 0.0 && omega.is_finite())
+        || !peak_velocity.is_finite()
+    {
+        return Err(HydraulicError::BadStep {
+            t: 0.0,
+            reason: format!(
+                "harmonic run needs cycles >= 1 ({cycles}), steps per cycle >= 1 ({steps_per_cycle}), omega > 0 ({omega} rad/s) and a finite peak velocity ({peak_velocity} m/s)"
+            ),
+        });
+    }
+    let mut dev = device.clone_device();
+    dev.reset();
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let n = cycles * steps_per_cycle;
+    let dt = period / steps_per_cycle as f64;
+    let amp = peak_velocity / omega;
+    let stroke = |k: usize| amp * (omega * k as f64 * dt).sin();
+    let mut hist = History::new(dev.as_ref(), if keep_history { n + 1 } else { 0 });
+    let mut buf = vec![0.0; hist.channel_names.len()];
+    let f0 = dev.committed_force();
+    if keep_history {
+        hist.push(
+            dev.as_ref(),
+            &mut buf,
+            0.0,
+            0.0,
+            peak_velocity,
+            f0,
+            f64::NAN,
+        );
+    }
+    let (mut fmax, mut fmin, mut work) = (f64::NEG_INFINITY, f64::INFINITY, 0.0);
+    let last_start = n - steps_per_cycle;
+    for k in 0..n {
+        let (d_i, d_f) = (stroke(k), stroke(k + 1));
+        let t_i = k as f64 * dt;
+        let sf = dev.trial_step(t_i, dt, d_i, d_f)?;
+        dev.commit();
+        if k >= last_start {
+            fmax = fmax.max(sf.force_end);
+            fmin = fmin.min(sf.force_end);
+            // Exact work of the step-averaged force over the step (Eq. 11).
+            work += sf.force_mean * (d_f - d_i);
+        }
+        if keep_history {
+            let t = t_i + dt;
+            hist.push(
+                dev.as_ref(),
+                &mut buf,
+                t,
+                d_f,
+                peak_velocity * (omega * t).cos(),
+                sf.force_end,
+                sf.force_mean,
+            );
+        }
+    }
+    Ok(HarmonicRun {
+        peak_velocity_m_s: peak_velocity,
+        peak_force_pos_n: fmax,
+        peak_force_neg_n: fmin,
+        dissipated_last_cycle_j: -work,
+        history: hist,
+    })
+}
+
+/// Runs the sweep: one fresh harmonic run per peak velocity.
+pub fn harmonic_sweep(
+    device: &dyn Device,
+    opts: &SweepOptions,
+    keep_history: bool,
+) -> Result<Vec<HarmonicRun>, HydraulicError> {
+    opts.peak_velocities_m_s
+        .iter()
+        .map(|&v| {
+            harmonic_run(
+                device,
+                opts.omega_rad_s,
+                v,
+                opts.cycles,
+                opts.steps_per_cycle,
+                keep_history,
+            )
+        })
+        .collect()
+}
+
+/// Errors reading a bench measurement CSV, naming the file and line or column.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchCsvError {
+    #[error("cannot read bench file {file}: {message}")]
+    Read { file: String, message: String },
+    #[error("bench file {file}: missing column `{column}` (header: {header})")]
+    MissingColumn {
+        file: String,
+        column: String,
+        header: String,
+    },
+    #[error("bench file {file}: column `{column}` has an unknown unit (accepted: {accepted})")]
+    UnknownUnit {
+        file: String,
+        column: String,
+        accepted: String,
+    },
+    #[error("bench file {file}, line {line}: {message}")]
+    Line {
+        file: String,
+        line: usize,
+        message: String,
+    },
+    #[error("bench file {file}: {message}")]
+    Other { file: String, message: String },
+}
+
+/// One measured bench test, in SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchTest {
+    pub name: String,
+    pub time_s: Vec<f64>,
+    pub stroke_m: Vec<f64>,
+    pub force_n: Option<Vec<f64>>,
+    pub velocity_m_s: Option<Vec<f64>>,
+}
+
+/// (quantity, accepted headers with their factor to SI)
+const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
+    ("time", &[("time_s", 1.0)]),
+    ("stroke", &[("stroke_m", 1.0), ("stroke_in", IN_TO_M)]),
+    ("force", &[("force_N", 1.0), ("force_lb", LB_TO_N)]),
+    (
+        "velocity",
+        &[("velocity_m_s", 1.0), ("velocity_in_s", IN_TO_M)],
+    ),
+];
+
+/// Reads a bench CSV file (FORMATS.md): `time_s`, `stroke_m` required, `force_N`,
+/// `velocity_m_s` optional, alternates `stroke_in`, `force_lb`, `velocity_in_s`.
+pub fn read_bench_csv(path: &Path) -> Result<BenchTest, BenchCsvError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| BenchCsvError::Read {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    let name = path
+        .file_stem()
+        .map_or_else(|| "test".to_string(), |s| s.to_string_lossy().into_owned());
+    parse_bench_csv(&text, &file, &name)
+}
+
+/// Parses bench CSV text; `file` names it in errors.
+pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, BenchCsvError> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = rdr
+        .headers()
+        .map_err(|e| BenchCsvError::Read {
+            file: file.into(),
+            message: e.to_string(),
+        })?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let joined = header.join(",");
+    // Column index and SI factor per quantity.
+    let mut cols: [Option<(usize, f64)>; 4] = [None; 4];
+    for (ci, h) in header.iter().enumerate() {
+        let Some(qi) = QUANTITIES
+            .iter()
+            .position(|(q, _)| h.starts_with(&format!("{q}_")) || h == q)
+        else {
+            continue; // other columns are allowed and ignored
+        };
+        let (q, alts) = QUANTITIES[qi];
+        let Some(&(_, factor)) = alts.iter().find(|(n, _)| n == h) else {
+            return Err(BenchCsvError::UnknownUnit {
+                file: file.into(),
+                column: h.clone(),
+                accepted: alts.iter().map(|a| a.0).collect::<Vec<_>>().join(", "),
+            });
+        };
+        if cols[qi].is_some() {
+            return Err(BenchCsvError::Other {
+                file: file.into(),
+                message: format!("two columns give the {q} (`{h}` and another)"),
+            });
+        }
+        cols[qi] = Some((ci, factor));
+    }
+    for qi in 0..2 {
+        if cols[qi].is_none() {
+            return Err(BenchCsvError::MissingColumn {
+                file: file.into(),
+                column: QUANTITIES[qi].1[0].0.into(),
+                header: joined,
+            });
+        }
+    }
+    let mut data: [Vec<f64>; 4] = Default::default();
+    for (ri, rec) in rdr.records().enumerate() {
+        let line = ri + 2;
+        let rec = rec.map_err(|e| BenchCsvError::Line {
+            file: file.into(),
+            line,
+            message: e.to_string(),
+        })?;
+        for qi in 0..4 {
+            let Some((ci, factor)) = cols[qi] else {
+                continue;
+            };
+            let cell = rec.get(ci).unwrap_or("");
+            let x: f64 = cell.parse().map_err(|_| BenchCsvError::Line {
+                file: file.into(),
+                line,
+                message: format!("`{}` = '{cell}' is not a number", header[ci]),
+            })?;
+            if !x.is_finite() {
+                return Err(BenchCsvError::Line {
+                    file: file.into(),
+                    line,
+                    message: format!("`{}` = {cell} is not finite", header[ci]),
+                });
+            }
+            data[qi].push(x * factor);
+        }
+        let t = &data[0];
+        if t.len() >= 2 && t[t.len() - 1] <= t[t.len() - 2] {
+            return Err(BenchCsvError::Line {
+                file: file.into(),
+                line,
+                message: format!(
+                    "time {} s does not increase (previous {} s)",
+                    t[t.len() - 1],
+                    t[t.len() - 2]
+                ),
+            });
+        }
+    }
+    if data[0].len() < 2 {
+        return Err(BenchCsvError::Other {
+            file: file.into(),
+            message: "need at least two samples".into(),
+        });
+    }
+    let [time_s, stroke_m, force, vel] = data;
+    Ok(BenchTest {
+        name: name.into(),
+        time_s,
+        stroke_m,
+        force_n: cols[2].map(|_| force),
+        velocity_m_s: cols[3].map(|_| vel),
+    })
+}
+
+/// Model response to a measured stroke history.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Replay {
+    /// Model force at each sample (force_end of the step ending there; the initial state's force
+    /// at the first sample).
+    pub force_model_n: Vec<f64>,
+    /// RMS of model - measured [N] over all samples (None without a measured force).
+    pub rms_error_n: Option<f64>,
+    pub history: History,
+}
+
+/// Drives `device` (reset first) with the measured stroke, one step per sample interval.
+pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, HydraulicError> {
+    let mut dev = device.clone_device();
+    dev.reset();
+    let n = test.time_s.len();
+    let mut hist = History::new(dev.as_ref(), n);
+    let mut buf = vec![0.0; hist.channel_names.len()];
+    let mut force = Vec::with_capacity(n);
+    // Velocity column: measured if given, else central differences of the stroke.
+    let vel = test
+        .velocity_m_s
+        .clone()
+        .unwrap_or_else(|| differentiate(&test.time_s, &test.stroke_m));
+    // First sample: the device's force with no step taken yet is its initial (static) force.
+    let first = dev.trial_step(test.time_s[0], 1e-9, test.stroke_m[0], test.stroke_m[0])?;
+    dev.reset();
+    force.push(first.force_end);
+    hist.push(
+        dev.as_ref(),
+        &mut buf,
+        test.time_s[0],
+        test.stroke_m[0],
+        vel[0],
+        first.force_end,
+        f64::NAN,
+    );
+    for k in 0..n - 1 {
+        let dt = test.time_s[k + 1] - test.time_s[k];
+        let sf = dev.trial_step(test.time_s[k], dt, test.stroke_m[k], test.stroke_m[k + 1])?;
+        dev.commit();
+        force.push(sf.force_end);
+        hist.push(
+            dev.as_ref(),
+            &mut buf,
+            test.time_s[k + 1],
+            test.stroke_m[k + 1],
+            vel[k + 1],
+            sf.force_end,
+            sf.force_mean,
+        );
+    }
+    let rms = test.force_n.as_ref().map(|m| {
+        let s: f64 = m.iter().zip(&force).map(|(a, b)| (a - b) * (a - b)).sum();
+        (s / n as f64).sqrt()
+    });
+    Ok(Replay {
+        force_model_n: force,
+        rms_error_n: rms,
+        history: hist,
+    })
+}
+
+/// Central differences (one-sided at the ends) on a non-uniform grid.
+pub fn differentiate(t: &[f64], x: &[f64]) -> Vec<f64> {
+    let n = t.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            (x[b] - x[a]) / (t[b] - t[a])
+        })
+        .collect()
+}

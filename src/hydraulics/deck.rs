@@ -1,0 +1,603 @@
+//! The damper deck of FORMATS.md: the `[damper]` table of any TOML file (other top-level tables
+//! are ignored; unknown keys inside `[damper...]` tables are errors).
+use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
+use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
+use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
+use super::fluid::Fluid;
+use super::integrators::IntegratorOptions;
+use super::Device;
+use std::path::Path;
+use toml::{Table, Value};
+
+/// Default laminar transition of the flow laws when the deck omits `dp_laminar_Pa`.
+pub const DEFAULT_DP_LAMINAR_PA: f64 = 1.0e3;
+/// Default cavitation band when the deck omits `p_cav_Pa`.
+pub const DEFAULT_P_CAV_PA: f64 = 1.0e4;
+
+/// Deck errors, naming the file and the key.
+#[derive(Debug, thiserror::Error)]
+pub enum DeckError {
+    #[error("cannot read deck {file}: {source}")]
+    Read {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("deck {file} is not valid TOML: {message}")]
+    Parse { file: String, message: String },
+    #[error("deck {file}: missing table [{table}]")]
+    MissingTable { file: String, table: String },
+    #[error("deck {file}: missing key `{key}` ({expected})")]
+    MissingKey {
+        file: String,
+        key: String,
+        expected: String,
+    },
+    #[error("deck {file}: unknown key `{key}` (known keys: {known})")]
+    UnknownKey {
+        file: String,
+        key: String,
+        known: String,
+    },
+    #[error("deck {file}: key `{key}` = {value}: {expected}")]
+    BadValue {
+        file: String,
+        key: String,
+        value: String,
+        expected: String,
+    },
+}
+
+/// Damper model selection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DamperModel {
+    Physical,
+    Linear,
+    Nonlinear,
+}
+
+impl DamperModel {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Physical => "physical",
+            Self::Linear => "linear",
+            Self::Nonlinear => "nonlinear",
+        }
+    }
+}
+
+impl std::str::FromStr for DamperModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "physical" => Ok(Self::Physical),
+            "linear" => Ok(Self::Linear),
+            "nonlinear" => Ok(Self::Nonlinear),
+            _ => Err(format!(
+                "unknown damper model '{s}' (expected physical, linear or nonlinear)"
+            )),
+        }
+    }
+}
+
+/// A loaded damper deck: the default model and whichever model tables the deck holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DamperDeck {
+    /// File (or source name) the deck came from, for messages.
+    pub source: String,
+    pub model: DamperModel,
+    pub linear_c_n_s_per_m: Option<f64>,
+    pub nonlinear: Option<(Vec<f64>, Vec<f64>)>,
+    pub physical: Option<CircuitParams>,
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn table<'t>(
+        &self,
+        parent: &'t Table,
+        path: &str,
+        name: &str,
+    ) -> Result<Option<&'t Table>, DeckError> {
+        match parent.get(name) {
+            None => Ok(None),
+            Some(Value::Table(t)) => Ok(Some(t)),
+            Some(v) => Err(self.bad(&format!("{path}.{name}"), v, "expected a table")),
+        }
+    }
+
+    fn bad(&self, key: &str, v: &Value, expected: &str) -> DeckError {
+        DeckError::BadValue {
+            file: self.file.into(),
+            key: key.into(),
+            value: v.to_string(),
+            expected: expected.into(),
+        }
+    }
+
+    fn known(&self, t: &Table, path: &str, keys: &[&str]) -> Result<(), DeckError> {
+        for k in t.keys() {
+            if !keys.contains(&k.as_str()) {
+                return Err(DeckError::UnknownKey {
+                    file: self.file.into(),
+                    key: format!("{path}.{k}"),
+                    known: keys.join(", "),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn num(&self, t: &Table, path: &str, key: &str, expected: &str) -> Result<f64, DeckError> {
+        let full = format!("{path}.{key}");
+        match t.get(key) {
+            None => Err(DeckError::MissingKey {
+                file: self.file.into(),
+                key: full,
+                expected: expected.into(),
+            }),
+            Some(v) => self.as_num(v, &full, expected),
+        }
+    }
+
+    fn as_num(&self, v: &Value, full: &str, expected: &str) -> Result<f64, DeckError> {
+        let x = match v {
+            Value::Float(x) => *x,
+            Value::Integer(i) => *i as f64,
+            _ => return Err(self.bad(full, v, &format!("expected a number ({expected})"))),
+        };
+        if !x.is_finite() {
+            return Err(self.bad(full, v, &format!("expected a finite number ({expected})")));
+        }
+        Ok(x)
+    }
+
+    /// Number satisfying `ok`, e.g. positive.
+    fn num_where(
+        &self,
+        t: &Table,
+        path: &str,
+        key: &str,
+        expected: &str,
+        ok: fn(f64) -> bool,
+    ) -> Result<f64, DeckError> {
+        let x = self.num(t, path, key, expected)?;
+        if !ok(x) {
+            return Err(self.bad(
+                &format!("{path}.{key}"),
+                &t[key],
+                &format!("expected {expected}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    fn array(&self, t: &Table, path: &str, key: &str) -> Result<Vec<f64>, DeckError> {
+        let full = format!("{path}.{key}");
+        match t.get(key) {
+            None => Err(DeckError::MissingKey {
+                file: self.file.into(),
+                key: full,
+                expected: "an array of numbers".into(),
+            }),
+            Some(Value::Array(a)) => a
+                .iter()
+                .map(|v| self.as_num(v, &full, "array of numbers"))
+                .collect(),
+            Some(v) => Err(self.bad(&full, v, "expected an array of numbers")),
+        }
+    }
+}
+
+fn positive(x: f64) -> bool {
+    x > 0.0
+}
+fn non_negative(x: f64) -> bool {
+    x >= 0.0
+}
+
+const PHYSICAL_KEYS: &[&str] = &[
+    "A0_m2",
+    "A1_m2",
+    "V0_m3",
+    "V1_m3",
+    "rho_kg_m3",
+    "bulk_alpha_per_Pa",
+    "bulk_beta_per_Pa2",
+    "A_orf_m2",
+    "Cd",
+    "p_s_Pa",
+    "dp_laminar_Pa",
+    "check_valve_area_m2",
+    "p_cav_Pa",
+    "relief_valve_0",
+    "relief_valve_1",
+];
+const VALVE_KEYS: &[&str] = &[
+    "m_kg",
+    "c_N_s_per_m",
+    "k_N_per_m",
+    "F_p_N",
+    "A_front_m2",
+    "A_back_m2",
+    "a_m",
+    "b",
+];
+
+impl DamperDeck {
+    /// Reads a deck file.
+    pub fn from_file(path: &Path) -> Result<Self, DeckError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| DeckError::Read {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_toml_str(&text, &file)
+    }
+
+    /// Parses deck text; `source_name` names it in errors.
+    pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, DeckError> {
+        let cx = Ctx { file: source_name };
+        let root: Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| DeckError::Parse {
+                file: source_name.into(),
+                message: e.to_string().trim_end().to_string(),
+            })?;
+        let damper = cx
+            .table(&root, "", "damper")?
+            .ok_or_else(|| DeckError::MissingTable {
+                file: source_name.into(),
+                table: "damper".into(),
+            })?;
+        cx.known(
+            damper,
+            "damper",
+            &["model", "linear", "nonlinear", "physical"],
+        )?;
+        let model = match damper.get("model") {
+            None => {
+                return Err(DeckError::MissingKey {
+                    file: source_name.into(),
+                    key: "damper.model".into(),
+                    expected: "physical, linear or nonlinear".into(),
+                })
+            }
+            Some(Value::String(s)) => s
+                .parse::<DamperModel>()
+                .map_err(|e| cx.bad("damper.model", &damper["model"], &e))?,
+            Some(v) => {
+                return Err(cx.bad(
+                    "damper.model",
+                    v,
+                    "expected a string: physical, linear or nonlinear",
+                ))
+            }
+        };
+
+        let linear = match cx.table(damper, "damper", "linear")? {
+            None => None,
+            Some(t) => {
+                cx.known(t, "damper.linear", &["c_N_s_per_m"])?;
+                Some(cx.num_where(
+                    t,
+                    "damper.linear",
+                    "c_N_s_per_m",
+                    "a positive damping coefficient",
+                    positive,
+                )?)
+            }
+        };
+
+        let nonlinear = match cx.table(damper, "damper", "nonlinear")? {
+            None => None,
+            Some(t) => {
+                let p = "damper.nonlinear";
+                cx.known(t, p, &["velocity_m_s", "force_N"])?;
+                let v = cx.array(t, p, "velocity_m_s")?;
+                let f = cx.array(t, p, "force_N")?;
+                MonotoneTable::new(v.clone(), f.clone()).map_err(|e| DeckError::BadValue {
+                    file: source_name.into(),
+                    key: format!("{p}.velocity_m_s/force_N"),
+                    value: format!("{v:?} / {f:?}"),
+                    expected: e,
+                })?;
+                Some((v, f))
+            }
+        };
+
+        let physical = match cx.table(damper, "damper", "physical")? {
+            None => None,
+            Some(t) => Some(Self::parse_physical(&cx, t)?),
+        };
+
+        let deck = Self {
+            source: source_name.into(),
+            model,
+            linear_c_n_s_per_m: linear,
+            nonlinear,
+            physical,
+        };
+        // The default model's table must be there.
+        deck.require(model)?;
+        Ok(deck)
+    }
+
+    fn parse_physical(cx: &Ctx, t: &Table) -> Result<CircuitParams, DeckError> {
+        let p = "damper.physical";
+        cx.known(t, p, PHYSICAL_KEYS)?;
+        let area = |k| cx.num_where(t, p, k, "a positive area in m^2", positive);
+        let vol = |k| cx.num_where(t, p, k, "a positive volume in m^3", positive);
+        let a0 = area("A0_m2")?;
+        let a1 = area("A1_m2")?;
+        let v0 = vol("V0_m3")?;
+        let v1 = vol("V1_m3")?;
+        let rho = cx.num_where(t, p, "rho_kg_m3", "a positive density in kg/m^3", positive)?;
+        let alpha = cx.num_where(
+            t,
+            p,
+            "bulk_alpha_per_Pa",
+            "a positive alpha in 1/Pa (Eq. 3)",
+            positive,
+        )?;
+        let beta = cx.num_where(
+            t,
+            p,
+            "bulk_beta_per_Pa2",
+            "a non-negative beta in 1/Pa^2 (Eq. 3)",
+            non_negative,
+        )?;
+        let a_orf = cx.num_where(
+            t,
+            p,
+            "A_orf_m2",
+            "a non-negative orifice area in m^2",
+            non_negative,
+        )?;
+        let cd = cx.num_where(t, p, "Cd", "a discharge coefficient in (0, 1]", |x| {
+            x > 0.0 && x <= 1.0
+        })?;
+        let p_s = cx.num_where(
+            t,
+            p,
+            "p_s_Pa",
+            "a non-negative background pressure in Pa",
+            non_negative,
+        )?;
+        let dp_l = if t.contains_key("dp_laminar_Pa") {
+            cx.num_where(t, p, "dp_laminar_Pa", "a positive pressure in Pa", positive)?
+        } else {
+            DEFAULT_DP_LAMINAR_PA
+        };
+        let p_cav = if t.contains_key("p_cav_Pa") {
+            cx.num_where(
+                t,
+                p,
+                "p_cav_Pa",
+                "a non-negative pressure in Pa (0 disables)",
+                non_negative,
+            )?
+        } else {
+            DEFAULT_P_CAV_PA
+        };
+        let cva = cx.num_where(
+            t,
+            p,
+            "check_valve_area_m2",
+            "a non-negative area in m^2 (0 disables)",
+            non_negative,
+        )?;
+        let mut relief = [None, None];
+        for (k, r) in relief.iter_mut().enumerate() {
+            let name = format!("relief_valve_{k}");
+            let Some(vt) = cx.table(t, p, &name)? else {
+                continue;
+            };
+            let vp = format!("{p}.{name}");
+            cx.known(vt, &vp, VALVE_KEYS)?;
+            let pos = |key: &str, what: &str| cx.num_where(vt, &vp, key, what, positive);
+            *r = Some(ReliefValve {
+                m: pos("m_kg", "a positive poppet mass in kg")?,
+                c: cx.num_where(
+                    vt,
+                    &vp,
+                    "c_N_s_per_m",
+                    "a non-negative poppet damping in N s/m",
+                    non_negative,
+                )?,
+                k: pos("k_N_per_m", "a positive spring constant in N/m")?,
+                f_p: cx.num_where(
+                    vt,
+                    &vp,
+                    "F_p_N",
+                    "a non-negative preload in N",
+                    non_negative,
+                )?,
+                a_front: pos("A_front_m2", "a positive area in m^2")?,
+                a_back: cx.num_where(
+                    vt,
+                    &vp,
+                    "A_back_m2",
+                    "a non-negative area in m^2",
+                    non_negative,
+                )?,
+                a: cx.num_where(
+                    vt,
+                    &vp,
+                    "a_m",
+                    "a non-negative coefficient in m (Eq. 7)",
+                    non_negative,
+                )?,
+                b: cx.num_where(
+                    vt,
+                    &vp,
+                    "b",
+                    "a non-negative coefficient (Eq. 7)",
+                    non_negative,
+                )?,
+                cd,
+            });
+        }
+        Ok(CircuitParams {
+            fluid: Fluid {
+                rho,
+                alpha,
+                beta,
+                p_cav,
+            },
+            dp_laminar: dp_l,
+            chambers: [
+                Chamber {
+                    area: a0,
+                    volume0: v0,
+                    lambda: 1.0,
+                },
+                Chamber {
+                    area: a1,
+                    volume0: v1,
+                    lambda: -1.0,
+                },
+            ],
+            orifice: (a_orf > 0.0).then_some(Orifice { area: a_orf, cd }),
+            relief,
+            check: (cva > 0.0).then_some(CheckValve { area: cva, cd }),
+            entrance: None,
+            p_s,
+            p_init: [p_s; 2],
+        })
+    }
+
+    /// Errors unless the deck holds the table of `model`.
+    pub fn require(&self, model: DamperModel) -> Result<(), DeckError> {
+        let present = match model {
+            DamperModel::Physical => self.physical.is_some(),
+            DamperModel::Linear => self.linear_c_n_s_per_m.is_some(),
+            DamperModel::Nonlinear => self.nonlinear.is_some(),
+        };
+        if present {
+            Ok(())
+        } else {
+            Err(DeckError::MissingTable {
+                file: self.source.clone(),
+                table: format!("damper.{}", model.name()),
+            })
+        }
+    }
+
+    /// Builds a device of the given model (errors when the deck lacks that model's table).
+    pub fn build(
+        &self,
+        model: DamperModel,
+        opts: IntegratorOptions,
+    ) -> Result<Box<dyn Device>, DeckError> {
+        self.require(model)?;
+        Ok(match model {
+            DamperModel::Physical => Box::new(self.physical_device(opts)?),
+            DamperModel::Linear => Box::new(LinearDashpot::new(
+                self.linear_c_n_s_per_m.unwrap_or_default(),
+            )),
+            DamperModel::Nonlinear => {
+                let (v, f) = self.nonlinear.clone().unwrap_or_default();
+                let table = MonotoneTable::new(v, f).map_err(|e| DeckError::BadValue {
+                    file: self.source.clone(),
+                    key: "damper.nonlinear".into(),
+                    value: String::new(),
+                    expected: e,
+                })?;
+                Box::new(NonlinearDashpot::new(table))
+            }
+        })
+    }
+
+    /// The physical model as a concrete device (for access to its parameters and state).
+    pub fn physical_device(&self, opts: IntegratorOptions) -> Result<CircuitDevice, DeckError> {
+        self.require(DamperModel::Physical)?;
+        let params = self
+            .physical
+            .clone()
+            .ok_or_else(|| DeckError::MissingTable {
+                file: self.source.clone(),
+                table: "damper.physical".into(),
+            })?;
+        Ok(CircuitDevice::new(params, opts))
+    }
+}
+
+pub const ACTUATOR_KEYS: &[&str] = &[
+    "A0_m2",
+    "A1_m2",
+    "V0_m3",
+    "V1_m3",
+    "p_E0_Pa",
+    "p_E1_Pa",
+    "A_orf0_m2",
+    "A_orf1_m2",
+    "Cd0",
+    "Cd1",
+    "p_s_Pa",
+    "B_Pa",
+    "rho_kg_m3",
+    "check_valve_area_m2",
+    "dp_laminar_Pa",
+];
+
+/// Reads the linear actuator of an `[actuator]` table (keys: [`ACTUATOR_KEYS`]; paper Table 1
+/// names with units; `dp_laminar_Pa` optional). Other top-level tables are ignored.
+pub fn actuator_from_toml_str(text: &str, source_name: &str) -> Result<ActuatorParams, DeckError> {
+    let cx = Ctx { file: source_name };
+    let root: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| DeckError::Parse {
+            file: source_name.into(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+    let p = "actuator";
+    let t = cx
+        .table(&root, "", p)?
+        .ok_or_else(|| DeckError::MissingTable {
+            file: source_name.into(),
+            table: p.into(),
+        })?;
+    cx.known(t, p, ACTUATOR_KEYS)?;
+    let pos = |k: &str, what: &str| cx.num_where(t, p, k, what, positive);
+    let nonneg = |k: &str, what: &str| cx.num_where(t, p, k, what, non_negative);
+    let cd = |k: &str| {
+        cx.num_where(t, p, k, "a discharge coefficient in (0, 1]", |x| {
+            x > 0.0 && x <= 1.0
+        })
+    };
+    Ok(ActuatorParams {
+        area_m2: [
+            pos("A0_m2", "a positive area in m^2")?,
+            pos("A1_m2", "a positive area in m^2")?,
+        ],
+        volume0_m3: [
+            pos("V0_m3", "a positive volume in m^3")?,
+            pos("V1_m3", "a positive volume in m^3")?,
+        ],
+        p_entrance_pa: [
+            nonneg("p_E0_Pa", "a non-negative pressure in Pa")?,
+            nonneg("p_E1_Pa", "a non-negative pressure in Pa")?,
+        ],
+        orifice_area_m2: [
+            nonneg("A_orf0_m2", "a non-negative area in m^2")?,
+            nonneg("A_orf1_m2", "a non-negative area in m^2")?,
+        ],
+        cd: [cd("Cd0")?, cd("Cd1")?],
+        p_s_pa: nonneg("p_s_Pa", "a non-negative pressure in Pa")?,
+        bulk_modulus_pa: pos("B_Pa", "a positive bulk modulus in Pa")?,
+        rho_kg_m3: pos("rho_kg_m3", "a positive density in kg/m^3")?,
+        check_valve_area_m2: nonneg(
+            "check_valve_area_m2",
+            "a non-negative area in m^2 (0 disables)",
+        )?,
+        dp_laminar_pa: if t.contains_key("dp_laminar_Pa") {
+            pos("dp_laminar_Pa", "a positive pressure in Pa")?
+        } else {
+            DEFAULT_DP_LAMINAR_PA
+        },
+    })
+}
