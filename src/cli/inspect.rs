@@ -49,7 +49,9 @@ pub fn summary(rec: &FlightRecord, name: &str) -> String {
     let _ = writeln!(
         s,
         "  controls [deg]: collective {}, lateral cyclic {}, longitudinal cyclic {}",
-        m.controls_deg.collective, m.controls_deg.lateral_cyclic, m.controls_deg.longitudinal_cyclic
+        m.controls_deg.collective,
+        m.controls_deg.lateral_cyclic,
+        m.controls_deg.longitudinal_cyclic
     );
     let known = [
         "counter",

@@ -270,7 +270,10 @@ pub(crate) fn parse_damper(
 ) -> Result<(Vec<DamperSample>, Vec<Loc>), FlightError> {
     let mut rd = reader(text);
     let header = rd.headers().map_err(|e| csv_err(path, e))?.clone();
-    let q = [(Quantity::DamperForce, true), (Quantity::DamperStroke, false)];
+    let q = [
+        (Quantity::DamperForce, true),
+        (Quantity::DamperStroke, false),
+    ];
     let cols = map_header(&header, path, &DAMP_FIXED, &q)?;
     let f_force = cols.units[2].map_or(1.0, |u| u.factor(Quantity::DamperForce, 0.0, 0.0));
     let f_stroke = cols.units[3].map_or(1.0, |u| u.factor(Quantity::DamperStroke, 0.0, 0.0));
@@ -327,21 +330,25 @@ pub(crate) fn airloads_text(rec: &FlightRecord) -> String {
         Quantity::PitchingMoment.si_column(),
     ];
     let (st, az) = (rec.stations_r_over_r(), rec.azimuths_deg());
-    let rows = rec.revolutions().iter().enumerate().flat_map(move |(ir, &rev)| {
-        az.iter().enumerate().flat_map(move |(ia, &psi)| {
-            st.iter().enumerate().map(move |(is, &r)| {
-                let i = rec.index(ir, ia, is);
-                [
-                    rev as f64,
-                    psi,
-                    r,
-                    rec.normal_n_per_m()[i],
-                    rec.chord_n_per_m()[i],
-                    rec.moment_n_m_per_m()[i],
-                ]
+    let rows = rec
+        .revolutions()
+        .iter()
+        .enumerate()
+        .flat_map(move |(ir, &rev)| {
+            az.iter().enumerate().flat_map(move |(ia, &psi)| {
+                st.iter().enumerate().map(move |(is, &r)| {
+                    let i = rec.index(ir, ia, is);
+                    [
+                        rev as f64,
+                        psi,
+                        r,
+                        rec.normal_n_per_m()[i],
+                        rec.chord_n_per_m()[i],
+                        rec.moment_n_m_per_m()[i],
+                    ]
+                })
             })
-        })
-    });
+        });
     crate::io::csv_string(&header, rows)
 }
 
@@ -349,7 +356,12 @@ pub(crate) fn airloads_text(rec: &FlightRecord) -> String {
 pub(crate) fn damper_text(rec: &FlightRecord) -> String {
     if rec.has_stroke() {
         crate::io::csv_string(
-            &["revolution", "azimuth_deg", "damper_force_N", "damper_stroke_m"],
+            &[
+                "revolution",
+                "azimuth_deg",
+                "damper_force_N",
+                "damper_stroke_m",
+            ],
             rec.damper().iter().map(|s| {
                 [
                     s.revolution as f64,
@@ -371,8 +383,14 @@ pub(crate) fn damper_text(rec: &FlightRecord) -> String {
 
 /// Writes the triple atomically, file by file (each file is complete or absent).
 pub fn write_csv(rec: &FlightRecord, stem: &Path) -> Result<(), FlightError> {
-    crate::io::write_atomic(&with_suffix(stem, ".airloads.csv"), airloads_text(rec).as_bytes())?;
-    crate::io::write_atomic(&with_suffix(stem, ".damper.csv"), damper_text(rec).as_bytes())?;
+    crate::io::write_atomic(
+        &with_suffix(stem, ".airloads.csv"),
+        airloads_text(rec).as_bytes(),
+    )?;
+    crate::io::write_atomic(
+        &with_suffix(stem, ".damper.csv"),
+        damper_text(rec).as_bytes(),
+    )?;
     crate::io::write_atomic(&with_suffix(stem, ".meta.json"), meta_text(rec).as_bytes())?;
     Ok(())
 }

@@ -382,12 +382,12 @@ pub fn read_mcap_from(
                 reader.notify_read(got);
             }
             LinearReadEvent::Record { data, opcode } => {
-                let record = ::mcap::parse_record(opcode, data).map_err(|e| {
-                    corrupt(format!("record with opcode {opcode:#04x}: {e}"))
-                })?;
+                let record = ::mcap::parse_record(opcode, data)
+                    .map_err(|e| corrupt(format!("record with opcode {opcode:#04x}: {e}")))?;
                 match record {
                     Record::Schema { header, data } => {
-                        schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
+                        schemas
+                            .insert(header.id, (header.name, header.encoding, data.into_owned()));
                     }
                     Record::Channel(ch) => {
                         let kind = Kind::of(&ch.topic);
@@ -455,11 +455,18 @@ pub fn read_mcap_from(
                                         m.azimuth_deg
                                     )));
                                 }
-                                if let Some(r) = m.r_over_r.iter().find(|&&r| !(r > 0.0 && r <= 1.0))
+                                if let Some(r) =
+                                    m.r_over_r.iter().find(|&&r| !(r > 0.0 && r <= 1.0))
                                 {
                                     return Err(msg_err(format!("r_over_R {r} is outside (0, 1]")));
                                 }
-                                times.push((kind, index, header.log_time, m.revolution, m.azimuth_deg));
+                                times.push((
+                                    kind,
+                                    index,
+                                    header.log_time,
+                                    m.revolution,
+                                    m.azimuth_deg,
+                                ));
                                 for k in 0..n {
                                     rows.rev.push(m.revolution);
                                     rows.psi.push(m.azimuth_deg);
@@ -479,7 +486,13 @@ pub fn read_mcap_from(
                                         m.azimuth_deg
                                     )));
                                 }
-                                times.push((kind, index, header.log_time, m.revolution, m.azimuth_deg));
+                                times.push((
+                                    kind,
+                                    index,
+                                    header.log_time,
+                                    m.revolution,
+                                    m.azimuth_deg,
+                                ));
                                 damper.push(DamperSample {
                                     revolution: m.revolution,
                                     azimuth_deg: m.azimuth_deg,
@@ -499,12 +512,19 @@ pub fn read_mcap_from(
         if !seen[k as usize] {
             return Err(chan_err(
                 k,
-                format!("missing; expected channel {} with schema `{}`", k.topic(), k.schema().0),
+                format!(
+                    "missing; expected channel {} with schema `{}`",
+                    k.topic(),
+                    k.schema().0
+                ),
             ));
         }
     }
     let Some(meta) = meta else {
-        return Err(chan_err(Kind::Meta, "no message; expected exactly one".into()));
+        return Err(chan_err(
+            Kind::Meta,
+            "no message; expected exactly one".into(),
+        ));
     };
     if rows.rev.is_empty() {
         return Err(chan_err(Kind::Airloads, "no messages".into()));

@@ -73,7 +73,12 @@ impl FlightMeta {
         };
         let synthetic = match raw.get("synthetic") {
             Some(Value::Bool(b)) => *b,
-            Some(v) => return Err(err("synthetic", &format!("expected true or false, found {v}"))),
+            Some(v) => {
+                return Err(err(
+                    "synthetic",
+                    &format!("expected true or false, found {v}"),
+                ))
+            }
             None => {
                 return Err(err(
                     "synthetic",
@@ -109,7 +114,11 @@ impl FlightMeta {
             radius_m: num("radius_m", true, true)?.unwrap_or_default(),
             forward_speed_kt: num("forward_speed_kt", false, false)?,
             advance_ratio: num("advance_ratio", false, false)?,
-            thrust_coefficient_over_solidity: num("thrust_coefficient_over_solidity", false, false)?,
+            thrust_coefficient_over_solidity: num(
+                "thrust_coefficient_over_solidity",
+                false,
+                false,
+            )?,
             density_kg_m3: num("density_kg_m3", false, true)?,
             speed_of_sound_m_s: num("speed_of_sound_m_s", false, true)?,
             chord_m: num("chord_m", false, true)?,
@@ -287,7 +296,9 @@ impl FlightRecord {
         };
         let n = stations_r_over_r.len() * revolutions.len() * azimuths_deg.len();
         if n == 0 {
-            return Err(inv("no airloads (need stations, revolutions, azimuths)".into()));
+            return Err(inv(
+                "no airloads (need stations, revolutions, azimuths)".into()
+            ));
         }
         for (name, v) in [
             ("normal force", &normal_n_per_m),
@@ -304,7 +315,9 @@ impl FlightRecord {
         if !stations_r_over_r.windows(2).all(|w| w[0] < w[1])
             || stations_r_over_r.iter().any(|&r| !(r > 0.0 && r <= 1.0))
         {
-            return Err(inv("stations r/R must increase strictly within (0, 1]".into()));
+            return Err(inv(
+                "stations r/R must increase strictly within (0, 1]".into()
+            ));
         }
         if !azimuths_deg.windows(2).all(|w| w[0] < w[1])
             || azimuths_deg.iter().any(|&p| !(0.0..360.0).contains(&p))
@@ -401,9 +414,7 @@ impl FlightRecord {
                     match got {
                         Some(k) if k == (rev, psi, r) => {}
                         _ => {
-                            return Err(inv(grid_gap_message(
-                                rev, psi, r, got, first.0, &stations,
-                            )))
+                            return Err(inv(grid_gap_message(rev, psi, r, got, first.0, &stations)))
                         }
                     }
                     let i = order[p];
@@ -564,7 +575,9 @@ impl FlightRecord {
 
 fn missing(sorted: &[u32]) -> Vec<u32> {
     match (sorted.first(), sorted.last()) {
-        (Some(&a), Some(&b)) => (a..=b).filter(|r| sorted.binary_search(r).is_err()).collect(),
+        (Some(&a), Some(&b)) => (a..=b)
+            .filter(|r| sorted.binary_search(r).is_err())
+            .collect(),
         _ => Vec::new(),
     }
 }
@@ -609,7 +622,10 @@ fn check_damper(d: &mut [DamperSample], locs: &[Loc], path: &Path) -> Result<(),
             || !s.azimuth_deg.is_finite()
             || s.stroke_m.is_some_and(|x| !x.is_finite())
         {
-            return Err(inv(format!("damper sample {i}{}: non-finite value", loc(i))));
+            return Err(inv(format!(
+                "damper sample {i}{}: non-finite value",
+                loc(i)
+            )));
         }
         if s.stroke_m.is_some() != d[0].stroke_m.is_some() {
             return Err(inv(format!(

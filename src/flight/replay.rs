@@ -279,7 +279,10 @@ impl AirloadReplay {
 }
 
 fn list(v: &[u32]) -> String {
-    v.iter().map(|r| r.to_string()).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|r| r.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Fourier coefficients of the samples on a uniform azimuth grid, harmonics 0..=n.
