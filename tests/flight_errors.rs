@@ -71,12 +71,12 @@ fn missing_and_unexpected_columns() {
     edit(&d, |s| {
         s.lines()
             .map(|l| {
-                l.rsplitn(2, ',')
-                    .nth(1)
+                l.rsplit_once(',')
                     .unwrap()
-                    .rsplitn(2, ',')
-                    .nth(1)
+                    .0
+                    .rsplit_once(',')
                     .unwrap()
+                    .0
                     .to_string()
                     + "\n"
             })
