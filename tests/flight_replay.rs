@@ -305,3 +305,60 @@ fn damper_channel_revolution_and_average() {
     assert!(avg.stroke_m.is_some());
     assert!(rec.damper_revolution(9).is_err());
 }
+
+#[test]
+fn non_uniform_azimuth_grid_is_exact_at_samples_and_linear_between() {
+    let az = vec![0.0, 10.0, 50.0, 200.0, 300.0];
+    let st = vec![0.4, 0.8];
+    let f = |p: f64, s: f64| 1000.0 * s + p * p * 0.01;
+    let mut v = Vec::new();
+    for rev in 0..2 {
+        for &p in &az {
+            for &s in &st {
+                v.push(f(p, s) + rev as f64);
+            }
+        }
+    }
+    let base = record(&[0, 1], 5, &st, |_, _, _, _| 0.0);
+    let rec = FlightRecord::new(
+        base.meta.clone(),
+        st.clone(),
+        vec![0, 1],
+        az.clone(),
+        v.clone(),
+        v.clone(),
+        v,
+        base.damper().to_vec(),
+    )
+    .unwrap();
+    let rp = AirloadReplay::new(&rec, ReplayMode::Revolution(1), ReplayOptions::default()).unwrap();
+    for &p in &az {
+        for &s in &st {
+            assert_eq!(rp.at_azimuth(p, s).normal_N_per_m, f(p, s) + 1.0);
+        }
+    }
+    // Between 300 and 360 (= 0): linear in the wrapped interval.
+    let got = rp.at_azimuth(330.0, 0.4).chord_N_per_m;
+    approx::assert_relative_eq!(
+        got,
+        0.5 * (f(300.0, 0.4) + f(0.0, 0.4)) + 1.0,
+        max_relative = 1e-14
+    );
+    let got = rp.at_azimuth(125.0, 0.8).moment_N_m_per_m;
+    approx::assert_relative_eq!(
+        got,
+        0.5 * (f(50.0, 0.8) + f(200.0, 0.8)) + 1.0,
+        max_relative = 1e-14
+    );
+    let e = AirloadReplay::new(
+        &rec,
+        ReplayMode::Average,
+        ReplayOptions {
+            harmonics: Some(1),
+            ..Default::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("uniform azimuth grid"), "{e}");
+}

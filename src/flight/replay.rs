@@ -77,6 +77,8 @@ pub struct AirloadReplay {
     psi0_deg: f64,
     /// Sample azimuths within the period, strictly increasing in [0, period).
     azimuths: Vec<f64>,
+    /// Step of a uniform azimuth grid [deg]: lets a query find its interval without a search.
+    uniform_step: Option<f64>,
     /// Spanwise nodes r/R: the stations plus the zero-load root and tip nodes.
     nodes: Vec<f64>,
     /// Loads at (azimuth, node), index `i_az * nodes.len() + i_node`.
@@ -194,7 +196,14 @@ impl AirloadReplay {
             None => None,
             Some(n) => Some((n, fourier(&azimuths, &values, n_nodes, n)?)),
         };
+        let step = period_deg / azimuths.len() as f64;
+        let uniform_step = azimuths
+            .iter()
+            .enumerate()
+            .all(|(j, &a)| (a - (azimuths[0] + j as f64 * step)).abs() <= 1e-9 * period_deg)
+            .then_some(step);
         Ok(Self {
+            uniform_step,
             omega_deg_s: record.meta.rotor_speed_deg_s(),
             radius_m: record.meta.radius_m,
             period_deg,
@@ -251,7 +260,22 @@ impl AirloadReplay {
         if n == 1 {
             return v(0);
         }
-        let j = az.partition_point(|&a| a <= psi);
+        // j = number of samples at or before psi.
+        let j = match self.uniform_step {
+            Some(step) => {
+                let g = ((psi - az[0]) / step).floor();
+                let mut j = if g < 0.0 { 0 } else { (g as usize + 1).min(n) };
+                // The guess is off by at most one where rounding bites; settle it exactly.
+                while j > 0 && az[j - 1] > psi {
+                    j -= 1;
+                }
+                while j < n && az[j] <= psi {
+                    j += 1;
+                }
+                j
+            }
+            None => az.partition_point(|&a| a <= psi),
+        };
         let (lo, hi, a_lo, a_hi) = if j == 0 {
             (n - 1, 0, az[n - 1] - self.period_deg, az[0])
         } else if j == n {
