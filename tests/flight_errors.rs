@@ -481,3 +481,52 @@ proptest! {
         let _ = FlightRecord::read(&stem);
     }
 }
+
+#[test]
+fn rows_in_any_order_load_the_same_record() {
+    let stem = csv_stem("shuffle");
+    let a = air(&stem);
+    edit(&a, |s| {
+        let mut l: Vec<&str> = s.lines().collect();
+        let header = l.remove(0);
+        // A deterministic shuffle: reverse, then interleave halves.
+        l.reverse();
+        let (x, y) = l.split_at(l.len() / 2);
+        let mut out = vec![header];
+        for k in 0..x.len().max(y.len()) {
+            out.extend(y.get(k));
+            out.extend(x.get(k));
+        }
+        out.join("\n") + "\n"
+    });
+    assert_same_bits(&small(), &FlightRecord::read(&stem).unwrap());
+}
+
+#[test]
+fn record_ending_inside_a_revolution_is_an_error() {
+    let stem = csv_stem("endgap");
+    // Drop the last azimuth (315 deg) of the last revolution (2): rows stay in canonical order.
+    edit(&air(&stem), |s| {
+        s.lines()
+            .filter(|l| !l.starts_with("2,315,"))
+            .map(|l| l.to_string() + "\n")
+            .collect()
+    });
+    let e = err_of(&stem);
+    assert!(
+        e.contains("revolution 2") && e.contains("315") && e.contains("missing"),
+        "{e}"
+    );
+    let stem = csv_stem("endgap2");
+    // Drop only the last station of the last row.
+    edit(&air(&stem), |s| {
+        let mut l: Vec<&str> = s.lines().collect();
+        l.pop();
+        l.join("\n") + "\n"
+    });
+    let e = err_of(&stem);
+    assert!(
+        e.contains("revolution 2") && e.contains("r/R 0.9") && e.contains("missing"),
+        "{e}"
+    );
+}

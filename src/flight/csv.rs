@@ -2,7 +2,7 @@
 //!
 //! Reading converts alternate units to SI (units.rs); writing is always SI with shortest
 //! round-trip number formatting, so CSV -> MCAP -> CSV gives back every value bit for bit.
-use super::record::{AirloadRows, DamperSample, FlightMeta, FlightRecord, Loc};
+use super::record::{AirloadAssembler, DamperSample, FlightMeta, FlightRecord, Loc};
 use super::units::{self, Quantity, Unit};
 use super::FlightError;
 use std::path::{Path, PathBuf};
@@ -23,9 +23,9 @@ pub fn read_csv(stem: &Path) -> Result<FlightRecord, FlightError> {
     let meta_path = with_suffix(stem, ".meta.json");
     let meta = FlightMeta::from_json_str(&read_text(&meta_path)?, &meta_path)?;
     let air_path = with_suffix(stem, ".airloads.csv");
-    let rows = parse_airloads(&read_text(&air_path)?, &air_path, &meta)?;
+    let rows = parse_airloads(open(&air_path)?, &air_path, &meta)?;
     let damp_path = with_suffix(stem, ".damper.csv");
-    let (damper, locs) = parse_damper(&read_text(&damp_path)?, &damp_path)?;
+    let (damper, locs) = parse_damper(open(&damp_path)?, &damp_path)?;
     FlightRecord::from_rows(meta, rows, &air_path, damper, &locs, &damp_path)
 }
 
@@ -122,12 +122,21 @@ fn map_header(
     })
 }
 
-fn reader(text: &str) -> csv::Reader<&[u8]> {
+fn open(path: &Path) -> Result<std::fs::File, FlightError> {
+    std::fs::File::open(path).map_err(|source| FlightError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// A CSV reader over any byte source (files are read as they are parsed, not loaded whole).
+fn reader<R: std::io::Read>(src: R) -> csv::Reader<R> {
     csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
         .flexible(false)
-        .from_reader(text.as_bytes())
+        .buffer_capacity(1 << 16)
+        .from_reader(src)
 }
 
 fn csv_err(path: &Path, e: csv::Error) -> FlightError {
@@ -199,11 +208,11 @@ const AIR_FIXED: [&str; 3] = ["revolution", "azimuth_deg", "r_over_R"];
 
 /// Parses `STEM.airloads.csv` into SI rows.
 pub(crate) fn parse_airloads(
-    text: &str,
+    src: impl std::io::Read,
     path: &Path,
     meta: &FlightMeta,
-) -> Result<AirloadRows, FlightError> {
-    let mut rd = reader(text);
+) -> Result<AirloadAssembler, FlightError> {
+    let mut rd = reader(src);
     let header = rd.headers().map_err(|e| csv_err(path, e))?.clone();
     let q = [
         (Quantity::NormalForce, true),
@@ -221,7 +230,7 @@ pub(crate) fn parse_airloads(
         .map(|k| cols.units[3 + k].map_or(1.0, |u| u.factor(q[k].0, q_c, chord)))
         .collect();
     let names: Vec<&str> = cols.idx.iter().map(|&i| &header[i]).collect();
-    let mut rows = AirloadRows::default();
+    let mut rows = AirloadAssembler::new(true);
     let mut rec = csv::ByteRecord::new();
     loop {
         match rd.read_byte_record(&mut rec) {
@@ -231,8 +240,8 @@ pub(crate) fn parse_airloads(
         }
         let line = rec.position().map_or(0, |p| p.line());
         let f = |k: usize| field(&rec, cols.idx[k], path, line, names[k]);
-        rows.rev.push(parse_rev(f(0)?, path, line)?);
-        rows.psi.push(parse_azimuth(f(1)?, path, line)?);
+        let rev = parse_rev(f(0)?, path, line)?;
+        let psi = parse_azimuth(f(1)?, path, line)?;
         let r = parse_f64(f(2)?, path, line, "r_over_R")?;
         if !(r > 0.0 && r <= 1.0) {
             return Err(FlightError::Line {
@@ -241,18 +250,13 @@ pub(crate) fn parse_airloads(
                 msg: format!("column `r_over_R`: {r} is outside (0, 1]"),
             });
         }
-        rows.r.push(r);
+        // x * 1.0 == x exactly, so SI columns pass through bit for bit.
         let v = |k: usize| -> Result<f64, FlightError> {
-            let x = parse_f64(f(k)?, path, line, names[k])?;
-            // Exact when already SI (no multiplication by 1.0 rounding concerns: x * 1.0 == x).
-            Ok(x * factor[k - 3])
+            Ok(parse_f64(f(k)?, path, line, names[k])? * factor[k - 3])
         };
-        rows.n.push(v(3)?);
-        rows.c.push(v(4)?);
-        rows.m.push(v(5)?);
-        rows.loc.push(Loc::Line(line));
+        rows.push(rev, psi, r, [v(3)?, v(4)?, v(5)?], line);
     }
-    if rows.rev.is_empty() {
+    if rows.is_empty() {
         return Err(FlightError::Invalid {
             path: path.to_path_buf(),
             msg: "no airload rows after the header".into(),
@@ -265,10 +269,10 @@ const DAMP_FIXED: [&str; 2] = ["revolution", "azimuth_deg"];
 
 /// Parses `STEM.damper.csv` into SI samples, with the line of each.
 pub(crate) fn parse_damper(
-    text: &str,
+    src: impl std::io::Read,
     path: &Path,
 ) -> Result<(Vec<DamperSample>, Vec<Loc>), FlightError> {
-    let mut rd = reader(text);
+    let mut rd = reader(src);
     let header = rd.headers().map_err(|e| csv_err(path, e))?.clone();
     let q = [
         (Quantity::DamperForce, true),

@@ -7,7 +7,7 @@
 //! crate from the open file as it asks for bytes (at most one chunk buffered, bounded by a record
 //! length limit), and decodes each message as it comes, in file order, which for files written
 //! here is log-time order. Only the decoded values are kept: they are the record.
-use super::record::{AirloadRows, DamperSample, FlightMeta, FlightRecord, Loc};
+use super::record::{AirloadAssembler, DamperSample, FlightMeta, FlightRecord, Loc};
 use super::FlightError;
 use ::mcap::records::{MessageHeader, Record};
 use ::mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -364,7 +364,7 @@ pub fn read_mcap_from(
     let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
     let mut channels: HashMap<u16, ChannelInfo> = HashMap::new();
     let mut meta: Option<FlightMeta> = None;
-    let mut rows = AirloadRows::default();
+    let mut rows = AirloadAssembler::new(false);
     let mut damper = Vec::new();
     let mut damper_locs = Vec::new();
     // (kind, message index, log time, revolution, azimuth), checked once Omega is known.
@@ -468,13 +468,13 @@ pub fn read_mcap_from(
                                     m.azimuth_deg,
                                 ));
                                 for k in 0..n {
-                                    rows.rev.push(m.revolution);
-                                    rows.psi.push(m.azimuth_deg);
-                                    rows.r.push(m.r_over_r[k]);
-                                    rows.n.push(m.normal[k]);
-                                    rows.c.push(m.chord[k]);
-                                    rows.m.push(m.moment[k]);
-                                    rows.loc.push(Loc::Message(index));
+                                    rows.push(
+                                        m.revolution,
+                                        m.azimuth_deg,
+                                        m.r_over_r[k],
+                                        [m.normal[k], m.chord[k], m.moment[k]],
+                                        index,
+                                    );
                                 }
                             }
                             Kind::Damper => {
@@ -526,7 +526,7 @@ pub fn read_mcap_from(
             "no message; expected exactly one".into(),
         ));
     };
-    if rows.rev.is_empty() {
+    if rows.is_empty() {
         return Err(chan_err(Kind::Airloads, "no messages".into()));
     }
     if damper.is_empty() {

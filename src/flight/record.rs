@@ -273,7 +273,199 @@ pub(crate) struct AirloadRows {
     pub n: Vec<f64>,
     pub c: Vec<f64>,
     pub m: Vec<f64>,
-    pub loc: Vec<Loc>,
+    /// Line or message number of each row (see `lines`).
+    pub loc: Vec<u64>,
+    /// True when `loc` holds CSV lines, false for MCAP message indices.
+    pub lines: bool,
+}
+
+impl AirloadRows {
+    fn loc(&self, i: usize) -> Loc {
+        if self.lines {
+            Loc::Line(self.loc[i])
+        } else {
+            Loc::Message(self.loc[i])
+        }
+    }
+    fn push(&mut self, rev: u32, psi: f64, r: f64, v: [f64; 3], loc: u64) {
+        self.rev.push(rev);
+        self.psi.push(psi);
+        self.r.push(r);
+        self.n.push(v[0]);
+        self.c.push(v[1]);
+        self.m.push(v[2]);
+        self.loc.push(loc);
+    }
+}
+
+/// Assembles airload rows onto the grid as they stream in. Rows in canonical order (revolution,
+/// then azimuth, then station, as rotorsim writes them) go straight into the final arrays; the
+/// first row out of that order moves everything to the general path (sort, then check), which
+/// also produces the error messages for duplicates and gaps.
+#[derive(Debug)]
+pub(crate) struct AirloadAssembler {
+    rows: Option<AirloadRows>,
+    lines: bool,
+    stations: Vec<f64>,
+    stations_closed: bool,
+    azimuths: Vec<f64>,
+    azimuths_closed: bool,
+    revolutions: Vec<u32>,
+    i_az: usize,
+    i_st: usize,
+    n: Vec<f64>,
+    c: Vec<f64>,
+    m: Vec<f64>,
+    loc: Vec<u64>,
+}
+
+impl AirloadAssembler {
+    /// `lines`: locations are CSV lines (else MCAP message indices).
+    pub fn new(lines: bool) -> Self {
+        Self {
+            rows: None,
+            lines,
+            stations: Vec::new(),
+            stations_closed: false,
+            azimuths: Vec::new(),
+            azimuths_closed: false,
+            revolutions: Vec::new(),
+            i_az: 0,
+            i_st: 0,
+            n: Vec::new(),
+            c: Vec::new(),
+            m: Vec::new(),
+            loc: Vec::new(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.loc.is_empty() && self.rows.as_ref().is_none_or(|r| r.rev.is_empty())
+    }
+
+    /// Adds one row (values in SI).
+    pub fn push(&mut self, rev: u32, psi: f64, r: f64, v: [f64; 3], loc: u64) {
+        if self.rows.is_none() && !self.fast(rev, psi, r) {
+            self.spill();
+        }
+        match &mut self.rows {
+            Some(rows) => rows.push(rev, psi, r, v, loc),
+            None => {
+                self.n.push(v[0]);
+                self.c.push(v[1]);
+                self.m.push(v[2]);
+                self.loc.push(loc);
+            }
+        }
+    }
+
+    /// Advances the grid position for a row in canonical order; false if it is not.
+    fn fast(&mut self, rev: u32, psi: f64, r: f64) -> bool {
+        let Some(&cur_rev) = self.revolutions.last() else {
+            self.revolutions.push(rev);
+            self.azimuths.push(psi);
+            self.stations.push(r);
+            return true;
+        };
+        let cur_psi = self.azimuths[self.i_az];
+        let at_last_station = |s: &Self| s.stations_closed && s.i_st + 1 == s.stations.len();
+        if rev == cur_rev && psi == cur_psi {
+            // Next station of the same azimuth.
+            if !self.stations_closed {
+                if r > self.stations[self.i_st] {
+                    self.stations.push(r);
+                    self.i_st += 1;
+                    return true;
+                }
+                return false;
+            }
+            if self.i_st + 1 < self.stations.len() && self.stations[self.i_st + 1] == r {
+                self.i_st += 1;
+                return true;
+            }
+            return false;
+        }
+        // A new azimuth or revolution closes the station grid (first azimuth of all).
+        if !self.stations_closed {
+            self.stations_closed = true;
+        }
+        if !at_last_station(self) || r != self.stations[0] {
+            return false;
+        }
+        if rev == cur_rev {
+            if !self.azimuths_closed {
+                if psi > cur_psi {
+                    self.azimuths.push(psi);
+                    self.i_az += 1;
+                    self.i_st = 0;
+                    return true;
+                }
+                return false;
+            }
+            if self.i_az + 1 < self.azimuths.len() && self.azimuths[self.i_az + 1] == psi {
+                self.i_az += 1;
+                self.i_st = 0;
+                return true;
+            }
+            return false;
+        }
+        // A new revolution closes the azimuth grid (first revolution).
+        self.azimuths_closed = true;
+        if rev > cur_rev && self.i_az + 1 == self.azimuths.len() && psi == self.azimuths[0] {
+            self.revolutions.push(rev);
+            self.i_az = 0;
+            self.i_st = 0;
+            return true;
+        }
+        false
+    }
+
+    /// Moves the rows gathered so far to the general path.
+    fn spill(&mut self) {
+        let mut rows = AirloadRows {
+            lines: self.lines,
+            ..Default::default()
+        };
+        let (n_st, n_az) = (self.stations.len(), self.azimuths.len());
+        for k in 0..self.loc.len() {
+            let (i_st, i_az, i_rev) = (k % n_st, (k / n_st) % n_az, k / (n_st * n_az));
+            rows.push(
+                self.revolutions[i_rev],
+                self.azimuths[i_az],
+                self.stations[i_st],
+                [self.n[k], self.c[k], self.m[k]],
+                self.loc[k],
+            );
+        }
+        *self = Self {
+            rows: Some(rows),
+            ..Self::new(self.lines)
+        };
+    }
+
+    /// The grid (stations, revolutions, azimuths, normal, chord, moment), or the rows when the
+    /// input was not in canonical order or ended inside a revolution.
+    #[allow(clippy::type_complexity, clippy::result_large_err)] // internal, moved once
+    fn finish(
+        mut self,
+    ) -> Result<(Vec<f64>, Vec<u32>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>), AirloadRows> {
+        // The last revolution has every azimuth, the last azimuth every station.
+        let complete = self.i_st + 1 == self.stations.len() && self.i_az + 1 == self.azimuths.len();
+        if self.rows.is_none() && !complete {
+            self.spill();
+        }
+        match self.rows {
+            Some(rows) => Err(rows),
+            None => Ok((
+                self.stations,
+                self.revolutions,
+                self.azimuths,
+                self.n,
+                self.c,
+                self.m,
+            )),
+        }
+    }
 }
 
 impl FlightRecord {
@@ -345,7 +537,7 @@ impl FlightRecord {
     /// Assembles rows read from a file onto the full grid; errors name `path` and the row.
     pub(crate) fn from_rows(
         meta: FlightMeta,
-        rows: AirloadRows,
+        asm: AirloadAssembler,
         path: &Path,
         mut damper: Vec<DamperSample>,
         damper_locs: &[Loc],
@@ -354,6 +546,22 @@ impl FlightRecord {
         let inv = |msg: String| FlightError::Invalid {
             path: path.to_path_buf(),
             msg,
+        };
+        let rows = match asm.finish() {
+            Ok((stations, revolutions, azimuths, normal, chord, moment)) => {
+                check_damper(&mut damper, damper_locs, damper_path)?;
+                return Ok(Self {
+                    meta,
+                    stations,
+                    revolutions,
+                    azimuths,
+                    normal,
+                    chord,
+                    moment,
+                    damper,
+                });
+            }
+            Err(rows) => rows,
         };
         let len = rows.rev.len();
         if len == 0 {
@@ -375,7 +583,8 @@ impl FlightRecord {
                 let (rv, p, r) = key(w[1]);
                 return Err(inv(format!(
                     "duplicate airload row: revolution {rv}, azimuth {p} deg, r/R {r} at {} and {}",
-                    rows.loc[w[0]], rows.loc[w[1]]
+                    rows.loc(w[0]),
+                    rows.loc(w[1])
                 )));
             }
         }
@@ -428,7 +637,7 @@ impl FlightRecord {
                 let (_, p, r) = key(order[pos]);
                 return Err(inv(format!(
                     "revolution {rev}: azimuth {p} deg (r/R {r}, {}) is not on the azimuth grid of revolution {} ({n_az} azimuths)",
-                    rows.loc[order[pos]], first.0
+                    rows.loc(order[pos]), first.0
                 )));
             }
         }
