@@ -1,6 +1,5 @@
 //! `rotorsim convert IN OUT`: flight record CSV triple <-> MCAP, without loss (issue #5).
 use crate::flight::FlightRecord;
-use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -14,8 +13,8 @@ pub struct ConvertArgs {
 }
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<()> {
-    let rec = FlightRecord::read(&args.input)
-        .with_context(|| format!("reading flight record {}", args.input.display()))?;
+    // The error names the file, line or channel already.
+    let rec = FlightRecord::read(&args.input)?;
     let out = args.output.to_string_lossy().into_owned();
     let label = if rec.meta.synthetic {
         " [SYNTHETIC (not flight-test data)]"

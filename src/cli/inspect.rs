@@ -1,6 +1,5 @@
 //! `rotorsim inspect RECORD`: what a flight record holds (issue #5).
 use crate::flight::FlightRecord;
-use anyhow::Context;
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -12,8 +11,8 @@ pub struct InspectArgs {
 }
 
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let rec = FlightRecord::read(&args.record)
-        .with_context(|| format!("reading flight record {}", args.record.display()))?;
+    // The error names the file, line or channel already.
+    let rec = FlightRecord::read(&args.record)?;
     print!("{}", summary(&rec, &args.record.display().to_string()));
     Ok(())
 }
