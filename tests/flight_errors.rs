@@ -530,3 +530,12 @@ fn record_ending_inside_a_revolution_is_an_error() {
         "{e}"
     );
 }
+
+#[test]
+fn byte_order_mark_and_crlf_are_accepted() {
+    let stem = csv_stem("bom");
+    edit(&air(&stem), |s| {
+        format!("\u{feff}{}", s.replace('\n', "\r\n"))
+    });
+    assert_same_bits(&small(), &FlightRecord::read(&stem).unwrap());
+}

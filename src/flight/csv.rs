@@ -52,7 +52,7 @@ fn map_header(
         v.join(",")
     };
     for (col, name) in header.iter().enumerate() {
-        let name = name.trim();
+        let name = name.trim().trim_start_matches('\u{feff}'); // a UTF-8 byte-order mark
         let slot = if let Some(k) = fixed.iter().position(|f| *f == name) {
             k
         } else if let Some((q, suffix)) = units::split_column(name) {
