@@ -1,13 +1,37 @@
-//! `rotorsim convert` (issue #5).
+//! `rotorsim convert IN OUT`: flight record CSV triple <-> MCAP, without loss (issue #5).
+use crate::flight::FlightRecord;
 use clap::Args;
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
-    /// Arguments of a command that is not available yet.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// Input record: an .mcap file, a CSV stem (flightdata/c8534like) or one of its three files.
+    pub input: PathBuf,
+    /// Output: a path ending in .mcap writes MCAP; anything else is the stem of a CSV triple
+    /// (STEM.meta.json, STEM.airloads.csv, STEM.damper.csv).
+    pub output: PathBuf,
 }
 
-pub fn run(_args: ConvertArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`rotorsim convert` is not available yet (tracked in issue #5)")
+pub fn run(args: ConvertArgs) -> anyhow::Result<()> {
+    // The error names the file, line or channel already.
+    let rec = FlightRecord::read(&args.input)?;
+    let out = args.output.to_string_lossy().into_owned();
+    let label = if rec.meta.synthetic {
+        " [SYNTHETIC (not flight-test data)]"
+    } else {
+        ""
+    };
+    if out.ends_with(".mcap") {
+        rec.write_mcap(&args.output)?;
+        println!("wrote {out}{label}");
+    } else {
+        let stem = crate::flight::record::CSV_SUFFIXES
+            .iter()
+            .find_map(|s| out.strip_suffix(s))
+            .unwrap_or(&out)
+            .to_string();
+        rec.write_csv(std::path::Path::new(&stem))?;
+        println!("wrote {stem}.meta.json, {stem}.airloads.csv, {stem}.damper.csv{label}");
+    }
+    Ok(())
 }

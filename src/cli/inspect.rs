@@ -1,13 +1,150 @@
-//! `rotorsim inspect` (issue #5).
+//! `rotorsim inspect RECORD`: what a flight record holds (issue #5).
+use crate::flight::FlightRecord;
 use clap::Args;
+use std::fmt::Write as _;
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
-    /// Arguments of a command that is not available yet.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// The record: an .mcap file, a CSV stem (flightdata/c8534like) or one of its three files.
+    pub record: PathBuf,
 }
 
-pub fn run(_args: InspectArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`rotorsim inspect` is not available yet (tracked in issue #5)")
+pub fn run(args: InspectArgs) -> anyhow::Result<()> {
+    // The error names the file, line or channel already.
+    let rec = FlightRecord::read(&args.record)?;
+    print!("{}", summary(&rec, &args.record.display().to_string()));
+    Ok(())
+}
+
+fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    })
+}
+
+/// The text `inspect` prints.
+pub fn summary(rec: &FlightRecord, name: &str) -> String {
+    let mut s = String::new();
+    let m = &rec.meta;
+    let banner = if m.synthetic {
+        "*** SYNTHETIC (not flight-test data) ***"
+    } else {
+        "measured (flight-test data)"
+    };
+    let _ = writeln!(s, "flight record {name}");
+    let _ = writeln!(s, "  {banner}");
+    if let Some(c) = &m.counter {
+        let _ = writeln!(s, "  counter: {c}");
+    }
+    if let Some(d) = &m.description {
+        let _ = writeln!(s, "  description: {d}");
+    }
+    let _ = writeln!(
+        s,
+        "  rotor speed: {} rad/s, radius: {} m",
+        m.rotor_speed_rad_s, m.radius_m
+    );
+    let _ = writeln!(
+        s,
+        "  controls [deg]: collective {}, lateral cyclic {}, longitudinal cyclic {}",
+        m.controls_deg.collective,
+        m.controls_deg.lateral_cyclic,
+        m.controls_deg.longitudinal_cyclic
+    );
+    let known = [
+        "counter",
+        "synthetic",
+        "description",
+        "rotor_speed_rad_s",
+        "radius_m",
+        "controls_deg",
+    ];
+    for (k, v) in m.raw.iter().filter(|(k, _)| !known.contains(&k.as_str())) {
+        let _ = writeln!(s, "  {k}: {v}");
+    }
+    let revs = rec.revolutions();
+    let az = rec.azimuths_deg();
+    let st = rec.stations_r_over_r();
+    let _ = writeln!(s, "channels:");
+    let _ = writeln!(
+        s,
+        "  airloads: normal_force_N_per_m, chord_force_N_per_m, pitching_moment_N_m_per_m (section frame: +z, -y = drag, nose up about +x)"
+    );
+    let _ = writeln!(
+        s,
+        "    revolutions: {} ({}..={}){}",
+        revs.len(),
+        revs[0],
+        revs[revs.len() - 1],
+        gaps(&rec.missing_revolutions())
+    );
+    let d = if az.len() > 1 {
+        format!(", step {} deg", az[1] - az[0])
+    } else {
+        String::new()
+    };
+    let uniform = az
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) - 360.0 / az.len() as f64).abs() < 1e-9);
+    let _ = writeln!(
+        s,
+        "    azimuths per revolution: {} ({} .. {} deg{d}, {})",
+        az.len(),
+        az[0],
+        az[az.len() - 1],
+        if uniform { "uniform" } else { "non-uniform" }
+    );
+    let _ = writeln!(s, "    stations r/R ({}): {:?}", st.len(), st);
+    for (name, unit, v) in [
+        ("normal force", "N/m", rec.normal_n_per_m()),
+        ("chord force", "N/m", rec.chord_n_per_m()),
+        ("pitching moment", "N m/m", rec.moment_n_m_per_m()),
+    ] {
+        let (lo, hi) = range(v.iter().copied());
+        let _ = writeln!(s, "    {name}: {lo} .. {hi} {unit}");
+    }
+    let dm = rec.damper();
+    let drevs = rec.damper_revolutions();
+    let _ = writeln!(
+        s,
+        "  damper: damper_force_N{}",
+        if rec.has_stroke() {
+            ", damper_stroke_m"
+        } else {
+            " (no stroke)"
+        }
+    );
+    let per_rev = dm.len() / drevs.len().max(1);
+    let _ = writeln!(
+        s,
+        "    samples: {} ({} revolutions x {} azimuths)",
+        dm.len(),
+        drevs.len(),
+        per_rev
+    );
+    let (lo, hi) = range(dm.iter().map(|x| x.force_N));
+    let _ = writeln!(s, "    force: {lo} .. {hi} N");
+    if rec.has_stroke() {
+        let (lo, hi) = range(dm.iter().filter_map(|x| x.stroke_m));
+        let _ = writeln!(s, "    stroke: {lo} .. {hi} m");
+    }
+    let t_end = rec.time_s(revs[revs.len() - 1], az[az.len() - 1]);
+    let _ = writeln!(
+        s,
+        "  time span: {} .. {t_end} s (time = (revolution * 360 + azimuth) / Omega)",
+        rec.time_s(revs[0], az[0])
+    );
+    if m.synthetic {
+        let _ = writeln!(s, "  {banner}");
+    }
+    s
+}
+
+fn gaps(missing: &[u32]) -> String {
+    if missing.is_empty() {
+        String::new()
+    } else {
+        format!(", GAPS: missing revolution(s) {missing:?}")
+    }
 }
