@@ -1,1 +1,14 @@
 //! Assembly, Newton iterations, generalized-alpha time integration, static and modal analyses.
+pub mod assembly;
+pub mod dynamic;
+pub mod fdcheck;
+pub mod modal;
+pub mod newton;
+pub mod state;
+pub mod statics;
+
+pub use assembly::Assembler;
+
+pub use newton::{NewtonError, NewtonOptions};
+pub use state::State;
+pub use statics::{static_solve, StaticOptions, StaticReport};

@@ -1,0 +1,1 @@
+//! Model deck (TOML).

@@ -1,0 +1,168 @@
+mod common;
+use rotorsim::solver::fdcheck::check_model;
+use rotorsim::solver::{static_solve, State, StaticOptions};
+use rotorsim::structure::*;
+
+#[test]
+fn roll_up_cantilever_tip_returns_to_root() {
+    // Simo & Vu-Quoc (1986): tip moment M = 2 pi EI / L rolls a cantilever into a full circle.
+    let (l, ei) = (10.0, 100.0);
+    let sec = common::uniform(1e6, 1e6, 100.0, ei, ei, 1.0, 0.02, 0.01, 0.01);
+    let mut m = Model::new();
+    let ids = m
+        .add_straight_beam(
+            "b",
+            10,
+            [0.0; 3],
+            [l, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            &sec,
+            0.0,
+            None,
+        )
+        .unwrap();
+    m.clamp("root", ids[0]).unwrap();
+    let tip = *ids.last().unwrap();
+    m.add_element(Element::Load(PointLoad {
+        name: "M".into(),
+        node: tip,
+        force_n: [0.0; 3],
+        moment_nm: [0.0, 0.0, 2.0 * std::f64::consts::PI * ei / l],
+        follower: false,
+        time: TimeTable::constant(),
+    }))
+    .unwrap();
+    let mut st = State::from_model(&m);
+    let opts = StaticOptions {
+        load_steps: 10,
+        ..Default::default()
+    };
+    let rep = static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).unwrap();
+    let x = st.x[tip];
+    let dist = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    println!(
+        "roll-up tip {:?}, |x_tip - x_root| / L = {:.3e}, iterations {:?}",
+        x,
+        dist / l,
+        rep.iterations
+    );
+    assert!(dist / l < 1e-3, "tip distance {dist}");
+    // tip rotation is a full turn: rotation vector ~ 0 (mod 2 pi)
+    let rv = st.rotation_vector(tip);
+    assert!(rv.iter().all(|v| v.abs() < 1e-2), "{rv:?}");
+}
+
+#[test]
+fn beam_joint_and_body_tangents_match_finite_differences() {
+    let mut sec = common::uniform(1e4, 5e3, 300.0, 500.0, 800.0, 2.0, 0.3, 0.1, 0.2);
+    sec.stations[0].cm2 = 0.05;
+    sec.stations[0].sc3 = 0.02;
+    sec.stations[0].ca2 = -0.03;
+    let mut m = Model::new();
+    m.gravity = [0.0, 0.0, -9.81];
+    let ids = m
+        .add_straight_beam(
+            "b",
+            2,
+            [0.0; 3],
+            [2.0, 0.5, 0.3],
+            [0.0, 1.0, 0.0],
+            &sec,
+            0.01,
+            None,
+        )
+        .unwrap();
+    if let Element::Beam(_) = &m.elements[0] {}
+    m.add_beam_load(
+        "b",
+        BeamLoad {
+            force_n_per_m: [1.0, 2.0, 3.0],
+            moment_nm_per_m: [0.5, -0.2, 0.1],
+            follower: true,
+            time: TimeTable::constant(),
+        },
+    )
+    .unwrap();
+    let p = m.nodes[ids[0]].x0;
+    let mut q = [[0.0; 3]; 3];
+    q[0][0] = 1.0;
+    q[1][1] = 1.0;
+    q[2][2] = 1.0;
+    let kinds = [
+        JointKind::Clamp,
+        JointKind::Revolute,
+        JointKind::Universal,
+        JointKind::Spherical,
+    ];
+    let hub = m.add_node("hub", [0.0, 0.0, -0.1], q).unwrap();
+    for (k, kind) in kinds.iter().enumerate() {
+        let j = m
+            .add_joint(&format!("j{k}"), *kind, Some(hub), ids[3 * (k % 2)], p, q)
+            .unwrap();
+        if let Element::Joint(jj) = &mut m.elements[j] {
+            jj.spring_nm_per_rad = 10.0;
+            jj.damper_nms_per_rad = 2.0;
+            if k == 0 {
+                jj.prescribed_angle = Some(AngleLaw {
+                    omega_rad_s: 3.0,
+                    table: None,
+                });
+            }
+            if k == 2 {
+                jj.displacement_m = Some(([0.01, 0.02, 0.0], TimeTable::constant()));
+            }
+        }
+    }
+    m.add_joint("g", JointKind::Revolute, None, hub, [0.0, 0.0, -0.1], q)
+        .unwrap();
+    m.add_element(Element::Rigid(RigidBody {
+        name: "body".into(),
+        node: ids[6],
+        mass_kg: 3.0,
+        cm_offset_m: [0.1, -0.2, 0.05],
+        inertia_kgm2: [[1.0, 0.1, 0.0], [0.1, 2.0, 0.2], [0.0, 0.2, 1.5]],
+    }))
+    .unwrap();
+    m.add_element(Element::Load(PointLoad {
+        name: "f".into(),
+        node: ids[6],
+        force_n: [1.0, 2.0, 3.0],
+        moment_nm: [0.3, 0.2, 0.1],
+        follower: true,
+        time: TimeTable::constant(),
+    }))
+    .unwrap();
+    // a deformed, moving state
+    let mut st = State::from_model(&m);
+    for i in 0..st.x.len() {
+        let f = i as f64;
+        st.x[i][1] += 0.05 * (0.7 * f).sin();
+        st.x[i][2] += 0.03 * f * f / 10.0;
+        st.q[i] = rotorsim::structure::rotation::update_left(
+            &st.q[i],
+            [0.1 * f.sin(), 0.2 * (0.3 * f).cos(), 0.15 * f / 7.0],
+        );
+        st.v[i] = [0.3 * f, -0.2, 0.1 * f.cos()];
+        st.w[i] = [0.5, 0.2 * f, -0.3];
+        st.a[i] = [1.0, f, -0.5];
+        st.al[i] = [0.2, -0.1 * f, 0.4];
+    }
+    let lam: Vec<f64> = (0..m.n_lambda())
+        .map(|k| 10.0 * ((k as f64) * 0.37).sin())
+        .collect();
+    let mut kin = vec![];
+    st.kin(&mut kin);
+    let ctx = EvalCtx {
+        t: 0.3,
+        load_factor: 0.8,
+        gravity: m.gravity,
+        cscale: 7.0,
+        inertia: true,
+    };
+    let res = check_model(&m, &kin, &lam, &ctx);
+    for r in &res {
+        println!("{:>8}: rel error {:.2e}", r.element, r.rel_error);
+        assert!(r.rel_error < 1e-6, "{} {}", r.element, r.rel_error);
+    }
+    assert_eq!(res.len(), m.elements.len());
+}
