@@ -11,3 +11,4 @@ pub mod report;
 pub mod rotor;
 pub mod solver;
 pub mod structure;
+pub mod verification;

@@ -166,3 +166,16 @@ fn beam_joint_and_body_tangents_match_finite_differences() {
     }
     assert_eq!(res.len(), m.elements.len());
 }
+
+/// Bathe & Bolourchi (1979) 45-degree bend; reference tip positions as tabulated by Simo &
+/// Vu-Quoc (1986).
+#[test]
+fn bend_45_degree_tip_positions() {
+    let res = rotorsim::verification::bend45(8).unwrap();
+    for (f, x, r) in &res {
+        let err = ((x[0] - r[0]).powi(2) + (x[1] - r[1]).powi(2) + (x[2] - r[2]).powi(2)).sqrt();
+        println!("F = {f}: tip {:.2?} ref {:?} |err| = {err:.3}", x, r);
+        // the published values come from a coarser mesh; agreement to 1 % of the radius
+        assert!(err < 1.0, "F={f}: {x:?} vs {r:?}");
+    }
+}

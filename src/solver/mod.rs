@@ -9,6 +9,7 @@ pub mod statics;
 
 pub use assembly::Assembler;
 
+pub use dynamic::{DynamicSolver, GenAlphaParams, StepInfo};
 pub use newton::{NewtonError, NewtonOptions};
 pub use state::State;
 pub use statics::{static_solve, StaticOptions, StaticReport};

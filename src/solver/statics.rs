@@ -16,6 +16,9 @@ pub struct StaticOptions {
     /// Steady rotation (rad/s, global vector through the origin): the solution is the
     /// equilibrium in the frame rotating with it.
     pub omega: Option<[f64; 3]>,
+    /// Load factor ramps linearly from `start_factor` (exclusive) to `end_factor`.
+    pub start_factor: f64,
+    pub end_factor: f64,
 }
 
 impl Default for StaticOptions {
@@ -25,6 +28,8 @@ impl Default for StaticOptions {
             newton: NewtonOptions::default(),
             time: 0.0,
             omega: None,
+            start_factor: 0.0,
+            end_factor: 1.0,
         }
     }
 }
@@ -138,7 +143,7 @@ pub fn static_solve(
     let nsteps = opts.load_steps.max(1);
     let g = model.gravity;
     for step in 1..=nsteps {
-        let lf = step as f64 / nsteps as f64;
+        let lf = opts.start_factor + (opts.end_factor - opts.start_factor) * step as f64 / nsteps as f64;
         ctx.load_factor = lf;
         ctx.gravity = fmul(lf, g);
         let mut r0 = 0.0;
