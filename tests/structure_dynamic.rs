@@ -75,3 +75,11 @@ fn free_flying_beam_energy_never_grows_with_numerical_dissipation() {
     assert!(emax <= 1.0 + 1e-9, "energy exceeded its initial value: {emax}");
     assert!(wgrow <= 0.0, "energy envelope grew by {wgrow}");
 }
+
+#[test]
+fn released_cantilever_vibrates_at_the_euler_bernoulli_frequency() {
+    let (w, w_ref) = rotorsim::verification::cantilever_release(8, 200, 6).unwrap();
+    let err = (w - w_ref).abs() / w_ref;
+    println!("released cantilever: omega = {w:.6} rad/s, Euler-Bernoulli {w_ref:.6}, rel error {err:.2e}");
+    assert!(err < 1e-3);
+}
