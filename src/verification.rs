@@ -143,3 +143,86 @@ pub fn cantilever_release(n_elem: usize, steps_per_period: usize, periods: usize
     let period = 2.0 * (crossings[n] - crossings[0]) / n as f64;
     Ok((2.0 * std::f64::consts::PI / period, w_ref))
 }
+
+/// Non-dimensional first and second flap frequencies `omega / sqrt(EI / (m L^4))` of a uniform
+/// rotating cantilever (no hub offset) vs `lambda = Omega / sqrt(EI / (m L^4))`, as tabulated by
+/// Wright, Smith, Thresher & Wang (1982), J. Appl. Mech. 49, 197-202 (same values in Hodges &
+/// Rutkowski 1981).
+pub const WRIGHT_FLAP: [(f64, f64, f64); 13] = [
+    (0.0, 3.5160, 22.0345),
+    (1.0, 3.6817, 22.1810),
+    (2.0, 4.1373, 22.6149),
+    (3.0, 4.7973, 23.3203),
+    (4.0, 5.5850, 24.2734),
+    (5.0, 6.4495, 25.4461),
+    (6.0, 7.3604, 26.8091),
+    (7.0, 8.2996, 28.3341),
+    (8.0, 9.2568, 29.9954),
+    (9.0, 10.2257, 31.7705),
+    (10.0, 11.2023, 33.6404),
+    (11.0, 12.1843, 35.5890),
+    (12.0, 13.1702, 37.6031),
+];
+
+/// One comparison of a computed quantity with its reference.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Check {
+    pub case: String,
+    pub quantity: String,
+    pub computed: f64,
+    pub reference: f64,
+    pub rel_error: f64,
+    pub source: String,
+}
+
+impl Check {
+    pub fn new(case: &str, quantity: &str, computed: f64, reference: f64, source: &str) -> Self {
+        Check {
+            case: case.into(),
+            quantity: quantity.into(),
+            computed,
+            reference,
+            rel_error: ((computed - reference) / reference).abs(),
+            source: source.into(),
+        }
+    }
+}
+
+/// Rotating uniform cantilever (L = 1 m, m = 1 kg/m, EI_flap = 1, EI_lag = 4, GJ = 0.05):
+/// first flap, first lag and first torsion frequency at `lambda` in `lambdas` (even, <= 12).
+/// References: flap from Wright et al. (1982); lag from the flap value of a beam with EI_lag at
+/// lambda/2 with `omega_lag^2 = omega_flap^2 - Omega^2`; torsion analytic
+/// `omega_T^2 = (pi/2L)^2 GJ/I1 + Omega^2 (I3 - I2)/I1`.
+pub fn rotating_cantilever(n_elem: usize, lambdas: &[f64]) -> Result<Vec<Check>, String> {
+    use crate::solver::modal::{modes, ModalOptions, ModeKind};
+    let (ei2, ei3, gj) = (1.0, 4.0, 0.05);
+    let (i1, i2, i3) = (1.01e-4, 1e-6, 1e-4);
+    let sec = uniform_section(1e6, 1e6, gj, ei2, ei3, 1.0, i1, i2, i3);
+    let mut out = vec![];
+    for &lam in lambdas {
+        let (mut m, _, _) = cantilever(n_elem, 1.0, &sec);
+        let mut st = State::from_model(&m);
+        let omega = [0.0, 0.0, lam];
+        let opts = StaticOptions {
+            omega: Some(omega),
+            load_steps: 1,
+            ..Default::default()
+        };
+        static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).map_err(|e| e.to_string())?;
+        let md = modes(&mut m, &st, &ModalOptions { n_modes: 12, omega: Some(omega) }).map_err(|e| e.to_string())?;
+        let first = |k: ModeKind| md.iter().find(|x| x.kind == k).map(|x| x.omega_rad_s);
+        let wf = first(ModeKind::Flap).ok_or("no flap mode")?;
+        let wl = first(ModeKind::Lag).ok_or("no lag mode")?;
+        let wt = first(ModeKind::Torsion).ok_or("no torsion mode")?;
+        let tab = |l: f64| WRIGHT_FLAP.iter().find(|r| (r.0 - l).abs() < 1e-9).map(|r| r.1);
+        let f_ref = tab(lam).ok_or("lambda not in table")?;
+        let lag_nd = tab(lam / 2.0).ok_or("lambda/2 not in table")?;
+        let l_ref = ((lag_nd * 2.0).powi(2) - lam * lam).sqrt();
+        let t_ref = ((std::f64::consts::FRAC_PI_2).powi(2) * gj / i1 + lam * lam * (i3 - i2) / i1).sqrt();
+        let case = format!("rotating_cantilever_lambda_{lam}");
+        out.push(Check::new(&case, "flap1_nondim", wf, f_ref, "Wright, Smith, Thresher & Wang 1982, J. Appl. Mech. 49:197 (table of rotating uniform cantilever flap frequencies)"));
+        out.push(Check::new(&case, "lag1_nondim", wl, l_ref, "Wright et al. 1982 flap value at lambda/2 with EI_lag = 4 EI_flap, omega_lag^2 = omega_flap^2 - Omega^2"));
+        out.push(Check::new(&case, "torsion1_nondim", wt, t_ref, "analytic uniform beam: omega^2 = (pi/2L)^2 GJ/I1 + Omega^2 (I3 - I2)/I1"));
+    }
+    Ok(out)
+}
