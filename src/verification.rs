@@ -4,7 +4,17 @@ use crate::structure::*;
 
 /// Uniform section with no offsets.
 #[allow(clippy::too_many_arguments)]
-pub fn uniform_section(ea: f64, ga: f64, gj: f64, ei2: f64, ei3: f64, m: f64, i1: f64, i2: f64, i3: f64) -> SectionTable {
+pub fn uniform_section(
+    ea: f64,
+    ga: f64,
+    gj: f64,
+    ei2: f64,
+    ei3: f64,
+    m: f64,
+    i1: f64,
+    i2: f64,
+    i3: f64,
+) -> SectionTable {
     SectionTable::uniform(SectionProps {
         s_m: 0.0,
         ea,
@@ -42,10 +52,21 @@ pub fn bend45(n_elem: usize) -> Result<Vec<(f64, [f64; 3], [f64; 3])>, String> {
     let curve = move |s: f64| {
         let p = s / r;
         let (sn, cs) = p.sin_cos();
-        ([r * sn, r * (1.0 - cs), 0.0], [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]])
+        (
+            [r * sn, r * (1.0 - cs), 0.0],
+            [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]],
+        )
     };
     let ids = m
-        .add_beam("arc", n_elem, r * std::f64::consts::FRAC_PI_4, &curve, &sec, 0.0, None)
+        .add_beam(
+            "arc",
+            n_elem,
+            r * std::f64::consts::FRAC_PI_4,
+            &curve,
+            &sec,
+            0.0,
+            None,
+        )
         .map_err(|e| e.to_string())?;
     m.clamp("root", ids[0]).map_err(|e| e.to_string())?;
     let tip = *ids.last().unwrap();
@@ -73,7 +94,12 @@ pub fn bend45(n_elem: usize) -> Result<Vec<(f64, [f64; 3], [f64; 3])>, String> {
             ..Default::default()
         };
         prev = f / 600.0;
-        static_solve(&mut m, &mut st, &opts, |s, n, it, r| { if std::env::var("DBG").is_ok() { eprintln!("step {s}/{n} it {it} r {r:.3e}") } }).map_err(|e| e.to_string())?;
+        static_solve(&mut m, &mut st, &opts, |s, n, it, r| {
+            if std::env::var("DBG").is_ok() {
+                eprintln!("step {s}/{n} it {it} r {r:.3e}")
+            }
+        })
+        .map_err(|e| e.to_string())?;
         out.push((f, st.x[tip], rf));
     }
     Ok(out)
@@ -85,7 +111,16 @@ pub fn bend45(n_elem: usize) -> Result<Vec<(f64, [f64; 3], [f64; 3])>, String> {
 pub fn cantilever(n_elem: usize, l: f64, sec: &SectionTable) -> (Model, usize, usize) {
     let mut m = Model::new();
     let ids = m
-        .add_straight_beam("beam", n_elem, [0.0; 3], [l, 0.0, 0.0], [0.0, 1.0, 0.0], sec, 0.0, None)
+        .add_straight_beam(
+            "beam",
+            n_elem,
+            [0.0; 3],
+            [l, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            sec,
+            0.0,
+            None,
+        )
         .expect("cantilever");
     let root = m.clamp("root", ids[0]).expect("clamp");
     let tip = *ids.last().unwrap();
@@ -107,7 +142,11 @@ pub fn cantilever(n_elem: usize, l: f64, sec: &SectionTable) -> (Model, usize, u
 /// Cantilever deflected statically by a tip force and released: returns the first flap
 /// frequency [rad/s] measured from zero crossings of the tip displacement, and its analytic
 /// Euler-Bernoulli value `3.5160 sqrt(EI / (m L^4))`.
-pub fn cantilever_release(n_elem: usize, steps_per_period: usize, periods: usize) -> Result<(f64, f64), String> {
+pub fn cantilever_release(
+    n_elem: usize,
+    steps_per_period: usize,
+    periods: usize,
+) -> Result<(f64, f64), String> {
     use crate::solver::DynamicSolver;
     let (ei, mass, l) = (100.0, 1.0, 10.0);
     let sec = uniform_section(1e6, 1e6, 100.0, ei, ei, mass, 1e-4, 5e-5, 5e-5);
@@ -117,7 +156,8 @@ pub fn cantilever_release(n_elem: usize, steps_per_period: usize, periods: usize
         p.force_n = [0.0, 0.0, 0.05];
     }
     let mut st = State::from_model(&m);
-    static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {}).map_err(|e| e.to_string())?;
+    static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {})
+        .map_err(|e| e.to_string())?;
     if let Element::Load(p) = &mut m.elements[load] {
         p.force_n = [0.0; 3];
     }
@@ -209,20 +249,40 @@ pub fn rotating_cantilever(n_elem: usize, lambdas: &[f64]) -> Result<Vec<Check>,
             ..Default::default()
         };
         static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).map_err(|e| e.to_string())?;
-        let md = modes(&mut m, &st, &ModalOptions { n_modes: 12, omega: Some(omega) }).map_err(|e| e.to_string())?;
+        let md = modes(
+            &mut m,
+            &st,
+            &ModalOptions {
+                n_modes: 12,
+                omega: Some(omega),
+            },
+        )
+        .map_err(|e| e.to_string())?;
         let first = |k: ModeKind| md.iter().find(|x| x.kind == k).map(|x| x.omega_rad_s);
         let wf = first(ModeKind::Flap).ok_or("no flap mode")?;
         let wl = first(ModeKind::Lag).ok_or("no lag mode")?;
         let wt = first(ModeKind::Torsion).ok_or("no torsion mode")?;
-        let tab = |l: f64| WRIGHT_FLAP.iter().find(|r| (r.0 - l).abs() < 1e-9).map(|r| r.1);
+        let tab = |l: f64| {
+            WRIGHT_FLAP
+                .iter()
+                .find(|r| (r.0 - l).abs() < 1e-9)
+                .map(|r| r.1)
+        };
         let f_ref = tab(lam).ok_or("lambda not in table")?;
         let lag_nd = tab(lam / 2.0).ok_or("lambda/2 not in table")?;
         let l_ref = ((lag_nd * 2.0).powi(2) - lam * lam).sqrt();
-        let t_ref = ((std::f64::consts::FRAC_PI_2).powi(2) * gj / i1 + lam * lam * (i3 - i2) / i1).sqrt();
+        let t_ref =
+            ((std::f64::consts::FRAC_PI_2).powi(2) * gj / i1 + lam * lam * (i3 - i2) / i1).sqrt();
         let case = format!("rotating_cantilever_lambda_{lam}");
         out.push(Check::new(&case, "flap1_nondim", wf, f_ref, "Wright, Smith, Thresher & Wang 1982, J. Appl. Mech. 49:197 (table of rotating uniform cantilever flap frequencies)"));
         out.push(Check::new(&case, "lag1_nondim", wl, l_ref, "Wright et al. 1982 flap value at lambda/2 with EI_lag = 4 EI_flap, omega_lag^2 = omega_flap^2 - Omega^2"));
-        out.push(Check::new(&case, "torsion1_nondim", wt, t_ref, "analytic uniform beam: omega^2 = (pi/2L)^2 GJ/I1 + Omega^2 (I3 - I2)/I1"));
+        out.push(Check::new(
+            &case,
+            "torsion1_nondim",
+            wt,
+            t_ref,
+            "analytic uniform beam: omega^2 = (pi/2L)^2 GJ/I1 + Omega^2 (I3 - I2)/I1",
+        ));
     }
     Ok(out)
 }

@@ -8,7 +8,17 @@ fn free_beam() -> (Model, State) {
     // translation plus a flexural velocity field, no loads, no constraints.
     let sec = common::uniform(1e4, 1e4, 500.0, 500.0, 500.0, 1.0, 10.0, 5.0, 5.0);
     let mut m = Model::new();
-    m.add_straight_beam("b", 4, [0.0; 3], [10.0, 0.0, 0.0], [0.0, 1.0, 0.0], &sec, 0.0, None).unwrap();
+    m.add_straight_beam(
+        "b",
+        4,
+        [0.0; 3],
+        [10.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        &sec,
+        0.0,
+        None,
+    )
+    .unwrap();
     let mut st = State::from_model(&m);
     st.set_rigid_rotation([5.0, 0.0, 0.0], [0.1, 0.3, 1.0]);
     for i in 0..st.x.len() {
@@ -46,8 +56,16 @@ fn free_flying_beam_conserves_energy_and_momentum_without_dissipation() {
     let e0 = e[0];
     let de = e.iter().map(|x| (x - e0).abs() / e0).fold(0.0, f64::max);
     let nrm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let dp = p.iter().map(|x| nrm([x[0] - p[0][0], x[1] - p[0][1], x[2] - p[0][2]])).fold(0.0, f64::max) / nrm(p[0]);
-    let dl = l.iter().map(|x| nrm([x[0] - l[0][0], x[1] - l[0][1], x[2] - l[0][2]])).fold(0.0, f64::max) / nrm(l[0]);
+    let dp = p
+        .iter()
+        .map(|x| nrm([x[0] - p[0][0], x[1] - p[0][1], x[2] - p[0][2]]))
+        .fold(0.0, f64::max)
+        / nrm(p[0]);
+    let dl = l
+        .iter()
+        .map(|x| nrm([x[0] - l[0][0], x[1] - l[0][1], x[2] - l[0][2]]))
+        .fold(0.0, f64::max)
+        / nrm(l[0]);
     println!("rho_inf = 1, 2000 steps (20 s): max |dE|/E = {de:.2e}, |dp|/|p| = {dp:.2e}, |dL|/|L| = {dl:.2e}");
     assert!(de < 5e-3, "energy drift {de}");
     assert!(dp < 1e-8, "linear momentum drift {dp}");
@@ -63,8 +81,14 @@ fn free_flying_beam_energy_never_grows_with_numerical_dissipation() {
     }
     let emax = e.iter().cloned().fold(0.0, f64::max) / e[0];
     // window maxima over 50 steps (about half the first flexible period)
-    let wmax: Vec<f64> = e.chunks(50).map(|c| c.iter().cloned().fold(0.0, f64::max)).collect();
-    let wgrow = wmax.windows(2).map(|w| (w[1] - w[0]) / e[0]).fold(f64::MIN, f64::max);
+    let wmax: Vec<f64> = e
+        .chunks(50)
+        .map(|c| c.iter().cloned().fold(0.0, f64::max))
+        .collect();
+    let wgrow = wmax
+        .windows(2)
+        .map(|w| (w[1] - w[0]) / e[0])
+        .fold(f64::MIN, f64::max);
     println!(
         "rho_inf = 0.6: E_end/E_0 = {:.6}, max E/E_0 = {emax:.9}, largest step-to-step growth {grow:.2e} E_0, largest growth of 0.5 s window maxima {wgrow:.2e} E_0",
         e[e.len() - 1] / e[0]
@@ -72,7 +96,10 @@ fn free_flying_beam_energy_never_grows_with_numerical_dissipation() {
     // Generalized-alpha is not strictly energy decaying step by step (the discrete energy
     // exchanges with the algorithmic accelerations); what holds is that the energy never
     // exceeds its initial value and its envelope decays.
-    assert!(emax <= 1.0 + 1e-9, "energy exceeded its initial value: {emax}");
+    assert!(
+        emax <= 1.0 + 1e-9,
+        "energy exceeded its initial value: {emax}"
+    );
     assert!(wgrow <= 0.0, "energy envelope grew by {wgrow}");
 }
 

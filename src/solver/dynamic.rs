@@ -80,10 +80,25 @@ impl DynamicSolver {
     /// taken as the initial true accelerations).
     pub fn new(model: Model, state: State, h: f64, rho_inf: f64) -> Result<Self, NewtonError> {
         let t = state.t;
-        let asm = Assembler::new(&model).map_err(|source| NewtonError::Linear { t, iteration: 0, source })?;
+        let asm = Assembler::new(&model).map_err(|source| NewtonError::Linear {
+            t,
+            iteration: 0,
+            source,
+        })?;
         let n = model.nodes.len();
         let ndof = asm.ndof;
-        let acc = (0..n).map(|i| [state.a[i][0], state.a[i][1], state.a[i][2], state.al[i][0], state.al[i][1], state.al[i][2]]).collect();
+        let acc = (0..n)
+            .map(|i| {
+                [
+                    state.a[i][0],
+                    state.a[i][1],
+                    state.a[i][2],
+                    state.al[i][0],
+                    state.al[i][1],
+                    state.al[i][2],
+                ]
+            })
+            .collect();
         let size = model_size(&state.x);
         let lam_offsets = lambda_offsets(&model);
         let mut s = DynamicSolver {
@@ -130,7 +145,16 @@ impl DynamicSolver {
             inertia: true,
         };
         self.asm
-            .assemble(&mut self.model, &self.kin, &self.lam_hat, &ctx, &seed, None, true, &mut self.res)
+            .assemble(
+                &mut self.model,
+                &self.kin,
+                &self.lam_hat,
+                &ctx,
+                &seed,
+                None,
+                true,
+                &mut self.res,
+            )
             .map_err(|source| NewtonError::Element { t, source })?;
         self.cscale = diag_scale(&self.asm) / h;
         for (l, lp) in self.lam_hat.iter_mut().zip(&self.state.lambda) {
@@ -157,8 +181,10 @@ impl DynamicSolver {
             let vdn = [self.state.a[i], self.state.al[i]].concat();
             for k in 0..6 {
                 a_new[i][k] = (p.alpha_f * vdn[k] - p.alpha_m * self.acc[i][k]) / (1.0 - p.alpha_m);
-                v_new[i][k] = vn[k] + h * (1.0 - p.gamma) * self.acc[i][k] + h * p.gamma * a_new[i][k];
-                self.dq[i][k] = vn[k] + h * (0.5 - p.beta) * self.acc[i][k] + h * p.beta * a_new[i][k];
+                v_new[i][k] =
+                    vn[k] + h * (1.0 - p.gamma) * self.acc[i][k] + h * p.gamma * a_new[i][k];
+                self.dq[i][k] =
+                    vn[k] + h * (0.5 - p.beta) * self.acc[i][k] + h * p.beta * a_new[i][k];
                 vd_new[i][k] = 0.0;
             }
         }
@@ -203,7 +229,16 @@ impl DynamicSolver {
             let seed = |node: usize, comp: usize| dyn_seed(comp, h, cv, ca, &tl[node]);
             let xp = &self.x_prev;
             self.asm
-                .assemble(&mut self.model, &self.kin, &lam_hat, &ctx, &seed, Some((t_n, h, xp)), true, &mut self.res)
+                .assemble(
+                    &mut self.model,
+                    &self.kin,
+                    &lam_hat,
+                    &ctx,
+                    &seed,
+                    Some((t_n, h, xp)),
+                    true,
+                    &mut self.res,
+                )
                 .map_err(|source| NewtonError::Element { t, source })?;
             let rn = norm(&self.res);
             if !rn.is_finite() {
@@ -223,7 +258,11 @@ impl DynamicSolver {
                     initial: r0,
                 });
             }
-            self.asm.factor().map_err(|source| NewtonError::Linear { t, iteration: it, source })?;
+            self.asm.factor().map_err(|source| NewtonError::Linear {
+                t,
+                iteration: it,
+                source,
+            })?;
             for r in self.res.iter_mut() {
                 *r = -*r;
             }
@@ -261,7 +300,9 @@ impl DynamicSolver {
         for i in 0..n {
             let vdn = [self.state.a[i], self.state.al[i]].concat();
             for k in 0..6 {
-                self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k] - p.alpha_m * self.acc[i][k]) / (1.0 - p.alpha_m);
+                self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k]
+                    - p.alpha_m * self.acc[i][k])
+                    / (1.0 - p.alpha_m);
             }
             self.state.x[i] = x_new[i];
             self.state.q[i] = q_new[i];
@@ -305,9 +346,15 @@ impl DynamicSolver {
             let mut e = [0.0; 3];
             e[comp % 3] = 1.0;
             if comp < 3 {
-                Seed { da: e, ..Default::default() }
+                Seed {
+                    da: e,
+                    ..Default::default()
+                }
             } else {
-                Seed { dal: e, ..Default::default() }
+                Seed {
+                    dal: e,
+                    ..Default::default()
+                }
             }
         };
         let ctx = EvalCtx {
@@ -320,9 +367,22 @@ impl DynamicSolver {
         self.model.update_distributed_loads(t, &self.kin);
         let xp = self.state.x.clone();
         self.asm
-            .assemble(&mut self.model, &self.kin, &self.lam_hat, &ctx, &seed, Some((t, 0.0, &xp)), true, &mut self.res)
+            .assemble(
+                &mut self.model,
+                &self.kin,
+                &self.lam_hat,
+                &ctx,
+                &seed,
+                Some((t, 0.0, &xp)),
+                true,
+                &mut self.res,
+            )
             .map_err(|source| NewtonError::Element { t, source })?;
-        self.asm.factor().map_err(|source| NewtonError::Linear { t, iteration: 0, source })?;
+        self.asm.factor().map_err(|source| NewtonError::Linear {
+            t,
+            iteration: 0,
+            source,
+        })?;
         for r in self.res.iter_mut() {
             *r = -*r;
         }

@@ -89,14 +89,24 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     let lam = st.lambda.clone();
     let mut res = vec![0.0; ndof];
     model.update_distributed_loads(st.t, &kin);
-    let mut run = |seed: &dyn Fn(usize, usize) -> Seed| -> Result<(DMatrix<f64>, DMatrix<f64>), ModalError> {
-        asm.assemble(model, &kin, &lam, &ctx, seed, Some((st.t, 0.0, &st.x)), true, &mut res)
+    let mut run =
+        |seed: &dyn Fn(usize, usize) -> Seed| -> Result<(DMatrix<f64>, DMatrix<f64>), ModalError> {
+            asm.assemble(
+                model,
+                &kin,
+                &lam,
+                &ctx,
+                seed,
+                Some((st.t, 0.0, &st.x)),
+                true,
+                &mut res,
+            )
             .map_err(|e| fail(e.to_string()))?;
-        let full = dense_block(&asm, ndof, 0..ndof);
-        let a = full.view((0, 0), (nn, nn)).into_owned();
-        let b = full.view((nn, 0), (ndof - nn, nn)).into_owned();
-        Ok((a, b))
-    };
+            let full = dense_block(&asm, ndof, 0..ndof);
+            let a = full.view((0, 0), (nn, nn)).into_owned();
+            let b = full.view((nn, 0), (ndof - nn, nn)).into_owned();
+            Ok((a, b))
+        };
     let e = |c: usize| {
         let mut e = [0.0; 3];
         e[c % 3] = 1.0;
@@ -104,23 +114,45 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     };
     let (k, b) = run(&|_, c| {
         if c < 3 {
-            Seed { dx: e(c), dv: cross(om, e(c)), da: cross(om, cross(om, e(c))), ..Default::default() }
+            Seed {
+                dx: e(c),
+                dv: cross(om, e(c)),
+                da: cross(om, cross(om, e(c))),
+                ..Default::default()
+            }
         } else {
-            Seed { dth: e(c), ..Default::default() }
+            Seed {
+                dth: e(c),
+                ..Default::default()
+            }
         }
     })?;
     let (g, _) = run(&|_, c| {
         if c < 3 {
-            Seed { dv: e(c), da: fmul(2.0, cross(om, e(c))), ..Default::default() }
+            Seed {
+                dv: e(c),
+                da: fmul(2.0, cross(om, e(c))),
+                ..Default::default()
+            }
         } else {
-            Seed { dw: e(c), dal: cross(om, e(c)), ..Default::default() }
+            Seed {
+                dw: e(c),
+                dal: cross(om, e(c)),
+                ..Default::default()
+            }
         }
     })?;
     let (m, _) = run(&|_, c| {
         if c < 3 {
-            Seed { da: e(c), ..Default::default() }
+            Seed {
+                da: e(c),
+                ..Default::default()
+            }
         } else {
-            Seed { dal: e(c), ..Default::default() }
+            Seed {
+                dal: e(c),
+                ..Default::default()
+            }
         }
     })?;
     // null space of B
@@ -130,7 +162,9 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
         let btb = b.transpose() * &b;
         let eig = SymmetricEigen::new(btb);
         let mx = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        let cols: Vec<usize> = (0..nn).filter(|&i| eig.eigenvalues[i] <= 1e-10 * mx).collect();
+        let cols: Vec<usize> = (0..nn)
+            .filter(|&i| eig.eigenvalues[i] <= 1e-10 * mx)
+            .collect();
         if nn - cols.len() != b.nrows() {
             return Err(fail(format!(
                 "constraint gradient has rank {} for {} constraints (redundant or singular constraint set)",
@@ -145,8 +179,12 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     let gr = nsp.transpose() * &g * &nsp;
     let mr = nsp.transpose() * &m * &nsp;
     let mlu = mr.clone().lu();
-    let mik = mlu.solve(&kr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
-    let mig = mlu.solve(&gr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+    let mik = mlu
+        .solve(&kr)
+        .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+    let mig = mlu
+        .solve(&gr)
+        .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
     let mut a = faer::Mat::<f64>::zeros(2 * nr, 2 * nr);
     for i in 0..nr {
         a[(i, nr + i)] = 1.0;
@@ -155,10 +193,14 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
             a[(nr + i, nr + j)] = -mig[(i, j)];
         }
     }
-    let eig = a.eigen().map_err(|e| fail(format!("eigen solver: {e:?}")))?;
+    let eig = a
+        .eigen()
+        .map_err(|e| fail(format!("eigen solver: {e:?}")))?;
     let s = eig.S();
     let u = eig.U();
-    let mut idx: Vec<usize> = (0..2 * nr).filter(|&i| s[i].im > 1e-9 * (1.0 + s[i].re.abs())).collect();
+    let mut idx: Vec<usize> = (0..2 * nr)
+        .filter(|&i| s[i].im > 1e-9 * (1.0 + s[i].re.abs()))
+        .collect();
     idx.sort_by(|&x, &y| s[x].norm().partial_cmp(&s[y].norm()).unwrap());
     let mut out = vec![];
     let rots: Vec<[[f64; 3]; 3]> = kin.iter().map(|k| k.r).collect();
@@ -174,9 +216,16 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
             }
             full[r] = acc;
         }
-        let (imax, _) = full.iter().enumerate().fold((0, 0.0), |b, (k, z)| if z.norm() > b.1 { (k, z.norm()) } else { b });
+        let (imax, _) =
+            full.iter().enumerate().fold(
+                (0, 0.0),
+                |b, (k, z)| if z.norm() > b.1 { (k, z.norm()) } else { b },
+            );
         let ph = full[imax].conj() / full[imax].norm();
-        let re: Vec<f64> = full.iter().map(|z| (*z * ph).re / full[imax].norm()).collect();
+        let re: Vec<f64> = full
+            .iter()
+            .map(|z| (*z * ph).re / full[imax].norm())
+            .collect();
         let mut fr = [0.0; 4];
         let mut shape = vec![[0.0; 6]; model.nodes.len()];
         for (nd, r) in rots.iter().enumerate() {
@@ -194,8 +243,16 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
         }
         let tot: f64 = fr.iter().sum::<f64>().max(1e-300);
         let fr = fr.map(|v| v / tot);
-        let kinds = [ModeKind::Flap, ModeKind::Lag, ModeKind::Torsion, ModeKind::Axial];
-        let (kmax, _) = fr.iter().enumerate().fold((0, -1.0), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
+        let kinds = [
+            ModeKind::Flap,
+            ModeKind::Lag,
+            ModeKind::Torsion,
+            ModeKind::Axial,
+        ];
+        let (kmax, _) = fr
+            .iter()
+            .enumerate()
+            .fold((0, -1.0), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
         out.push(Mode {
             freq_hz: wabs / (2.0 * std::f64::consts::PI),
             omega_rad_s: wabs,

@@ -143,7 +143,8 @@ pub fn static_solve(
     let nsteps = opts.load_steps.max(1);
     let g = model.gravity;
     for step in 1..=nsteps {
-        let lf = opts.start_factor + (opts.end_factor - opts.start_factor) * step as f64 / nsteps as f64;
+        let lf =
+            opts.start_factor + (opts.end_factor - opts.start_factor) * step as f64 / nsteps as f64;
         ctx.load_factor = lf;
         ctx.gravity = fmul(lf, g);
         let mut r0 = 0.0;
@@ -253,4 +254,57 @@ pub fn commit(model: &mut Model, kin: &[NodeKin<f64>]) {
     for s in model.step_elements.iter_mut() {
         s.commit();
     }
+}
+
+/// Check that the constraint gradient has full row rank at `st`; names the first redundant
+/// joint (singular constraint set) otherwise.
+pub fn check_constraints(model: &mut Model, st: &State) -> Result<(), String> {
+    let mut asm = Assembler::new(model).map_err(|e| e.to_string())?;
+    let nn = 6 * model.nodes.len();
+    let ndof = asm.ndof;
+    if ndof == nn {
+        return Ok(());
+    }
+    let mut kin = vec![];
+    st.kin(&mut kin);
+    let ctx = EvalCtx {
+        t: st.t,
+        ..Default::default()
+    };
+    let lam = vec![0.0; ndof - nn];
+    let mut res = vec![0.0; ndof];
+    asm.assemble(
+        model,
+        &kin,
+        &lam,
+        &ctx,
+        &static_seed([0.0; 3]),
+        None,
+        true,
+        &mut res,
+    )
+    .map_err(|e| e.to_string())?;
+    let d = asm.to_dense();
+    let mut basis: Vec<Vec<f64>> = vec![];
+    for (ei, e) in model.elements.iter().enumerate() {
+        for k in 0..e.n_lambda() {
+            let row = asm.lam_start[ei] + k;
+            let mut v: Vec<f64> = d[row][..nn].to_vec();
+            let n0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for b in &basis {
+                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                v.iter_mut().zip(b).for_each(|(x, y)| *x -= p * y);
+            }
+            let n1 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if n0 == 0.0 || n1 <= 1e-8 * n0 {
+                return Err(format!(
+                    "singular constraint set: constraint {} of joint `{}` is redundant with the constraints before it (e.g. a node clamped twice, or a revolute axis already locked)",
+                    k + 1,
+                    e.name()
+                ));
+            }
+            basis.push(v.iter().map(|x| x / n1).collect());
+        }
+    }
+    Ok(())
 }
