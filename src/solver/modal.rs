@@ -178,26 +178,52 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     let kr = nsp.transpose() * &k * &nsp;
     let gr = nsp.transpose() * &g * &nsp;
     let mr = nsp.transpose() * &m * &nsp;
-    let mlu = mr.clone().lu();
-    let mik = mlu
-        .solve(&kr)
-        .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
-    let mig = mlu
-        .solve(&gr)
-        .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+    // Shift-invert form when K is regular: eigenvalues 1/s of
+    // A^-1 = [-K^-1 G, -K^-1 M; I, 0] resolve the lowest modes to full relative precision even
+    // with very stiff axial/shear modes; otherwise the direct form [0 I; -M^-1 K, -M^-1 G].
+    let klu = kr.clone().lu();
+    let kinv = klu.solve(&DMatrix::<f64>::identity(nr, nr)).filter(|ki| ki.iter().all(|v| v.is_finite()));
     let mut a = faer::Mat::<f64>::zeros(2 * nr, 2 * nr);
-    for i in 0..nr {
-        a[(i, nr + i)] = 1.0;
-        for j in 0..nr {
-            a[(nr + i, j)] = -mik[(i, j)];
-            a[(nr + i, nr + j)] = -mig[(i, j)];
+    let inverted = kinv.is_some();
+    if let Some(ki) = kinv {
+        let kig = &ki * &gr;
+        let kim = &ki * &mr;
+        for i in 0..nr {
+            a[(nr + i, i)] = 1.0;
+            for j in 0..nr {
+                a[(i, j)] = -kig[(i, j)];
+                a[(i, nr + j)] = -kim[(i, j)];
+            }
+        }
+    } else {
+        let mlu = mr.clone().lu();
+        let mik = mlu.solve(&kr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+        let mig = mlu.solve(&gr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+        for i in 0..nr {
+            a[(i, nr + i)] = 1.0;
+            for j in 0..nr {
+                a[(nr + i, j)] = -mik[(i, j)];
+                a[(nr + i, nr + j)] = -mig[(i, j)];
+            }
         }
     }
-    let eig = a
-        .eigen()
-        .map_err(|e| fail(format!("eigen solver: {e:?}")))?;
-    let s = eig.S();
+    let eig = a.eigen().map_err(|e| fail(format!("eigen solver: {e:?}")))?;
+    let s_raw = eig.S();
     let u = eig.U();
+    let s: Vec<faer::c64> = (0..2 * nr)
+        .map(|i| {
+            let z = s_raw[i];
+            if inverted {
+                if z.norm() == 0.0 {
+                    faer::c64::new(f64::INFINITY, 0.0)
+                } else {
+                    z.conj() / (z.norm() * z.norm())
+                }
+            } else {
+                z
+            }
+        })
+        .collect();
     let mut idx: Vec<usize> = (0..2 * nr)
         .filter(|&i| s[i].im > 1e-9 * (1.0 + s[i].re.abs()))
         .collect();
