@@ -291,13 +291,25 @@ pub fn rotating_cantilever(n_elem: usize, lambdas: &[f64]) -> Result<Vec<Check>,
 /// translation plus a flexural velocity field, no loads, no constraints; L = 10 m, h = 0.01 s.
 /// Returns per step: total energy, linear momentum, angular momentum about the origin.
 #[allow(clippy::type_complexity)]
-pub fn free_flying(rho_inf: f64, steps: usize) -> Result<(Vec<f64>, Vec<[f64; 3]>, Vec<[f64; 3]>), String> {
+pub fn free_flying(
+    rho_inf: f64,
+    steps: usize,
+) -> Result<(Vec<f64>, Vec<[f64; 3]>, Vec<[f64; 3]>), String> {
     use crate::solver::dynamic::{energy, momentum};
     use crate::solver::DynamicSolver;
     let sec = uniform_section(1e4, 1e4, 500.0, 500.0, 500.0, 1.0, 10.0, 5.0, 5.0);
     let mut m = Model::new();
-    m.add_straight_beam("b", 4, [0.0; 3], [10.0, 0.0, 0.0], [0.0, 1.0, 0.0], &sec, 0.0, None)
-        .map_err(|e| e.to_string())?;
+    m.add_straight_beam(
+        "b",
+        4,
+        [0.0; 3],
+        [10.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        &sec,
+        0.0,
+        None,
+    )
+    .map_err(|e| e.to_string())?;
     let mut st = State::from_model(&m);
     st.set_rigid_rotation([5.0, 0.0, 0.0], [0.1, 0.3, 1.0]);
     for i in 0..st.x.len() {
@@ -337,13 +349,25 @@ pub fn mesh_convergence() -> Result<Vec<(String, Vec<usize>, Vec<f64>, Vec<f64>)
     let mut errs = vec![];
     for &n in &ns {
         let x = tip(n)?;
-        errs.push(((x[0] - fine[0]).powi(2) + (x[1] - fine[1]).powi(2) + (x[2] - fine[2]).powi(2)).sqrt() / 100.0);
+        errs.push(
+            ((x[0] - fine[0]).powi(2) + (x[1] - fine[1]).powi(2) + (x[2] - fine[2]).powi(2)).sqrt()
+                / 100.0,
+        );
     }
     let ord = observed_orders(&errs);
-    out.push(("bend45_tip_position_F600 (error / R vs 32 elements)".to_string(), ns, errs, ord));
+    out.push((
+        "bend45_tip_position_F600 (error / R vs 32 elements)".to_string(),
+        ns,
+        errs,
+        ord,
+    ));
     // first flap frequency of a non-rotating cantilever vs a 32-element solution
     let freq = |n: usize| -> Result<f64, String> {
-        Ok(rotating_cantilever(n, &[0.0])?.into_iter().find(|c| c.quantity == "flap1_nondim").map(|c| c.computed).unwrap_or(f64::NAN))
+        Ok(rotating_cantilever(n, &[0.0])?
+            .into_iter()
+            .find(|c| c.quantity == "flap1_nondim")
+            .map(|c| c.computed)
+            .unwrap_or(f64::NAN))
     };
     let fine = freq(16)?;
     let ns = vec![1, 2, 4];
@@ -352,6 +376,11 @@ pub fn mesh_convergence() -> Result<Vec<(String, Vec<usize>, Vec<f64>, Vec<f64>)
         errs.push((freq(n)? - fine).abs() / fine);
     }
     let ord = observed_orders(&errs);
-    out.push(("cantilever_flap1_frequency (relative error vs 16 elements)".to_string(), ns, errs, ord));
+    out.push((
+        "cantilever_flap1_frequency (relative error vs 16 elements)".to_string(),
+        ns,
+        errs,
+        ord,
+    ));
     Ok(out)
 }

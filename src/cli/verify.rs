@@ -1,8 +1,8 @@
 //! `rotorsim verify` (issue #3): runs the structural verification suite, writes DIR/verify.json
 //! (`{case, quantity, computed, reference, rel_error, source, tolerance, pass}`) and a table.
-use clap::Args;
 use crate::io::OutDir;
 use crate::verification::*;
+use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -43,8 +43,12 @@ fn suite() -> Result<Vec<(Check, f64)>, String> {
             p.moment_nm = [0.0, 2.0 * std::f64::consts::PI * ei / l, 0.0];
         }
         let mut st = crate::solver::State::from_model(&m);
-        let opts = crate::solver::StaticOptions { load_steps: 10, ..Default::default() };
-        crate::solver::static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).map_err(|e| e.to_string())?;
+        let opts = crate::solver::StaticOptions {
+            load_steps: 10,
+            ..Default::default()
+        };
+        crate::solver::static_solve(&mut m, &mut st, &opts, |_, _, _, _| {})
+            .map_err(|e| e.to_string())?;
         let x = st.x[tip];
         let d = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() / l;
         out.push((abs_check("rollup_M_2piEI_over_L", "tip_to_root_distance_over_L", d, "Simo & Vu-Quoc 1986, Comput. Methods Appl. Mech. Eng. 58:79 (tip returns to the root)"), 1e-6));
@@ -64,16 +68,54 @@ fn suite() -> Result<Vec<(Check, f64)>, String> {
     out.push((Check::new("cantilever_release", "flap1_rad_s", w, w_ref, "Euler-Bernoulli cantilever 3.5160 sqrt(EI/mL^4); generalized-alpha rho_inf = 1, 200 steps per period"), 1e-3));
     let (e, p, l) = free_flying(1.0, 2000)?;
     let nrm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let de = e.iter().map(|x| (x - e[0]).abs() / e[0]).fold(0.0, f64::max);
-    let dp = p.iter().map(|x| nrm([x[0] - p[0][0], x[1] - p[0][1], x[2] - p[0][2]])).fold(0.0, f64::max) / nrm(p[0]);
-    let dl = l.iter().map(|x| nrm([x[0] - l[0][0], x[1] - l[0][1], x[2] - l[0][2]])).fold(0.0, f64::max) / nrm(l[0]);
+    let de = e
+        .iter()
+        .map(|x| (x - e[0]).abs() / e[0])
+        .fold(0.0, f64::max);
+    let dp = p
+        .iter()
+        .map(|x| nrm([x[0] - p[0][0], x[1] - p[0][1], x[2] - p[0][2]]))
+        .fold(0.0, f64::max)
+        / nrm(p[0]);
+    let dl = l
+        .iter()
+        .map(|x| nrm([x[0] - l[0][0], x[1] - l[0][1], x[2] - l[0][2]]))
+        .fold(0.0, f64::max)
+        / nrm(l[0]);
     let src = "conservation laws of the free beam (Simo & Vu-Quoc 1988 free-flying beam problem type), rho_inf = 1, 2000 steps of 0.01 s";
-    out.push((abs_check("free_flying_beam", "max_rel_energy_change", de, src), 1e-3));
-    out.push((abs_check("free_flying_beam", "max_rel_linear_momentum_change", dp, src), 1e-10));
-    out.push((abs_check("free_flying_beam", "max_rel_angular_momentum_change", dl, src), 1e-3));
+    out.push((
+        abs_check("free_flying_beam", "max_rel_energy_change", de, src),
+        1e-3,
+    ));
+    out.push((
+        abs_check(
+            "free_flying_beam",
+            "max_rel_linear_momentum_change",
+            dp,
+            src,
+        ),
+        1e-10,
+    ));
+    out.push((
+        abs_check(
+            "free_flying_beam",
+            "max_rel_angular_momentum_change",
+            dl,
+            src,
+        ),
+        1e-3,
+    ));
     let (e, _, _) = free_flying(0.6, 1000)?;
     let grow = e.iter().map(|x| (x - e[0]) / e[0]).fold(f64::MIN, f64::max);
-    out.push((abs_check("free_flying_beam_rho0.6", "max_energy_above_initial_rel", grow.max(0.0), "energy must not exceed its initial value with numerical dissipation"), 1e-9));
+    out.push((
+        abs_check(
+            "free_flying_beam_rho0.6",
+            "max_energy_above_initial_rel",
+            grow.max(0.0),
+            "energy must not exceed its initial value with numerical dissipation",
+        ),
+        1e-9,
+    ));
     for (q, ns, errs, ord) in mesh_convergence()? {
         for (k, o) in ord.iter().enumerate() {
             out.push((
@@ -104,23 +146,46 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<()> {
     let entries: Vec<Entry> = checks
         .into_iter()
         .map(|(c, tol)| {
-            let pass = if tol.is_nan() { c.computed > 3.0 } else { c.rel_error <= tol };
-            Entry { tolerance: if tol.is_nan() { 0.0 } else { tol }, pass, check: c }
+            let pass = if tol.is_nan() {
+                c.computed > 3.0
+            } else {
+                c.rel_error <= tol
+            };
+            Entry {
+                tolerance: if tol.is_nan() { 0.0 } else { tol },
+                pass,
+                check: c,
+            }
         })
         .collect();
-    println!("{:<44} {:<34} {:>14} {:>14} {:>10} {:>8}  pass", "case", "quantity", "computed", "reference", "rel_error", "tol");
+    println!(
+        "{:<44} {:<34} {:>14} {:>14} {:>10} {:>8}  pass",
+        "case", "quantity", "computed", "reference", "rel_error", "tol"
+    );
     for e in &entries {
         let c = &e.check;
         println!(
             "{:<44} {:<34} {:>14.6} {:>14.6} {:>10.2e} {:>8.1e}  {}",
-            c.case, c.quantity, c.computed, c.reference, c.rel_error, e.tolerance, if e.pass { "yes" } else { "NO" }
+            c.case,
+            c.quantity,
+            c.computed,
+            c.reference,
+            c.rel_error,
+            e.tolerance,
+            if e.pass { "yes" } else { "NO" }
         );
     }
-    out.write("verify.json", serde_json::to_string_pretty(&entries)?.as_bytes())?;
+    out.write(
+        "verify.json",
+        serde_json::to_string_pretty(&entries)?.as_bytes(),
+    )?;
     let failed = entries.iter().filter(|e| !e.pass).count();
     if failed > 0 {
         out.finish()?;
-        anyhow::bail!("{failed} verification checks failed (see {})", args.out.join("verify.json").display());
+        anyhow::bail!(
+            "{failed} verification checks failed (see {})",
+            args.out.join("verify.json").display()
+        );
     }
     println!("all {} checks pass", entries.len());
     out.finish()?;

@@ -182,7 +182,9 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     // A^-1 = [-K^-1 G, -K^-1 M; I, 0] resolve the lowest modes to full relative precision even
     // with very stiff axial/shear modes; otherwise the direct form [0 I; -M^-1 K, -M^-1 G].
     let klu = kr.clone().lu();
-    let kinv = klu.solve(&DMatrix::<f64>::identity(nr, nr)).filter(|ki| ki.iter().all(|v| v.is_finite()));
+    let kinv = klu
+        .solve(&DMatrix::<f64>::identity(nr, nr))
+        .filter(|ki| ki.iter().all(|v| v.is_finite()));
     let mut a = faer::Mat::<f64>::zeros(2 * nr, 2 * nr);
     let inverted = kinv.is_some();
     if let Some(ki) = kinv {
@@ -197,8 +199,12 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
         }
     } else {
         let mlu = mr.clone().lu();
-        let mik = mlu.solve(&kr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
-        let mig = mlu.solve(&gr).ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+        let mik = mlu
+            .solve(&kr)
+            .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
+        let mig = mlu
+            .solve(&gr)
+            .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
         for i in 0..nr {
             a[(i, nr + i)] = 1.0;
             for j in 0..nr {
@@ -207,7 +213,9 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
             }
         }
     }
-    let eig = a.eigen().map_err(|e| fail(format!("eigen solver: {e:?}")))?;
+    let eig = a
+        .eigen()
+        .map_err(|e| fail(format!("eigen solver: {e:?}")))?;
     let s_raw = eig.S();
     let u = eig.U();
     let s: Vec<faer::c64> = (0..2 * nr)

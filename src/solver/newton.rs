@@ -31,6 +31,13 @@ pub enum NewtonError {
         residual: f64,
         initial: f64,
     },
+    #[error("static Newton iterations did not converge at load factor {load_factor}: {iterations} iterations, residual norm {residual:.3e} (initial {initial:.3e})")]
+    StaticDiverged {
+        load_factor: f64,
+        iterations: usize,
+        residual: f64,
+        initial: f64,
+    },
     #[error("non-finite residual at t = {t} s, iteration {iteration}")]
     NonFinite { t: f64, iteration: usize },
     #[error("at t = {t} s, iteration {iteration}: {source}")]

@@ -177,8 +177,8 @@ pub fn static_solve(
                 break;
             }
             if it >= opts.newton.max_iterations {
-                return Err(NewtonError::Diverged {
-                    t: lf,
+                return Err(NewtonError::StaticDiverged {
+                    load_factor: lf,
                     iterations: it,
                     residual: rn,
                     initial: r0,
