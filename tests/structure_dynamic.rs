@@ -110,3 +110,39 @@ fn released_cantilever_vibrates_at_the_euler_bernoulli_frequency() {
     println!("released cantilever: omega = {w:.6} rad/s, Euler-Bernoulli {w_ref:.6}, rel error {err:.2e}");
     assert!(err < 1e-3);
 }
+
+#[test]
+fn prescribed_revolute_spins_a_rigid_body_with_centripetal_reaction() {
+    // hub node on a revolute joint about z with prescribed omega; a rigid mass with offset
+    // r along x: the joint must supply the centripetal force m omega^2 r.
+    let mut m = Model::new();
+    let hub = m.add_node("hub", [0.0; 3], rotorsim::structure::rotation::ident()).unwrap();
+    let j = m.add_joint("shaft", JointKind::Revolute, None, hub, [0.0; 3], rotorsim::structure::rotation::ident()).unwrap();
+    if let Element::Joint(jj) = &mut m.elements[j] {
+        jj.prescribed_angle = Some(AngleLaw { omega_rad_s: 3.0, table: None });
+    }
+    let (mass, r) = (2.0, 0.5);
+    m.add_element(Element::Rigid(RigidBody { name: "mass".into(), node: hub, mass_kg: mass, cm_offset_m: [r, 0.0, 0.0], inertia_kgm2: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]] })).unwrap();
+    m.add_sensor("shaft", SensorKind::Joint(j));
+    let mut st = State::from_model(&m);
+    st.set_rigid_rotation([0.0; 3], [0.0, 0.0, 3.0]);
+    let mut s = DynamicSolver::new(m, st, 0.005, 0.8).unwrap();
+    for _ in 0..400 {
+        s.step().unwrap();
+    }
+    let h = s.sensor_header();
+    let v = s.sensor_values();
+    let get = |n: &str| v[h.iter().position(|x| x == n).unwrap()];
+    let t = s.state.t;
+    let ang = get("shaft.angle_rad");
+    assert!((ang - 3.0 * t).abs() < 1e-8, "angle {ang} vs {}", 3.0 * t);
+    let (fx, fy) = (get("shaft.fx_N"), get("shaft.fy_N"));
+    let f = (fx * fx + fy * fy).sqrt();
+    let expect = mass * 9.0 * r;
+    println!("t = {t}: angle {ang:.6} rad, reaction {f:.6} N, m omega^2 r = {expect}");
+    assert!((f - expect).abs() / expect < 1e-6);
+    // reaction points from the mass to the axis
+    let q = s.state.q[0];
+    let e1 = q * nalgebra::Vector3::x();
+    assert!((fx * e1[0] + fy * e1[1]) / f < -0.999999);
+}

@@ -70,6 +70,13 @@ pub struct DynamicSolver {
     tl: Vec<[[f64; 3]; 3]>,
     x_prev: Vec<[f64; 3]>,
     lam_offsets: Vec<usize>,
+    ws_a: Vec<[f64; 6]>,
+    ws_vd: Vec<[f64; 6]>,
+    ws_v: Vec<[f64; 6]>,
+    ws_x: Vec<[f64; 3]>,
+    ws_q: Vec<nalgebra::UnitQuaternion<f64>>,
+    ws_q2: Vec<nalgebra::UnitQuaternion<f64>>,
+    ws_lam: Vec<f64>,
     /// Total Newton iterations so far.
     pub total_iterations: usize,
     pub steps: usize,
@@ -119,6 +126,13 @@ impl DynamicSolver {
             lam_offsets,
             total_iterations: 0,
             steps: 0,
+            ws_a: vec![],
+            ws_vd: vec![],
+            ws_v: vec![],
+            ws_x: vec![],
+            ws_q: vec![],
+            ws_q2: vec![],
+            ws_lam: vec![],
             state,
         };
         s.init_scaling()?;
@@ -173,12 +187,15 @@ impl DynamicSolver {
         let t = t_n + h;
         let (cv, ca) = self.coeffs();
         // predictor (vd_{n+1} = 0)
-        let mut a_new = vec![[0.0; 6]; n];
-        let mut vd_new = vec![[0.0; 6]; n];
-        let mut v_new = vec![[0.0; 6]; n];
+        let mut a_new = std::mem::take(&mut self.ws_a);
+        let mut vd_new = std::mem::take(&mut self.ws_vd);
+        let mut v_new = std::mem::take(&mut self.ws_v);
+        a_new.resize(n, [0.0; 6]);
+        vd_new.resize(n, [0.0; 6]);
+        v_new.resize(n, [0.0; 6]);
         for i in 0..n {
-            let vn = [self.state.v[i], self.state.w[i]].concat();
-            let vdn = [self.state.a[i], self.state.al[i]].concat();
+            let vn = cat(self.state.v[i], self.state.w[i]);
+            let vdn = cat(self.state.a[i], self.state.al[i]);
             for k in 0..6 {
                 a_new[i][k] = (p.alpha_f * vdn[k] - p.alpha_m * self.acc[i][k]) / (1.0 - p.alpha_m);
                 v_new[i][k] =
@@ -189,8 +206,10 @@ impl DynamicSolver {
             }
         }
         self.x_prev.clone_from(&self.state.x);
-        let q_prev = self.state.q.clone();
-        let mut lam_hat = self.lam_hat.clone();
+        let mut q_prev = std::mem::take(&mut self.ws_q);
+        q_prev.clone_from(&self.state.q);
+        let mut lam_hat = std::mem::take(&mut self.ws_lam);
+        lam_hat.clone_from(&self.lam_hat);
         let mut ctx = EvalCtx {
             t,
             load_factor: 1.0,
@@ -201,8 +220,10 @@ impl DynamicSolver {
         ctx.cscale = self.cscale;
         let mut r0 = 0.0;
         let mut it = 0;
-        let mut x_new = self.x_prev.clone();
-        let mut q_new = q_prev.clone();
+        let mut x_new = std::mem::take(&mut self.ws_x);
+        x_new.clone_from(&self.x_prev);
+        let mut q_new = std::mem::take(&mut self.ws_q2);
+        q_new.clone_from(&q_prev);
         loop {
             // configuration from dq
             for i in 0..n {
@@ -298,7 +319,7 @@ impl DynamicSolver {
         }
         // accept
         for i in 0..n {
-            let vdn = [self.state.a[i], self.state.al[i]].concat();
+            let vdn = cat(self.state.a[i], self.state.al[i]);
             for k in 0..6 {
                 self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k]
                     - p.alpha_m * self.acc[i][k])
@@ -311,7 +332,13 @@ impl DynamicSolver {
             self.state.a[i] = [vd_new[i][0], vd_new[i][1], vd_new[i][2]];
             self.state.al[i] = [vd_new[i][3], vd_new[i][4], vd_new[i][5]];
         }
-        self.lam_hat = lam_hat;
+        self.ws_lam = std::mem::replace(&mut self.lam_hat, lam_hat);
+        self.ws_a = a_new;
+        self.ws_vd = vd_new;
+        self.ws_v = v_new;
+        self.ws_x = x_new;
+        self.ws_q = q_prev;
+        self.ws_q2 = q_new;
         for (lp, l) in self.state.lambda.iter_mut().zip(&self.lam_hat) {
             *lp = l * self.cscale;
         }
@@ -408,6 +435,10 @@ impl DynamicSolver {
     pub fn energy(&self) -> (f64, f64) {
         energy(&self.model, &self.state)
     }
+}
+
+fn cat(a: [f64; 3], b: [f64; 3]) -> [f64; 6] {
+    [a[0], a[1], a[2], b[0], b[1], b[2]]
 }
 
 const IDENT: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];

@@ -140,6 +140,7 @@ pub fn static_solve(
         *l = lp / ctx.cscale;
     }
     let mut report = StaticReport::default();
+    let mut xi: Vec<[f64; 3]> = st.x.clone();
     let nsteps = opts.load_steps.max(1);
     let g = model.gravity;
     for step in 1..=nsteps {
@@ -152,7 +153,7 @@ pub fn static_solve(
         loop {
             mk_kin(st, &mut kin);
             model.update_distributed_loads(t, &kin);
-            let xi: Vec<[f64; 3]> = st.x.clone();
+            xi.copy_from_slice(&st.x);
             asm.assemble(
                 model,
                 &kin,
