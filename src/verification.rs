@@ -44,8 +44,11 @@ pub const BEND45_REF: [(f64, [f64; 3]); 3] = [
     (600.0, [47.23, 15.79, 53.37]),
 ];
 
+/// (force, computed tip, reference tip).
+pub type BendResult = (f64, [f64; 3], [f64; 3]);
+
 /// 45-degree bend: returns (force, computed tip, reference tip).
-pub fn bend45(n_elem: usize) -> Result<Vec<(f64, [f64; 3], [f64; 3])>, String> {
+pub fn bend45(n_elem: usize) -> Result<Vec<BendResult>, String> {
     let r = 100.0;
     let sec = uniform_section(1e7, 5e6, 7.05e5, 1e7 / 12.0, 1e7 / 12.0, 1.0, 1.0, 0.5, 0.5);
     let mut m = Model::new();

@@ -116,13 +116,34 @@ fn prescribed_revolute_spins_a_rigid_body_with_centripetal_reaction() {
     // hub node on a revolute joint about z with prescribed omega; a rigid mass with offset
     // r along x: the joint must supply the centripetal force m omega^2 r.
     let mut m = Model::new();
-    let hub = m.add_node("hub", [0.0; 3], rotorsim::structure::rotation::ident()).unwrap();
-    let j = m.add_joint("shaft", JointKind::Revolute, None, hub, [0.0; 3], rotorsim::structure::rotation::ident()).unwrap();
+    let hub = m
+        .add_node("hub", [0.0; 3], rotorsim::structure::rotation::ident())
+        .unwrap();
+    let j = m
+        .add_joint(
+            "shaft",
+            JointKind::Revolute,
+            None,
+            hub,
+            [0.0; 3],
+            rotorsim::structure::rotation::ident(),
+        )
+        .unwrap();
     if let Element::Joint(jj) = &mut m.elements[j] {
-        jj.prescribed_angle = Some(AngleLaw { omega_rad_s: 3.0, table: None });
+        jj.prescribed_angle = Some(AngleLaw {
+            omega_rad_s: 3.0,
+            table: None,
+        });
     }
     let (mass, r) = (2.0, 0.5);
-    m.add_element(Element::Rigid(RigidBody { name: "mass".into(), node: hub, mass_kg: mass, cm_offset_m: [r, 0.0, 0.0], inertia_kgm2: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]] })).unwrap();
+    m.add_element(Element::Rigid(RigidBody {
+        name: "mass".into(),
+        node: hub,
+        mass_kg: mass,
+        cm_offset_m: [r, 0.0, 0.0],
+        inertia_kgm2: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+    }))
+    .unwrap();
     m.add_sensor("shaft", SensorKind::Joint(j));
     let mut st = State::from_model(&m);
     st.set_rigid_rotation([0.0; 3], [0.0, 0.0, 3.0]);

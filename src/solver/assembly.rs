@@ -314,15 +314,9 @@ impl Assembler {
             &self.row_idx,
         );
         let a = SparseColMatRef::new(sym, &self.values);
-        let mut stack = MemStack::new(&mut self.buf);
+        let stack = MemStack::new(&mut self.buf);
         self.symbolic
-            .factorize_numeric_lu(
-                &mut self.numeric,
-                a,
-                Par::Seq,
-                &mut stack,
-                Default::default(),
-            )
+            .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
             .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
         self.factored = true;
         Ok(())
@@ -332,9 +326,9 @@ impl Assembler {
     pub fn solve(&mut self, rhs: &mut [f64]) {
         assert!(self.factored);
         let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        let mut stack = MemStack::new(&mut self.buf);
+        let stack = MemStack::new(&mut self.buf);
         let n = rhs.len();
         let m = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, &mut stack);
+        lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, stack);
     }
 }

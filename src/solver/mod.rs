@@ -1,4 +1,6 @@
 //! Assembly, Newton iterations, generalized-alpha time integration, static and modal analyses.
+// Index loops mirror the component formulas of the formulation.
+#![allow(clippy::needless_range_loop)]
 pub mod assembly;
 pub mod dynamic;
 pub mod fdcheck;

@@ -1,4 +1,6 @@
 //! Structural elements: rotations, geometrically exact beams, rigid bodies, joints, forces.
+// Index loops mirror the component formulas of the formulation.
+#![allow(clippy::needless_range_loop)]
 pub mod beam;
 pub mod deck;
 pub mod joint;

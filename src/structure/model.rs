@@ -89,6 +89,8 @@ pub struct Node {
 }
 
 /// Built-in elements.
+// Beams are the common case in a model; storing them inline keeps the element loop contiguous.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum Element {
     Beam(Beam),
