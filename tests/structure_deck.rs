@@ -5,16 +5,21 @@ use rotorsim::structure::*;
 use std::path::Path;
 
 fn example(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/examples")
+        .join(name)
 }
 
 #[test]
 fn all_example_decks_parse() {
-    for e in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples")).unwrap() {
+    for e in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples")).unwrap()
+    {
         let p = e.unwrap().path();
         if p.extension().map(|x| x == "toml").unwrap_or(false) {
             let name = p.display().to_string();
-            if name.contains("uh60a") && !Path::new("/work/shared/data/uh60a/blade_sections_yeo.csv").exists() {
+            if name.contains("uh60a")
+                && !Path::new("/work/shared/data/uh60a/blade_sections_yeo.csv").exists()
+            {
                 continue;
             }
             load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -26,7 +31,10 @@ fn all_example_decks_parse() {
 fn bend45_deck_matches_programmatic_model() {
     let (deck, mut m) = load_deck(&example("bend45.toml")).unwrap();
     let mut st = State::from_model(&m);
-    let opts = StaticOptions { load_steps: deck.statics.load_steps, ..Default::default() };
+    let opts = StaticOptions {
+        load_steps: deck.statics.load_steps,
+        ..Default::default()
+    };
     static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).unwrap();
     let tip = st.x[m.node_id("arc.n24").unwrap()];
     let prog = rotorsim::verification::bend45(8).unwrap()[2].1;
@@ -39,7 +47,11 @@ fn bend45_deck_matches_programmatic_model() {
 #[test]
 fn compound_pendulum_on_revolute_and_spherical_joints() {
     // rigid body hanging below a pivot; small-amplitude period 2 pi sqrt(I_O / (m g d))
-    for kind in [JointKind::Revolute, JointKind::Spherical, JointKind::Universal] {
+    for kind in [
+        JointKind::Revolute,
+        JointKind::Spherical,
+        JointKind::Universal,
+    ] {
         let mut m = Model::new();
         m.gravity = [0.0, 0.0, -9.81];
         let n = m.add_node("pivot", [0.0; 3], rotation::ident()).unwrap();

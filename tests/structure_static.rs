@@ -179,3 +179,93 @@ fn bend_45_degree_tip_positions() {
         assert!(err < 1.0, "F={f}: {x:?} vs {r:?}");
     }
 }
+
+#[test]
+fn multilane_and_single_lane_beam_tangents_agree() {
+    use rotorsim::solver::Assembler;
+    let mut sec = common::uniform(1e4, 5e3, 300.0, 500.0, 800.0, 2.0, 0.3, 0.1, 0.2);
+    sec.stations[0].cm3 = 0.04;
+    sec.stations[0].ca2 = 0.02;
+    let mut m = Model::new();
+    m.gravity = [0.0, -9.81, 0.0];
+    let ids = m
+        .add_straight_beam(
+            "b",
+            3,
+            [0.0; 3],
+            [2.0, 0.3, 0.1],
+            [0.0, 1.0, 0.0],
+            &sec,
+            0.02,
+            None,
+        )
+        .unwrap();
+    m.clamp("root", ids[0]).unwrap();
+    m.add_beam_load(
+        "b",
+        BeamLoad {
+            force_n_per_m: [0.1, 0.2, 0.3],
+            moment_nm_per_m: [0.0, 0.1, 0.0],
+            follower: true,
+            time: TimeTable::constant(),
+        },
+    )
+    .unwrap();
+    let mut st = State::from_model(&m);
+    for i in 0..st.x.len() {
+        let f = i as f64;
+        st.x[i][2] += 0.01 * f * f;
+        st.q[i] = rotorsim::structure::rotation::update_left(&st.q[i], [0.05 * f, 0.02, -0.03 * f]);
+        st.v[i] = [0.1, 0.2 * f, 0.0];
+        st.w[i] = [0.3, 0.0, 0.1 * f];
+        st.a[i] = [0.0, 1.0, f];
+        st.al[i] = [0.5, -0.5, 0.2];
+    }
+    let mut kin = vec![];
+    st.kin(&mut kin);
+    let seed = |n: usize, c: usize| {
+        let mut e = [0.0; 3];
+        e[c % 3] = 1.0 + 0.1 * n as f64;
+        if c < 3 {
+            Seed {
+                dx: e,
+                dv: [0.3 * e[0], 0.2 * e[1], e[2]],
+                da: [2.0 * e[0], e[1], 0.5 * e[2]],
+                ..Default::default()
+            }
+        } else {
+            Seed {
+                dth: [e[0], 0.5 * e[1], e[2]],
+                dw: e,
+                dal: [e[2], e[0], e[1]],
+                ..Default::default()
+            }
+        }
+    };
+    let ctx = EvalCtx {
+        t: 0.1,
+        load_factor: 1.0,
+        gravity: m.gravity,
+        cscale: 3.0,
+        inertia: true,
+    };
+    let lam = vec![0.5; m.n_lambda()];
+    let mut a1 = Assembler::new(&m).unwrap();
+    let mut a2 = Assembler::new(&m).unwrap();
+    a2.multilane = false;
+    let mut r1 = vec![0.0; a1.ndof];
+    let mut r2 = vec![0.0; a1.ndof];
+    a1.assemble(&mut m, &kin, &lam, &ctx, &seed, None, true, &mut r1)
+        .unwrap();
+    a2.assemble(&mut m, &kin, &lam, &ctx, &seed, None, true, &mut r2)
+        .unwrap();
+    let scale = a2.values.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let diff = a1
+        .values
+        .iter()
+        .zip(&a2.values)
+        .fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
+    println!("multi-lane vs single-lane: max difference {diff:.2e} (scale {scale:.2e})");
+    assert!(diff <= 1e-12 * scale);
+    assert_eq!(r1, r2);
+}

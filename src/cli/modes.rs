@@ -125,7 +125,11 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
         let hs: Vec<&str> = h.iter().map(|s| s.as_str()).collect();
         out.write("fan.csv", csv_string(&hs, &fan).as_bytes())?;
         let sp: Vec<f64> = fan.iter().map(|r| r[0]).collect();
-        let mut plot = crate::report::plot::Plot::new("Fan plot (modes sorted by frequency)", "rotor speed [rad/s]", "frequency [Hz]");
+        let mut plot = crate::report::plot::Plot::new(
+            "Fan plot (modes sorted by frequency)",
+            "rotor speed [rad/s]",
+            "frequency [Hz]",
+        );
         for k in 1..=md.count {
             let f: Vec<f64> = fan.iter().map(|r| r[k]).collect();
             if f.iter().all(|v| v.is_finite()) {
@@ -133,7 +137,10 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
             }
         }
         for n in 1..=4 {
-            let f: Vec<f64> = sp.iter().map(|w| n as f64 * w / (2.0 * std::f64::consts::PI)).collect();
+            let f: Vec<f64> = sp
+                .iter()
+                .map(|w| n as f64 * w / (2.0 * std::f64::consts::PI))
+                .collect();
             plot = plot.dashed(&format!("{n}/rev"), &sp, &f);
         }
         out.write("fan.svg", plot.to_svg(900, 600)?.as_bytes())?;

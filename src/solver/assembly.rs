@@ -2,7 +2,7 @@
 //! dual numbers, sparse LU (faer) with the symbolic factorisation done once.
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
 use crate::structure::model::{Element, ElementError, ElementOutput, Model};
-use crate::structure::real::{c, Dual, Real};
+use crate::structure::real::{c, Dual, DualN, Real};
 use crate::structure::rotation::*;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
@@ -37,6 +37,30 @@ pub struct Assembler {
     buf: MemBuffer,
     factored: bool,
     step_out: ElementOutput,
+    /// Beam tangents from one 24-lane dual evaluation (true) or 24 single-lane ones (false);
+    /// both give the same exact derivatives.
+    pub multilane: bool,
+}
+
+/// Node kinematics with the 6 seeds of local node `l` in lanes 6l..6l+6.
+fn seeded_lanes(k: &NodeKin<f64>, l: usize, seed: &dyn Fn(usize) -> Seed) -> NodeKin<DualN<24>> {
+    let mut out: NodeKin<DualN<24>> = k.lift();
+    for c in 0..6 {
+        let s = seed(c);
+        let lane = 6 * l + c;
+        let dr = mm(&skew(s.dth), &k.r);
+        for i in 0..3 {
+            out.x[i].d[lane] = s.dx[i];
+            out.v[i].d[lane] = s.dv[i];
+            out.w[i].d[lane] = s.dw[i];
+            out.a[i].d[lane] = s.da[i];
+            out.al[i].d[lane] = s.dal[i];
+            for j in 0..3 {
+                out.r[i][j].d[lane] = dr[i][j];
+            }
+        }
+    }
+    out
 }
 
 fn seeded_node(k: &NodeKin<f64>, s: Option<&Seed>) -> NodeKin<Dual<f64>> {
@@ -170,6 +194,7 @@ impl Assembler {
             buf: MemBuffer::new(req),
             factored: false,
             step_out: ElementOutput::default(),
+            multilane: true,
         })
     }
 
@@ -245,6 +270,21 @@ impl Assembler {
                 continue;
             }
             let pos = &self.elem_pos[ei];
+            if let (Element::Beam(bm), true) = (e, self.multilane) {
+                // all 24 columns from one multi-lane evaluation
+                let mut k24 = [NodeKin::<DualN<24>>::ground(); 4];
+                for l in 0..4 {
+                    k24[l] = seeded_lanes(&kf[l], l, &|c| seed(dofs[6 * l] / 6, c));
+                }
+                let mut o24 = [DualN::<24>::default(); 24];
+                bm.residual(&k24, ctx, &mut o24);
+                for a in 0..24 {
+                    for b in 0..24 {
+                        self.values[pos[a * 24 + b]] += o24[a].d[b];
+                    }
+                }
+                continue;
+            }
             for l in 0..nnodes {
                 kd[l] = seeded_node(&kf[l], None);
             }

@@ -198,3 +198,161 @@ mod tests {
         assert!((y.d.d - 6.0 * 0.4).abs() < 1e-12);
     }
 }
+
+/// Multi-lane dual number: one value and `N` directional derivatives, so that all columns of an
+/// element tangent come from a single evaluation (shares the real-part work).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualN<const N: usize> {
+    pub v: f64,
+    pub d: [f64; N],
+}
+
+impl<const N: usize> DualN<N> {
+    #[inline]
+    pub fn new(v: f64, d: [f64; N]) -> Self {
+        DualN { v, d }
+    }
+    #[inline]
+    fn chain(self, v: f64, f: f64) -> Self {
+        let mut d = self.d;
+        for x in d.iter_mut() {
+            *x *= f;
+        }
+        DualN { v, d }
+    }
+}
+
+impl<const N: usize> Default for DualN<N> {
+    fn default() -> Self {
+        DualN {
+            v: 0.0,
+            d: [0.0; N],
+        }
+    }
+}
+
+impl<const N: usize> Add for DualN<N> {
+    type Output = Self;
+    #[inline]
+    fn add(mut self, o: Self) -> Self {
+        self.v += o.v;
+        for i in 0..N {
+            self.d[i] += o.d[i];
+        }
+        self
+    }
+}
+impl<const N: usize> Sub for DualN<N> {
+    type Output = Self;
+    #[inline]
+    fn sub(mut self, o: Self) -> Self {
+        self.v -= o.v;
+        for i in 0..N {
+            self.d[i] -= o.d[i];
+        }
+        self
+    }
+}
+impl<const N: usize> Mul for DualN<N> {
+    type Output = Self;
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        let mut d = [0.0; N];
+        for i in 0..N {
+            d[i] = self.v * o.d[i] + self.d[i] * o.v;
+        }
+        DualN { v: self.v * o.v, d }
+    }
+}
+impl<const N: usize> Div for DualN<N> {
+    type Output = Self;
+    #[inline]
+    fn div(self, o: Self) -> Self {
+        let inv = 1.0 / o.v;
+        let q = self.v * inv;
+        let mut d = [0.0; N];
+        for i in 0..N {
+            d[i] = (self.d[i] - q * o.d[i]) * inv;
+        }
+        DualN { v: q, d }
+    }
+}
+impl<const N: usize> Neg for DualN<N> {
+    type Output = Self;
+    #[inline]
+    fn neg(mut self) -> Self {
+        self.v = -self.v;
+        for x in self.d.iter_mut() {
+            *x = -*x;
+        }
+        self
+    }
+}
+impl<const N: usize> AddAssign for DualN<N> {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        self.v += o.v;
+        for i in 0..N {
+            self.d[i] += o.d[i];
+        }
+    }
+}
+impl<const N: usize> SubAssign for DualN<N> {
+    #[inline]
+    fn sub_assign(&mut self, o: Self) {
+        self.v -= o.v;
+        for i in 0..N {
+            self.d[i] -= o.d[i];
+        }
+    }
+}
+impl<const N: usize> MulAssign for DualN<N> {
+    #[inline]
+    fn mul_assign(&mut self, o: Self) {
+        *self = *self * o;
+    }
+}
+
+impl<const N: usize> Real for DualN<N> {
+    #[inline]
+    fn cst(v: f64) -> Self {
+        DualN { v, d: [0.0; N] }
+    }
+    #[inline]
+    fn re(&self) -> f64 {
+        self.v
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        let s = self.v.sqrt();
+        self.chain(s, 0.5 / s)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        self.chain(self.v.sin(), self.v.cos())
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        self.chain(self.v.cos(), -self.v.sin())
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        let den = 1.0 / (x.v * x.v + self.v * self.v);
+        let mut d = [0.0; N];
+        for i in 0..N {
+            d[i] = (x.v * self.d[i] - self.v * x.d[i]) * den;
+        }
+        DualN {
+            v: self.v.atan2(x.v),
+            d,
+        }
+    }
+    #[inline]
+    fn scale(mut self, s: f64) -> Self {
+        self.v *= s;
+        for x in self.d.iter_mut() {
+            *x *= s;
+        }
+        self
+    }
+}
