@@ -124,3 +124,106 @@ fn actuator_pitches_a_beam_deck_follows_the_rigid_body_estimate() {
     println!("pitch angle at 1 s: {ang_1s:.5} rad, rigid-body estimate {expect:.5} rad");
     assert!((ang_1s.abs() - expect).abs() / expect < 0.05);
 }
+
+#[test]
+fn revolute_spring_damper_and_prescribed_displacement() {
+    // flywheel on a revolute joint with torsional spring k and damper c: free vibration at
+    // omega_d = omega_n sqrt(1 - zeta^2), decay exp(-zeta omega_n t)
+    let (k, c, j) = (40.0, 0.4, 0.5);
+    let mut m = Model::new();
+    let n = m.add_node("hub", [0.0; 3], rotation::ident()).unwrap();
+    let jid = m
+        .add_joint(
+            "shaft",
+            JointKind::Revolute,
+            None,
+            n,
+            [0.0; 3],
+            rotation::ident(),
+        )
+        .unwrap();
+    if let Element::Joint(jj) = &mut m.elements[jid] {
+        jj.spring_nm_per_rad = k;
+        jj.damper_nms_per_rad = c;
+    }
+    m.add_element(Element::Rigid(RigidBody {
+        name: "wheel".into(),
+        node: n,
+        mass_kg: 1.0,
+        cm_offset_m: [0.0; 3],
+        inertia_kgm2: [[0.3, 0.0, 0.0], [0.0, 0.3, 0.0], [0.0, 0.0, j]],
+    }))
+    .unwrap();
+    m.add_sensor("shaft", SensorKind::Joint(jid));
+    let mut st = State::from_model(&m);
+    st.w[n] = [0.0, 0.0, 1.0];
+    let wn = (k / j).sqrt();
+    let zeta = c / (2.0 * (k * j).sqrt());
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    let h = 2.0 * std::f64::consts::PI / wd / 400.0;
+    let mut s = DynamicSolver::new(m, st, h, 1.0).unwrap();
+    let ia = s
+        .sensor_header()
+        .iter()
+        .position(|x| x == "shaft.angle_rad")
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for _ in 0..800 {
+        s.step().unwrap();
+        let t = s.state.t;
+        let exact = (1.0 / wd) * (-zeta * wn * t).exp() * (wd * t).sin();
+        worst = worst.max((s.sensor_values()[ia] - exact).abs());
+    }
+    println!(
+        "spring-damper flywheel: max |angle - exact| = {worst:.2e} rad (amplitude {:.3})",
+        1.0 / wd
+    );
+    assert!(worst < 2e-3 * (1.0 / wd));
+
+    // prescribed displacement: a node follows u(t) = (0.1, 0, -0.05) * table(t)
+    let mut m = Model::new();
+    let n = m.add_node("p", [1.0, 0.0, 0.0], rotation::ident()).unwrap();
+    let jid = m
+        .add_joint(
+            "drive",
+            JointKind::Clamp,
+            None,
+            n,
+            [1.0, 0.0, 0.0],
+            rotation::ident(),
+        )
+        .unwrap();
+    if let Element::Joint(jj) = &mut m.elements[jid] {
+        jj.displacement_m = Some((
+            [0.1, 0.0, -0.05],
+            TimeTable {
+                points: vec![(0.0, 0.0), (1.0, 1.0), (2.0, -1.0)],
+            },
+        ));
+    }
+    m.add_element(Element::Rigid(RigidBody {
+        name: "b".into(),
+        node: n,
+        mass_kg: 2.0,
+        cm_offset_m: [0.0; 3],
+        inertia_kgm2: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+    }))
+    .unwrap();
+    let st = State::from_model(&m);
+    let mut s = DynamicSolver::new(m, st, 0.01, 0.8).unwrap();
+    for _ in 0..150 {
+        s.step().unwrap();
+    }
+    // t = 1.5: factor 0 -> x = 1.0, z = 0
+    let x = s.state.x[0];
+    assert!((x[0] - 1.0).abs() < 1e-10 && x[2].abs() < 1e-10, "{x:?}");
+    for _ in 0..20 {
+        s.step().unwrap();
+    }
+    let x = s.state.x[0];
+    // t = 1.7: factor -0.4
+    assert!(
+        (x[0] - 0.96).abs() < 1e-10 && (x[2] - 0.02).abs() < 1e-10,
+        "{x:?}"
+    );
+}
