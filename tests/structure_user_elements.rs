@@ -127,6 +127,10 @@ fn step_element_damper_is_committed_once_per_converged_step_and_can_abort() {
         s.step().unwrap();
         amp.push(s.sensor_values());
     }
+    // with the exact step-element tangent the iteration count is that of the undamped case
+    // (169 for 40 steps of 0.5 s, measured)
+    println!("Newton iterations over 40 steps: {}", s.total_iterations);
+    assert!(s.total_iterations <= 175, "{}", s.total_iterations);
     let hdr = s.sensor_header();
     let ic = hdr.iter().position(|h| h == "damper.commits").unwrap();
     let iz = hdr.iter().position(|h| h == "tip.z_m").unwrap();
