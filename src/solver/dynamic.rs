@@ -77,6 +77,8 @@ pub struct DynamicSolver {
     ws_q: Vec<nalgebra::UnitQuaternion<f64>>,
     ws_q2: Vec<nalgebra::UnitQuaternion<f64>>,
     ws_lam: Vec<f64>,
+    /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
+    pub last_residuals: Vec<f64>,
     /// Total Newton iterations so far.
     pub total_iterations: usize,
     pub steps: usize,
@@ -133,6 +135,7 @@ impl DynamicSolver {
             ws_q: vec![],
             ws_q2: vec![],
             ws_lam: vec![],
+            last_residuals: Vec::with_capacity(64),
             state,
         };
         s.init_scaling()?;
@@ -220,6 +223,7 @@ impl DynamicSolver {
         ctx.cscale = self.cscale;
         let mut r0 = 0.0;
         let mut it = 0;
+        self.last_residuals.clear();
         let mut x_new = std::mem::take(&mut self.ws_x);
         x_new.clone_from(&self.x_prev);
         let mut q_new = std::mem::take(&mut self.ws_q2);
@@ -264,6 +268,9 @@ impl DynamicSolver {
             let rn = norm(&self.res);
             if !rn.is_finite() {
                 return Err(NewtonError::NonFinite { t, iteration: it });
+            }
+            if self.last_residuals.len() < self.last_residuals.capacity() {
+                self.last_residuals.push(rn);
             }
             if it == 0 {
                 r0 = rn;
