@@ -232,3 +232,60 @@ fn newton_converges_quadratically_with_large_rotations_and_constraints() {
     );
     assert!(worst < 1e-2, "{worst}");
 }
+
+#[test]
+fn stiffness_proportional_damping_gives_modal_damping_mu_omega_over_two() {
+    use rotorsim::solver::{static_solve, StaticOptions};
+    let (ei, l, mu) = (100.0, 10.0_f64, 0.05);
+    let sec = common::uniform(1e6, 1e6, 100.0, ei, ei, 1.0, 1e-4, 5e-5, 5e-5);
+    let mut m = Model::new();
+    let ids = m
+        .add_straight_beam(
+            "b",
+            6,
+            [0.0; 3],
+            [l, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            &sec,
+            mu,
+            None,
+        )
+        .unwrap();
+    m.clamp("root", ids[0]).unwrap();
+    let tip = *ids.last().unwrap();
+    let load = m
+        .add_element(Element::Load(PointLoad {
+            name: "f".into(),
+            node: tip,
+            force_n: [0.0, 0.0, 0.01],
+            moment_nm: [0.0; 3],
+            follower: false,
+            time: TimeTable::constant(),
+        }))
+        .unwrap();
+    let mut st = State::from_model(&m);
+    static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {}).unwrap();
+    if let Element::Load(p) = &mut m.elements[load] {
+        p.force_n = [0.0; 3];
+    }
+    let w1 = 3.516015 * (ei / l.powi(4)).sqrt();
+    let period = 2.0 * std::f64::consts::PI / w1;
+    let h = period / 200.0;
+    let mut s = DynamicSolver::new(m, st, h, 1.0).unwrap();
+    let mut z = vec![];
+    for _ in 0..(200 * 8) {
+        s.step().unwrap();
+        z.push(s.state.x[tip][2]);
+    }
+    // positive peaks after the higher modes have decayed
+    let peaks: Vec<f64> = (1..z.len() - 1)
+        .filter(|&i| z[i] > z[i - 1] && z[i] >= z[i + 1] && z[i] > 0.0)
+        .map(|i| z[i])
+        .collect();
+    let n = peaks.len() - 1;
+    let delta = (peaks[2] / peaks[n]).ln() / (n - 2) as f64;
+    let zeta = delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt();
+    let expect = mu * w1 / 2.0;
+    println!("stiffness-proportional damping: zeta = {zeta:.5}, mu omega_1 / 2 = {expect:.5}");
+    assert!((zeta - expect).abs() / expect < 0.02);
+}
