@@ -208,6 +208,15 @@ impl Assembler {
         self.values[self.col_ptr[i] + s.binary_search(&i).unwrap()]
     }
 
+    /// Replace the entries of rows `>= first_row` by those of `other` (same pattern).
+    pub fn overwrite_rows_from(&mut self, other: &[f64], first_row: usize) {
+        for (p, &r) in self.row_idx.iter().enumerate() {
+            if r >= first_row {
+                self.values[p] = other[p];
+            }
+        }
+    }
+
     /// Dense copy of the assembled matrix (tests, modal analysis).
     pub fn to_dense(&self) -> Vec<Vec<f64>> {
         let mut m = vec![vec![0.0; self.ndof]; self.ndof];

@@ -361,22 +361,21 @@ impl DynamicSolver {
         })
     }
 
-    /// Consistent initial accelerations for a model without constraints: solves
-    /// `M vd_0 = -r(q_0, v_0, vd = 0)` (inertial forces, gravity, applied loads at t_0) and uses
-    /// them as the initial algorithmic accelerations. Models with constraints keep the
-    /// accelerations given in the state.
+    /// Consistent initial accelerations: solves `M vd_0 + B^T lambda_0 = -r(q_0, v_0, vd = 0)`
+    /// with `B vd_0 = -gamma`, `gamma = d^2 Phi / dt^2` along `(x + v t, exp(w t) R, t)`
+    /// (velocity-dependent and explicit-time terms, by a Richardson-extrapolated second
+    /// difference), and uses them as the initial algorithmic accelerations; also sets the
+    /// initial multipliers.
     pub fn init_accelerations(&mut self) -> Result<(), NewtonError> {
-        if !self.lam_hat.is_empty() {
-            return Ok(());
-        }
         let t = self.state.t;
         let n = self.model.nodes.len();
+        let nn = 6 * n;
         for i in 0..n {
             self.state.a[i] = [0.0; 3];
             self.state.al[i] = [0.0; 3];
         }
         self.state.kin(&mut self.kin);
-        let seed = |_: usize, comp: usize| {
+        let seed_acc = |_: usize, comp: usize| {
             let mut e = [0.0; 3];
             e[comp % 3] = 1.0;
             if comp < 3 {
@@ -400,32 +399,109 @@ impl DynamicSolver {
         };
         self.model.update_distributed_loads(t, &self.kin);
         let xp = self.state.x.clone();
+        let zero_lam = vec![0.0; self.lam_hat.len()];
+        if !self.lam_hat.is_empty() {
+            // constraint rows: B from the configuration seeds
+            let mut tmp = vec![0.0; self.asm.ndof];
+            self.asm
+                .assemble(
+                    &mut self.model,
+                    &self.kin,
+                    &zero_lam,
+                    &ctx,
+                    &super::statics::static_seed([0.0; 3]),
+                    Some((t, 0.0, &xp)),
+                    true,
+                    &mut tmp,
+                )
+                .map_err(|source| NewtonError::Element { t, source })?;
+        }
+        let b_values = self.asm.values.clone();
         self.asm
             .assemble(
                 &mut self.model,
                 &self.kin,
-                &self.lam_hat,
+                &zero_lam,
                 &ctx,
-                &seed,
+                &seed_acc,
                 Some((t, 0.0, &xp)),
                 true,
                 &mut self.res,
             )
             .map_err(|source| NewtonError::Element { t, source })?;
+        self.asm.overwrite_rows_from(&b_values, nn);
+        for r in self.res.iter_mut().take(nn) {
+            *r = -*r;
+        }
+        // acceleration-level constraint right-hand side
+        let size = self.size;
+        let wmax = self
+            .state
+            .w
+            .iter()
+            .flat_map(|w| w.iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let vmax = self
+            .state
+            .v
+            .iter()
+            .flat_map(|v| v.iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let tau = 1e-2 / (1.0 + wmax + vmax / size);
+        let mut row = nn;
+        for e in &self.model.elements {
+            if let crate::structure::model::Element::Joint(j) = e {
+                let nl = j.n_lambda();
+                let phi_at = |s: f64, out: &mut [f64; 6]| {
+                    let mv_node = |k: &NodeKin<f64>| NodeKin {
+                        x: add(k.x, fmul(s, k.v)),
+                        r: mm(&exp_map(fmul(s, k.w)), &k.r),
+                        ..*k
+                    };
+                    let a = j
+                        .node_a
+                        .map(|i| mv_node(&self.kin[i]))
+                        .unwrap_or_else(NodeKin::ground);
+                    let b = mv_node(&self.kin[j.node_b]);
+                    j.phi(&a, &b, t + s, out);
+                };
+                let mut g0 = [0.0; 6];
+                phi_at(0.0, &mut g0);
+                let second = |tau: f64| {
+                    let mut gp = [0.0; 6];
+                    let mut gm = [0.0; 6];
+                    phi_at(tau, &mut gp);
+                    phi_at(-tau, &mut gm);
+                    std::array::from_fn::<f64, 6, _>(|k| {
+                        (gp[k] - 2.0 * g0[k] + gm[k]) / (tau * tau)
+                    })
+                };
+                let d1 = second(tau);
+                let d2 = second(0.5 * tau);
+                for k in 0..nl {
+                    let gamma = (4.0 * d2[k] - d1[k]) / 3.0;
+                    self.res[row + k] = -self.cscale * gamma;
+                }
+                row += nl;
+            }
+        }
         self.asm.factor().map_err(|source| NewtonError::Linear {
             t,
             iteration: 0,
             source,
         })?;
-        for r in self.res.iter_mut() {
-            *r = -*r;
-        }
         self.asm.solve(&mut self.res);
         for i in 0..n {
             let r = &self.res[6 * i..6 * i + 6];
             self.state.a[i] = [r[0], r[1], r[2]];
             self.state.al[i] = [r[3], r[4], r[5]];
             self.acc[i].copy_from_slice(r);
+        }
+        for (k, l) in self.lam_hat.iter_mut().enumerate() {
+            *l = self.res[nn + k];
+        }
+        for (lp, l) in self.state.lambda.iter_mut().zip(&self.lam_hat) {
+            *lp = l * self.cscale;
         }
         Ok(())
     }
