@@ -66,6 +66,18 @@ fn joint_with_missing_node_is_reported() {
 }
 
 #[test]
+fn unconnected_node_is_reported() {
+    let e = err(&format!(
+        "{BASE}\n[[node]]\nname = \"lonely\"\nposition_m = [0.0, 1.0, 0.0]\n"
+    ));
+    println!("{e}");
+    assert!(
+        e.contains("node `lonely`") && e.contains("not connected"),
+        "{e}"
+    );
+}
+
+#[test]
 fn singular_constraint_set_is_reported() {
     let text =
         format!("{BASE}\n[[joint]]\nname = \"again\"\ntype = \"revolute\"\nnode_b = \"b.n0\"\n");

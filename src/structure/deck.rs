@@ -532,5 +532,17 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
         };
         m.add_sensor(&s.name, kind);
     }
+    let mut used = vec![false; m.nodes.len()];
+    for e in &m.elements {
+        for n in e.node_list() {
+            used[n] = true;
+        }
+    }
+    if let Some(i) = used.iter().position(|u| !u) {
+        return Err(inv(
+            format!("node `{}`", m.nodes[i].name),
+            "not connected to any element or joint (it would have no mass and no stiffness)".into(),
+        ));
+    }
     Ok(m)
 }
