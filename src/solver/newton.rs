@@ -31,7 +31,7 @@ pub enum NewtonError {
         residual: f64,
         initial: f64,
     },
-    #[error("static Newton iterations did not converge at load factor {load_factor}: {iterations} iterations, residual norm {residual:.3e} (initial {initial:.3e})")]
+    #[error("static Newton iterations did not converge at load factor {load_factor}: {iterations} iterations, residual norm {residual:.3e} (initial {initial:.3e}); try more load steps, and check that every rigid-body motion and mechanism dof is restrained (a free revolute has no static equilibrium under load)")]
     StaticDiverged {
         load_factor: f64,
         iterations: usize,
