@@ -2,9 +2,9 @@
 //! generalized-alpha steps on one core. Reports cost per step; iterations per step are printed
 //! so that the cost per Newton iteration follows.
 use criterion::{criterion_group, criterion_main, Criterion};
+use rotorsim::solver::verification::{cantilever, uniform_section};
 use rotorsim::solver::{static_solve, DynamicSolver, State, StaticOptions};
 use rotorsim::structure::Element;
-use rotorsim::verification::{cantilever, uniform_section};
 
 fn released_cantilever(n_elem: usize) -> DynamicSolver {
     let sec = uniform_section(1e6, 1e6, 100.0, 100.0, 100.0, 1.0, 1e-4, 5e-5, 5e-5);

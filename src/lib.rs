@@ -11,4 +11,3 @@ pub mod report;
 pub mod rotor;
 pub mod solver;
 pub mod structure;
-pub mod verification;

@@ -1,4 +1,4 @@
-use rotorsim::verification::mesh_convergence;
+use rotorsim::solver::verification::mesh_convergence;
 
 #[test]
 fn mesh_convergence_observed_orders() {

@@ -37,7 +37,7 @@ fn bend45_deck_matches_programmatic_model() {
     };
     static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).unwrap();
     let tip = st.x[m.node_id("arc.n24").unwrap()];
-    let prog = rotorsim::verification::bend45(8).unwrap()[2].1;
+    let prog = rotorsim::solver::verification::bend45(8).unwrap()[2].1;
     println!("deck tip {tip:?}, programmatic {prog:?}");
     for k in 0..3 {
         assert!((tip[k] - prog[k]).abs() < 1e-6);

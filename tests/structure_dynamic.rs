@@ -1,7 +1,8 @@
-mod common;
+mod structure_common;
 use rotorsim::solver::dynamic::{energy, momentum};
 use rotorsim::solver::{DynamicSolver, State};
 use rotorsim::structure::*;
+use structure_common as common;
 
 fn free_beam() -> (Model, State) {
     // Free-flying flexible beam (in the spirit of Simo & Vu-Quoc 1988): initial rigid spin and
@@ -105,7 +106,7 @@ fn free_flying_beam_energy_never_grows_with_numerical_dissipation() {
 
 #[test]
 fn released_cantilever_vibrates_at_the_euler_bernoulli_frequency() {
-    let (w, w_ref) = rotorsim::verification::cantilever_release(8, 200, 6).unwrap();
+    let (w, w_ref) = rotorsim::solver::verification::cantilever_release(8, 200, 6).unwrap();
     let err = (w - w_ref).abs() / w_ref;
     println!("released cantilever: omega = {w:.6} rad/s, Euler-Bernoulli {w_ref:.6}, rel error {err:.2e}");
     assert!(err < 1e-3);

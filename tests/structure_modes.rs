@@ -1,4 +1,4 @@
-use rotorsim::verification::rotating_cantilever;
+use rotorsim::solver::verification::rotating_cantilever;
 
 #[test]
 fn rotating_cantilever_flap_lag_torsion_frequencies() {

@@ -1,7 +1,8 @@
-mod common;
+mod structure_common;
 use rotorsim::solver::fdcheck::check_model;
 use rotorsim::solver::{static_solve, State, StaticOptions};
 use rotorsim::structure::*;
+use structure_common as common;
 
 #[test]
 fn roll_up_cantilever_tip_returns_to_root() {
@@ -171,7 +172,7 @@ fn beam_joint_and_body_tangents_match_finite_differences() {
 /// Vu-Quoc (1986).
 #[test]
 fn bend_45_degree_tip_positions() {
-    let res = rotorsim::verification::bend45(8).unwrap();
+    let res = rotorsim::solver::verification::bend45(8).unwrap();
     for (f, x, r) in &res {
         let err = ((x[0] - r[0]).powi(2) + (x[1] - r[1]).powi(2) + (x[2] - r[2]).powi(2)).sqrt();
         println!("F = {f}: tip {:.2?} ref {:?} |err| = {err:.3}", x, r);

@@ -1,8 +1,8 @@
 //! User elements with internal state (StepElement) and external distributed loads.
 use rotorsim::solver::fdcheck::check_model;
+use rotorsim::solver::verification::{cantilever, uniform_section};
 use rotorsim::solver::{static_solve, DynamicSolver, NewtonError, State, StaticOptions};
 use rotorsim::structure::*;
-use rotorsim::verification::{cantilever, uniform_section};
 
 /// Linear spring-dashpot between two nodes with a committed-state counter; errors when the
 /// stretch exceeds a limit.

@@ -1,7 +1,7 @@
 //! `rotorsim verify` (issue #3): runs the structural verification suite, writes DIR/verify.json
 //! (`{case, quantity, computed, reference, rel_error, source, tolerance, pass}`) and a table.
 use crate::io::OutDir;
-use crate::verification::*;
+use crate::solver::verification::*;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -8,6 +8,7 @@ pub mod modal;
 pub mod newton;
 pub mod state;
 pub mod statics;
+pub mod verification;
 
 pub use assembly::Assembler;
 

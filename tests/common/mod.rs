@@ -1,2 +1,0 @@
-#![allow(dead_code)]
-pub use rotorsim::verification::uniform_section as uniform;
