@@ -16,7 +16,8 @@ pub struct VerifyArgs {
 struct Entry {
     #[serde(flatten)]
     check: Check,
-    tolerance: f64,
+    /// Tolerance on rel_error; null where the criterion is stated in `source` (observed order).
+    tolerance: Option<f64>,
     pass: bool,
 }
 
