@@ -1,1 +1,22 @@
 //! Structural elements: rotations, geometrically exact beams, rigid bodies, joints, forces.
+// Index loops mirror the component formulas of the formulation.
+#![allow(clippy::needless_range_loop)]
+pub mod beam;
+pub mod deck;
+pub mod joint;
+pub mod kin;
+pub mod model;
+pub mod real;
+pub mod rigid;
+pub mod rotation;
+pub mod section;
+
+pub use beam::{Beam, BeamLoad, SectionLoad};
+pub use joint::{AngleLaw, Joint, JointKind};
+pub use kin::{EvalCtx, NodeKin, Seed, TimeTable};
+pub use model::{
+    DistributedLoad, Element, ElementError, ElementOutput, LoadPoint, Model, ModelError, Sensor,
+    SensorKind, StepElement,
+};
+pub use rigid::{PointLoad, RigidBody};
+pub use section::{SectionProps, SectionTable};

@@ -1,0 +1,383 @@
+//! Global assembly: dof numbering, sparse pattern (built once), residual and tangent by seeded
+//! dual numbers, sparse LU (faer) with the symbolic factorisation done once.
+use crate::structure::kin::{EvalCtx, NodeKin, Seed};
+use crate::structure::model::{Element, ElementError, ElementOutput, Model};
+use crate::structure::real::{c, Dual, DualN, Real};
+use crate::structure::rotation::*;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par};
+use thiserror::Error;
+
+/// Largest number of local dofs of a built-in element (beam: 4 nodes x 6).
+pub const MAXL: usize = 24;
+
+#[derive(Debug, Error)]
+pub enum LinearError {
+    #[error("sparse LU factorisation failed (singular iteration matrix: check for redundant or conflicting constraints, unconstrained rigid-body motion, or zero mass with free dofs): {0}")]
+    Singular(String),
+}
+
+/// Dof layout: node n has dofs 6n..6n+6 (translation, rotation); multipliers follow.
+pub struct Assembler {
+    pub n_nodes: usize,
+    pub ndof: usize,
+    /// Global dofs of each element (local order).
+    pub elem_dofs: Vec<Vec<usize>>,
+    /// First multiplier dof of each element.
+    pub lam_start: Vec<usize>,
+    elem_pos: Vec<Vec<usize>>,
+    step_pos: Vec<Vec<usize>>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    pub values: Vec<f64>,
+    symbolic: SymbolicLu<usize>,
+    numeric: NumericLu<usize, f64>,
+    buf: MemBuffer,
+    factored: bool,
+    step_out: ElementOutput,
+    /// Beam tangents from one 24-lane dual evaluation (true) or 24 single-lane ones (false);
+    /// both give the same exact derivatives.
+    pub multilane: bool,
+}
+
+/// Node kinematics with the 6 seeds of local node `l` in lanes 6l..6l+6.
+fn seeded_lanes(k: &NodeKin<f64>, l: usize, seed: &dyn Fn(usize) -> Seed) -> NodeKin<DualN<24>> {
+    let mut out: NodeKin<DualN<24>> = k.lift();
+    for c in 0..6 {
+        let s = seed(c);
+        let lane = 6 * l + c;
+        let dr = mm(&skew(s.dth), &k.r);
+        for i in 0..3 {
+            out.x[i].d[lane] = s.dx[i];
+            out.v[i].d[lane] = s.dv[i];
+            out.w[i].d[lane] = s.dw[i];
+            out.a[i].d[lane] = s.da[i];
+            out.al[i].d[lane] = s.dal[i];
+            for j in 0..3 {
+                out.r[i][j].d[lane] = dr[i][j];
+            }
+        }
+    }
+    out
+}
+
+fn seeded_node(k: &NodeKin<f64>, s: Option<&Seed>) -> NodeKin<Dual<f64>> {
+    let d = |v: &[f64; 3], e: &[f64; 3]| -> [Dual<f64>; 3] {
+        std::array::from_fn(|i| Dual::new(v[i], e[i]))
+    };
+    let z = [0.0; 3];
+    match s {
+        None => NodeKin {
+            x: d(&k.x, &z),
+            r: std::array::from_fn(|i| d(&k.r[i], &z)),
+            v: d(&k.v, &z),
+            w: d(&k.w, &z),
+            a: d(&k.a, &z),
+            al: d(&k.al, &z),
+        },
+        Some(s) => {
+            let dr = mm(&skew(s.dth), &k.r);
+            NodeKin {
+                x: d(&k.x, &s.dx),
+                r: std::array::from_fn(|i| d(&k.r[i], &dr[i])),
+                v: d(&k.v, &s.dv),
+                w: d(&k.w, &s.dw),
+                a: d(&k.a, &s.da),
+                al: d(&k.al, &s.dal),
+            }
+        }
+    }
+}
+
+/// Residual of one built-in element in scalar `T`; `k` holds the element's nodes in order.
+pub fn element_residual<T: Real>(
+    e: &Element,
+    k: &[NodeKin<T>],
+    lam: &[T],
+    ctx: &EvalCtx,
+    out: &mut [T],
+) {
+    match e {
+        Element::Beam(b) => {
+            let kk = [k[0], k[1], k[2], k[3]];
+            b.residual(&kk, ctx, out)
+        }
+        Element::Rigid(b) => b.residual(&k[0], ctx, out),
+        Element::Load(l) => l.residual(&k[0], ctx, out),
+        Element::Joint(j) => {
+            if j.node_a.is_some() {
+                j.residual(&k[0], &k[1], lam, ctx, out)
+            } else {
+                j.residual(&NodeKin::ground(), &k[0], lam, ctx, out)
+            }
+        }
+    }
+}
+
+impl Assembler {
+    pub fn new(model: &Model) -> Result<Self, LinearError> {
+        let n_nodes = model.nodes.len();
+        let mut next = 6 * n_nodes;
+        let mut elem_dofs = vec![];
+        let mut lam_start = vec![];
+        for e in &model.elements {
+            let mut d: Vec<usize> = e
+                .node_list()
+                .iter()
+                .flat_map(|&n| 6 * n..6 * n + 6)
+                .collect();
+            lam_start.push(next);
+            for _ in 0..e.n_lambda() {
+                d.push(next);
+                next += 1;
+            }
+            elem_dofs.push(d);
+        }
+        let ndof = next;
+        let step_dofs: Vec<Vec<usize>> = model
+            .step_elements
+            .iter()
+            .map(|s| s.nodes().iter().flat_map(|&n| 6 * n..6 * n + 3).collect())
+            .collect();
+        // pattern: dense element blocks + diagonal
+        let mut cols: Vec<Vec<usize>> = (0..ndof).map(|i| vec![i]).collect();
+        for d in elem_dofs.iter().chain(step_dofs.iter()) {
+            for &j in d {
+                cols[j].extend(d.iter().copied());
+            }
+        }
+        let mut col_ptr = vec![0usize];
+        let mut row_idx = vec![];
+        for cl in cols.iter_mut() {
+            cl.sort_unstable();
+            cl.dedup();
+            row_idx.extend(cl.iter().copied());
+            col_ptr.push(row_idx.len());
+        }
+        let pos = |i: usize, j: usize| -> usize {
+            let s = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+            col_ptr[j] + s.binary_search(&i).expect("pattern entry")
+        };
+        let block = |d: &Vec<usize>| -> Vec<usize> {
+            let n = d.len();
+            let mut p = vec![0; n * n];
+            for (a, &i) in d.iter().enumerate() {
+                for (b, &j) in d.iter().enumerate() {
+                    p[a * n + b] = pos(i, j);
+                }
+            }
+            p
+        };
+        let elem_pos = elem_dofs.iter().map(block).collect();
+        let step_pos = step_dofs.iter().map(block).collect();
+        let sym = SymbolicSparseColMatRef::new_checked(ndof, ndof, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_lu(sym, Default::default())
+            .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
+        let req = symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let nnz = row_idx.len();
+        Ok(Assembler {
+            n_nodes,
+            ndof,
+            elem_dofs,
+            lam_start,
+            elem_pos,
+            step_pos,
+            col_ptr,
+            row_idx,
+            values: vec![0.0; nnz],
+            symbolic,
+            numeric: NumericLu::new(),
+            buf: MemBuffer::new(req),
+            factored: false,
+            step_out: ElementOutput::default(),
+            multilane: true,
+        })
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Diagonal entry (after assembly).
+    pub fn diag(&self, i: usize) -> f64 {
+        let s = &self.row_idx[self.col_ptr[i]..self.col_ptr[i + 1]];
+        self.values[self.col_ptr[i] + s.binary_search(&i).unwrap()]
+    }
+
+    /// Replace the entries of rows `>= first_row` by those of `other` (same pattern).
+    pub fn overwrite_rows_from(&mut self, other: &[f64], first_row: usize) {
+        for (p, &r) in self.row_idx.iter().enumerate() {
+            if r >= first_row {
+                self.values[p] = other[p];
+            }
+        }
+    }
+
+    /// Dense copy of the assembled matrix (tests, modal analysis).
+    pub fn to_dense(&self) -> Vec<Vec<f64>> {
+        let mut m = vec![vec![0.0; self.ndof]; self.ndof];
+        for j in 0..self.ndof {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                m[self.row_idx[p]][j] += self.values[p];
+            }
+        }
+        m
+    }
+
+    /// Assemble residual `res` (all dofs) and, if `matrix`, the matrix whose column for node dof
+    /// (n, comp) is the derivative of the residual along `seed(n, comp)` and for a multiplier is
+    /// the derivative w.r.t. `lambda_hat`. `lam_hat` holds scaled multipliers (all multiplier
+    /// dofs, indexed from 0). Step elements get `(t_i, dt, x_i)` and contribute `-force`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble(
+        &mut self,
+        model: &mut Model,
+        kin: &[NodeKin<f64>],
+        lam_hat: &[f64],
+        ctx: &EvalCtx,
+        seed: &dyn Fn(usize, usize) -> Seed,
+        step: Option<(f64, f64, &[[f64; 3]])>,
+        matrix: bool,
+        res: &mut [f64],
+    ) -> Result<(), ElementError> {
+        res.iter_mut().for_each(|r| *r = 0.0);
+        if matrix {
+            self.values.iter_mut().for_each(|v| *v = 0.0);
+        }
+        let nl6 = 6 * self.n_nodes;
+        let mut kf = [NodeKin::<f64>::ground(); 4];
+        let mut kd = [NodeKin::<Dual<f64>>::ground(); 4];
+        let mut lam_f = [0.0f64; 6];
+        let mut lam_d = [Dual::<f64>::cst(0.0); 6];
+        let mut out_f = [0.0f64; MAXL];
+        let mut out_d = [Dual::<f64>::cst(0.0); MAXL];
+        for (ei, e) in model.elements.iter().enumerate() {
+            let dofs = &self.elem_dofs[ei];
+            let n = dofs.len();
+            let nnodes = match e {
+                Element::Beam(_) => 4,
+                Element::Joint(j) => 1 + j.node_a.is_some() as usize,
+                _ => 1,
+            };
+            for l in 0..nnodes {
+                kf[l] = kin[dofs[6 * l] / 6];
+            }
+            let nlam = n - 6 * nnodes;
+            for l in 0..nlam {
+                lam_f[l] = lam_hat[dofs[6 * nnodes + l] - nl6];
+            }
+            out_f[..n].iter_mut().for_each(|x| *x = 0.0);
+            element_residual(e, &kf[..nnodes], &lam_f[..nlam], ctx, &mut out_f[..n]);
+            for a in 0..n {
+                res[dofs[a]] += out_f[a];
+            }
+            if !matrix {
+                continue;
+            }
+            let pos = &self.elem_pos[ei];
+            if let (Element::Beam(bm), true) = (e, self.multilane) {
+                // all 24 columns from one multi-lane evaluation
+                let mut k24 = [NodeKin::<DualN<24>>::ground(); 4];
+                for l in 0..4 {
+                    k24[l] = seeded_lanes(&kf[l], l, &|c| seed(dofs[6 * l] / 6, c));
+                }
+                let mut o24 = [DualN::<24>::default(); 24];
+                bm.residual(&k24, ctx, &mut o24);
+                for a in 0..24 {
+                    for b in 0..24 {
+                        self.values[pos[a * 24 + b]] += o24[a].d[b];
+                    }
+                }
+                continue;
+            }
+            for l in 0..nnodes {
+                kd[l] = seeded_node(&kf[l], None);
+            }
+            for l in 0..nlam {
+                lam_d[l] = Dual::new(lam_f[l], 0.0);
+            }
+            for b in 0..n {
+                if b < 6 * nnodes {
+                    let (l, comp) = (b / 6, b % 6);
+                    let s = seed(dofs[6 * l] / 6, comp);
+                    kd[l] = seeded_node(&kf[l], Some(&s));
+                    out_d[..n].iter_mut().for_each(|x| *x = Dual::cst(0.0));
+                    element_residual(e, &kd[..nnodes], &lam_d[..nlam], ctx, &mut out_d[..n]);
+                    kd[l] = seeded_node(&kf[l], None);
+                } else {
+                    let l = b - 6 * nnodes;
+                    lam_d[l].d = 1.0;
+                    out_d[..n].iter_mut().for_each(|x| *x = Dual::cst(0.0));
+                    element_residual(e, &kd[..nnodes], &lam_d[..nlam], ctx, &mut out_d[..n]);
+                    lam_d[l].d = 0.0;
+                }
+                for a in 0..n {
+                    self.values[pos[a * n + b]] += out_d[a].d;
+                }
+            }
+        }
+        if let Some((t_i, dt, x_i)) = step {
+            for (si, s) in model.step_elements.iter_mut().enumerate() {
+                let nd = s.nodes();
+                let xi = [x_i[nd[0]], x_i[nd[1]]];
+                let xf = [kin[nd[0]].x, kin[nd[1]].x];
+                self.step_out = ElementOutput::default();
+                s.evaluate(t_i, dt, xi, xf, &mut self.step_out)?;
+                for k in 0..2 {
+                    for i in 0..3 {
+                        res[6 * nd[k] + i] -= self.step_out.force[k][i];
+                    }
+                }
+                if matrix {
+                    let pos = &self.step_pos[si];
+                    for k in 0..2 {
+                        for l in 0..2 {
+                            for j in 0..3 {
+                                let sd = seed(nd[l], j).dx;
+                                for i in 0..3 {
+                                    let d: f64 =
+                                        (0..3).map(|m| self.step_out.jac[k][l][i][m] * sd[m]).sum();
+                                    self.values[pos[(3 * k + i) * 6 + 3 * l + j]] -= d;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let _ = c::<f64>(0.0);
+        Ok(())
+    }
+
+    /// Numeric LU of the assembled matrix (symbolic analysis reused).
+    pub fn factor(&mut self) -> Result<(), LinearError> {
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.ndof,
+            self.ndof,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        let a = SparseColMatRef::new(sym, &self.values);
+        let stack = MemStack::new(&mut self.buf);
+        self.symbolic
+            .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
+            .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Solve in place with the last factorisation.
+    pub fn solve(&mut self, rhs: &mut [f64]) {
+        assert!(self.factored);
+        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
+        let stack = MemStack::new(&mut self.buf);
+        let n = rhs.len();
+        let m = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, stack);
+    }
+}

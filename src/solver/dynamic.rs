@@ -1,0 +1,582 @@
+//! Generalized-alpha time integration for index-3 constrained systems on the Lie group
+//! R^3 x SO(3) per node (Arnold & Bruls 2007; Bruls, Cardona & Arnold 2012), with Chung-Hulbert
+//! parameters from the spectral radius at infinity `rho_inf`.
+//!
+//! Per step: `x_{n+1} = x_n + h dq_x`, `R_{n+1} = exp(h dq_th) R_n` (spatial),
+//! `dq = v_n + h (1/2 - beta) a_n + h beta a_{n+1}`, `v_{n+1} = v_n + h (1 - gamma) a_n + h gamma a_{n+1}`,
+//! `(1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) vd_{n+1} + alpha_f vd_n`, with the
+//! equations of motion and constraints `Phi(q_{n+1}) = 0` enforced at t_{n+1}. Newton unknowns
+//! are `dq` and scaled multipliers; the iteration matrix is the exact derivative including the
+//! tangent operator of the exponential map.
+use super::assembly::Assembler;
+use super::newton::{model_size, norm, NewtonError, NewtonOptions};
+use super::state::{lambda_offsets, sensor_header, sensor_values, State};
+use super::statics::{commit, diag_scale};
+use crate::structure::kin::{EvalCtx, NodeKin, Seed};
+use crate::structure::model::Model;
+use crate::structure::rotation::*;
+
+/// Generalized-alpha parameters (Chung & Hulbert 1993).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GenAlphaParams {
+    pub rho_inf: f64,
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub gamma: f64,
+    pub beta: f64,
+}
+
+impl GenAlphaParams {
+    pub fn from_rho_inf(rho: f64) -> Self {
+        let rho = rho.clamp(0.0, 1.0);
+        let alpha_m = (2.0 * rho - 1.0) / (rho + 1.0);
+        let alpha_f = rho / (rho + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        let beta = 0.25 * (gamma + 0.5).powi(2);
+        GenAlphaParams {
+            rho_inf: rho,
+            alpha_m,
+            alpha_f,
+            gamma,
+            beta,
+        }
+    }
+}
+
+/// Statistics of one step.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepInfo {
+    pub t: f64,
+    pub iterations: usize,
+    pub residual: f64,
+}
+
+/// Dynamic solver owning the model and the state; step it with [`DynamicSolver::step`].
+pub struct DynamicSolver {
+    pub model: Model,
+    pub state: State,
+    pub h: f64,
+    pub params: GenAlphaParams,
+    pub newton: NewtonOptions,
+    asm: Assembler,
+    /// Algorithmic accelerations per node (translation, rotation).
+    acc: Vec<[f64; 6]>,
+    lam_hat: Vec<f64>,
+    cscale: f64,
+    size: f64,
+    res: Vec<f64>,
+    kin: Vec<NodeKin<f64>>,
+    dq: Vec<[f64; 6]>,
+    tl: Vec<[[f64; 3]; 3]>,
+    x_prev: Vec<[f64; 3]>,
+    lam_offsets: Vec<usize>,
+    ws_a: Vec<[f64; 6]>,
+    ws_vd: Vec<[f64; 6]>,
+    ws_v: Vec<[f64; 6]>,
+    ws_x: Vec<[f64; 3]>,
+    ws_q: Vec<nalgebra::UnitQuaternion<f64>>,
+    ws_q2: Vec<nalgebra::UnitQuaternion<f64>>,
+    ws_lam: Vec<f64>,
+    /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
+    pub last_residuals: Vec<f64>,
+    /// Total Newton iterations so far.
+    pub total_iterations: usize,
+    pub steps: usize,
+}
+
+impl DynamicSolver {
+    /// Set up with initial state `state` (velocities as given; accelerations of the state are
+    /// taken as the initial true accelerations).
+    pub fn new(model: Model, state: State, h: f64, rho_inf: f64) -> Result<Self, NewtonError> {
+        let t = state.t;
+        let asm = Assembler::new(&model).map_err(|source| NewtonError::Linear {
+            t,
+            iteration: 0,
+            source,
+        })?;
+        let n = model.nodes.len();
+        let ndof = asm.ndof;
+        let acc = (0..n)
+            .map(|i| {
+                [
+                    state.a[i][0],
+                    state.a[i][1],
+                    state.a[i][2],
+                    state.al[i][0],
+                    state.al[i][1],
+                    state.al[i][2],
+                ]
+            })
+            .collect();
+        let size = model_size(&state.x);
+        let lam_offsets = lambda_offsets(&model);
+        let mut s = DynamicSolver {
+            model,
+            h,
+            params: GenAlphaParams::from_rho_inf(rho_inf),
+            newton: NewtonOptions::default(),
+            asm,
+            acc,
+            lam_hat: vec![0.0; ndof - 6 * n],
+            cscale: 1.0,
+            size,
+            res: vec![0.0; ndof],
+            kin: Vec::with_capacity(n),
+            dq: vec![[0.0; 6]; n],
+            tl: vec![[[0.0; 3]; 3]; n],
+            x_prev: state.x.clone(),
+            lam_offsets,
+            total_iterations: 0,
+            steps: 0,
+            ws_a: vec![],
+            ws_vd: vec![],
+            ws_v: vec![],
+            ws_x: vec![],
+            ws_q: vec![],
+            ws_q2: vec![],
+            ws_lam: vec![],
+            last_residuals: Vec::with_capacity(64),
+            state,
+        };
+        s.init_scaling()?;
+        Ok(s)
+    }
+
+    fn coeffs(&self) -> (f64, f64) {
+        let p = &self.params;
+        let ca = (1.0 - p.alpha_m) / ((1.0 - p.alpha_f) * self.h * p.beta);
+        (p.gamma / p.beta, ca)
+    }
+
+    fn init_scaling(&mut self) -> Result<(), NewtonError> {
+        let t = self.state.t;
+        self.state.kin(&mut self.kin);
+        let (cv, ca) = self.coeffs();
+        let h = self.h;
+        let seed = move |_: usize, comp: usize| dyn_seed(comp, h, cv, ca, &IDENT);
+        let ctx = EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: 1.0,
+            inertia: true,
+        };
+        self.asm
+            .assemble(
+                &mut self.model,
+                &self.kin,
+                &self.lam_hat,
+                &ctx,
+                &seed,
+                None,
+                true,
+                &mut self.res,
+            )
+            .map_err(|source| NewtonError::Element { t, source })?;
+        self.cscale = diag_scale(&self.asm) / h;
+        for (l, lp) in self.lam_hat.iter_mut().zip(&self.state.lambda) {
+            *l = lp / self.cscale;
+        }
+        Ok(())
+    }
+
+    /// Advance one step of size `h`. On error the state is left at the last converged step.
+    pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
+        let p = self.params;
+        let h = self.h;
+        let n = self.model.nodes.len();
+        let nn = 6 * n;
+        let t_n = self.state.t;
+        let t = t_n + h;
+        let (cv, ca) = self.coeffs();
+        // predictor (vd_{n+1} = 0)
+        let mut a_new = std::mem::take(&mut self.ws_a);
+        let mut vd_new = std::mem::take(&mut self.ws_vd);
+        let mut v_new = std::mem::take(&mut self.ws_v);
+        a_new.resize(n, [0.0; 6]);
+        vd_new.resize(n, [0.0; 6]);
+        v_new.resize(n, [0.0; 6]);
+        for i in 0..n {
+            let vn = cat(self.state.v[i], self.state.w[i]);
+            let vdn = cat(self.state.a[i], self.state.al[i]);
+            for k in 0..6 {
+                a_new[i][k] = (p.alpha_f * vdn[k] - p.alpha_m * self.acc[i][k]) / (1.0 - p.alpha_m);
+                v_new[i][k] =
+                    vn[k] + h * (1.0 - p.gamma) * self.acc[i][k] + h * p.gamma * a_new[i][k];
+                self.dq[i][k] =
+                    vn[k] + h * (0.5 - p.beta) * self.acc[i][k] + h * p.beta * a_new[i][k];
+                vd_new[i][k] = 0.0;
+            }
+        }
+        self.x_prev.clone_from(&self.state.x);
+        let mut q_prev = std::mem::take(&mut self.ws_q);
+        q_prev.clone_from(&self.state.q);
+        let mut lam_hat = std::mem::take(&mut self.ws_lam);
+        lam_hat.clone_from(&self.lam_hat);
+        let mut ctx = EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: self.cscale,
+            inertia: true,
+        };
+        ctx.cscale = self.cscale;
+        let mut r0 = 0.0;
+        let mut it = 0;
+        self.last_residuals.clear();
+        let mut x_new = std::mem::take(&mut self.ws_x);
+        x_new.clone_from(&self.x_prev);
+        let mut q_new = std::mem::take(&mut self.ws_q2);
+        q_new.clone_from(&q_prev);
+        loop {
+            // configuration from dq
+            for i in 0..n {
+                let th = [h * self.dq[i][3], h * self.dq[i][4], h * self.dq[i][5]];
+                for k in 0..3 {
+                    x_new[i][k] = self.x_prev[i][k] + h * self.dq[i][k];
+                }
+                q_new[i] = update_left(&q_prev[i], th);
+                self.tl[i] = tangent_left(th);
+            }
+            self.kin.clear();
+            for i in 0..n {
+                self.kin.push(NodeKin {
+                    x: x_new[i],
+                    r: quat_to_arr(&q_new[i]),
+                    v: [v_new[i][0], v_new[i][1], v_new[i][2]],
+                    w: [v_new[i][3], v_new[i][4], v_new[i][5]],
+                    a: [vd_new[i][0], vd_new[i][1], vd_new[i][2]],
+                    al: [vd_new[i][3], vd_new[i][4], vd_new[i][5]],
+                });
+            }
+            self.model.update_distributed_loads(t, &self.kin);
+            let tl = &self.tl;
+            let seed = |node: usize, comp: usize| dyn_seed(comp, h, cv, ca, &tl[node]);
+            let xp = &self.x_prev;
+            self.asm
+                .assemble(
+                    &mut self.model,
+                    &self.kin,
+                    &lam_hat,
+                    &ctx,
+                    &seed,
+                    Some((t_n, h, xp)),
+                    true,
+                    &mut self.res,
+                )
+                .map_err(|source| NewtonError::Element { t, source })?;
+            let rn = norm(&self.res);
+            if !rn.is_finite() {
+                return Err(NewtonError::NonFinite { t, iteration: it });
+            }
+            if self.last_residuals.len() < self.last_residuals.capacity() {
+                self.last_residuals.push(rn);
+            }
+            if it == 0 {
+                r0 = rn;
+            }
+            if rn <= self.newton.rtol * r0 || rn == 0.0 {
+                break;
+            }
+            if it >= self.newton.max_iterations {
+                return Err(NewtonError::Diverged {
+                    t,
+                    iterations: it,
+                    residual: rn,
+                    initial: r0,
+                });
+            }
+            self.asm.factor().map_err(|source| NewtonError::Linear {
+                t,
+                iteration: it,
+                source,
+            })?;
+            for r in self.res.iter_mut() {
+                *r = -*r;
+            }
+            self.asm.solve(&mut self.res);
+            let mut dmax: f64 = 0.0;
+            for i in 0..n {
+                for k in 0..6 {
+                    let d = self.res[6 * i + k];
+                    self.dq[i][k] += d;
+                    v_new[i][k] += cv * d;
+                    vd_new[i][k] += ca * d;
+                    dmax = dmax.max((h * d).abs());
+                }
+            }
+            for (k, l) in lam_hat.iter_mut().enumerate() {
+                *l += self.res[nn + k];
+            }
+            it += 1;
+            if !dmax.is_finite() {
+                return Err(NewtonError::NonFinite { t, iteration: it });
+            }
+            if dmax <= self.newton.xtol * self.size {
+                // final configuration update happens at the top of the loop
+                for i in 0..n {
+                    let th = [h * self.dq[i][3], h * self.dq[i][4], h * self.dq[i][5]];
+                    for k in 0..3 {
+                        x_new[i][k] = self.x_prev[i][k] + h * self.dq[i][k];
+                    }
+                    q_new[i] = update_left(&q_prev[i], th);
+                }
+                break;
+            }
+        }
+        // accept
+        for i in 0..n {
+            let vdn = cat(self.state.a[i], self.state.al[i]);
+            for k in 0..6 {
+                self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k]
+                    - p.alpha_m * self.acc[i][k])
+                    / (1.0 - p.alpha_m);
+            }
+            self.state.x[i] = x_new[i];
+            self.state.q[i] = q_new[i];
+            self.state.v[i] = [v_new[i][0], v_new[i][1], v_new[i][2]];
+            self.state.w[i] = [v_new[i][3], v_new[i][4], v_new[i][5]];
+            self.state.a[i] = [vd_new[i][0], vd_new[i][1], vd_new[i][2]];
+            self.state.al[i] = [vd_new[i][3], vd_new[i][4], vd_new[i][5]];
+        }
+        self.ws_lam = std::mem::replace(&mut self.lam_hat, lam_hat);
+        self.ws_a = a_new;
+        self.ws_vd = vd_new;
+        self.ws_v = v_new;
+        self.ws_x = x_new;
+        self.ws_q = q_prev;
+        self.ws_q2 = q_new;
+        for (lp, l) in self.state.lambda.iter_mut().zip(&self.lam_hat) {
+            *lp = l * self.cscale;
+        }
+        self.state.t = t;
+        self.state.kin(&mut self.kin);
+        commit(&mut self.model, &self.kin);
+        self.total_iterations += it;
+        self.steps += 1;
+        Ok(StepInfo {
+            t,
+            iterations: it,
+            residual: r0,
+        })
+    }
+
+    /// Consistent initial accelerations: solves `M vd_0 + B^T lambda_0 = -r(q_0, v_0, vd = 0)`
+    /// with `B vd_0 = -gamma`, `gamma = d^2 Phi / dt^2` along `(x + v t, exp(w t) R, t)`
+    /// (velocity-dependent and explicit-time terms, by a Richardson-extrapolated second
+    /// difference), and uses them as the initial algorithmic accelerations; also sets the
+    /// initial multipliers.
+    pub fn init_accelerations(&mut self) -> Result<(), NewtonError> {
+        let t = self.state.t;
+        let n = self.model.nodes.len();
+        let nn = 6 * n;
+        for i in 0..n {
+            self.state.a[i] = [0.0; 3];
+            self.state.al[i] = [0.0; 3];
+        }
+        self.state.kin(&mut self.kin);
+        let seed_acc = |_: usize, comp: usize| {
+            let mut e = [0.0; 3];
+            e[comp % 3] = 1.0;
+            if comp < 3 {
+                Seed {
+                    da: e,
+                    ..Default::default()
+                }
+            } else {
+                Seed {
+                    dal: e,
+                    ..Default::default()
+                }
+            }
+        };
+        let ctx = EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: self.cscale,
+            inertia: true,
+        };
+        self.model.update_distributed_loads(t, &self.kin);
+        let xp = self.state.x.clone();
+        let zero_lam = vec![0.0; self.lam_hat.len()];
+        if !self.lam_hat.is_empty() {
+            // constraint rows: B from the configuration seeds
+            let mut tmp = vec![0.0; self.asm.ndof];
+            self.asm
+                .assemble(
+                    &mut self.model,
+                    &self.kin,
+                    &zero_lam,
+                    &ctx,
+                    &super::statics::static_seed([0.0; 3]),
+                    Some((t, 0.0, &xp)),
+                    true,
+                    &mut tmp,
+                )
+                .map_err(|source| NewtonError::Element { t, source })?;
+        }
+        let b_values = self.asm.values.clone();
+        self.asm
+            .assemble(
+                &mut self.model,
+                &self.kin,
+                &zero_lam,
+                &ctx,
+                &seed_acc,
+                Some((t, 0.0, &xp)),
+                true,
+                &mut self.res,
+            )
+            .map_err(|source| NewtonError::Element { t, source })?;
+        self.asm.overwrite_rows_from(&b_values, nn);
+        for r in self.res.iter_mut().take(nn) {
+            *r = -*r;
+        }
+        // acceleration-level constraint right-hand side
+        let size = self.size;
+        let wmax = self
+            .state
+            .w
+            .iter()
+            .flat_map(|w| w.iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let vmax = self
+            .state
+            .v
+            .iter()
+            .flat_map(|v| v.iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let tau = 1e-2 / (1.0 + wmax + vmax / size);
+        let mut row = nn;
+        for e in &self.model.elements {
+            if let crate::structure::model::Element::Joint(j) = e {
+                let nl = j.n_lambda();
+                let phi_at = |s: f64, out: &mut [f64; 6]| {
+                    let mv_node = |k: &NodeKin<f64>| NodeKin {
+                        x: add(k.x, fmul(s, k.v)),
+                        r: mm(&exp_map(fmul(s, k.w)), &k.r),
+                        ..*k
+                    };
+                    let a = j
+                        .node_a
+                        .map(|i| mv_node(&self.kin[i]))
+                        .unwrap_or_else(NodeKin::ground);
+                    let b = mv_node(&self.kin[j.node_b]);
+                    j.phi(&a, &b, t + s, out);
+                };
+                let mut g0 = [0.0; 6];
+                phi_at(0.0, &mut g0);
+                let second = |tau: f64| {
+                    let mut gp = [0.0; 6];
+                    let mut gm = [0.0; 6];
+                    phi_at(tau, &mut gp);
+                    phi_at(-tau, &mut gm);
+                    std::array::from_fn::<f64, 6, _>(|k| {
+                        (gp[k] - 2.0 * g0[k] + gm[k]) / (tau * tau)
+                    })
+                };
+                let d1 = second(tau);
+                let d2 = second(0.5 * tau);
+                for k in 0..nl {
+                    let gamma = (4.0 * d2[k] - d1[k]) / 3.0;
+                    self.res[row + k] = -self.cscale * gamma;
+                }
+                row += nl;
+            }
+        }
+        self.asm.factor().map_err(|source| NewtonError::Linear {
+            t,
+            iteration: 0,
+            source,
+        })?;
+        self.asm.solve(&mut self.res);
+        for i in 0..n {
+            let r = &self.res[6 * i..6 * i + 6];
+            self.state.a[i] = [r[0], r[1], r[2]];
+            self.state.al[i] = [r[3], r[4], r[5]];
+            self.acc[i].copy_from_slice(r);
+        }
+        for (k, l) in self.lam_hat.iter_mut().enumerate() {
+            *l = self.res[nn + k];
+        }
+        for (lp, l) in self.state.lambda.iter_mut().zip(&self.lam_hat) {
+            *lp = l * self.cscale;
+        }
+        Ok(())
+    }
+
+    pub fn sensor_header(&self) -> Vec<String> {
+        sensor_header(&self.model)
+    }
+
+    pub fn sensor_values(&self) -> Vec<f64> {
+        sensor_values(&self.model, &self.state, &self.lam_offsets)
+    }
+
+    /// Kinetic and strain energy of beams and rigid bodies.
+    pub fn energy(&self) -> (f64, f64) {
+        energy(&self.model, &self.state)
+    }
+}
+
+fn cat(a: [f64; 3], b: [f64; 3]) -> [f64; 6] {
+    [a[0], a[1], a[2], b[0], b[1], b[2]]
+}
+
+const IDENT: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+fn dyn_seed(comp: usize, h: f64, cv: f64, ca: f64, tl: &[[f64; 3]; 3]) -> Seed {
+    let mut e = [0.0; 3];
+    e[comp % 3] = 1.0;
+    if comp < 3 {
+        Seed {
+            dx: fmul(h, e),
+            dv: fmul(cv, e),
+            da: fmul(ca, e),
+            ..Default::default()
+        }
+    } else {
+        Seed {
+            dth: fmul(h, mv(tl, e)),
+            dw: fmul(cv, e),
+            dal: fmul(ca, e),
+            ..Default::default()
+        }
+    }
+}
+
+/// (kinetic, strain) energy of the model at a state.
+pub fn energy(model: &Model, st: &State) -> (f64, f64) {
+    use crate::structure::model::Element;
+    let mut ke = 0.0;
+    let mut se = 0.0;
+    for e in &model.elements {
+        match e {
+            Element::Beam(b) => {
+                let k = b.nodes.map(|i| st.node_kin(i));
+                ke += b.kinetic_energy(&k);
+                se += b.strain_energy(&k);
+            }
+            Element::Rigid(r) => ke += r.kinetic_energy(&st.node_kin(r.node)),
+            _ => {}
+        }
+    }
+    (ke, se)
+}
+
+/// Linear and angular momentum (about the origin) of all beams.
+pub fn momentum(model: &Model, st: &State) -> ([f64; 3], [f64; 3]) {
+    use crate::structure::model::Element;
+    let mut p = [0.0; 3];
+    let mut l = [0.0; 3];
+    for e in &model.elements {
+        if let Element::Beam(b) = e {
+            let k = b.nodes.map(|i| st.node_kin(i));
+            let (pp, hh) = b.momentum(&k);
+            p = add(p, pp);
+            l = add(l, hh);
+        }
+    }
+    (p, l)
+}

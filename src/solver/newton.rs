@@ -1,0 +1,69 @@
+//! Newton iteration options and failure reporting.
+use super::assembly::LinearError;
+use crate::structure::model::ElementError;
+use thiserror::Error;
+
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonOptions {
+    pub max_iterations: usize,
+    /// Convergence when ||r|| <= rtol * ||r_0|| (r_0: residual of the predictor / load step).
+    pub rtol: f64,
+    /// ... or when the largest configuration correction <= xtol * model size.
+    pub xtol: f64,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        NewtonOptions {
+            max_iterations: 25,
+            rtol: 1e-9,
+            xtol: 1e-11,
+        }
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum NewtonError {
+    #[error("Newton iterations did not converge at t = {t} s: {iterations} iterations, residual norm {residual:.3e} (initial {initial:.3e})")]
+    Diverged {
+        t: f64,
+        iterations: usize,
+        residual: f64,
+        initial: f64,
+    },
+    #[error("static Newton iterations did not converge at load factor {load_factor}: {iterations} iterations, residual norm {residual:.3e} (initial {initial:.3e}); try more load steps, and check that every rigid-body motion and mechanism dof is restrained (a free revolute has no static equilibrium under load)")]
+    StaticDiverged {
+        load_factor: f64,
+        iterations: usize,
+        residual: f64,
+        initial: f64,
+    },
+    #[error("non-finite residual at t = {t} s, iteration {iteration}")]
+    NonFinite { t: f64, iteration: usize },
+    #[error("at t = {t} s, iteration {iteration}: {source}")]
+    Linear {
+        t: f64,
+        iteration: usize,
+        source: LinearError,
+    },
+    #[error("at t = {t} s: {source}")]
+    Element { t: f64, source: ElementError },
+}
+
+pub fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Size of the model (for the increment criterion): bounding-box diagonal, at least 1.
+pub fn model_size(x: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in x {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let d: f64 = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    d.max(1.0)
+}

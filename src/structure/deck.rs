@@ -1,0 +1,548 @@
+//! Model deck (TOML), documented in docs/model_deck.md. Unknown keys are rejected; every
+//! reference (node, beam, joint) is checked and reported with the deck file and the key.
+use super::beam::BeamLoad;
+use super::joint::{AngleLaw, JointKind};
+use super::kin::TimeTable;
+use super::model::{frame_from_axis, Element, Model, SensorKind};
+use super::rigid::{PointLoad, RigidBody};
+use super::rotation::*;
+use super::section::{SectionProps, SectionTable};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum DeckError {
+    #[error("deck {file}: cannot read: {source}")]
+    Io {
+        file: String,
+        source: std::io::Error,
+    },
+    #[error("deck {file}: {msg}")]
+    Parse { file: String, msg: String },
+    #[error("deck {file}, {key}: {msg}")]
+    Invalid {
+        file: String,
+        key: String,
+        msg: String,
+    },
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Deck {
+    #[serde(default)]
+    pub title: Option<String>,
+    #[serde(default)]
+    pub gravity_m_s2: [f64; 3],
+    #[serde(default, rename = "node")]
+    pub nodes: Vec<NodeDeck>,
+    #[serde(default, rename = "beam")]
+    pub beams: Vec<BeamDeck>,
+    #[serde(default, rename = "rigid_body")]
+    pub rigid_bodies: Vec<RigidDeck>,
+    #[serde(default, rename = "joint")]
+    pub joints: Vec<JointDeck>,
+    #[serde(default, rename = "load")]
+    pub loads: Vec<LoadDeck>,
+    #[serde(default, rename = "distributed_load")]
+    pub distributed_loads: Vec<DistDeck>,
+    #[serde(default, rename = "sensor")]
+    pub sensors: Vec<SensorDeck>,
+    #[serde(default, rename = "static")]
+    pub statics: StaticDeck,
+    #[serde(default)]
+    pub dynamic: DynamicDeck,
+    #[serde(default)]
+    pub modes: ModesDeck,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeDeck {
+    pub name: String,
+    pub position_m: [f64; 3],
+    #[serde(default)]
+    pub rotation_vector_rad: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcDeck {
+    pub center_m: [f64; 3],
+    pub radius_m: f64,
+    pub start_deg: f64,
+    pub end_deg: f64,
+    #[serde(default = "z_axis")]
+    pub normal: [f64; 3],
+    /// Direction of angle 0 in the arc plane.
+    #[serde(default = "x_axis")]
+    pub zero_direction: [f64; 3],
+}
+
+fn z_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+fn x_axis() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn y_axis() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamDeck {
+    pub name: String,
+    pub elements: usize,
+    #[serde(default)]
+    pub start_m: Option<[f64; 3]>,
+    #[serde(default)]
+    pub end_m: Option<[f64; 3]>,
+    #[serde(default)]
+    pub arc: Option<ArcDeck>,
+    /// Existing node used as the first beam node (its position must match the start).
+    #[serde(default)]
+    pub start_node: Option<String>,
+    #[serde(default = "y_axis")]
+    pub e2_direction: [f64; 3],
+    #[serde(default)]
+    pub sections_csv: Option<String>,
+    #[serde(default)]
+    pub section: Option<SectionProps>,
+    #[serde(default)]
+    pub sections: Option<Vec<SectionProps>>,
+    #[serde(default)]
+    pub damping_mu_s: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidDeck {
+    pub name: String,
+    pub node: String,
+    pub mass_kg: f64,
+    #[serde(default)]
+    pub cm_offset_m: [f64; 3],
+    pub inertia_kgm2: [[f64; 3]; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDeck {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub node_a: Option<String>,
+    pub node_b: String,
+    #[serde(default)]
+    pub position_m: Option<[f64; 3]>,
+    /// Joint z axis (revolute axis), global.
+    #[serde(default = "z_axis")]
+    pub axis: [f64; 3],
+    #[serde(default = "x_axis")]
+    pub x_direction: [f64; 3],
+    #[serde(default, rename = "stiffness_Nm_per_rad")]
+    pub stiffness: f64,
+    #[serde(default, rename = "damping_Nms_per_rad")]
+    pub damping: f64,
+    #[serde(default)]
+    pub omega_rad_s: Option<f64>,
+    /// (t_s, angle_rad) pairs added to omega t.
+    #[serde(default)]
+    pub angle_table: Option<Vec<[f64; 2]>>,
+    #[serde(default)]
+    pub displacement_m: Option<[f64; 3]>,
+    /// (t_s, factor) pairs scaling displacement_m.
+    #[serde(default)]
+    pub displacement_table: Option<Vec<[f64; 2]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadDeck {
+    pub name: String,
+    pub node: String,
+    #[serde(default, rename = "force_N")]
+    pub force: [f64; 3],
+    #[serde(default, rename = "moment_Nm")]
+    pub moment: [f64; 3],
+    #[serde(default)]
+    pub follower: bool,
+    #[serde(default)]
+    pub time_table: Option<Vec<[f64; 2]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistDeck {
+    pub beam: String,
+    #[serde(default, rename = "force_N_per_m")]
+    pub force: [f64; 3],
+    #[serde(default, rename = "moment_Nm_per_m")]
+    pub moment: [f64; 3],
+    #[serde(default)]
+    pub follower: bool,
+    #[serde(default)]
+    pub time_table: Option<Vec<[f64; 2]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorDeck {
+    pub name: String,
+    #[serde(default)]
+    pub node: Option<String>,
+    #[serde(default)]
+    pub joint: Option<String>,
+    #[serde(default)]
+    pub beam: Option<String>,
+    #[serde(default)]
+    pub s_m: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticDeck {
+    #[serde(default = "ten")]
+    pub load_steps: usize,
+    #[serde(default = "max_it")]
+    pub max_iterations: usize,
+    /// Steady rotation about the origin (rotating-frame equilibrium).
+    #[serde(default)]
+    pub omega_rad_s: Option<[f64; 3]>,
+}
+
+impl Default for StaticDeck {
+    fn default() -> Self {
+        StaticDeck {
+            load_steps: 10,
+            max_iterations: 25,
+            omega_rad_s: None,
+        }
+    }
+}
+
+fn ten() -> usize {
+    10
+}
+fn max_it() -> usize {
+    25
+}
+fn one() -> usize {
+    1
+}
+fn rho_default() -> f64 {
+    0.9
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicDeck {
+    #[serde(default)]
+    pub time_step_s: Option<f64>,
+    #[serde(default)]
+    pub end_time_s: Option<f64>,
+    #[serde(default = "rho_default")]
+    pub rho_inf: f64,
+    #[serde(default = "one")]
+    pub output_every: usize,
+    #[serde(default = "max_it")]
+    pub max_iterations: usize,
+    /// Initial rigid rotation (rad/s) about the origin applied to all nodes.
+    #[serde(default)]
+    pub initial_omega_rad_s: Option<[f64; 3]>,
+    /// Start from the static equilibrium of the deck's loads at t = 0.
+    #[serde(default)]
+    pub start_from_static: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModesDeck {
+    #[serde(default = "ten")]
+    pub count: usize,
+    /// Rotation axis for rotating-frame analyses.
+    #[serde(default = "z_axis")]
+    pub axis: [f64; 3],
+    /// Rotation speeds for a fan plot (empty = non-rotating only).
+    #[serde(default)]
+    pub speeds_rad_s: Vec<f64>,
+}
+
+impl Default for ModesDeck {
+    fn default() -> Self {
+        ModesDeck {
+            count: 10,
+            axis: z_axis(),
+            speeds_rad_s: vec![],
+        }
+    }
+}
+
+fn table(t: &Option<Vec<[f64; 2]>>) -> TimeTable {
+    TimeTable {
+        points: t
+            .as_ref()
+            .map(|v| v.iter().map(|p| (p[0], p[1])).collect())
+            .unwrap_or_default(),
+    }
+}
+
+/// Parse a deck and build the model.
+pub fn load_deck(path: &Path) -> Result<(Deck, Model), DeckError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| DeckError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse_deck(&text, &file, &base)
+}
+
+/// Parse deck text (`file` names it in errors; relative CSV paths resolve against `base`).
+pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), DeckError> {
+    let deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
+        file: file.into(),
+        msg: e.to_string().trim_end().to_string(),
+    })?;
+    let model = build(&deck, file, base)?;
+    Ok((deck, model))
+}
+
+fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
+    let inv = |key: String, msg: String| DeckError::Invalid {
+        file: file.into(),
+        key,
+        msg,
+    };
+    let mut m = Model::new();
+    m.gravity = d.gravity_m_s2;
+    for (i, n) in d.nodes.iter().enumerate() {
+        let r = exp_map(n.rotation_vector_rad);
+        m.add_node(&n.name, n.position_m, r)
+            .map_err(|e| inv(format!("node[{i}] `{}`", n.name), e.to_string()))?;
+    }
+    let node = |m: &Model, key: &str, name: &str| -> Result<usize, DeckError> {
+        m.node_id(name).map_err(|_| inv(key.into(), format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)")))
+    };
+    for (i, b) in d.beams.iter().enumerate() {
+        let key = format!("beam[{i}] `{}`", b.name);
+        let sec = match (&b.sections_csv, &b.section, &b.sections) {
+            (Some(p), None, None) => {
+                let pb = PathBuf::from(p);
+                let pb = if pb.is_absolute() { pb } else { base.join(pb) };
+                SectionTable::from_csv(&pb).map_err(|e| inv(format!("{key}.sections_csv"), e.to_string()))?
+            }
+            (None, Some(s), None) => SectionTable::new(vec![*s], file).map_err(|e| inv(format!("{key}.section"), e.to_string()))?,
+            (None, None, Some(v)) => SectionTable::new(v.clone(), file).map_err(|e| inv(format!("{key}.sections"), e.to_string()))?,
+            (None, None, None) => return Err(inv(key, "missing section data: give exactly one of `sections_csv`, `section` (uniform) or `sections` (inline table)".into())),
+            _ => return Err(inv(key, "give only one of `sections_csv`, `section`, `sections`".into())),
+        };
+        let first = match &b.start_node {
+            Some(n) => Some(node(&m, &format!("{key}.start_node"), n)?),
+            None => None,
+        };
+        if b.elements == 0 {
+            return Err(inv(format!("{key}.elements"), "must be at least 1".into()));
+        }
+        let res = match (&b.arc, b.start_m, b.end_m) {
+            (None, Some(a), Some(e)) => m.add_straight_beam(
+                &b.name,
+                b.elements,
+                a,
+                e,
+                b.e2_direction,
+                &sec,
+                b.damping_mu_s,
+                first,
+            ),
+            (Some(arc), None, None) => {
+                let n = arc.normal;
+                let nn = fmul(1.0 / dot(n, n).sqrt(), n);
+                let u0 = sub(arc.zero_direction, fmul(dot(arc.zero_direction, nn), nn));
+                let u = fmul(1.0 / dot(u0, u0).sqrt(), u0);
+                let v = cross(nn, u);
+                let (a0, a1) = (arc.start_deg.to_radians(), arc.end_deg.to_radians());
+                let sgn = if a1 >= a0 { 1.0 } else { -1.0 };
+                let r = arc.radius_m;
+                let c = arc.center_m;
+                let len = r * (a1 - a0).abs();
+                let curve = move |s: f64| {
+                    let p = a0 + sgn * s / r;
+                    let x = add(c, add(fmul(r * p.cos(), u), fmul(r * p.sin(), v)));
+                    let t = fmul(sgn, add(fmul(-p.sin(), u), fmul(p.cos(), v)));
+                    let e2 = cross(nn, t);
+                    (
+                        [x[0], x[1], x[2]],
+                        [
+                            [t[0], e2[0], nn[0]],
+                            [t[1], e2[1], nn[1]],
+                            [t[2], e2[2], nn[2]],
+                        ],
+                    )
+                };
+                m.add_beam(
+                    &b.name,
+                    b.elements,
+                    len,
+                    &curve,
+                    &sec,
+                    b.damping_mu_s,
+                    first,
+                )
+            }
+            _ => {
+                return Err(inv(
+                    key,
+                    "give either `start_m` and `end_m` (straight) or `arc`".into(),
+                ))
+            }
+        };
+        let ids = res.map_err(|e| inv(key.clone(), e.to_string()))?;
+        if let (Some(f), Some(a)) = (first, b.start_m) {
+            let d = sub(m.nodes[f].x0, a);
+            if dot(d, d).sqrt() > 1e-9 * (1.0 + dot(a, a).sqrt()) {
+                return Err(inv(
+                    format!("{key}.start_node"),
+                    "start node position differs from start_m".into(),
+                ));
+            }
+        }
+        let _ = ids;
+    }
+    for (i, r) in d.rigid_bodies.iter().enumerate() {
+        let key = format!("rigid_body[{i}] `{}`", r.name);
+        let n = node(&m, &format!("{key}.node"), &r.node)?;
+        if r.mass_kg < 0.0 {
+            return Err(inv(format!("{key}.mass_kg"), "must be non-negative".into()));
+        }
+        m.add_element(Element::Rigid(RigidBody {
+            name: r.name.clone(),
+            node: n,
+            mass_kg: r.mass_kg,
+            cm_offset_m: r.cm_offset_m,
+            inertia_kgm2: r.inertia_kgm2,
+        }))
+        .map_err(|e| inv(key, e.to_string()))?;
+    }
+    for (i, j) in d.joints.iter().enumerate() {
+        let key = format!("joint[{i}] `{}`", j.name);
+        let kind = match j.kind.as_str() {
+            "clamp" | "prescribed" => JointKind::Clamp,
+            "revolute" => JointKind::Revolute,
+            "universal" => JointKind::Universal,
+            "spherical" => JointKind::Spherical,
+            other => return Err(inv(format!("{key}.type"), format!("unknown joint type `{other}` (expected clamp, revolute, universal, spherical, prescribed)"))),
+        };
+        let a = match j.node_a.as_deref() {
+            None | Some("ground") => None,
+            Some(n) => Some(node(&m, &format!("{key}.node_a"), n)?),
+        };
+        let b = node(&m, &format!("{key}.node_b"), &j.node_b)?;
+        let p = j.position_m.unwrap_or(m.nodes[b].x0);
+        let q = frame_from_axis(j.axis, j.x_direction);
+        // frame_from_axis gives columns (axis, ~x, .): reorder to (x, y, z = axis)
+        let q = [
+            [q[0][1], q[0][2], q[0][0]],
+            [q[1][1], q[1][2], q[1][0]],
+            [q[2][1], q[2][2], q[2][0]],
+        ];
+        let id = m
+            .add_joint(&j.name, kind, a, b, p, q)
+            .map_err(|e| inv(key.clone(), e.to_string()))?;
+        if let Element::Joint(jj) = &mut m.elements[id] {
+            jj.spring_nm_per_rad = j.stiffness;
+            jj.damper_nms_per_rad = j.damping;
+            if j.omega_rad_s.is_some() || j.angle_table.is_some() {
+                if !matches!(kind, JointKind::Revolute | JointKind::Clamp) {
+                    return Err(inv(
+                        format!("{key}.omega_rad_s"),
+                        "prescribed rotation needs a revolute or prescribed joint".into(),
+                    ));
+                }
+                jj.prescribed_angle = Some(AngleLaw {
+                    omega_rad_s: j.omega_rad_s.unwrap_or(0.0),
+                    table: j.angle_table.as_ref().map(|_| table(&j.angle_table)),
+                });
+            }
+            if let Some(u) = j.displacement_m {
+                jj.displacement_m = Some((u, table(&j.displacement_table)));
+            }
+        }
+    }
+    for (i, l) in d.loads.iter().enumerate() {
+        let key = format!("load[{i}] `{}`", l.name);
+        let n = node(&m, &format!("{key}.node"), &l.node)?;
+        m.add_element(Element::Load(PointLoad {
+            name: l.name.clone(),
+            node: n,
+            force_n: l.force,
+            moment_nm: l.moment,
+            follower: l.follower,
+            time: table(&l.time_table),
+        }))
+        .map_err(|e| inv(key, e.to_string()))?;
+    }
+    for (i, l) in d.distributed_loads.iter().enumerate() {
+        let key = format!("distributed_load[{i}]");
+        m.add_beam_load(
+            &l.beam,
+            BeamLoad {
+                force_n_per_m: l.force,
+                moment_nm_per_m: l.moment,
+                follower: l.follower,
+                time: table(&l.time_table),
+            },
+        )
+        .map_err(|e| inv(format!("{key}.beam"), e.to_string()))?;
+    }
+    for (i, s) in d.sensors.iter().enumerate() {
+        let key = format!("sensor[{i}] `{}`", s.name);
+        let kind = match (&s.node, &s.joint, &s.beam) {
+            (Some(n), None, None) => SensorKind::Node(node(&m, &format!("{key}.node"), n)?),
+            (None, Some(j), None) => {
+                let id = m
+                    .element_id(j)
+                    .filter(|&id| matches!(m.elements[id], Element::Joint(_)))
+                    .ok_or_else(|| {
+                        inv(
+                            format!("{key}.joint"),
+                            format!("joint `{j}` does not exist"),
+                        )
+                    })?;
+                SensorKind::Joint(id)
+            }
+            (None, None, Some(b)) => {
+                let ids = m.beams.get(b).cloned().ok_or_else(|| {
+                    inv(format!("{key}.beam"), format!("beam `{b}` does not exist"))
+                })?;
+                SensorKind::Section {
+                    elements: ids,
+                    s_m: s.s_m.unwrap_or(0.0),
+                }
+            }
+            _ => {
+                return Err(inv(
+                    key,
+                    "give exactly one of `node`, `joint`, `beam` (with `s_m`)".into(),
+                ))
+            }
+        };
+        m.add_sensor(&s.name, kind);
+    }
+    let mut used = vec![false; m.nodes.len()];
+    for e in &m.elements {
+        for n in e.node_list() {
+            used[n] = true;
+        }
+    }
+    if let Some(i) = used.iter().position(|u| !u) {
+        return Err(inv(
+            format!("node `{}`", m.nodes[i].name),
+            "not connected to any element or joint (it would have no mass and no stiffness)".into(),
+        ));
+    }
+    Ok(m)
+}

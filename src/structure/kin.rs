@@ -1,0 +1,109 @@
+//! Nodal kinematics passed to element residuals, and evaluation context.
+use super::real::{c, Real};
+use super::rotation::{M3, V3};
+
+/// Position, rotation, spatial velocities and accelerations of a node in scalar type `T`.
+/// `w` is the spatial angular velocity, `al` its time derivative.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeKin<T> {
+    pub x: V3<T>,
+    pub r: M3<T>,
+    pub v: V3<T>,
+    pub w: V3<T>,
+    pub a: V3<T>,
+    pub al: V3<T>,
+}
+
+impl<T: Real> NodeKin<T> {
+    pub fn ground() -> Self {
+        let z = [c(0.0); 3];
+        NodeKin {
+            x: z,
+            r: super::rotation::ident(),
+            v: z,
+            w: z,
+            a: z,
+            al: z,
+        }
+    }
+}
+
+impl NodeKin<f64> {
+    /// Lift to a dual-capable scalar with zero derivative parts.
+    pub fn lift<T: Real>(&self) -> NodeKin<T> {
+        use super::rotation::{m3c, v3c};
+        NodeKin {
+            x: v3c(&self.x),
+            r: m3c(&self.r),
+            v: v3c(&self.v),
+            w: v3c(&self.w),
+            a: v3c(&self.a),
+            al: v3c(&self.al),
+        }
+    }
+}
+
+/// Direction of a seeded derivative on one node: configuration perturbation (`dx`, `dth`
+/// spatial rotation increment), and velocity/acceleration perturbations.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Seed {
+    pub dx: [f64; 3],
+    pub dth: [f64; 3],
+    pub dv: [f64; 3],
+    pub dw: [f64; 3],
+    pub da: [f64; 3],
+    pub dal: [f64; 3],
+}
+
+/// Evaluation context common to all elements.
+#[derive(Clone, Copy, Debug)]
+pub struct EvalCtx {
+    /// Time [s] (pseudo-time in static analyses).
+    pub t: f64,
+    /// Multiplier applied to all applied loads (load stepping in static analyses).
+    pub load_factor: f64,
+    pub gravity: [f64; 3],
+    /// Constraint scaling: multipliers are `cscale * lambda_hat`, constraint rows `cscale * Phi`.
+    pub cscale: f64,
+    /// Whether inertial forces are included.
+    pub inertia: bool,
+}
+
+impl Default for EvalCtx {
+    fn default() -> Self {
+        EvalCtx {
+            t: 0.0,
+            load_factor: 1.0,
+            gravity: [0.0; 3],
+            cscale: 1.0,
+            inertia: true,
+        }
+    }
+}
+
+/// Piecewise-linear time function given as (t, factor) pairs; empty means constant 1.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TimeTable {
+    pub points: Vec<(f64, f64)>,
+}
+
+impl TimeTable {
+    pub fn constant() -> Self {
+        TimeTable { points: vec![] }
+    }
+    pub fn eval(&self, t: f64) -> f64 {
+        let p = &self.points;
+        if p.is_empty() {
+            return 1.0;
+        }
+        if t <= p[0].0 {
+            return p[0].1;
+        }
+        if t >= p[p.len() - 1].0 {
+            return p[p.len() - 1].1;
+        }
+        let k = p.partition_point(|q| q.0 <= t) - 1;
+        let w = (t - p[k].0) / (p[k + 1].0 - p[k].0);
+        p[k].1 + w * (p[k + 1].1 - p[k].1)
+    }
+}
