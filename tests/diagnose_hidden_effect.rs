@@ -11,7 +11,14 @@ use rotorsim::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
 
 /// 4 cycles at 1 kHz keep the test fast; the hit-rate example uses the full campaign.
 fn run(h: &support::Hidden, seed: u64) -> rotorsim::diagnose::Outcome {
-    let data = support::campaign(&h.deck, &[1.0, 2.0, 3.0, 4.0, 6.0, 8.0], 4, 1000.0, 0.01, seed);
+    let data = support::campaign(
+        &h.deck,
+        &[1.0, 2.0, 3.0, 4.0, 6.0, 8.0],
+        4,
+        1000.0,
+        0.01,
+        seed,
+    );
     diagnose(&support::nominal_deck(), &data, &DiagnoseOptions::default()).unwrap()
 }
 
@@ -77,7 +84,10 @@ fn hidden_effects_drawn_at_random_are_found() {
 #[test]
 fn every_kind_is_found() {
     for (i, k) in support::KINDS.iter().enumerate() {
-        if matches!(k, Cause::SealFriction | Cause::ReliefAsymmetry | Cause::PistonLeakage) {
+        if matches!(
+            k,
+            Cause::SealFriction | Cause::ReliefAsymmetry | Cause::PistonLeakage
+        ) {
             // Covered by the random draws above (seeds 0, 11, 7).
             continue;
         }
@@ -104,9 +114,15 @@ fn one_amplitude_is_reported_as_a_limitation() {
     let data = support::campaign(&h.deck, &[3.0], 6, 1000.0, 0.01, 3);
     let o = diagnose(&support::nominal_deck(), &data, &DiagnoseOptions::default()).unwrap();
     let d = &o.diagnosis;
-    assert!(d.validation.method.starts_with("held-out cycles"), "{}", d.validation.method);
     assert!(
-        d.limitations.iter().any(|l| l.contains("one stroke amplitude")),
+        d.validation.method.starts_with("held-out cycles"),
+        "{}",
+        d.validation.method
+    );
+    assert!(
+        d.limitations
+            .iter()
+            .any(|l| l.contains("one stroke amplitude")),
         "{:?}",
         d.limitations
     );
@@ -128,13 +144,19 @@ fn bad_data_gets_a_clear_message() {
         *f = f.min(9000.0);
     }
     let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
-    assert!(matches!(e, DiagnoseError::Clipping { value, .. } if value == 9000.0), "{e}");
+    assert!(
+        matches!(e, DiagnoseError::Clipping { value, .. } if value == 9000.0),
+        "{e}"
+    );
     assert!(e.to_string().contains("clipped"), "{e}");
     // Too short: one cycle.
     let data = support::campaign(&h.deck, &[2.0, 4.0], 1, 1000.0, 0.01, 2);
     let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
     assert!(
-        matches!(e, DiagnoseError::TooShort { .. } | DiagnoseError::NoCycle { .. }),
+        matches!(
+            e,
+            DiagnoseError::TooShort { .. } | DiagnoseError::NoCycle { .. }
+        ),
         "{e}"
     );
     // No force column.
@@ -154,6 +176,16 @@ fn generator_is_seeded_and_noisy_at_one_percent() {
     simulate(&h.deck, &a[0], a[0].time_s.len(), 1e-5, &mut clean).unwrap();
     let peak = clean.iter().fold(0.0f64, |x, f| x.max(f.abs()));
     let n = clean.len() as f64;
-    let rms = (a[0].force_n.iter().zip(&clean).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / n).sqrt();
-    assert!((rms / peak - 0.01).abs() < 0.001, "noise {rms} vs peak {peak}");
+    let rms = (a[0]
+        .force_n
+        .iter()
+        .zip(&clean)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    assert!(
+        (rms / peak - 0.01).abs() < 0.001,
+        "noise {rms} vs peak {peak}"
+    );
 }
