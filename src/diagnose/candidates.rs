@@ -145,3 +145,33 @@ impl Cause {
         d
     }
 }
+
+/// Name of a combination of causes, e.g. `entrained_air+free_play`.
+pub fn combined_name(causes: &[Cause]) -> String {
+    causes
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join("+")
+}
+
+/// Parameters of a combination (concatenated; None if any cause is not applicable).
+pub fn combined_params(causes: &[Cause], base: &DamperDeck, s: Scales) -> Option<Vec<ParamSpec>> {
+    let mut v = Vec::new();
+    for c in causes {
+        v.extend(c.params(base, s)?);
+    }
+    Some(v)
+}
+
+/// The base deck with every cause of a combination applied, each taking its share of `x`.
+pub fn apply_all(causes: &[Cause], base: &DamperDeck, s: Scales, x: &[f64]) -> DamperDeck {
+    let mut d = base.clone();
+    let mut i = 0;
+    for c in causes {
+        let k = c.params(base, s).map_or(0, |p| p.len());
+        d = c.apply(&d, &x[i..i + k]);
+        i += k;
+    }
+    d
+}

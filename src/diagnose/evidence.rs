@@ -117,8 +117,35 @@ pub fn evidence(
         "peak-to-peak force measured/baseline by stroke amplitude: {}",
         per_test.join(", ")
     ));
+    let what = cause
+        .split('+')
+        .map(|c| cause_sentence(c, params))
+        .collect::<Vec<_>>()
+        .join("; ");
+    ev.push(what);
+    ev.push(format!(
+        "held-out RMS error: baseline {base_held:.1} N, extended {ext_held:.1} N (gain {:.3})",
+        1.0 - ext_held / base_held
+    ));
+    if cands.len() >= 2 {
+        ev.push(format!(
+            "ranking by BIC: {}",
+            cands
+                .iter()
+                .map(|c| format!(
+                    "{} {:.0} (held-out {:.1} N)",
+                    c.cause, c.bic, c.held_out_rms_N
+                ))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
+    }
+    ev
+}
+
+fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
     let p = |k: &str| params.get(k).copied().unwrap_or(f64::NAN);
-    let what = match cause {
+    match cause {
         "seal_friction" => format!(
             "seal friction F_c = {:.0} N: the force jumps by ~2 F_c = {:.0} N at every velocity reversal",
             p("F_c_N"),
@@ -151,24 +178,5 @@ pub fn evidence(
             p("relief_a_m")
         ),
         _ => "no candidate beats the baseline by more than the noise-level threshold".to_string(),
-    };
-    ev.push(what);
-    ev.push(format!(
-        "held-out RMS error: baseline {base_held:.1} N, extended {ext_held:.1} N (gain {:.3})",
-        1.0 - ext_held / base_held
-    ));
-    if cands.len() >= 2 {
-        ev.push(format!(
-            "ranking by BIC: {}",
-            cands
-                .iter()
-                .map(|c| format!(
-                    "{} {:.0} (held-out {:.1} N)",
-                    c.cause, c.bic, c.held_out_rms_N
-                ))
-                .collect::<Vec<_>>()
-                .join("; ")
-        ));
     }
-    ev
 }

@@ -1,7 +1,7 @@
 //! Fitting and ranking: every candidate's parameters by Levenberg-Marquardt (bounded through a
 //! logistic-log transform, multi-start), BIC on the fit data, RMS on held-out data, and the
 //! choice of the cause.
-use super::candidates::{Cause, ParamSpec, Scales};
+use super::candidates::{apply_all, combined_name, combined_params, Cause, ParamSpec, Scales};
 use super::data::{check_measurements, noise_sigma, Measurement};
 use super::DiagnoseError;
 use crate::hydraulics::{
@@ -26,6 +26,8 @@ pub struct DiagnoseOptions {
     pub candidates: Vec<Cause>,
     /// Levenberg-Marquardt patience (function evaluations per parameter, the crate's measure).
     pub patience: usize,
+    /// Try pairs of causes when the best single one leaves a systematic residual.
+    pub pairs: bool,
 }
 
 impl Default for DiagnoseOptions {
@@ -35,6 +37,7 @@ impl Default for DiagnoseOptions {
             max_substep_s: 3.0e-5,
             candidates: Cause::CANDIDATES.to_vec(),
             patience: 8,
+            pairs: true,
         }
     }
 }
@@ -206,7 +209,8 @@ fn to_z(p: &ParamSpec, x: f64) -> f64 {
 }
 
 struct Problem<'a> {
-    cause: Cause,
+    cause: &'a [Cause],
+    scales: Scales,
     base: &'a DamperDeck,
     spec: &'a [ParamSpec],
     data: &'a [Measurement],
@@ -221,7 +225,7 @@ struct Problem<'a> {
 impl Problem<'_> {
     fn residuals_at(&self, z: &[f64]) -> Option<DVector<f64>> {
         self.evals.set(self.evals.get() + 1);
-        let deck = self.cause.apply(self.base, &to_x(self.spec, z));
+        let deck = apply_all(self.cause, self.base, self.scales, &to_x(self.spec, z));
         let n: usize = self.windows.iter().map(|w| w.to - w.from).sum();
         let mut r = DVector::zeros(n);
         let mut buf = Vec::new();
@@ -272,6 +276,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 }
 
+/// A fitted and evaluated candidate: row, full replays, deck, fitted parameters.
+type Evaluated = (Candidate, Option<Vec<Vec<f64>>>, DamperDeck, Vec<f64>);
+
 /// Result of one multi-start fit of one candidate.
 struct Fit {
     x: Vec<f64>,
@@ -279,8 +286,10 @@ struct Fit {
     evals: usize,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fit_one(
-    cause: Cause,
+    cause: &[Cause],
+    scales: Scales,
     base: &DamperDeck,
     spec: &[ParamSpec],
     z0: Vec<f64>,
@@ -291,6 +300,7 @@ fn fit_one(
 ) -> Option<Fit> {
     let mut pb = Problem {
         cause,
+        scales,
         base,
         spec,
         data,
@@ -445,50 +455,6 @@ pub fn diagnose(
     let n_fit: usize = fit_w.iter().map(|w| w.to - w.from).sum();
     let n_held: usize = held_w.iter().map(|w| w.to - w.from).sum();
 
-    // Fit jobs: (candidate, start) pairs, in parallel.
-    let cands: Vec<(Cause, Vec<ParamSpec>)> = opts
-        .candidates
-        .iter()
-        .filter_map(|&c| c.params(base, scales).map(|s| (c, s)))
-        .collect();
-    let mut jobs = Vec::new();
-    for (ci, (_, spec)) in cands.iter().enumerate() {
-        // Grid of starts: the product of each parameter's starting values.
-        let mut starts: Vec<Vec<f64>> = vec![vec![]];
-        for p in spec {
-            starts = starts
-                .into_iter()
-                .flat_map(|s| {
-                    p.starts.iter().map(move |&x| {
-                        let mut t = s.clone();
-                        t.push(to_z(p, x));
-                        t
-                    })
-                })
-                .collect();
-        }
-        for z0 in starts {
-            jobs.push((ci, z0));
-        }
-    }
-    let fits: Vec<(usize, Option<Fit>)> = jobs
-        .into_par_iter()
-        .map(|(ci, z0)| {
-            let (c, spec) = &cands[ci];
-            (ci, fit_one(*c, base, spec, z0, data, &fit_w, opts, scale))
-        })
-        .collect();
-    let mut best: Vec<Option<Fit>> = (0..cands.len()).map(|_| None).collect();
-    let mut evals = vec![0usize; cands.len()];
-    for (ci, f) in fits {
-        if let Some(f) = f {
-            evals[ci] += f.evals;
-            if best[ci].as_ref().is_none_or(|b| f.rss < b.rss) {
-                best[ci] = Some(f);
-            }
-        }
-    }
-
     // Full replays: baseline and every fitted candidate.
     let sim_all = |deck: &DamperDeck| -> Result<Vec<Vec<f64>>, DiagnoseError> {
         data.iter()
@@ -510,54 +476,151 @@ pub fn diagnose(
     let base_held = rms_over(&held_w, &baseline, data);
     let base_fit_rss = rms_over(&fit_w, &baseline, data).powi(2) * n_fit as f64;
     let base_bic = bic(base_fit_rss, n_fit, 0);
-    let evaluated: Vec<(Candidate, Option<Vec<Vec<f64>>>, DamperDeck)> = cands
-        .par_iter()
-        .zip(best.par_iter())
-        .zip(evals.par_iter())
-        .map(|(((c, spec), f), &ev)| {
-            let mut row = Candidate {
-                cause: c.name().into(),
-                rms_N: f64::NAN,
-                bic: f64::INFINITY,
-                parameters: BTreeMap::new(),
-                held_out_rms_N: f64::NAN,
-                k: spec.len(),
-                fit_evaluations: ev,
-                failure: None,
-            };
-            let Some(f) = f else {
-                row.failure = Some("model failed at every starting point".into());
-                return (row, None, base.clone());
-            };
-            let deck = c.apply(base, &f.x);
-            for (p, x) in spec.iter().zip(&f.x) {
-                row.parameters.insert(p.name.into(), *x);
-            }
-            match sim_all(&deck) {
-                Ok(sim) => {
-                    row.rms_N = rms_over(&all_w, &sim, data);
-                    row.held_out_rms_N = rms_over(&held_w, &sim, data);
-                    row.bic = bic(f.rss, n_fit, spec.len());
-                    (row, Some(sim), deck)
-                }
-                Err(e) => {
-                    row.failure = Some(e.to_string());
-                    (row, None, deck)
-                }
-            }
-        })
+    // Stage 1: every single cause; fit jobs are (candidate, start) pairs, in parallel.
+    let singles: Vec<(Vec<Cause>, Vec<ParamSpec>)> = opts
+        .candidates
+        .iter()
+        .filter_map(|&c| c.params(base, scales).map(|s| (vec![c], s)))
         .collect();
-    let mut evaluated = evaluated;
+    let stage = |cands: &[(Vec<Cause>, Vec<ParamSpec>)]| -> Vec<Evaluated> {
+        let mut jobs = Vec::new();
+        for (ci, (_, spec)) in cands.iter().enumerate() {
+            // Grid of starts: the product of each parameter's starting values.
+            let mut starts: Vec<Vec<f64>> = vec![vec![]];
+            for p in spec {
+                starts = starts
+                    .into_iter()
+                    .flat_map(|s| {
+                        p.starts.iter().map(move |&x| {
+                            let mut t = s.clone();
+                            t.push(to_z(p, x));
+                            t
+                        })
+                    })
+                    .collect();
+            }
+            for z0 in starts {
+                jobs.push((ci, z0));
+            }
+        }
+        let fits: Vec<(usize, Option<Fit>)> = jobs
+            .into_par_iter()
+            .map(|(ci, z0)| {
+                let (c, spec) = &cands[ci];
+                (
+                    ci,
+                    fit_one(c, scales, base, spec, z0, data, &fit_w, opts, scale),
+                )
+            })
+            .collect();
+        let mut best: Vec<Option<Fit>> = (0..cands.len()).map(|_| None).collect();
+        let mut evals = vec![0usize; cands.len()];
+        for (ci, f) in fits.into_iter() {
+            if let Some(f) = f {
+                evals[ci] += f.evals;
+                if best[ci].as_ref().is_none_or(|b| f.rss < b.rss) {
+                    best[ci] = Some(f);
+                }
+            }
+        }
+        cands
+            .par_iter()
+            .zip(best.par_iter())
+            .zip(evals.par_iter())
+            .map(|(((c, spec), f), &ev)| {
+                let mut row = Candidate {
+                    cause: combined_name(c),
+                    rms_N: f64::NAN,
+                    bic: f64::INFINITY,
+                    parameters: BTreeMap::new(),
+                    held_out_rms_N: f64::NAN,
+                    k: spec.len(),
+                    fit_evaluations: ev,
+                    failure: None,
+                };
+                let Some(f) = f else {
+                    row.failure = Some("model failed at every starting point".into());
+                    return (row, None, base.clone(), vec![]);
+                };
+                let deck = apply_all(c, base, scales, &f.x);
+                for (p, x) in spec.iter().zip(&f.x) {
+                    row.parameters.insert(p.name.into(), *x);
+                }
+                match sim_all(&deck) {
+                    Ok(sim) => {
+                        row.rms_N = rms_over(&all_w, &sim, data);
+                        row.held_out_rms_N = rms_over(&held_w, &sim, data);
+                        row.bic = bic(f.rss, n_fit, spec.len());
+                        (row, Some(sim), deck, f.x.clone())
+                    }
+                    Err(e) => {
+                        row.failure = Some(e.to_string());
+                        (row, None, deck, f.x.clone())
+                    }
+                }
+            })
+            .collect()
+    };
+    let mut evaluated = stage(&singles);
+    evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+    let threshold = 0.05 * sigma + 3.0 * sigma / (2.0 * n_held.max(1) as f64).sqrt();
+    // Stage 2: when the best single cause leaves a systematic residual (held-out RMS above
+    // 1.5 sigma) and itself passes, pair it with each of the next three singles (joint fit,
+    // starting from its own fitted value): effects do come together (the paper's conclusions).
+    let mut pair_ref: Option<(f64, f64)> = None;
+    if let Some((row, Some(_), _, x1)) = evaluated.first() {
+        let first_ok = row.bic < base_bic && base_held - row.held_out_rms_N > threshold;
+        if first_ok && row.held_out_rms_N > 1.5 * sigma && opts.pairs {
+            let c1 = singles
+                .iter()
+                .find(|(c, _)| combined_name(c) == row.cause)
+                .map(|(c, _)| c[0]);
+            if let Some(c1) = c1 {
+                let pairs: Vec<(Vec<Cause>, Vec<ParamSpec>)> = evaluated
+                    .iter()
+                    .skip(1)
+                    .filter(|e| e.1.is_some())
+                    .take(3)
+                    .filter_map(|e| {
+                        let c2 = singles
+                            .iter()
+                            .find(|(c, _)| combined_name(c) == e.0.cause)?
+                            .0[0];
+                        let mut spec = combined_params(&[c1, c2], base, scales)?;
+                        for (p, x) in spec.iter_mut().zip(x1) {
+                            p.starts = vec![*x];
+                        }
+                        Some((vec![c1, c2], spec))
+                    })
+                    .collect();
+                pair_ref = Some((row.bic, row.held_out_rms_N));
+                evaluated.extend(stage(&pairs));
+            }
+        }
+    }
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
 
     // Choice: the lowest BIC, if it beats the baseline's BIC and improves the held-out RMS by
     // more than the noise-level threshold.
-    let threshold = 0.05 * sigma + 3.0 * sigma / (2.0 * n_held.max(1) as f64).sqrt();
-    let chosen = evaluated.first().filter(|(row, sim, _)| {
-        sim.is_some() && row.bic < base_bic && base_held - row.held_out_rms_N > threshold
+    // A pair must beat the single it extends as the single beat the baseline.
+    let chosen = evaluated.iter().find(|(row, sim, _, _)| {
+        let (ref_bic, ref_held) = if row.cause.contains('+') {
+            pair_ref.unwrap_or((f64::NEG_INFINITY, f64::NEG_INFINITY))
+        } else {
+            (base_bic, base_held)
+        };
+        sim.is_some() && row.bic < ref_bic && ref_held - row.held_out_rms_N > threshold
+    });
+    // Only the lowest-BIC candidate may be chosen, unless it is a pair that fails its own test
+    // (then the best single is next in line).
+    let chosen = chosen.filter(|c| {
+        evaluated
+            .iter()
+            .take_while(|e| !std::ptr::eq(*e, *c))
+            .all(|e| e.0.cause.contains('+'))
     });
     let (cause, params, ext_sim, ext_deck, ext_rms, ext_held) = match chosen {
-        Some((row, Some(sim), deck)) => (
+        Some((row, Some(sim), deck, _)) => (
             row.cause.clone(),
             row.parameters.clone(),
             sim.clone(),
