@@ -71,27 +71,27 @@ fn assert_found(h: &support::Hidden, seed: u64) {
     assert_eq!(r.force_model_n, m.extended_n, "written deck differs");
 }
 
+/// Seeds of the fast subset of the sweep.
+const SEEDS: [u64; 3] = [0, 7, 11];
+
 /// Seeded random draws (kind and magnitude): the fast subset of the sweep.
 #[test]
 fn hidden_effects_drawn_at_random_are_found() {
-    for seed in [0u64, 7, 11] {
+    for seed in SEEDS {
         let h = support::draw(seed);
         assert_found(&h, seed);
     }
 }
 
-/// Every kind once (mid-range magnitude), so each is exercised whatever the draws.
+/// Every kind the random draws above did not hit, once (mid-range magnitude).
 #[test]
 fn every_kind_is_found() {
+    let drawn: Vec<Cause> = SEEDS.iter().map(|&s| support::draw(s).cause).collect();
     for (i, k) in support::KINDS.iter().enumerate() {
-        if matches!(
-            k,
-            Cause::SealFriction | Cause::ReliefAsymmetry | Cause::PistonLeakage
-        ) {
-            // Covered by the random draws above (seeds 0, 11, 7).
+        if drawn.contains(k) {
             continue;
         }
-        let h = support::hidden(*k, 0.3 + 0.1 * i as f64);
+        let h = support::hidden(*k, 0.3 + 0.05 * i as f64);
         assert_found(&h, 100 + i as u64);
     }
 }

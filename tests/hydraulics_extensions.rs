@@ -84,7 +84,7 @@ fn default_extensions_are_bit_for_bit_the_paper_model() {
 #[test]
 fn written_deck_reads_back_with_every_extension() {
     let d = deck_with(
-        "seal_friction_N = 321.5\nstribeck_static_N = 400.0\nfree_play_m = 2.5e-4\nair_fraction = 0.013\nleakage_m3_per_s_Pa = 7.0e-12",
+        "seal_friction_N = 321.5\nstribeck_static_N = 400.0\nfree_play_m = 2.5e-4\nair_fraction = 0.013\nleakage_m3_per_s_Pa = 7.0e-12\nair_fraction_1 = 0.05\naccumulator_bleed_m3_per_s_Pa = 2.0e-12",
     );
     let back = DamperDeck::from_toml_str(&d.to_toml(), "back").unwrap();
     assert_eq!(back.physical, d.physical);
@@ -272,6 +272,11 @@ fn extension_jacobian_matches_finite_differences() {
         fraction: 0.03,
         p_ref: 5.0e5,
     });
+    p.ext.air_by_chamber[1] = Some(EntrainedAir {
+        fraction: 0.08,
+        p_ref: 5.0e5,
+    });
+    p.ext.bleed = Some(Leakage { conductance: 3e-12 });
     for (p0, p1) in [(3.0e6, 2.0e5), (6.0e5, 4.0e5), (5.0e4, 8.0e6)] {
         let mut y = State::zeros();
         y[IP0] = p0;
@@ -295,4 +300,65 @@ fn extension_jacobian_matches_finite_differences() {
             }
         }
     }
+}
+
+/// Accumulator bleed of a sealed chamber held still: p - p_s decays as exp(-t/tau),
+/// tau = V / (k B) in the linear regime.
+#[test]
+fn accumulator_bleed_relaxes_to_p_s_with_the_analytic_time_constant() {
+    let fluid = Fluid::constant_bulk(850.0, 1.5e9);
+    let dp0 = 2.0e3;
+    let mut p = sealed(fluid, [5.0e5 + dp0, 5.0e5 - dp0]);
+    let k = 1.0e-12;
+    p.ext.bleed = Some(Leakage { conductance: k });
+    let b = fluid.bulk(5.0e5).0;
+    let tau = 6.0e-5 / (k * b);
+    let mut dev = CircuitDevice::new(p, opts());
+    let dt = tau / 50.0;
+    for step in 1..=100 {
+        dev.trial_step((step - 1) as f64 * dt, dt, 0.0, 0.0)
+            .unwrap();
+        dev.commit();
+        let y = dev.state();
+        let e = dp0 * (-(step as f64) * dt / tau).exp();
+        assert!(
+            (y[IP0] - 5.0e5 - e).abs() < 1e-6 * dp0,
+            "step {step}: {}",
+            y[IP0]
+        );
+        assert!(
+            (y[IP1] - 5.0e5 + e).abs() < 1e-6 * dp0,
+            "step {step}: {}",
+            y[IP1]
+        );
+    }
+}
+
+/// Air in chamber 1 only: chamber 0 follows the oil's Eq. (3), chamber 1 the mixture law.
+#[test]
+fn air_by_chamber_acts_on_its_chamber_only() {
+    let fluid = Fluid {
+        rho: 850.0,
+        alpha: 6.667e-10,
+        beta: 0.0,
+        p_cav: 0.0,
+    };
+    let air = EntrainedAir {
+        fraction: 0.05,
+        p_ref: 5.0e5,
+    };
+    let mut p = sealed(fluid, [5.0e5; 2]);
+    p.ext.air_by_chamber[1] = Some(air);
+    let mut dev = CircuitDevice::new(p.clone(), opts());
+    let d_end = 1.0e-3; // chamber 0 grows, chamber 1 shrinks
+    for k in 0..200 {
+        let (a, b) = (d_end * k as f64 / 200.0, d_end * (k + 1) as f64 / 200.0);
+        dev.trial_step(k as f64 * 1e-4, 1e-4, a, b).unwrap();
+        dev.commit();
+    }
+    let c = &p.chambers;
+    let p0 = fluid.sealed_pressure(5.0e5, c[0].volume0, c[0].volume(d_end));
+    assert!((dev.state()[IP0] - p0).abs() < 1e-6 * p0.abs().max(1e5));
+    let ratio = c[1].volume(d_end) / c[1].volume0;
+    assert!((air.sealed_volume_ratio(&fluid, dev.state()[IP1]) - ratio).abs() < 1e-8);
 }

@@ -12,6 +12,10 @@ pub enum Cause {
     AreaAsymmetry,
     ReliefAsymmetry,
     PistonLeakage,
+    /// Entrained air, a different fraction in each chamber.
+    EntrainedAirByChamber,
+    /// Bleed of both chambers to the accumulator at p_s.
+    AccumulatorBleed,
     /// Re-calibration of the orifice area (C_d A_orf) and relief-valve flow-area coefficient a.
     Recalibration,
 }
@@ -33,13 +37,15 @@ pub struct Scales {
 }
 
 impl Cause {
-    pub const CANDIDATES: [Cause; 7] = [
+    pub const CANDIDATES: [Cause; 9] = [
         Cause::SealFriction,
         Cause::FreePlay,
         Cause::EntrainedAir,
+        Cause::EntrainedAirByChamber,
         Cause::AreaAsymmetry,
         Cause::ReliefAsymmetry,
         Cause::PistonLeakage,
+        Cause::AccumulatorBleed,
         Cause::Recalibration,
     ];
 
@@ -52,6 +58,8 @@ impl Cause {
             Cause::AreaAsymmetry => "area_asymmetry",
             Cause::ReliefAsymmetry => "relief_asymmetry",
             Cause::PistonLeakage => "piston_leakage",
+            Cause::AccumulatorBleed => "accumulator_bleed",
+            Cause::EntrainedAirByChamber => "entrained_air_by_chamber",
             Cause::Recalibration => "recalibration",
         }
     }
@@ -82,6 +90,10 @@ impl Cause {
                 )]
             }
             Cause::EntrainedAir => vec![p("air_fraction", 1e-5, 0.3, vec![3e-3, 3e-2])],
+            Cause::EntrainedAirByChamber => vec![
+                p("air_fraction_0", 1e-5, 0.3, vec![1e-3, 3e-2]),
+                p("air_fraction_1", 1e-5, 0.3, vec![1e-3, 3e-2]),
+            ],
             Cause::AreaAsymmetry => {
                 let a1 = c.chambers[1].area;
                 vec![p("A1_m2", 0.4 * a1, 1.3 * a1, vec![0.9 * a1])]
@@ -94,6 +106,12 @@ impl Cause {
                 ]
             }
             Cause::PistonLeakage => vec![p("leakage_m3_per_s_Pa", 1e-15, 1e-8, vec![1e-12, 1e-11])],
+            Cause::AccumulatorBleed => vec![p(
+                "accumulator_bleed_m3_per_s_Pa",
+                1e-15,
+                1e-8,
+                vec![1e-12, 1e-11],
+            )],
             Cause::Recalibration => {
                 let a = c.orifice?.area;
                 let mut v = vec![p("A_orf_m2", 0.2 * a, 5.0 * a, vec![a])];
@@ -122,6 +140,14 @@ impl Cause {
                     p_ref: c.p_s.max(crate::hydraulics::extensions::AIR_P_MIN_PA),
                 })
             }
+            Cause::EntrainedAirByChamber => {
+                for k in 0..2 {
+                    c.ext.air_by_chamber[k] = Some(EntrainedAir {
+                        fraction: x[k],
+                        p_ref: c.p_s.max(crate::hydraulics::extensions::AIR_P_MIN_PA),
+                    });
+                }
+            }
             Cause::AreaAsymmetry => c.chambers[1].area = x[0],
             Cause::ReliefAsymmetry => {
                 for (k, v) in x.iter().enumerate().take(2) {
@@ -131,6 +157,7 @@ impl Cause {
                 }
             }
             Cause::PistonLeakage => c.ext.leakage = Some(Leakage { conductance: x[0] }),
+            Cause::AccumulatorBleed => c.ext.bleed = Some(Leakage { conductance: x[0] }),
             Cause::Recalibration => {
                 if let Some(o) = c.orifice.as_mut() {
                     o.area = x[0];

@@ -159,6 +159,11 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             "entrained air {:.2}% by volume at p_s: the oil is soft near the background pressure, so the force lags and dwells near zero after each reversal",
             100.0 * p("air_fraction")
         ),
+        "entrained_air_by_chamber" => format!(
+            "entrained air {:.2}% in chamber 0 and {:.2}% in chamber 1 (by volume at p_s): the force lags differently in the two stroke directions and dwells near zero after reversals",
+            100.0 * p("air_fraction_0"),
+            100.0 * p("air_fraction_1")
+        ),
         "area_asymmetry" => format!(
             "rod-side area A1 = {:.4e} m^2: the two stroke directions displace different volumes, so positive and negative peaks differ",
             p("A1_m2")
@@ -171,6 +176,10 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
         "piston_leakage" => format!(
             "piston leakage {:.3e} m^3/(s Pa): a laminar bypass that lowers the force most at small amplitudes",
             p("leakage_m3_per_s_Pa")
+        ),
+        "accumulator_bleed" => format!(
+            "bleed of each chamber to the accumulator, {:.3e} m^3/(s Pa): the mean chamber pressure returns toward p_s instead of being pumped up by the check valves, so the oil is soft and the force dwells near zero at reversals",
+            p("accumulator_bleed_m3_per_s_Pa")
         ),
         "recalibration" => format!(
             "re-calibrated coefficients: A_orf = {:.4e} m^2, relief-valve a = {:.4e} m",

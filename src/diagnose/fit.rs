@@ -580,18 +580,25 @@ pub fn diagnose(
                     .iter()
                     .skip(1)
                     .filter(|e| e.1.is_some())
-                    .take(3)
                     .filter_map(|e| {
                         let c2 = singles
                             .iter()
                             .find(|(c, _)| combined_name(c) == e.0.cause)?
                             .0[0];
+                        // Two forms of the same element are not a pair.
+                        let air = |c: Cause| {
+                            matches!(c, Cause::EntrainedAir | Cause::EntrainedAirByChamber)
+                        };
+                        if air(c1) && air(c2) {
+                            return None;
+                        }
                         let mut spec = combined_params(&[c1, c2], base, scales)?;
                         for (p, x) in spec.iter_mut().zip(x1) {
                             p.starts = vec![*x];
                         }
                         Some((vec![c1, c2], spec))
                     })
+                    .take(3)
                     .collect();
                 pair_ref = Some((row.bic, row.held_out_rms_N));
                 evaluated.extend(stage(&pairs));
@@ -638,7 +645,8 @@ pub fn diagnose(
         ),
     };
     if one_amp {
-        if let (Some(a), Some(b)) = (evaluated.first(), evaluated.get(1)) {
+        let mut singles_ev = evaluated.iter().filter(|e| !e.0.cause.contains('+'));
+        if let (Some(a), Some(b)) = (singles_ev.next(), singles_ev.next()) {
             if cause != "none"
                 && b.0.held_out_rms_N - a.0.held_out_rms_N < threshold.max(0.05 * base_held)
             {

@@ -190,6 +190,8 @@ pub struct Flows {
     pub entrance: [f64; 2],
     /// Piston leakage, positive 0 -> 1.
     pub leakage: f64,
+    /// Bleed to the accumulator out of chamber k.
+    pub bleed: [f64; 2],
 }
 
 impl CircuitParams {
@@ -200,10 +202,10 @@ impl CircuitParams {
         }
     }
 
-    /// Bulk modulus of the chamber contents at p: Eq. (3), or the oil/air mixture.
+    /// Bulk modulus of the contents of chamber k at p: Eq. (3), or the oil/air mixture.
     #[inline]
-    pub fn bulk(&self, p: f64) -> (f64, f64) {
-        match &self.ext.air {
+    pub fn bulk(&self, k: usize, p: f64) -> (f64, f64) {
+        match self.ext.air_of(k) {
             None => self.fluid.bulk(p),
             Some(a) => a.bulk(&self.fluid, p),
         }
@@ -220,7 +222,7 @@ impl CircuitParams {
     pub fn static_stiffness(&self, y: &State, d: f64) -> f64 {
         let mut k = 0.0;
         for (i, c) in self.chambers.iter().enumerate() {
-            let (b, _) = self.bulk(y[i]);
+            let (b, _) = self.bulk(i, y[i]);
             k += b * c.area * c.area / c.volume(d);
         }
         k
@@ -284,6 +286,13 @@ impl CircuitParams {
             dq[1][IP0] += g;
             dq[1][IP1] -= g;
         }
+        if let Some(bl) = &self.ext.bleed {
+            let g = bl.conductance;
+            for (k, ip) in [(0, IP0), (1, IP1)] {
+                fl.bleed[k] = g * (y[ip] - self.p_s);
+                dq[k][ip] -= g;
+            }
+        }
         for k in 0..2 {
             let Some(rv) = &self.relief[k] else { continue };
             let (ix, iv) = if k == 0 { (IX0, IV0) } else { (IX1, IV1) };
@@ -332,11 +341,13 @@ impl CircuitParams {
             }
         }
         let qn = [
-            -fl.orifice - fl.leakage - fl.relief[0] + fl.relief[1] + fl.check[0] + fl.entrance[0],
-            fl.orifice + fl.leakage + fl.relief[0] - fl.relief[1] + fl.check[1] + fl.entrance[1],
+            -fl.orifice - fl.leakage - fl.relief[0] + fl.relief[1] + fl.check[0] + fl.entrance[0]
+                - fl.bleed[0],
+            fl.orifice + fl.leakage + fl.relief[0] - fl.relief[1] + fl.check[1] + fl.entrance[1]
+                - fl.bleed[1],
         ];
         for (k, ip) in [(0, IP0), (1, IP1)] {
-            let (rate, drate_dp, b_over_v) = match &self.ext.air {
+            let (rate, drate_dp, b_over_v) = match self.ext.air_of(k) {
                 None => self.chambers[k].pressure_rate(&self.fluid, y[ip], vol[k], qn[k], d_dot),
                 Some(a) => self.chambers[k].pressure_rate_with_bulk(
                     &self.fluid,

@@ -113,6 +113,9 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "free_play_m",
     "air_fraction",
     "leakage_m3_per_s_Pa",
+    "accumulator_bleed_m3_per_s_Pa",
+    "air_fraction_0",
+    "air_fraction_1",
 ];
 
 struct Ctx<'a> {
@@ -543,6 +546,14 @@ impl DamperDeck {
             "a non-negative conductance in m^3/(s Pa)",
             non_negative,
         )?;
+        let bleed = opt(
+            "accumulator_bleed_m3_per_s_Pa",
+            "a non-negative conductance in m^3/(s Pa)",
+            non_negative,
+        )?;
+        if let Some(k) = bleed.filter(|k| *k > 0.0) {
+            c.ext.bleed = Some(Leakage { conductance: k });
+        }
         let mut e = DeviceExtensions::default();
         let f_c = f_c.unwrap_or(0.0);
         let f_s = f_s.unwrap_or(f_c);
@@ -573,6 +584,25 @@ impl DamperDeck {
         }
         if let Some(k) = leak.filter(|k| *k > 0.0) {
             c.ext.leakage = Some(Leakage { conductance: k });
+        }
+        for ch in 0..2 {
+            let key = format!("air_fraction_{ch}");
+            let v = opt(&key, "a volume fraction in [0, 1)", |x| {
+                (0.0..1.0).contains(&x)
+            })?;
+            if let Some(a) = v.filter(|a| *a > 0.0) {
+                if c.p_s <= 0.0 {
+                    return Err(cx.bad(
+                        &format!("{p}.{key}"),
+                        &t[key.as_str()],
+                        "entrained air is given at the background pressure p_s_Pa, which must then be positive",
+                    ));
+                }
+                c.ext.air_by_chamber[ch] = Some(EntrainedAir {
+                    fraction: a,
+                    p_ref: c.p_s,
+                });
+            }
         }
         Ok(e)
     }
@@ -718,6 +748,14 @@ impl DamperDeck {
             }
             if let Some(l) = c.ext.leakage {
                 ext.push(("leakage_m3_per_s_Pa", l.conductance));
+            }
+            for (ch, a) in c.ext.air_by_chamber.iter().enumerate() {
+                if let Some(a) = a {
+                    ext.push((["air_fraction_0", "air_fraction_1"][ch], a.fraction));
+                }
+            }
+            if let Some(l) = c.ext.bleed {
+                ext.push(("accumulator_bleed_m3_per_s_Pa", l.conductance));
             }
             if !ext.is_empty() {
                 s.push_str("\n[damper.physical.extensions]\n");

@@ -133,7 +133,21 @@ pub struct Leakage {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HydraulicExtensions {
     pub air: Option<EntrainedAir>,
+    /// Air in one chamber only (e.g. trapped on the rod side): chamber k uses
+    /// `air_by_chamber[k]` where given, else `air`.
+    pub air_by_chamber: [Option<EntrainedAir>; 2],
     pub leakage: Option<Leakage>,
+    /// Bleed of each chamber to the accumulator at p_s, `Q_k = k (p_k - p_s)` out of chamber k
+    /// (the accumulator's link that the paper's conclusions say is not modelled).
+    pub bleed: Option<Leakage>,
+}
+
+impl HydraulicExtensions {
+    /// The air of chamber k, if any.
+    #[inline]
+    pub fn air_of(&self, k: usize) -> Option<&EntrainedAir> {
+        self.air_by_chamber[k].as_ref().or(self.air.as_ref())
+    }
 }
 
 /// A circuit device with seal friction and/or free play in the attachments.

@@ -100,6 +100,15 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
             let v = loglerp(3e-12, 2e-11);
             ("leakage_m3_per_s_Pa", v, 0.25, vec![v])
         }
+        Cause::EntrainedAirByChamber => {
+            // Air trapped on one side (chamber 1), a trace in chamber 0.
+            let v = loglerp(0.01, 0.08);
+            ("air_fraction_1", v, 0.25, vec![1e-4, v])
+        }
+        Cause::AccumulatorBleed => {
+            let v = loglerp(2e-12, 2e-11);
+            ("accumulator_bleed_m3_per_s_Pa", v, 0.25, vec![v])
+        }
         Cause::Recalibration => {
             let a = c.orifice.unwrap().area * lerp(0.7, 1.4);
             ("A_orf_m2", a, 0.1, vec![a, c.relief[0].unwrap().a])
@@ -115,14 +124,16 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
     }
 }
 
-/// Kinds drawn by [`draw`].
-pub const KINDS: [Cause; 6] = [
+/// Kinds drawn by [`draw`]: the six of issue #7 and the two found on the flight record.
+pub const KINDS: [Cause; 8] = [
     Cause::SealFriction,
     Cause::FreePlay,
     Cause::EntrainedAir,
     Cause::AreaAsymmetry,
     Cause::ReliefAsymmetry,
     Cause::PistonLeakage,
+    Cause::EntrainedAirByChamber,
+    Cause::AccumulatorBleed,
 ];
 
 /// One hidden effect drawn at random from the seed.
