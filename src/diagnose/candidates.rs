@@ -141,9 +141,9 @@ impl Cause {
                 })
             }
             Cause::EntrainedAirByChamber => {
-                for k in 0..2 {
-                    c.ext.air_by_chamber[k] = Some(EntrainedAir {
-                        fraction: x[k],
+                for (slot, &a) in c.ext.air_by_chamber.iter_mut().zip(x) {
+                    *slot = Some(EntrainedAir {
+                        fraction: a,
                         p_ref: c.p_s.max(crate::hydraulics::extensions::AIR_P_MIN_PA),
                     });
                 }

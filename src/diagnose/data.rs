@@ -79,7 +79,7 @@ pub(crate) fn min_max(x: &[f64]) -> (f64, f64) {
 /// Period from the mean upward crossings of x (with a hysteresis of 10% of the half range).
 pub fn estimate_period(t: &[f64], x: &[f64]) -> Option<f64> {
     let (lo, hi) = min_max(x);
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let mid = 0.5 * (lo + hi);

@@ -233,8 +233,8 @@ impl Problem<'_> {
         for w in self.windows {
             let m = &self.data[w.test];
             simulate(&deck, m, w.to, self.max_h, &mut buf).ok()?;
-            for k in w.from..w.to {
-                r[i] = (buf[k] - m.force_n[k]) / self.scale;
+            for (b, f) in buf[w.from..w.to].iter().zip(&m.force_n[w.from..w.to]) {
+                r[i] = (b - f) / self.scale;
                 i += 1;
             }
         }
@@ -333,9 +333,9 @@ fn fit_one(
 fn rms_over(windows: &[Window], model: &[Vec<f64>], data: &[Measurement]) -> f64 {
     let (mut s, mut n) = (0.0, 0usize);
     for w in windows {
-        for k in w.from..w.to {
-            let e = model[w.test][k] - data[w.test].force_n[k];
-            s += e * e;
+        let (a, b) = (&model[w.test], &data[w.test].force_n);
+        for (x, y) in a[w.from..w.to].iter().zip(&b[w.from..w.to]) {
+            s += (x - y) * (x - y);
             n += 1;
         }
     }
@@ -403,8 +403,7 @@ pub fn diagnose(
         // One amplitude: fit on the first cycles of every test, validate on the later ones.
         let mut fw = Vec::new();
         let mut hw = Vec::new();
-        for i in 0..data.len() {
-            let m = &data[i];
+        for (i, m) in data.iter().enumerate() {
             let cyc = m.cycles().floor();
             let split = (opts.fit_cycles as f64)
                 .min((1.0 + cyc) / 2.0)
