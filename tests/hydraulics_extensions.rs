@@ -362,3 +362,73 @@ fn air_by_chamber_acts_on_its_chamber_only() {
     let ratio = c[1].volume(d_end) / c[1].volume0;
     assert!((air.sealed_volume_ratio(&fluid, dev.state()[IP1]) - ratio).abs() < 1e-8);
 }
+
+/// Elastic mount in series with a linear dashpot is a Maxwell element: under `d = A sin(wt)` the
+/// steady force is `F = -c w A cos(wt - phi) / sqrt(1 + (c w/k)^2)`, `phi = atan(c w/k)` lag.
+#[test]
+fn series_mount_with_a_dashpot_is_a_maxwell_element() {
+    let (c, k, a, w) = (1.0e5, 2.0e7, 2.0e-3, 27.0);
+    let mut dev = SeriesMount::new(Box::new(LinearDashpot::new(c)), k);
+    let period = 2.0 * std::f64::consts::PI / w;
+    let n = 20_000;
+    let dt = period / n as f64;
+    let cycles = 3;
+    let (mut sc, mut ss) = (0.0, 0.0);
+    for i in 0..cycles * n {
+        let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+        let sf = dev
+            .trial_step(t0, dt, a * (w * t0).sin(), a * (w * t1).sin())
+            .unwrap();
+        dev.commit();
+        if i >= (cycles - 1) * n {
+            // The step's force belongs to the step's mean rate, at its midpoint.
+            let tm = 0.5 * (t0 + t1);
+            sc += sf.force_end * (w * tm).cos();
+            ss += sf.force_end * (w * tm).sin();
+        }
+    }
+    let (fc, fs) = (2.0 * sc / n as f64, 2.0 * ss / n as f64);
+    let amp = (fc * fc + fs * fs).sqrt();
+    let x = c * w / k;
+    let amp_exact = c * w * a / (1.0 + x * x).sqrt();
+    assert!(
+        (amp - amp_exact).abs() < 1e-4 * amp_exact,
+        "amplitude {amp} vs {amp_exact}"
+    );
+    // F = -F0 cos(wt - phi) = -F0 (cos phi cos wt + sin phi sin wt).
+    let phi = (fs / fc).atan();
+    assert!(
+        (phi - x.atan()).abs() < 1e-3,
+        "lag {phi} rad vs {} rad",
+        x.atan()
+    );
+    assert!(fc < 0.0);
+}
+
+#[test]
+fn series_mount_deck_key_wraps_the_damper() {
+    let d = deck_with("mount_stiffness_N_per_m = 5.0e7\nseal_friction_N = 100.0");
+    assert_eq!(d.extensions.mount_stiffness_n_per_m, Some(5.0e7));
+    let back = DamperDeck::from_toml_str(&d.to_toml(), "back").unwrap();
+    assert_eq!(back.extensions, d.extensions);
+    // Stiff mounts: the rigid damper's force.
+    let stiff = deck_with("mount_stiffness_N_per_m = 1.0e15");
+    let plain = DamperDeck::from_toml_str(&nominal_text(), "plain").unwrap();
+    let run = |dk: &DamperDeck| {
+        harmonic_run(
+            dk.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            27.02,
+            0.05,
+            2,
+            256,
+            true,
+        )
+        .unwrap()
+        .history
+        .force_n
+    };
+    let (fa, fb) = (run(&stiff), run(&plain));
+    for (x, y) in fa.iter().zip(&fb) {
+        assert!((x - y).abs() < 0.5, "{x} vs {y}");
+    }
+}

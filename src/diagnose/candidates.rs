@@ -14,6 +14,8 @@ pub enum Cause {
     PistonLeakage,
     /// Entrained air, a different fraction in each chamber.
     EntrainedAirByChamber,
+    /// Elastic mounts in series (attachment compliance).
+    MountCompliance,
     /// Bleed of both chambers to the accumulator at p_s.
     AccumulatorBleed,
     /// Re-calibration of the orifice area (C_d A_orf) and relief-valve flow-area coefficient a.
@@ -37,7 +39,7 @@ pub struct Scales {
 }
 
 impl Cause {
-    pub const CANDIDATES: [Cause; 9] = [
+    pub const CANDIDATES: [Cause; 10] = [
         Cause::SealFriction,
         Cause::FreePlay,
         Cause::EntrainedAir,
@@ -46,6 +48,7 @@ impl Cause {
         Cause::ReliefAsymmetry,
         Cause::PistonLeakage,
         Cause::AccumulatorBleed,
+        Cause::MountCompliance,
         Cause::Recalibration,
     ];
 
@@ -59,6 +62,7 @@ impl Cause {
             Cause::ReliefAsymmetry => "relief_asymmetry",
             Cause::PistonLeakage => "piston_leakage",
             Cause::AccumulatorBleed => "accumulator_bleed",
+            Cause::MountCompliance => "mount_compliance",
             Cause::EntrainedAirByChamber => "entrained_air_by_chamber",
             Cause::Recalibration => "recalibration",
         }
@@ -106,6 +110,7 @@ impl Cause {
                 ]
             }
             Cause::PistonLeakage => vec![p("leakage_m3_per_s_Pa", 1e-15, 1e-8, vec![1e-12, 1e-11])],
+            Cause::MountCompliance => vec![p("mount_stiffness_N_per_m", 1e6, 1e10, vec![1e7, 1e8])],
             Cause::AccumulatorBleed => vec![p(
                 "accumulator_bleed_m3_per_s_Pa",
                 1e-15,
@@ -158,6 +163,7 @@ impl Cause {
             }
             Cause::PistonLeakage => c.ext.leakage = Some(Leakage { conductance: x[0] }),
             Cause::AccumulatorBleed => c.ext.bleed = Some(Leakage { conductance: x[0] }),
+            Cause::MountCompliance => d.extensions.mount_stiffness_n_per_m = Some(x[0]),
             Cause::Recalibration => {
                 if let Some(o) = c.orifice.as_mut() {
                     o.area = x[0];

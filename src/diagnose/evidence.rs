@@ -177,6 +177,10 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             "piston leakage {:.3e} m^3/(s Pa): a laminar bypass that lowers the force most at small amplitudes",
             p("leakage_m3_per_s_Pa")
         ),
+        "mount_compliance" => format!(
+            "elastic mounts in series, stiffness {:.3e} N/m: the link force lags the damper's own force (a Maxwell element), most visibly as a delayed build-up after each reversal",
+            p("mount_stiffness_N_per_m")
+        ),
         "accumulator_bleed" => format!(
             "bleed of each chamber to the accumulator, {:.3e} m^3/(s Pa): the mean chamber pressure returns toward p_s instead of being pumped up by the check valves, so the oil is soft and the force dwells near zero at reversals",
             p("accumulator_bleed_m3_per_s_Pa")

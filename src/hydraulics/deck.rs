@@ -4,7 +4,7 @@ use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
 use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
 use super::extensions::{
-    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction,
+    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction, SeriesMount,
 };
 use super::fluid::Fluid;
 use super::integrators::IntegratorOptions;
@@ -102,6 +102,8 @@ pub struct DamperDeck {
 pub struct DeviceExtensions {
     pub friction: Option<SealFriction>,
     pub free_play: Option<FreePlay>,
+    /// Stiffness of elastic mounts in series [N/m].
+    pub mount_stiffness_n_per_m: Option<f64>,
 }
 
 /// Keys of `[damper.physical.extensions]` (all optional; absent or 0 = off).
@@ -116,6 +118,7 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "accumulator_bleed_m3_per_s_Pa",
     "air_fraction_0",
     "air_fraction_1",
+    "mount_stiffness_N_per_m",
 ];
 
 struct Ctx<'a> {
@@ -555,6 +558,11 @@ impl DamperDeck {
             c.ext.bleed = Some(Leakage { conductance: k });
         }
         let mut e = DeviceExtensions::default();
+        e.mount_stiffness_n_per_m = opt(
+            "mount_stiffness_N_per_m",
+            "a positive stiffness in N/m (absent: rigid mounts)",
+            positive,
+        )?;
         let f_c = f_c.unwrap_or(0.0);
         let f_s = f_s.unwrap_or(f_c);
         if f_c > 0.0 || f_s > 0.0 {
@@ -635,10 +643,14 @@ impl DamperDeck {
             DamperModel::Physical => {
                 let dev = self.physical_device(opts)?;
                 let e = self.extensions;
-                if e.friction.is_some() || e.free_play.is_some() {
+                let dev: Box<dyn Device> = if e.friction.is_some() || e.free_play.is_some() {
                     Box::new(ExtendedDamper::new(dev, e.friction, e.free_play))
                 } else {
                     Box::new(dev)
+                };
+                match e.mount_stiffness_n_per_m {
+                    Some(k) => Box::new(SeriesMount::new(dev, k)),
+                    None => dev,
                 }
             }
             DamperModel::Linear => Box::new(LinearDashpot::new(
@@ -742,6 +754,9 @@ impl DamperDeck {
             }
             if let Some(p) = e.free_play {
                 ext.push(("free_play_m", p.gap));
+            }
+            if let Some(k) = e.mount_stiffness_n_per_m {
+                ext.push(("mount_stiffness_N_per_m", k));
             }
             if let Some(a) = c.ext.air {
                 ext.push(("air_fraction", a.fraction));

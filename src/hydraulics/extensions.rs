@@ -267,6 +267,135 @@ impl Device for ExtendedDamper {
     }
 }
 
+/// Elastic mounts (rod-end bearings, bushings, airframe attachment) in series with a damper:
+/// a spring of stiffness `k` between the attachment stroke `d` and the device stroke `d_h`.
+/// The link force is the device force `F(d_h)` and also the spring's, `F = k (d_h - d)`
+/// (a damper pushing its ends apart compresses the spring), so every step solves
+/// `g(d_h) = d_h - d_f - F(d_h)/k = 0` for the end-of-step device stroke by secant iterations
+/// started with the device's own tangent (Eq. 16 estimate), to a force mismatch of 0.1 N. A Maxwell element when the device is
+/// a linear dashpot: force lag `atan(c omega / k)`.
+#[derive(Debug, Clone)]
+pub struct SeriesMount {
+    inner: Box<dyn Device>,
+    k: f64,
+    d_h: f64,
+    fresh: bool,
+    trial: Option<f64>,
+}
+
+/// Iterations of the series-mount solve.
+const MOUNT_MAX_ITER: usize = 40;
+
+impl SeriesMount {
+    pub fn new(inner: Box<dyn Device>, k_n_per_m: f64) -> Self {
+        Self {
+            inner,
+            k: k_n_per_m,
+            d_h: 0.0,
+            fresh: true,
+            trial: None,
+        }
+    }
+
+    /// Device stroke behind the mount at the committed state [m].
+    pub fn device_stroke(&self) -> f64 {
+        self.d_h
+    }
+}
+
+impl Device for SeriesMount {
+    fn trial_step(
+        &mut self,
+        t_i: f64,
+        dt: f64,
+        d_i: f64,
+        d_f: f64,
+    ) -> Result<StepForce, HydraulicError> {
+        check_step(t_i, dt, d_i, d_f)?;
+        if self.fresh {
+            self.d_h = d_i + self.inner.committed_force() / self.k;
+        }
+        let dh_i = self.d_h;
+        // Converged when the spring and device forces agree to 0.1 N (the device force is only
+        // piecewise smooth in the stroke: valve and seat switching limit the secant to ~0.05 N).
+        let tol = 0.1 / self.k;
+        // Start: the spring keeps its deflection.
+        let mut x0 = d_f + (dh_i - d_i);
+        let mut s0 = self.inner.trial_step(t_i, dt, dh_i, x0)?;
+        let mut g0 = x0 - d_f - s0.force_end / self.k;
+        if g0.abs() <= tol {
+            self.trial = Some(x0);
+            return Ok(s0);
+        }
+        let slope = 1.0 - s0.dforce_dstroke / self.k;
+        let mut x1 = x0 - g0 / slope.max(1.0);
+        for iteration in 0..MOUNT_MAX_ITER {
+            let s1 = self.inner.trial_step(t_i, dt, dh_i, x1)?;
+            let g1 = x1 - d_f - s1.force_end / self.k;
+            if g1.abs() <= tol || g1 == g0 {
+                self.trial = Some(x1);
+                // Link force: d F / d d_f through the spring, F = k (d_h - d).
+                let kd = -s1.dforce_dstroke;
+                return Ok(StepForce {
+                    dforce_dstroke: -(kd * self.k) / (kd + self.k),
+                    ..s1
+                });
+            }
+            let x2 = x1 - g1 * (x1 - x0) / (g1 - g0);
+            (x0, g0, x1) = (x1, g1, x2);
+            s0 = s1;
+            if !x1.is_finite() {
+                return Err(HydraulicError::BadStep {
+                    t: t_i + dt,
+                    reason: format!(
+                        "series mount solve diverged at iteration {iteration} (force mismatch {:.3e} N)",
+                        g1.abs() * self.k
+                    ),
+                });
+            }
+        }
+        let _ = s0;
+        Err(HydraulicError::BadStep {
+            t: t_i + dt,
+            reason: format!(
+                "series mount solve did not converge in {MOUNT_MAX_ITER} iterations (force mismatch {:.3e} N)",
+                g0.abs() * self.k
+            ),
+        })
+    }
+
+    fn commit(&mut self) {
+        if let Some(x) = self.trial.take() {
+            self.inner.commit();
+            self.d_h = x;
+            self.fresh = false;
+        }
+    }
+
+    fn channel_names(&self) -> &'static [&'static str] {
+        self.inner.channel_names()
+    }
+
+    fn channels(&self, out: &mut [f64]) {
+        self.inner.channels(out)
+    }
+
+    fn committed_force(&self) -> f64 {
+        self.inner.committed_force()
+    }
+
+    fn clone_device(&self) -> Box<dyn Device> {
+        Box::new(self.clone())
+    }
+
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.d_h = 0.0;
+        self.fresh = true;
+        self.trial = None;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -105,6 +105,10 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
             let v = loglerp(0.01, 0.08);
             ("air_fraction_1", v, 0.25, vec![1e-4, v])
         }
+        Cause::MountCompliance => {
+            let v = loglerp(2e7, 2e8);
+            ("mount_stiffness_N_per_m", v, 0.25, vec![v])
+        }
         Cause::AccumulatorBleed => {
             let v = loglerp(2e-12, 2e-11);
             ("accumulator_bleed_m3_per_s_Pa", v, 0.25, vec![v])
@@ -124,8 +128,9 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
     }
 }
 
-/// Kinds drawn by [`draw`]: the six of issue #7 and the two found on the flight record.
-pub const KINDS: [Cause; 8] = [
+/// Kinds drawn by [`draw`]: the six of issue #7 and three added while diagnosing the flight
+/// record.
+pub const KINDS: [Cause; 9] = [
     Cause::SealFriction,
     Cause::FreePlay,
     Cause::EntrainedAir,
@@ -134,6 +139,7 @@ pub const KINDS: [Cause; 8] = [
     Cause::PistonLeakage,
     Cause::EntrainedAirByChamber,
     Cause::AccumulatorBleed,
+    Cause::MountCompliance,
 ];
 
 /// One hidden effect drawn at random from the seed.
