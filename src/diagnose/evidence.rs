@@ -58,6 +58,40 @@ fn amp(c: &Curves) -> f64 {
     0.5 * (hi - lo)
 }
 
+/// Shift (in samples, positive: measured later) of the measured force against the baseline that
+/// minimises their RMS difference, searched over +-5% of the cycle and refined by a parabola;
+/// returns (shift in samples, RMS at zero shift, RMS at the best integer shift).
+fn best_lag(c: &Curves) -> Option<(f64, f64, f64)> {
+    let n = c.time_s.len();
+    let period = period_of(c);
+    let dt = (c.time_s[n - 1] - c.time_s[0]) / (n - 1) as f64;
+    let max = ((0.05 * period / dt).ceil() as usize).max(1);
+    if c.from + 2 * max + 8 >= n {
+        return None;
+    }
+    let rms = |s: isize| {
+        let (mut acc, mut cnt) = (0.0, 0usize);
+        for k in c.from + max..n - max {
+            let e = c.measured_n[k] - c.baseline_n[(k as isize - s) as usize];
+            acc += e * e;
+            cnt += 1;
+        }
+        (acc / cnt as f64).sqrt()
+    };
+    let m = max as isize;
+    let vals: Vec<f64> = (-m..=m).map(rms).collect();
+    let (ib, &vb) = vals.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+    let mut shift = ib as f64 - m as f64;
+    if ib > 0 && ib + 1 < vals.len() {
+        let (a, b, cc) = (vals[ib - 1], vals[ib], vals[ib + 1]);
+        let den = a - 2.0 * b + cc;
+        if den > 0.0 {
+            shift += 0.5 * (a - cc) / den;
+        }
+    }
+    Some((shift, vals[max], vb))
+}
+
 /// Evidence strings of a diagnosis.
 pub fn evidence(
     curves: &[Curves],
@@ -104,6 +138,21 @@ pub fn evidence(
             -mn / mp,
             -bn / bp
         ));
+    }
+    if let Some(c) = curves.first() {
+        if let Some((shift, r0, rb)) = best_lag(c) {
+            let n = c.time_s.len();
+            let dt = (c.time_s[n - 1] - c.time_s[0]) / (n - 1) as f64;
+            let lag = shift * dt;
+            ev.push(format!(
+                "{}: the measured force {} the baseline model by {:.2} ms ({:.1} deg of the stroke cycle); shifting the model by that much lowers the RMS difference from {r0:.0} to {rb:.0} N{}",
+                c.name,
+                if lag >= 0.0 { "lags" } else { "leads" },
+                1e3 * lag.abs(),
+                360.0 * lag.abs() / period_of(c),
+                if rb < 0.7 * r0 { ": a phase lag (compliance in the load path)" } else { "" }
+            ));
+        }
     }
     let per_test: Vec<String> = curves
         .iter()
