@@ -369,13 +369,7 @@ pub fn diagnose(
         from: data[i].cycle_start(1.0),
         to: data[i].time_s.len(),
     };
-    let (fit_w, train_w, held_w, method, roles): (
-        Vec<Window>,
-        Vec<Window>,
-        Vec<Window>,
-        String,
-        Vec<String>,
-    );
+    let (fit_w, held_w, method, roles): (Vec<Window>, Vec<Window>, String, Vec<String>);
     if !one_amp && data.len() >= 2 {
         let train: Vec<usize> = order.iter().step_by(2).copied().collect();
         let held: Vec<usize> = order.iter().skip(1).step_by(2).copied().collect();
@@ -388,7 +382,6 @@ pub fn diagnose(
                 ..full(i)
             })
             .collect();
-        train_w = train.iter().map(|&i| full(i)).collect();
         held_w = held.iter().map(|&i| full(i)).collect();
         method = format!(
             "held-out tests: fit on {} test(s) (alternate amplitudes, cycles 2-{} each), validated on {} other test(s) at amplitudes in between",
@@ -424,7 +417,6 @@ pub fn diagnose(
                 .push("too few cycles to hold any out: validation repeats the fit data".into());
             hw = fw.clone();
         }
-        train_w = fw.clone();
         fit_w = fw;
         held_w = hw;
         method = format!(
@@ -675,11 +667,11 @@ pub fn diagnose(
         .iter()
         .zip(data)
         .map(|(c, m)| {
-            let w = [full(0)].map(|_| Window {
+            let w = [Window {
                 test: 0,
                 from: c.from,
                 to: c.time_s.len(),
-            });
+            }];
             let one = std::slice::from_ref(m);
             TestSummary {
                 name: c.name.clone(),
@@ -691,7 +683,6 @@ pub fn diagnose(
             }
         })
         .collect();
-    let _ = train_w;
     let cand_rows: Vec<Candidate> = evaluated.iter().map(|e| e.0.clone()).collect();
     let evidence = super::evidence::evidence(
         &curves, sigma, &cause, &params, &cand_rows, base_held, ext_held,

@@ -38,8 +38,6 @@ pub enum DiagnoseError {
     },
     #[error("{test}: the stroke does not oscillate (no cycle found): cannot estimate the stroking period")]
     NoCycle { test: String },
-    #[error("{test}: time step not uniform enough ({detail})")]
-    Grid { test: String, detail: String },
     #[error("no measurements given")]
     Empty,
     #[error(
