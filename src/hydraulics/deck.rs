@@ -557,12 +557,14 @@ impl DamperDeck {
         if let Some(k) = bleed.filter(|k| *k > 0.0) {
             c.ext.bleed = Some(Leakage { conductance: k });
         }
-        let mut e = DeviceExtensions::default();
-        e.mount_stiffness_n_per_m = opt(
-            "mount_stiffness_N_per_m",
-            "a positive stiffness in N/m (absent: rigid mounts)",
-            positive,
-        )?;
+        let mut e = DeviceExtensions {
+            mount_stiffness_n_per_m: opt(
+                "mount_stiffness_N_per_m",
+                "a positive stiffness in N/m (absent: rigid mounts)",
+                positive,
+            )?,
+            ..Default::default()
+        };
         let f_c = f_c.unwrap_or(0.0);
         let f_s = f_s.unwrap_or(f_c);
         if f_c > 0.0 || f_s > 0.0 {
