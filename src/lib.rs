@@ -4,6 +4,7 @@
 //! Systems" (equation numbers in doc comments, "Eq. N", refer to that paper).
 pub mod analysis;
 pub mod cli;
+pub mod diagnose;
 pub mod flight;
 pub mod hydraulics;
 pub mod io;

@@ -39,6 +39,7 @@ fn sealed(fluid: Fluid, p_init: f64) -> CircuitParams {
         entrance: None,
         p_s: p_init,
         p_init: [p_init; 2],
+        ext: Default::default(),
     }
 }
 

@@ -4,6 +4,7 @@
 //! nothing; the impulse `int F dt` is integrated alongside so that `F_m` of Eq. (13) has the
 //! order of the scheme.
 use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
+use super::extensions::HydraulicExtensions;
 use super::fluid::Fluid;
 use super::integrators::{integrate, IntegratorOptions, OdeSystem};
 use super::{check_step, Device, HydraulicError, StepForce};
@@ -104,6 +105,8 @@ pub struct CircuitParams {
     pub p_s: f64,
     /// Initial chamber pressures [Pa].
     pub p_init: [f64; 2],
+    /// Entrained air and piston leakage (issue #7; default: none, the paper's model).
+    pub ext: HydraulicExtensions,
 }
 
 /// Linear actuator properties (paper Table 1 via [`ActuatorParams::paper_table1`]).
@@ -169,6 +172,7 @@ impl ActuatorParams {
             }),
             p_s: self.p_s_pa,
             p_init: [self.p_s_pa; 2],
+            ext: HydraulicExtensions::default(),
         }
     }
 }
@@ -184,6 +188,10 @@ pub struct Flows {
     pub check: [f64; 2],
     /// Entrance orifice into chamber k.
     pub entrance: [f64; 2],
+    /// Piston leakage, positive 0 -> 1.
+    pub leakage: f64,
+    /// Bleed to the accumulator out of chamber k.
+    pub bleed: [f64; 2],
 }
 
 impl CircuitParams {
@@ -191,6 +199,15 @@ impl CircuitParams {
         FlowLaw {
             rho: self.fluid.rho,
             dp_laminar: self.dp_laminar,
+        }
+    }
+
+    /// Bulk modulus of the contents of chamber k at p: Eq. (3), or the oil/air mixture.
+    #[inline]
+    pub fn bulk(&self, k: usize, p: f64) -> (f64, f64) {
+        match self.ext.air_of(k) {
+            None => self.fluid.bulk(p),
+            Some(a) => a.bulk(&self.fluid, p),
         }
     }
 
@@ -205,7 +222,7 @@ impl CircuitParams {
     pub fn static_stiffness(&self, y: &State, d: f64) -> f64 {
         let mut k = 0.0;
         for (i, c) in self.chambers.iter().enumerate() {
-            let (b, _) = self.fluid.bulk(y[i]);
+            let (b, _) = self.bulk(i, y[i]);
             k += b * c.area * c.area / c.volume(d);
         }
         k
@@ -261,6 +278,21 @@ impl CircuitParams {
             dq[1][IP0] += dqd;
             dq[1][IP1] -= dqd;
         }
+        if let Some(lk) = &self.ext.leakage {
+            let g = lk.conductance;
+            fl.leakage = g * (p0 - p1);
+            dq[0][IP0] -= g;
+            dq[0][IP1] += g;
+            dq[1][IP0] += g;
+            dq[1][IP1] -= g;
+        }
+        if let Some(bl) = &self.ext.bleed {
+            let g = bl.conductance;
+            for (k, ip) in [(0, IP0), (1, IP1)] {
+                fl.bleed[k] = g * (y[ip] - self.p_s);
+                dq[k][ip] -= g;
+            }
+        }
         for k in 0..2 {
             let Some(rv) = &self.relief[k] else { continue };
             let (ix, iv) = if k == 0 { (IX0, IV0) } else { (IX1, IV1) };
@@ -309,12 +341,23 @@ impl CircuitParams {
             }
         }
         let qn = [
-            -fl.orifice - fl.relief[0] + fl.relief[1] + fl.check[0] + fl.entrance[0],
-            fl.orifice + fl.relief[0] - fl.relief[1] + fl.check[1] + fl.entrance[1],
+            -fl.orifice - fl.leakage - fl.relief[0] + fl.relief[1] + fl.check[0] + fl.entrance[0]
+                - fl.bleed[0],
+            fl.orifice + fl.leakage + fl.relief[0] - fl.relief[1] + fl.check[1] + fl.entrance[1]
+                - fl.bleed[1],
         ];
         for (k, ip) in [(0, IP0), (1, IP1)] {
-            let (rate, drate_dp, b_over_v) =
-                self.chambers[k].pressure_rate(&self.fluid, y[ip], vol[k], qn[k], d_dot);
+            let (rate, drate_dp, b_over_v) = match self.ext.air_of(k) {
+                None => self.chambers[k].pressure_rate(&self.fluid, y[ip], vol[k], qn[k], d_dot),
+                Some(a) => self.chambers[k].pressure_rate_with_bulk(
+                    &self.fluid,
+                    a.bulk(&self.fluid, y[ip]),
+                    y[ip],
+                    vol[k],
+                    qn[k],
+                    d_dot,
+                ),
+            };
             f[ip] = rate;
             if JAC {
                 for (c, dqc) in dq[k].iter().enumerate() {

@@ -3,6 +3,9 @@
 use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
 use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
+use super::extensions::{
+    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction, SeriesMount,
+};
 use super::fluid::Fluid;
 use super::integrators::IntegratorOptions;
 use super::Device;
@@ -89,7 +92,34 @@ pub struct DamperDeck {
     pub linear_c_n_s_per_m: Option<f64>,
     pub nonlinear: Option<(Vec<f64>, Vec<f64>)>,
     pub physical: Option<CircuitParams>,
+    /// Device-level extensions of the physical model (`[damper.physical.extensions]`: seal
+    /// friction, free play); the hydraulic ones (air, leakage) live in `physical.ext`.
+    pub extensions: DeviceExtensions,
 }
+
+/// Seal friction and free play of the physical damper (issue #7; default: none).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DeviceExtensions {
+    pub friction: Option<SealFriction>,
+    pub free_play: Option<FreePlay>,
+    /// Stiffness of elastic mounts in series [N/m].
+    pub mount_stiffness_n_per_m: Option<f64>,
+}
+
+/// Keys of `[damper.physical.extensions]` (all optional; absent or 0 = off).
+pub const EXTENSION_KEYS: &[&str] = &[
+    "seal_friction_N",
+    "stribeck_static_N",
+    "stribeck_velocity_m_s",
+    "friction_smoothing_m_s",
+    "free_play_m",
+    "air_fraction",
+    "leakage_m3_per_s_Pa",
+    "accumulator_bleed_m3_per_s_Pa",
+    "air_fraction_0",
+    "air_fraction_1",
+    "mount_stiffness_N_per_m",
+];
 
 struct Ctx<'a> {
     file: &'a str,
@@ -215,6 +245,7 @@ const PHYSICAL_KEYS: &[&str] = &[
     "p_cav_Pa",
     "relief_valve_0",
     "relief_valve_1",
+    "extensions",
 ];
 const VALVE_KEYS: &[&str] = &[
     "m_kg",
@@ -309,9 +340,16 @@ impl DamperDeck {
             }
         };
 
-        let physical = match cx.table(damper, "damper", "physical")? {
-            None => None,
-            Some(t) => Some(Self::parse_physical(&cx, t)?),
+        let (physical, extensions) = match cx.table(damper, "damper", "physical")? {
+            None => (None, DeviceExtensions::default()),
+            Some(t) => {
+                let mut c = Self::parse_physical(&cx, t)?;
+                let e = match cx.table(t, "damper.physical", "extensions")? {
+                    None => DeviceExtensions::default(),
+                    Some(et) => Self::parse_extensions(&cx, et, &mut c)?,
+                };
+                (Some(c), e)
+            }
         };
 
         let deck = Self {
@@ -320,6 +358,7 @@ impl DamperDeck {
             linear_c_n_s_per_m: linear,
             nonlinear,
             physical,
+            extensions,
         };
         // The default model's table must be there.
         deck.require(model)?;
@@ -467,7 +506,115 @@ impl DamperDeck {
             entrance: None,
             p_s,
             p_init: [p_s; 2],
+            ext: HydraulicExtensions::default(),
         })
+    }
+
+    fn parse_extensions(
+        cx: &Ctx,
+        t: &Table,
+        c: &mut CircuitParams,
+    ) -> Result<DeviceExtensions, DeckError> {
+        let p = "damper.physical.extensions";
+        cx.known(t, p, EXTENSION_KEYS)?;
+        let opt = |k: &str, what: &str, ok: fn(f64) -> bool| -> Result<Option<f64>, DeckError> {
+            if t.contains_key(k) {
+                cx.num_where(t, p, k, what, ok).map(Some)
+            } else {
+                Ok(None)
+            }
+        };
+        let f_c = opt("seal_friction_N", "a non-negative force in N", non_negative)?;
+        let f_s = opt(
+            "stribeck_static_N",
+            "a non-negative force in N",
+            non_negative,
+        )?;
+        let v_s = opt(
+            "stribeck_velocity_m_s",
+            "a positive velocity in m/s",
+            positive,
+        )?;
+        let v_eps = opt(
+            "friction_smoothing_m_s",
+            "a positive velocity in m/s",
+            positive,
+        )?;
+        let gap = opt("free_play_m", "a non-negative gap in m", non_negative)?;
+        let air = opt("air_fraction", "a volume fraction in [0, 1)", |x| {
+            (0.0..1.0).contains(&x)
+        })?;
+        let leak = opt(
+            "leakage_m3_per_s_Pa",
+            "a non-negative conductance in m^3/(s Pa)",
+            non_negative,
+        )?;
+        let bleed = opt(
+            "accumulator_bleed_m3_per_s_Pa",
+            "a non-negative conductance in m^3/(s Pa)",
+            non_negative,
+        )?;
+        if let Some(k) = bleed.filter(|k| *k > 0.0) {
+            c.ext.bleed = Some(Leakage { conductance: k });
+        }
+        let mut e = DeviceExtensions {
+            mount_stiffness_n_per_m: opt(
+                "mount_stiffness_N_per_m",
+                "a positive stiffness in N/m (absent: rigid mounts)",
+                positive,
+            )?,
+            ..Default::default()
+        };
+        let f_c = f_c.unwrap_or(0.0);
+        let f_s = f_s.unwrap_or(f_c);
+        if f_c > 0.0 || f_s > 0.0 {
+            let d = SealFriction::coulomb(f_c);
+            e.friction = Some(SealFriction {
+                f_c,
+                f_s,
+                v_s: v_s.unwrap_or(d.v_s),
+                v_eps: v_eps.unwrap_or(d.v_eps),
+            });
+        }
+        if let Some(g) = gap.filter(|g| *g > 0.0) {
+            e.free_play = Some(FreePlay { gap: g });
+        }
+        if let Some(a) = air.filter(|a| *a > 0.0) {
+            if c.p_s <= 0.0 {
+                return Err(cx.bad(
+                    &format!("{p}.air_fraction"),
+                    &t["air_fraction"],
+                    "entrained air is given at the background pressure p_s_Pa, which must then be positive",
+                ));
+            }
+            c.ext.air = Some(EntrainedAir {
+                fraction: a,
+                p_ref: c.p_s,
+            });
+        }
+        if let Some(k) = leak.filter(|k| *k > 0.0) {
+            c.ext.leakage = Some(Leakage { conductance: k });
+        }
+        for ch in 0..2 {
+            let key = format!("air_fraction_{ch}");
+            let v = opt(&key, "a volume fraction in [0, 1)", |x| {
+                (0.0..1.0).contains(&x)
+            })?;
+            if let Some(a) = v.filter(|a| *a > 0.0) {
+                if c.p_s <= 0.0 {
+                    return Err(cx.bad(
+                        &format!("{p}.{key}"),
+                        &t[key.as_str()],
+                        "entrained air is given at the background pressure p_s_Pa, which must then be positive",
+                    ));
+                }
+                c.ext.air_by_chamber[ch] = Some(EntrainedAir {
+                    fraction: a,
+                    p_ref: c.p_s,
+                });
+            }
+        }
+        Ok(e)
     }
 
     /// Errors unless the deck holds the table of `model`.
@@ -495,7 +642,19 @@ impl DamperDeck {
     ) -> Result<Box<dyn Device>, DeckError> {
         self.require(model)?;
         Ok(match model {
-            DamperModel::Physical => Box::new(self.physical_device(opts)?),
+            DamperModel::Physical => {
+                let dev = self.physical_device(opts)?;
+                let e = self.extensions;
+                let dev: Box<dyn Device> = if e.friction.is_some() || e.free_play.is_some() {
+                    Box::new(ExtendedDamper::new(dev, e.friction, e.free_play))
+                } else {
+                    Box::new(dev)
+                };
+                match e.mount_stiffness_n_per_m {
+                    Some(k) => Box::new(SeriesMount::new(dev, k)),
+                    None => dev,
+                }
+            }
             DamperModel::Linear => Box::new(LinearDashpot::new(
                 self.linear_c_n_s_per_m.unwrap_or_default(),
             )),
@@ -524,6 +683,123 @@ impl DamperDeck {
             })?;
         Ok(CircuitDevice::new(params, opts))
     }
+}
+
+impl DamperDeck {
+    /// The deck as TOML (`[damper]` of FORMATS.md plus `[damper.physical.extensions]` where
+    /// any extension is on), readable by [`DamperDeck::from_toml_str`]; numbers use the shortest
+    /// round-trip formatting, so the deck reads back to the same values.
+    pub fn to_toml(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(s, "[damper]\nmodel = \"{}\"", self.model.name());
+        if let Some(c) = self.linear_c_n_s_per_m {
+            let _ = writeln!(s, "\n[damper.linear]\nc_N_s_per_m = {}", num(c));
+        }
+        if let Some((v, f)) = &self.nonlinear {
+            let _ = writeln!(
+                s,
+                "\n[damper.nonlinear]\nvelocity_m_s = {}\nforce_N = {}",
+                arr(v),
+                arr(f)
+            );
+        }
+        if let Some(c) = &self.physical {
+            let cd = c
+                .orifice
+                .map(|o| o.cd)
+                .or(c.check.map(|v| v.cd))
+                .or(c.relief.iter().flatten().next().map(|r| r.cd))
+                .unwrap_or(0.611);
+            let kv = [
+                ("A0_m2", c.chambers[0].area),
+                ("A1_m2", c.chambers[1].area),
+                ("V0_m3", c.chambers[0].volume0),
+                ("V1_m3", c.chambers[1].volume0),
+                ("rho_kg_m3", c.fluid.rho),
+                ("bulk_alpha_per_Pa", c.fluid.alpha),
+                ("bulk_beta_per_Pa2", c.fluid.beta),
+                ("A_orf_m2", c.orifice.map_or(0.0, |o| o.area)),
+                ("Cd", cd),
+                ("p_s_Pa", c.p_s),
+                ("dp_laminar_Pa", c.dp_laminar),
+                ("check_valve_area_m2", c.check.map_or(0.0, |v| v.area)),
+                ("p_cav_Pa", c.fluid.p_cav),
+            ];
+            s.push_str("\n[damper.physical]\n");
+            for (k, v) in kv {
+                let _ = writeln!(s, "{k} = {}", num(v));
+            }
+            for (k, rv) in c.relief.iter().enumerate() {
+                let Some(r) = rv else { continue };
+                let _ = writeln!(s, "\n[damper.physical.relief_valve_{k}]");
+                for (key, v) in [
+                    ("m_kg", r.m),
+                    ("c_N_s_per_m", r.c),
+                    ("k_N_per_m", r.k),
+                    ("F_p_N", r.f_p),
+                    ("A_front_m2", r.a_front),
+                    ("A_back_m2", r.a_back),
+                    ("a_m", r.a),
+                    ("b", r.b),
+                ] {
+                    let _ = writeln!(s, "{key} = {}", num(v));
+                }
+            }
+            let e = &self.extensions;
+            let mut ext = Vec::new();
+            if let Some(f) = e.friction {
+                ext.push(("seal_friction_N", f.f_c));
+                ext.push(("stribeck_static_N", f.f_s));
+                ext.push(("stribeck_velocity_m_s", f.v_s));
+                ext.push(("friction_smoothing_m_s", f.v_eps));
+            }
+            if let Some(p) = e.free_play {
+                ext.push(("free_play_m", p.gap));
+            }
+            if let Some(k) = e.mount_stiffness_n_per_m {
+                ext.push(("mount_stiffness_N_per_m", k));
+            }
+            if let Some(a) = c.ext.air {
+                ext.push(("air_fraction", a.fraction));
+            }
+            if let Some(l) = c.ext.leakage {
+                ext.push(("leakage_m3_per_s_Pa", l.conductance));
+            }
+            for (ch, a) in c.ext.air_by_chamber.iter().enumerate() {
+                if let Some(a) = a {
+                    ext.push((["air_fraction_0", "air_fraction_1"][ch], a.fraction));
+                }
+            }
+            if let Some(l) = c.ext.bleed {
+                ext.push(("accumulator_bleed_m3_per_s_Pa", l.conductance));
+            }
+            if !ext.is_empty() {
+                s.push_str("\n[damper.physical.extensions]\n");
+                for (k, v) in ext {
+                    let _ = writeln!(s, "{k} = {}", num(v));
+                }
+            }
+        }
+        s
+    }
+}
+
+/// Shortest round-trip float, always with a decimal point or exponent (TOML float).
+fn num(x: f64) -> String {
+    let s = format!("{x:?}");
+    if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+fn arr(v: &[f64]) -> String {
+    format!(
+        "[{}]",
+        v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", ")
+    )
 }
 
 pub const ACTUATOR_KEYS: &[&str] = &[

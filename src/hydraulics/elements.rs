@@ -34,7 +34,21 @@ impl Chamber {
         q: f64,
         d_dot: f64,
     ) -> (f64, f64, f64) {
-        let (b, db) = fluid.bulk(p);
+        self.pressure_rate_with_bulk(fluid, fluid.bulk(p), p, v, q, d_dot)
+    }
+
+    /// [`Chamber::pressure_rate`] with the bulk modulus `(B, dB/dp)` given (e.g. the effective
+    /// modulus of oil with entrained air).
+    #[inline]
+    pub fn pressure_rate_with_bulk(
+        &self,
+        fluid: &Fluid,
+        (b, db): (f64, f64),
+        p: f64,
+        v: f64,
+        q: f64,
+        d_dot: f64,
+    ) -> (f64, f64, f64) {
         let net = q - self.area * self.lambda * d_dot;
         if net < 0.0 {
             let (s, ds) = fluid.cavitation_factor(p);

@@ -10,6 +10,7 @@ pub mod circuit;
 pub mod dashpot;
 pub mod deck;
 pub mod elements;
+pub mod extensions;
 pub mod fluid;
 pub mod integrators;
 
@@ -17,8 +18,11 @@ pub use circuit::{
     ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear, Tangent,
 };
 pub use dashpot::{LinearDashpot, NonlinearDashpot};
-pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError};
+pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError, DeviceExtensions};
 pub use elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
+pub use extensions::{
+    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction, SeriesMount,
+};
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
 

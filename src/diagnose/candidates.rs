@@ -1,0 +1,210 @@
+//! The candidate model extensions: each a physical element of the hydraulic library (or a
+//! re-calibration of uncertain nominal coefficients), with its fitted parameters and bounds.
+use crate::hydraulics::{DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction};
+
+/// Named causes (FORMATS.md `cause`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Cause {
+    None,
+    SealFriction,
+    FreePlay,
+    EntrainedAir,
+    AreaAsymmetry,
+    ReliefAsymmetry,
+    PistonLeakage,
+    /// Entrained air, a different fraction in each chamber.
+    EntrainedAirByChamber,
+    /// Elastic mounts in series (attachment compliance).
+    MountCompliance,
+    /// Bleed of both chambers to the accumulator at p_s.
+    AccumulatorBleed,
+    /// Re-calibration of the orifice area (C_d A_orf) and relief-valve flow-area coefficient a.
+    Recalibration,
+}
+
+/// One fitted parameter: name (with unit), bounds, starting values (multi-start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub lo: f64,
+    pub hi: f64,
+    pub starts: Vec<f64>,
+}
+
+/// What the fit needs to know about the data to bound the parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct Scales {
+    pub peak_force_n: f64,
+    pub min_amplitude_m: f64,
+}
+
+impl Cause {
+    pub const CANDIDATES: [Cause; 10] = [
+        Cause::SealFriction,
+        Cause::FreePlay,
+        Cause::EntrainedAir,
+        Cause::EntrainedAirByChamber,
+        Cause::AreaAsymmetry,
+        Cause::ReliefAsymmetry,
+        Cause::PistonLeakage,
+        Cause::AccumulatorBleed,
+        Cause::MountCompliance,
+        Cause::Recalibration,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Cause::None => "none",
+            Cause::SealFriction => "seal_friction",
+            Cause::FreePlay => "free_play",
+            Cause::EntrainedAir => "entrained_air",
+            Cause::AreaAsymmetry => "area_asymmetry",
+            Cause::ReliefAsymmetry => "relief_asymmetry",
+            Cause::PistonLeakage => "piston_leakage",
+            Cause::AccumulatorBleed => "accumulator_bleed",
+            Cause::MountCompliance => "mount_compliance",
+            Cause::EntrainedAirByChamber => "entrained_air_by_chamber",
+            Cause::Recalibration => "recalibration",
+        }
+    }
+
+    /// The fitted parameters and their bounds for a base deck (None: not applicable, e.g.
+    /// relief asymmetry without relief valves).
+    pub fn params(self, base: &DamperDeck, s: Scales) -> Option<Vec<ParamSpec>> {
+        let c = base.physical.as_ref()?;
+        let p = |name, lo: f64, hi: f64, starts: Vec<f64>| ParamSpec {
+            name,
+            lo,
+            hi,
+            starts,
+        };
+        Some(match self {
+            Cause::None => vec![],
+            Cause::SealFriction => {
+                let f = s.peak_force_n.max(1.0);
+                vec![p("F_c_N", 1e-3 * f, 0.3 * f, vec![0.01 * f, 0.05 * f])]
+            }
+            Cause::FreePlay => {
+                let a = s.min_amplitude_m;
+                vec![p(
+                    "gap_m",
+                    1e-3 * a,
+                    1.5 * a,
+                    vec![0.03 * a, 0.15 * a, 0.5 * a],
+                )]
+            }
+            Cause::EntrainedAir => vec![p("air_fraction", 1e-5, 0.3, vec![3e-3, 3e-2])],
+            Cause::EntrainedAirByChamber => vec![
+                p("air_fraction_0", 1e-5, 0.3, vec![1e-3, 3e-2]),
+                p("air_fraction_1", 1e-5, 0.3, vec![1e-3, 3e-2]),
+            ],
+            Cause::AreaAsymmetry => {
+                let a1 = c.chambers[1].area;
+                vec![p("A1_m2", 0.4 * a1, 1.3 * a1, vec![0.9 * a1])]
+            }
+            Cause::ReliefAsymmetry => {
+                let (r0, r1) = (c.relief[0]?, c.relief[1]?);
+                vec![
+                    p("F_p0_N", 0.2 * r0.f_p, 5.0 * r0.f_p, vec![r0.f_p]),
+                    p("F_p1_N", 0.2 * r1.f_p, 5.0 * r1.f_p, vec![r1.f_p]),
+                ]
+            }
+            Cause::PistonLeakage => vec![p("leakage_m3_per_s_Pa", 1e-15, 1e-8, vec![1e-12, 1e-11])],
+            Cause::MountCompliance => vec![p("mount_stiffness_N_per_m", 1e6, 1e10, vec![1e7, 1e8])],
+            Cause::AccumulatorBleed => vec![p(
+                "accumulator_bleed_m3_per_s_Pa",
+                1e-15,
+                1e-8,
+                vec![1e-12, 1e-11],
+            )],
+            Cause::Recalibration => {
+                let a = c.orifice?.area;
+                let mut v = vec![p("A_orf_m2", 0.2 * a, 5.0 * a, vec![a])];
+                if let Some(r) = c.relief[0].or(c.relief[1]) {
+                    v.push(p("relief_a_m", 0.05 * r.a, 20.0 * r.a, vec![r.a]));
+                }
+                v
+            }
+        })
+    }
+
+    /// The base deck with this extension set to the parameter values `x` (same order as
+    /// [`Cause::params`]).
+    pub fn apply(self, base: &DamperDeck, x: &[f64]) -> DamperDeck {
+        let mut d = base.clone();
+        let Some(c) = d.physical.as_mut() else {
+            return d;
+        };
+        match self {
+            Cause::None => {}
+            Cause::SealFriction => d.extensions.friction = Some(SealFriction::coulomb(x[0])),
+            Cause::FreePlay => d.extensions.free_play = Some(FreePlay { gap: x[0] }),
+            Cause::EntrainedAir => {
+                c.ext.air = Some(EntrainedAir {
+                    fraction: x[0],
+                    p_ref: c.p_s.max(crate::hydraulics::extensions::AIR_P_MIN_PA),
+                })
+            }
+            Cause::EntrainedAirByChamber => {
+                for (slot, &a) in c.ext.air_by_chamber.iter_mut().zip(x) {
+                    *slot = Some(EntrainedAir {
+                        fraction: a,
+                        p_ref: c.p_s.max(crate::hydraulics::extensions::AIR_P_MIN_PA),
+                    });
+                }
+            }
+            Cause::AreaAsymmetry => c.chambers[1].area = x[0],
+            Cause::ReliefAsymmetry => {
+                for (k, v) in x.iter().enumerate().take(2) {
+                    if let Some(r) = c.relief[k].as_mut() {
+                        r.f_p = *v;
+                    }
+                }
+            }
+            Cause::PistonLeakage => c.ext.leakage = Some(Leakage { conductance: x[0] }),
+            Cause::AccumulatorBleed => c.ext.bleed = Some(Leakage { conductance: x[0] }),
+            Cause::MountCompliance => d.extensions.mount_stiffness_n_per_m = Some(x[0]),
+            Cause::Recalibration => {
+                if let Some(o) = c.orifice.as_mut() {
+                    o.area = x[0];
+                }
+                if let Some(&a) = x.get(1) {
+                    for r in c.relief.iter_mut().flatten() {
+                        r.a = a;
+                    }
+                }
+            }
+        }
+        d
+    }
+}
+
+/// Name of a combination of causes, e.g. `entrained_air+free_play`.
+pub fn combined_name(causes: &[Cause]) -> String {
+    causes
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join("+")
+}
+
+/// Parameters of a combination (concatenated; None if any cause is not applicable).
+pub fn combined_params(causes: &[Cause], base: &DamperDeck, s: Scales) -> Option<Vec<ParamSpec>> {
+    let mut v = Vec::new();
+    for c in causes {
+        v.extend(c.params(base, s)?);
+    }
+    Some(v)
+}
+
+/// The base deck with every cause of a combination applied, each taking its share of `x`.
+pub fn apply_all(causes: &[Cause], base: &DamperDeck, s: Scales, x: &[f64]) -> DamperDeck {
+    let mut d = base.clone();
+    let mut i = 0;
+    for c in causes {
+        let k = c.params(base, s).map_or(0, |p| p.len());
+        d = c.apply(&d, &x[i..i + k]);
+        i += k;
+    }
+    d
+}

@@ -1,0 +1,53 @@
+//! Model diagnosis (issue #7): residual analysis of the baseline damper model against measured
+//! stroke-driven data, a library of physical extensions fitted by nonlinear least squares
+//! (Levenberg-Marquardt), ranking by BIC, validation on held-out data and the choice of a cause
+//! (or `none`). See docs/diagnosis.md.
+pub mod candidates;
+pub mod data;
+pub mod evidence;
+pub mod fit;
+pub mod report;
+
+pub use candidates::Cause;
+pub use data::{check_measurements, Measurement};
+pub use fit::{diagnose, Curves, DiagnoseOptions, Diagnosis, Outcome};
+
+/// Errors of the diagnosis: what cannot be decided and why.
+#[derive(Debug, thiserror::Error)]
+pub enum DiagnoseError {
+    #[error("{test}: no measured force: a diagnosis compares the model force with the measured one (bench CSV needs a `force_N` or `force_lb` column)")]
+    NoForce { test: String },
+    #[error("{test}: force clipped: {count} samples sit exactly at {value} N (flat top); the peaks, where relief-valve and asymmetry effects show, are not measured: re-record with a larger range")]
+    Clipping {
+        test: String,
+        value: f64,
+        count: usize,
+    },
+    #[error("{test}: sample rate too low for the cycle: {samples_per_cycle:.1} samples per stroke cycle (period {period_s:.4} s); at least {min} are needed to resolve reversals and relief-valve opening")]
+    SampleRate {
+        test: String,
+        samples_per_cycle: f64,
+        period_s: f64,
+        min: usize,
+    },
+    #[error("{test}: {cycles:.1} stroke cycles found; at least {min} are needed (one to settle the model from its initial state, the rest to compare)")]
+    TooShort {
+        test: String,
+        cycles: f64,
+        min: usize,
+    },
+    #[error("{test}: the stroke does not oscillate (no cycle found): cannot estimate the stroking period")]
+    NoCycle { test: String },
+    #[error("no measurements given")]
+    Empty,
+    #[error(
+        "the base deck has no [damper.physical] table: the diagnosis extends the physical model"
+    )]
+    NoPhysical,
+    #[error("model replay of {test} failed: {source}")]
+    Model {
+        test: String,
+        #[source]
+        source: crate::hydraulics::HydraulicError,
+    },
+}

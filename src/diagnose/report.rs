@@ -1,0 +1,149 @@
+//! DIR/diagnosis.html: residuals vs time, stroke and velocity; force-stroke and force-velocity
+//! loops (measured, baseline, extended); the candidates table.
+use super::fit::{Curves, Diagnosis};
+use crate::report::html::HtmlReport;
+use crate::report::plot::{Plot, PlotError};
+
+/// HTML report of a diagnosis; `source` describes the data (and says synthetic where it is).
+pub fn html(d: &Diagnosis, curves: &[Curves], source: &str) -> Result<String, PlotError> {
+    let mut r = HtmlReport::new("rotorsim diagnosis");
+    r.heading(1, &format!("Diagnosis: {}", d.cause));
+    r.paragraph(source);
+    let params: Vec<String> = d
+        .parameters
+        .iter()
+        .map(|(k, v)| format!("{k} = {v:.6e}"))
+        .collect();
+    r.paragraph(&format!(
+        "Cause: {}{}. RMS error over all compared samples: baseline {:.1} N, extended {:.1} N. Validation ({}): baseline {:.1} N, extended {:.1} N, gain {:.3}.",
+        d.cause,
+        if params.is_empty() { String::new() } else { format!(" ({})", params.join(", ")) },
+        d.baseline_rms_N,
+        d.extended_rms_N,
+        d.validation.method,
+        d.validation.baseline_rms_N,
+        d.validation.extended_rms_N,
+        d.gain
+    ));
+    for l in &d.limitations {
+        r.notice(l);
+    }
+    r.heading(2, "Evidence");
+    r.list(&d.evidence);
+    r.heading(2, "Candidates (ranked by BIC)");
+    let rows: Vec<Vec<String>> = d
+        .candidates
+        .iter()
+        .map(|c| {
+            vec![
+                c.cause.clone(),
+                c.k.to_string(),
+                format!("{:.1}", c.bic),
+                format!("{:.1}", c.rms_N),
+                format!("{:.1}", c.held_out_rms_N),
+                c.parameters
+                    .iter()
+                    .map(|(k, v)| format!("{k} = {v:.4e}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                c.failure.clone().unwrap_or_default(),
+            ]
+        })
+        .collect();
+    r.table(
+        &[
+            "cause",
+            "k",
+            "BIC",
+            "RMS all [N]",
+            "RMS held-out [N]",
+            "parameters",
+            "failure",
+        ],
+        &rows,
+    );
+    r.paragraph(&format!(
+        "Baseline BIC {:.1}; noise sigma {:.1} N; threshold {:.1} N. {}",
+        d.baseline_bic, d.noise_sigma_N, d.threshold_N, d.criterion
+    ));
+    r.heading(2, "Per test");
+    let rows: Vec<Vec<String>> = d
+        .tests
+        .iter()
+        .map(|t| {
+            vec![
+                t.name.clone(),
+                t.role.clone(),
+                format!("{:.3}", 1e3 * t.amplitude_m),
+                format!("{:.0}", t.peak_force_N),
+                format!("{:.1}", t.baseline_rms_N),
+                format!("{:.1}", t.extended_rms_N),
+            ]
+        })
+        .collect();
+    r.table(
+        &[
+            "test",
+            "role",
+            "amplitude [mm]",
+            "peak force [N]",
+            "baseline RMS [N]",
+            "extended RMS [N]",
+        ],
+        &rows,
+    );
+    for c in curves.iter().take(6) {
+        let s = c.from;
+        let t = &c.time_s[s..];
+        let res_b: Vec<f64> = (s..c.time_s.len())
+            .map(|k| c.measured_n[k] - c.baseline_n[k])
+            .collect();
+        let res_e: Vec<f64> = (s..c.time_s.len())
+            .map(|k| c.measured_n[k] - c.extended_n[k])
+            .collect();
+        r.heading(2, &format!("{} ({})", c.name, c.role));
+        let p = Plot::new(
+            &format!("{}: residual (measured - model) vs time", c.name),
+            "time [s]",
+            "residual [N]",
+        )
+        .points("baseline", t, &res_b)
+        .points("extended", t, &res_e);
+        r.svg("residual vs time", &p.to_svg(800, 320)?);
+        let p = Plot::new(
+            &format!("{}: residual vs stroke", c.name),
+            "stroke [m]",
+            "residual [N]",
+        )
+        .points("baseline", &c.stroke_m[s..], &res_b)
+        .points("extended", &c.stroke_m[s..], &res_e);
+        r.svg("residual vs stroke", &p.to_svg(800, 320)?);
+        let p = Plot::new(
+            &format!("{}: residual vs velocity", c.name),
+            "stroke rate [m/s]",
+            "residual [N]",
+        )
+        .points("baseline", &c.velocity_m_s[s..], &res_b)
+        .points("extended", &c.velocity_m_s[s..], &res_e);
+        r.svg("residual vs velocity", &p.to_svg(800, 320)?);
+        let p = Plot::new(
+            &format!("{}: force vs stroke", c.name),
+            "stroke [m]",
+            "force [N]",
+        )
+        .points("measured", &c.stroke_m[s..], &c.measured_n[s..])
+        .line("baseline", &c.stroke_m[s..], &c.baseline_n[s..])
+        .dashed("extended", &c.stroke_m[s..], &c.extended_n[s..]);
+        r.svg("force-stroke loop", &p.to_svg(800, 420)?);
+        let p = Plot::new(
+            &format!("{}: force vs velocity", c.name),
+            "stroke rate [m/s]",
+            "force [N]",
+        )
+        .points("measured", &c.velocity_m_s[s..], &c.measured_n[s..])
+        .line("baseline", &c.velocity_m_s[s..], &c.baseline_n[s..])
+        .dashed("extended", &c.velocity_m_s[s..], &c.extended_n[s..]);
+        r.svg("force-velocity loop", &p.to_svg(800, 420)?);
+    }
+    Ok(r.finish())
+}

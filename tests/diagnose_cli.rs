@@ -1,0 +1,141 @@
+//! `rotorsim diagnose` end to end: the shipped (SYNTHETIC) flight record, the FORMATS.md JSON
+//! keys, the written deck through `rotorsim bench`, and the clear errors.
+use rotorsim::cli::bench::{run as bench, BenchArgs};
+use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
+use std::path::{Path, PathBuf};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rotorsim-diag-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn args(out: PathBuf) -> DiagnoseArgs {
+    DiagnoseArgs {
+        deck: None,
+        measured: vec![],
+        rotor: Some(root().join("flightdata/damper_nominal.toml")),
+        flight: Some(root().join("flightdata/c8534like")),
+        out,
+        write_deck: None,
+        fit_cycles: 3,
+        max_substep: 3.0e-5,
+    }
+}
+
+#[test]
+fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
+    let dir = tmp("flight");
+    let deck = dir.join("extended.toml");
+    diagnose(DiagnoseArgs {
+        write_deck: Some(deck.clone()),
+        ..args(dir.join("out"))
+    })
+    .unwrap();
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/diagnosis.json")).unwrap())
+            .unwrap();
+    for k in [
+        "cause",
+        "parameters",
+        "baseline_rms_N",
+        "extended_rms_N",
+        "gain",
+        "validation",
+        "candidates",
+        "evidence",
+    ] {
+        assert!(j.get(k).is_some(), "missing key {k}");
+    }
+    for k in ["method", "baseline_rms_N", "extended_rms_N"] {
+        assert!(j["validation"].get(k).is_some(), "missing validation.{k}");
+    }
+    for c in j["candidates"].as_array().unwrap() {
+        for k in ["cause", "rms_N", "bic", "parameters"] {
+            assert!(c.get(k).is_some(), "candidate lacks {k}");
+        }
+    }
+    assert_ne!(j["cause"], "none");
+    assert!(j["gain"].as_f64().unwrap() > 0.0);
+    assert!(dir.join("out/diagnosis.html").exists());
+    assert!(!dir.join("out/INCOMPLETE").exists());
+    let html = std::fs::read_to_string(dir.join("out/diagnosis.html")).unwrap();
+    assert!(html.contains("SYNTHETIC"));
+    // The written deck is a damper deck `bench` accepts.
+    let text = std::fs::read_to_string(&deck).unwrap();
+    assert!(text.contains("[damper.physical.extensions]"));
+    bench(BenchArgs {
+        deck,
+        damper: None,
+        omega: 27.02,
+        peak_velocity: vec![2.0],
+        velocity_unit: "in/s".into(),
+        cycles: 2,
+        steps_per_cycle: 256,
+        substeps: 25,
+        integrator: "rk4".into(),
+        measured: vec![],
+        out: dir.join("bench"),
+    })
+    .unwrap();
+}
+
+#[test]
+fn flight_record_without_stroke_says_the_rotor_run_is_not_available() {
+    let dir = tmp("nostroke");
+    let src = root().join("flightdata");
+    for ext in ["meta.json", "airloads.csv"] {
+        std::fs::copy(
+            src.join(format!("c8534like.{ext}")),
+            dir.join(format!("r.{ext}")),
+        )
+        .unwrap();
+    }
+    let damper = std::fs::read_to_string(src.join("c8534like.damper.csv")).unwrap();
+    let stripped: String = damper
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
+        .collect();
+    std::fs::write(dir.join("r.damper.csv"), stripped).unwrap();
+    let e = diagnose(DiagnoseArgs {
+        flight: Some(dir.join("r")),
+        ..args(dir.join("out"))
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("no damper stroke") && e.contains("not available yet"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bench_file_without_force_is_named() {
+    let dir = tmp("noforce");
+    let f = dir.join("t.csv");
+    let mut s = String::from("time_s,stroke_m\n");
+    for k in 0..2000 {
+        let t = k as f64 * 5e-4;
+        s.push_str(&format!("{t},{}\n", 1e-3 * (27.0 * t).sin()));
+    }
+    std::fs::write(&f, s).unwrap();
+    let e = diagnose(DiagnoseArgs {
+        deck: Some(root().join("flightdata/damper_nominal.toml")),
+        measured: vec![f],
+        rotor: None,
+        flight: None,
+        ..args(dir.join("out"))
+    })
+    .unwrap_err();
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("t.csv") && msg.contains("no measured force"),
+        "{msg}"
+    );
+    assert!(!dir.join("out").exists(), "no output on bad input");
+}

@@ -1,0 +1,434 @@
+//! The issue #7 extensions of the hydraulic library against analytic results, their analytic
+//! Jacobian against finite differences, and the deck keys (defaults off: bit-for-bit the same).
+use rotorsim::hydraulics::bench::{harmonic_run, replay, BenchTest};
+use rotorsim::hydraulics::circuit::{State, IP0, IP1, NS};
+use rotorsim::hydraulics::*;
+
+fn nominal_text() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/flightdata/damper_nominal.toml"
+    ))
+    .unwrap()
+}
+
+fn deck_with(ext: &str) -> DamperDeck {
+    let text = format!("{}\n[damper.physical.extensions]\n{ext}\n", nominal_text());
+    DamperDeck::from_toml_str(&text, "test deck").unwrap()
+}
+
+fn opts() -> IntegratorOptions {
+    IntegratorOptions {
+        scheme: Scheme::Rk4,
+        substeps: 40,
+    }
+}
+
+fn sealed(fluid: Fluid, p: [f64; 2]) -> CircuitParams {
+    let ch = |lambda| Chamber {
+        area: 1.6e-3,
+        volume0: 6.0e-5,
+        lambda,
+    };
+    CircuitParams {
+        fluid,
+        dp_laminar: 1e3,
+        chambers: [ch(1.0), ch(-1.0)],
+        orifice: None,
+        relief: [None, None],
+        check: None,
+        entrance: None,
+        p_s: 5.0e5,
+        p_init: p,
+        ext: HydraulicExtensions::default(),
+    }
+}
+
+#[test]
+fn default_extensions_are_bit_for_bit_the_paper_model() {
+    let plain = DamperDeck::from_toml_str(&nominal_text(), "plain").unwrap();
+    let zero = deck_with(
+        "seal_friction_N = 0.0\nfree_play_m = 0.0\nair_fraction = 0.0\nleakage_m3_per_s_Pa = 0.0",
+    );
+    assert_eq!(plain.physical, zero.physical);
+    for v in [0.02, 0.1] {
+        let a = harmonic_run(
+            plain.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            27.02,
+            v,
+            3,
+            256,
+            true,
+        )
+        .unwrap();
+        let b = harmonic_run(
+            zero.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            27.02,
+            v,
+            3,
+            256,
+            true,
+        )
+        .unwrap();
+        assert_eq!(a.history.force_n, b.history.force_n);
+        assert_eq!(a.history.channels, b.history.channels);
+    }
+    // A deck without the table writes no extension table and reads back identically.
+    let back = DamperDeck::from_toml_str(&plain.to_toml(), "back").unwrap();
+    assert!(!plain.to_toml().contains("extensions"));
+    assert_eq!(back.physical, plain.physical);
+    assert_eq!(back.linear_c_n_s_per_m, plain.linear_c_n_s_per_m);
+    assert_eq!(back.nonlinear, plain.nonlinear);
+}
+
+#[test]
+fn written_deck_reads_back_with_every_extension() {
+    let d = deck_with(
+        "seal_friction_N = 321.5\nstribeck_static_N = 400.0\nfree_play_m = 2.5e-4\nair_fraction = 0.013\nleakage_m3_per_s_Pa = 7.0e-12\nair_fraction_1 = 0.05\naccumulator_bleed_m3_per_s_Pa = 2.0e-12",
+    );
+    let back = DamperDeck::from_toml_str(&d.to_toml(), "back").unwrap();
+    assert_eq!(back.physical, d.physical);
+    assert_eq!(back.extensions, d.extensions);
+    assert_eq!(back.extensions.friction.unwrap().f_s, 400.0);
+}
+
+#[test]
+fn bad_extension_keys_are_named() {
+    let text = format!(
+        "{}\n[damper.physical.extensions]\nair_fraction = 1.5\n",
+        nominal_text()
+    );
+    let e = DamperDeck::from_toml_str(&text, "x.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("damper.physical.extensions.air_fraction"), "{e}");
+    let text = format!(
+        "{}\n[damper.physical.extensions]\nfriction_N = 1.0\n",
+        nominal_text()
+    );
+    let e = DamperDeck::from_toml_str(&text, "x.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unknown key") && e.contains("seal_friction_N"),
+        "{e}"
+    );
+}
+
+/// Constant-velocity stroking (after a settling ramp): friction adds exactly -F_c sign(v).
+#[test]
+fn coulomb_friction_adds_exactly_fc_in_steady_stroking() {
+    let plain = DamperDeck::from_toml_str(&nominal_text(), "plain").unwrap();
+    let fric = deck_with("seal_friction_N = 412.0");
+    for v in [0.03, -0.03] {
+        let n = 400;
+        let dt = 1e-4;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        let test = BenchTest {
+            name: "ramp".into(),
+            stroke_m: t.iter().map(|t| v * t).collect(),
+            time_s: t,
+            force_n: None,
+            velocity_m_s: None,
+        };
+        let a = replay(
+            plain.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            &test,
+        )
+        .unwrap();
+        let b = replay(
+            fric.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            &test,
+        )
+        .unwrap();
+        for k in 10..n {
+            let d = b.force_model_n[k] - a.force_model_n[k];
+            assert!(
+                (d + 412.0 * v.signum()).abs() < 1e-9,
+                "v {v}, sample {k}: friction force {d}"
+            );
+        }
+    }
+}
+
+/// Free play: zero force while the stroke is inside the gap, the plain damper's force (of the
+/// piston stroke, shifted by half the gap) once it is taken up.
+#[test]
+fn free_play_transmits_no_force_inside_the_gap() {
+    let gap = 0.4e-3;
+    let dk = deck_with(&format!("free_play_m = {gap}"));
+    let dev = dk.build(DamperModel::Physical, opts()).unwrap();
+    let n = 2000;
+    let dt = 1e-4;
+    let a = 1.0e-3;
+    let w = 2.0 * std::f64::consts::PI / (n as f64 * dt);
+    let t: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
+    let d: Vec<f64> = t.iter().map(|t| a * (w * t).sin()).collect();
+    let test = BenchTest {
+        name: "play".into(),
+        time_s: t.clone(),
+        stroke_m: d.clone(),
+        force_n: None,
+        velocity_m_s: None,
+    };
+    let r = replay(dev.as_ref(), &test).unwrap();
+    // After the peak (k = n/4) the stroke turns back: inside the gap until it has come back by
+    // the whole gap, d < a - gap.
+    let mut inside = 0;
+    for (k, &dk) in d.iter().enumerate().take(n / 2).skip(n / 4 + 1) {
+        if dk > a - gap + 1e-9 {
+            assert_eq!(r.force_model_n[k], 0.0, "sample {k}, stroke {dk}");
+            inside += 1;
+        } else if dk < a - gap - 2e-6 {
+            assert!(
+                r.force_model_n[k] > 0.0,
+                "sample {k}: contact, pushing back"
+            );
+        }
+    }
+    assert!(inside > 50, "{inside} samples inside the gap");
+}
+
+/// Leakage of a sealed pair held still: dp = p0 - p1 decays as exp(-t/tau),
+/// tau = 1 / (k B (1/V0 + 1/V1)) in the linear regime (dp << B; B of Eq. 3 at the mean
+/// pressure, `B = 1/alpha + p` for beta = 0).
+#[test]
+fn leakage_decays_exponentially_with_the_analytic_time_constant() {
+    let fluid = Fluid::constant_bulk(850.0, 1.5e9);
+    let b = fluid.bulk(5.0e5).0;
+    let k = 1.0e-12;
+    let dp0 = 2.0e3;
+    let mut p = sealed(fluid, [5.0e5 + dp0 / 2.0, 5.0e5 - dp0 / 2.0]);
+    p.ext.leakage = Some(Leakage { conductance: k });
+    let tau = 1.0 / (k * b * (2.0 / 6.0e-5));
+    let mut dev = CircuitDevice::new(p, opts());
+    let dt = tau / 50.0;
+    for step in 1..=100 {
+        dev.trial_step((step - 1) as f64 * dt, dt, 0.0, 0.0)
+            .unwrap();
+        dev.commit();
+        let y = dev.state();
+        let expect = dp0 * (-(step as f64) * dt / tau).exp();
+        assert!(
+            ((y[IP0] - y[IP1]) - expect).abs() < 1e-6 * dp0,
+            "step {step}: {} vs {expect}",
+            y[IP0] - y[IP1]
+        );
+        // Mass is conserved: the mean pressure stays.
+        assert!(((y[IP0] + y[IP1]) / 2.0 - 5.0e5).abs() < 1e-6 * dp0);
+    }
+}
+
+/// Entrained air: a sealed chamber compressed follows the mixture's sealed-volume law
+/// `V/V_ref = (1 - a0) c_l(p_ref)/c_l(p) + a0 p_ref/p` (isothermal air, Eq. 3 liquid).
+#[test]
+fn entrained_air_sealed_compression_matches_the_mixture_law() {
+    for beta in [0.0, 2.0e-18] {
+        let fluid = Fluid {
+            rho: 850.0,
+            alpha: 6.667e-10,
+            beta,
+            p_cav: 0.0,
+        };
+        let air = EntrainedAir {
+            fraction: 0.02,
+            p_ref: 5.0e5,
+        };
+        let mut p = sealed(fluid, [5.0e5; 2]);
+        p.ext.air = Some(air);
+        let mut dev = CircuitDevice::new(p.clone(), opts());
+        let n = 200;
+        let d_end = -1.0e-3; // chamber 0 shrinks by 1.6e-6 m^3 (2.7%)
+        for k in 0..n {
+            let (a, b) = (
+                d_end * k as f64 / n as f64,
+                d_end * (k + 1) as f64 / n as f64,
+            );
+            dev.trial_step(k as f64 * 1e-4, 1e-4, a, b).unwrap();
+            dev.commit();
+        }
+        let c = &p.chambers[0];
+        let ratio = c.volume(d_end) / c.volume0;
+        let p0 = dev.state()[IP0];
+        let got = air.sealed_volume_ratio(&fluid, p0);
+        assert!(
+            (got - ratio).abs() < 1e-8,
+            "beta {beta}: V/V0 at p0 = {p0} is {got}, chamber {ratio}"
+        );
+        // Air makes it softer than the oil alone.
+        let oil = fluid.sealed_pressure(5.0e5, c.volume0, c.volume(d_end));
+        assert!(p0 < 0.5 * oil, "{p0} vs oil only {oil}");
+    }
+}
+
+#[test]
+fn extension_jacobian_matches_finite_differences() {
+    let mut p = DamperDeck::from_toml_str(&nominal_text(), "n")
+        .unwrap()
+        .physical
+        .unwrap();
+    p.ext.leakage = Some(Leakage { conductance: 5e-12 });
+    p.ext.air = Some(EntrainedAir {
+        fraction: 0.03,
+        p_ref: 5.0e5,
+    });
+    p.ext.air_by_chamber[1] = Some(EntrainedAir {
+        fraction: 0.08,
+        p_ref: 5.0e5,
+    });
+    p.ext.bleed = Some(Leakage { conductance: 3e-12 });
+    for (p0, p1) in [(3.0e6, 2.0e5), (6.0e5, 4.0e5), (5.0e4, 8.0e6)] {
+        let mut y = State::zeros();
+        y[IP0] = p0;
+        y[IP1] = p1;
+        let (_, j, _) = p.evaluate::<true>(0.0, 1e-3, 0.05, &y, None).unwrap();
+        for c in [IP0, IP1] {
+            let h = 1e-3 * (1.0 + y[c].abs() * 1e-6);
+            let (mut yp, mut ym) = (y, y);
+            yp[c] += h;
+            ym[c] -= h;
+            let fp = p.evaluate::<false>(0.0, 1e-3, 0.05, &yp, None).unwrap().0;
+            let fm = p.evaluate::<false>(0.0, 1e-3, 0.05, &ym, None).unwrap().0;
+            for r in 0..NS {
+                let fd = (fp[r] - fm[r]) / (2.0 * h);
+                let an = j[(r, c)];
+                let scale = an.abs().max(fd.abs()).max(1e-12);
+                assert!(
+                    (fd - an).abs() <= 1e-5 * scale + 1e-9,
+                    "p = ({p0}, {p1}): J[{r},{c}] analytic {an:e} vs FD {fd:e}"
+                );
+            }
+        }
+    }
+}
+
+/// Accumulator bleed of a sealed chamber held still: p - p_s decays as exp(-t/tau),
+/// tau = V / (k B) in the linear regime.
+#[test]
+fn accumulator_bleed_relaxes_to_p_s_with_the_analytic_time_constant() {
+    let fluid = Fluid::constant_bulk(850.0, 1.5e9);
+    let dp0 = 2.0e3;
+    let mut p = sealed(fluid, [5.0e5 + dp0, 5.0e5 - dp0]);
+    let k = 1.0e-12;
+    p.ext.bleed = Some(Leakage { conductance: k });
+    let b = fluid.bulk(5.0e5).0;
+    let tau = 6.0e-5 / (k * b);
+    let mut dev = CircuitDevice::new(p, opts());
+    let dt = tau / 50.0;
+    for step in 1..=100 {
+        dev.trial_step((step - 1) as f64 * dt, dt, 0.0, 0.0)
+            .unwrap();
+        dev.commit();
+        let y = dev.state();
+        let e = dp0 * (-(step as f64) * dt / tau).exp();
+        assert!(
+            (y[IP0] - 5.0e5 - e).abs() < 1e-6 * dp0,
+            "step {step}: {}",
+            y[IP0]
+        );
+        assert!(
+            (y[IP1] - 5.0e5 + e).abs() < 1e-6 * dp0,
+            "step {step}: {}",
+            y[IP1]
+        );
+    }
+}
+
+/// Air in chamber 1 only: chamber 0 follows the oil's Eq. (3), chamber 1 the mixture law.
+#[test]
+fn air_by_chamber_acts_on_its_chamber_only() {
+    let fluid = Fluid {
+        rho: 850.0,
+        alpha: 6.667e-10,
+        beta: 0.0,
+        p_cav: 0.0,
+    };
+    let air = EntrainedAir {
+        fraction: 0.05,
+        p_ref: 5.0e5,
+    };
+    let mut p = sealed(fluid, [5.0e5; 2]);
+    p.ext.air_by_chamber[1] = Some(air);
+    let mut dev = CircuitDevice::new(p.clone(), opts());
+    let d_end = 1.0e-3; // chamber 0 grows, chamber 1 shrinks
+    for k in 0..200 {
+        let (a, b) = (d_end * k as f64 / 200.0, d_end * (k + 1) as f64 / 200.0);
+        dev.trial_step(k as f64 * 1e-4, 1e-4, a, b).unwrap();
+        dev.commit();
+    }
+    let c = &p.chambers;
+    let p0 = fluid.sealed_pressure(5.0e5, c[0].volume0, c[0].volume(d_end));
+    assert!((dev.state()[IP0] - p0).abs() < 1e-6 * p0.abs().max(1e5));
+    let ratio = c[1].volume(d_end) / c[1].volume0;
+    assert!((air.sealed_volume_ratio(&fluid, dev.state()[IP1]) - ratio).abs() < 1e-8);
+}
+
+/// Elastic mount in series with a linear dashpot is a Maxwell element: under `d = A sin(wt)` the
+/// steady force is `F = -c w A cos(wt - phi) / sqrt(1 + (c w/k)^2)`, `phi = atan(c w/k)` lag.
+#[test]
+fn series_mount_with_a_dashpot_is_a_maxwell_element() {
+    let (c, k, a, w) = (1.0e5, 2.0e7, 2.0e-3, 27.0);
+    let mut dev = SeriesMount::new(Box::new(LinearDashpot::new(c)), k);
+    let period = 2.0 * std::f64::consts::PI / w;
+    let n = 20_000;
+    let dt = period / n as f64;
+    let cycles = 3;
+    let (mut sc, mut ss) = (0.0, 0.0);
+    for i in 0..cycles * n {
+        let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+        let sf = dev
+            .trial_step(t0, dt, a * (w * t0).sin(), a * (w * t1).sin())
+            .unwrap();
+        dev.commit();
+        if i >= (cycles - 1) * n {
+            // The step's force belongs to the step's mean rate, at its midpoint.
+            let tm = 0.5 * (t0 + t1);
+            sc += sf.force_end * (w * tm).cos();
+            ss += sf.force_end * (w * tm).sin();
+        }
+    }
+    let (fc, fs) = (2.0 * sc / n as f64, 2.0 * ss / n as f64);
+    let amp = (fc * fc + fs * fs).sqrt();
+    let x = c * w / k;
+    let amp_exact = c * w * a / (1.0 + x * x).sqrt();
+    assert!(
+        (amp - amp_exact).abs() < 1e-4 * amp_exact,
+        "amplitude {amp} vs {amp_exact}"
+    );
+    // F = -F0 cos(wt - phi) = -F0 (cos phi cos wt + sin phi sin wt).
+    let phi = (fs / fc).atan();
+    assert!(
+        (phi - x.atan()).abs() < 1e-3,
+        "lag {phi} rad vs {} rad",
+        x.atan()
+    );
+    assert!(fc < 0.0);
+}
+
+#[test]
+fn series_mount_deck_key_wraps_the_damper() {
+    let d = deck_with("mount_stiffness_N_per_m = 5.0e7\nseal_friction_N = 100.0");
+    assert_eq!(d.extensions.mount_stiffness_n_per_m, Some(5.0e7));
+    let back = DamperDeck::from_toml_str(&d.to_toml(), "back").unwrap();
+    assert_eq!(back.extensions, d.extensions);
+    // Stiff mounts: the rigid damper's force.
+    let stiff = deck_with("mount_stiffness_N_per_m = 1.0e15");
+    let plain = DamperDeck::from_toml_str(&nominal_text(), "plain").unwrap();
+    let run = |dk: &DamperDeck| {
+        harmonic_run(
+            dk.build(DamperModel::Physical, opts()).unwrap().as_ref(),
+            27.02,
+            0.05,
+            2,
+            256,
+            true,
+        )
+        .unwrap()
+        .history
+        .force_n
+    };
+    let (fa, fb) = (run(&stiff), run(&plain));
+    for (x, y) in fa.iter().zip(&fb) {
+        assert!((x - y).abs() < 0.5, "{x} vs {y}");
+    }
+}
