@@ -17,11 +17,6 @@ fn all_example_decks_parse() {
         let p = e.unwrap().path();
         if p.extension().map(|x| x == "toml").unwrap_or(false) {
             let name = p.display().to_string();
-            if name.contains("uh60a")
-                && !Path::new("/work/shared/data/uh60a/blade_sections_yeo.csv").exists()
-            {
-                continue;
-            }
             load_deck(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }
