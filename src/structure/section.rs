@@ -405,13 +405,7 @@ mod tests {
 
     #[test]
     fn reads_the_uh60a_table_and_interpolates() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared/data/uh60a/blade_sections_yeo.csv");
-        let path = if path.exists() {
-            path
-        } else {
-            Path::new("/work/shared/data/uh60a/blade_sections_yeo.csv").to_path_buf()
-        };
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors/data/blade_sections_yeo.csv");
         let t = SectionTable::from_csv(&path).expect("table");
         assert_eq!(t.stations.len(), 46);
         let a = t.stations[1];
