@@ -1,1 +1,66 @@
-//! Rotor deck -> multibody model.
+//! Rotor deck -> multibody model, and the forced-response simulation interface used by
+//! `rotorsim run` (issue #6).
+//!
+//! Split of responsibilities: this module builds a rotor (deck, expansion to a model deck,
+//! the UH-60A multibody model, airload replay, swashplate controls, damper coupling) and
+//! exposes it through [`ForcedResponse`]; `crate::run` drives any [`ForcedResponse`] to a
+//! periodic solution and writes the outputs (summary.json, last_rev.csv, report.html,
+//! result.mcap). Keep the trait small and stable: both sides code against it.
+
+/// Wall-clock split of a simulation (seconds since construction).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Total time spent in `step` [s].
+    pub total_s: f64,
+    /// Of which inside the hydraulic device (trial steps, sub-stepping) [s].
+    pub hydraulics_s: f64,
+    /// Structural steps taken and Newton iterations in total.
+    pub steps: usize,
+    pub iterations: usize,
+}
+
+/// Names of the channels every [`ForcedResponse`] reports first, in this order. Sign
+/// conventions are those of ../shared/FORMATS.md (stroke positive in extension, force positive
+/// when the damper pushes its end points apart). Tip motion is in the hub (rotating) frame,
+/// relative to the undeformed blade: flap up positive, lag positive aft (against rotation),
+/// elastic twist nose-up positive.
+pub const BASE_CHANNELS: [&str; 6] = [
+    "damper_force_N",
+    "damper_stroke_m",
+    "damper_stroke_rate_m_s",
+    "tip_flap_m",
+    "tip_lag_m",
+    "tip_twist_rad",
+];
+
+/// One time-marching forced-response simulation of a rotor blade with one damper model.
+pub trait ForcedResponse: Send {
+    /// Model label: "linear", "nonlinear" or "physical".
+    fn label(&self) -> &str;
+    /// Rotor period 2 pi / Omega [s].
+    fn period_s(&self) -> f64;
+    /// Structural time step [s] (period / steps per revolution).
+    fn time_step_s(&self) -> f64;
+    /// Current time [s]; starts at 0 (azimuth 0 of the reference blade).
+    fn time_s(&self) -> f64;
+    /// Azimuth of the reference blade [deg] (FORMATS: 0 over the tail, increasing with
+    /// rotation), not wrapped.
+    fn azimuth_deg(&self) -> f64 {
+        self.time_s() / self.period_s() * 360.0
+    }
+    /// Advance one structural step. Numerical failure returns an error naming the time, the
+    /// Newton iteration and the residual.
+    fn step(&mut self) -> anyhow::Result<()>;
+    /// Channel names with units: [`BASE_CHANNELS`] first, then model-specific ones (for the
+    /// physical damper the device channels: p0_Pa, p1_Pa, q_orifice_m3_s, x_valve0_m, ...;
+    /// valve velocities as v_valve0_m_s, v_valve1_m_s).
+    fn channel_names(&self) -> Vec<String>;
+    /// Current channel values, same order as `channel_names`. Must not allocate.
+    fn channels(&self, out: &mut [f64]);
+    /// Force limits of the device [N] (min, max) where it has them (physical damper: the
+    /// relief-valve limits), else None.
+    fn force_limits_n(&self) -> Option<(f64, f64)> {
+        None
+    }
+    fn timing(&self) -> Timing;
+}
