@@ -64,3 +64,62 @@ pub trait ForcedResponse: Send {
     }
     fn timing(&self) -> Timing;
 }
+
+use crate::flight::FlightRecord;
+use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
+use std::path::Path;
+
+/// Options of one forced-response run.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions {
+    /// Structural steps per rotor revolution (paper: 256).
+    pub steps_per_rev: usize,
+    /// Hydraulic integrator and sub-steps per structural step (paper: RK4, 25).
+    pub hydraulics: IntegratorOptions,
+    /// Generalized-alpha spectral radius at infinity.
+    pub rho_inf: f64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            steps_per_rev: 256,
+            hydraulics: IntegratorOptions::default(),
+            rho_inf: 0.9,
+        }
+    }
+}
+
+/// A rotor deck (rotors/*.toml): rotor, blade, root retention, bearing, pitch control, damper
+/// attachment geometry and the `[damper]` table. Schema: docs/rotor_deck.md.
+#[derive(Clone, Debug)]
+pub struct RotorDeck {
+    /// File the deck was read from (relative paths inside it resolve against its folder).
+    pub path: std::path::PathBuf,
+}
+
+impl RotorDeck {
+    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+        anyhow::bail!(
+            "{}: rotor decks are not available yet (issue #6)",
+            path.display()
+        )
+    }
+    /// The deck's `[damper]` table.
+    pub fn damper(&self) -> anyhow::Result<DamperDeck> {
+        Ok(DamperDeck::from_file(&self.path)?)
+    }
+}
+
+/// Build the forced-response simulation of `rotor` with damper `damper` (its `model` variant)
+/// under the airloads and controls of `record`.
+pub fn build(
+    rotor: &RotorDeck,
+    damper: &DamperDeck,
+    model: DamperModel,
+    record: &FlightRecord,
+    opts: &RunOptions,
+) -> anyhow::Result<Box<dyn ForcedResponse>> {
+    let _ = (rotor, damper, model, record, opts);
+    anyhow::bail!("rotor model not available yet (issue #6)")
+}
