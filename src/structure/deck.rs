@@ -683,12 +683,14 @@ fn hydraulic_element(
     })?;
     let device: Box<dyn Device> = match (root.contains_key("actuator"), root.contains_key("damper"))
     {
-        (true, true) => return Err(inv(
-            "deck",
-            format!(
+        (true, true) => {
+            return Err(inv(
+                "deck",
+                format!(
                 "device deck {dfile} has both [actuator] and [damper]: give one device per deck"
             ),
-        )),
+            ))
+        }
         (false, false) => {
             return Err(inv(
                 "deck",
