@@ -179,3 +179,73 @@ fn rotor_deck_unknown_key_names_file_line_key() {
     assert!(e.contains("arm_lenght_m"), "{e}");
     assert!(e.contains("line"), "{e}");
 }
+
+#[test]
+fn expand_prints_a_model_deck_that_loads_back() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .args(["expand", "--rotor"])
+        .arg(repo("rotors/uh60a.toml"))
+        .arg("--flight")
+        .arg(repo("flightdata/c8534like.meta.json"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    // paths in the expanded deck are relative to the rotor deck's folder
+    let (deck, mut model) =
+        rotorsim::structure::deck::parse_deck(&text, "expanded.toml", &repo("rotors")).unwrap();
+    // 13 + 3 + 2 + 2 + 3 cubic elements
+    let beams = |n: &str| model.beams.get(n).map(|v| v.len()).unwrap_or(0);
+    assert_eq!(
+        [
+            beams("blade"),
+            beams("seg1"),
+            beams("seg2"),
+            beams("seg3"),
+            beams("pitch_link")
+        ],
+        [13, 3, 2, 2, 3]
+    );
+    // the damper as a [[hydraulic]] element reading the rotor deck's [damper] table
+    assert_eq!(deck.hydraulic_probes.len(), 1);
+    assert_eq!(model.step_elements.len(), 1);
+    // bearing: lag, flap, pitch revolute joints at the hinge with the deck's springs
+    let spec = RotorDeck::from_file(&repo("rotors/uh60a.toml"))
+        .unwrap()
+        .spec;
+    for (name, k) in [
+        ("lag", spec.bearing.lag_k),
+        ("flap", spec.bearing.flap_k),
+        ("pitch", spec.bearing.pitch_k),
+    ] {
+        let id = model.element_id(name).unwrap();
+        match &model.elements[id] {
+            rotorsim::structure::Element::Joint(j) => {
+                assert_eq!(j.kind, rotorsim::structure::JointKind::Revolute);
+                assert_eq!(j.spring_nm_per_rad, k);
+            }
+            _ => panic!("{name} is not a joint"),
+        }
+    }
+    // a consistent, non-redundant constraint set
+    let st = rotorsim::solver::State::from_model(&model);
+    rotorsim::solver::statics::check_constraints(&mut model, &st).unwrap();
+    // the swashplate law at t = 0: collective only (cyclic ramps in), z = horn_y sin(th0)
+    let th0 = 11.4584f64.to_radians();
+    assert!(
+        (spec.swash_z(spec.pitch_rad(
+            &rotorsim::rotor::expand::Controls {
+                th0_deg: 11.4584,
+                th1c_deg: 1.806,
+                th1s_deg: -7.8657
+            },
+            0.0
+        )) - 0.2 * th0.sin())
+        .abs()
+            < 1e-12
+    );
+}
