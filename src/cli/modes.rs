@@ -191,7 +191,7 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
             return Err(bad("three fields needed"));
         }
         let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
-        if !(h > 0.0) || b < a {
+        if h.is_nan() || h <= 0.0 || b < a {
             return Err(bad("STEP must be positive and STOP >= START"));
         }
         let n = ((b - a) / h + 1e-9).floor() as usize;
@@ -314,9 +314,8 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     if let Some(rf) = &reference {
         for p in &pts {
             if let Some((_, r)) = rf.iter().find(|(x, _)| (x - p.fraction).abs() < 1e-6) {
-                for k in 0..5 {
-                    let e = 100.0 * (p.tracked_hz[k] - r[k]) / r[k];
-                    cmp.push((p.fraction, k, p.tracked_hz[k], r[k], e));
+                for (k, (&m, &re)) in p.tracked_hz.iter().zip(r.iter()).enumerate() {
+                    cmp.push((p.fraction, k, m, re, 100.0 * (m - re) / re));
                 }
             }
         }
