@@ -27,7 +27,8 @@ fn solver(
 
 fn main() {
     let steps = 2000;
-    let variants: Vec<(&str, Box<dyn Fn(String) -> String>)> = vec![
+    type Edit = Box<dyn Fn(String) -> String>;
+    let variants: Vec<(&str, Edit)> = vec![
         ("rk4 N=48 (paper)", Box::new(|t| t)),
         (
             "implicit N=4",

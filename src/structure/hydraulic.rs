@@ -110,7 +110,7 @@ impl HydraulicProbe {
 
 #[derive(Debug, Clone, Copy, Default)]
 struct Trial {
-    force_mean: f64,
+    force_applied: f64,
     stroke_m: f64,
     rate_m_s: f64,
 }
@@ -245,9 +245,17 @@ impl HydraulicForceElement {
             AppliedForce::End => {
                 // d F_end / d d_f by a forward difference of the whole step (flows included);
                 // the perturbed step runs first so that the nominal one stays the trial state.
-                let h = FD_REL * l_ref.abs().max(1e-3);
+                // (backward when d_f + h is beyond the device's travel).
+                let mut h = FD_REL * l_ref.abs().max(1e-3);
                 self.probe.trials.fetch_add(2, Ordering::Relaxed);
-                let sp = self.device.trial_step(t_i, dt, d_i, d_f + h)?;
+                let sp = match self.device.trial_step(t_i, dt, d_i, d_f + h) {
+                    Ok(s) => s,
+                    Err(_) => {
+                        h = -h;
+                        self.probe.trials.fetch_add(1, Ordering::Relaxed);
+                        self.device.trial_step(t_i, dt, d_i, d_f + h)?
+                    }
+                };
                 let sf = self.device.trial_step(t_i, dt, d_i, d_f)?;
                 self.last_step = Some(sf);
                 Ok((sf.force_end, (sp.force_end - sf.force_end) / h))
@@ -323,7 +331,7 @@ impl StepElement for HydraulicForceElement {
         }
         self.last_applied = force;
         self.trial = Some(Trial {
-            force_mean: force,
+            force_applied: force,
             stroke_m: d_f,
             rate_m_s: rate,
         });
@@ -372,6 +380,6 @@ impl StepElement for HydraulicForceElement {
 impl HydraulicForceElement {
     /// Step force applied over the last converged step [N] (`F_m` of Eq. 13 or `F_end`).
     pub fn committed_step_force(&self) -> f64 {
-        self.committed.force_mean
+        self.committed.force_applied
     }
 }
