@@ -39,6 +39,9 @@ pub struct BladeTable {
     /// Built-in twist `[[r_m, deg], ...]`.
     #[serde(default)]
     pub twist_deg: Vec<[f64; 2]>,
+    /// Gain g of the perturbation aerodynamic damping (src/rotor/transient.rs); 0 disables.
+    #[serde(default)]
+    pub perturbation_damping_gain: f64,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -196,6 +199,10 @@ impl RotorSpec {
                 self.damper_attachment.horn_mass_kg,
             ),
             ("blade.damping_mu_s", self.blade.damping_mu_s),
+            (
+                "blade.perturbation_damping_gain",
+                self.blade.perturbation_damping_gain,
+            ),
         ] {
             nonneg(k, v)?;
         }

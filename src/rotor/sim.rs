@@ -186,16 +186,22 @@ pub fn build_sim(
     )?;
     let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
     let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
-    model.add_distributed_load(
+    let airloads = BladeAirloads {
+        full,
+        mean,
+        root_r_m: spec.blade.root_r_m,
+        t_ramp,
+        scale: scale.clone(),
+    };
+    let load = super::transient::blade_load(
+        airloads,
+        &model,
         names::BLADE,
-        Box::new(BladeAirloads {
-            full,
-            mean,
-            root_r_m: spec.blade.root_r_m,
-            t_ramp,
-            scale: scale.clone(),
-        }),
+        spec,
+        record,
+        opts.steps_per_rev,
     )?;
+    model.add_distributed_load(names::BLADE, load)?;
     // initial state: rotating static equilibrium under the mean loads and the collective
     let mut st = State::from_model(&model);
     let sopts = StaticOptions {
