@@ -42,6 +42,13 @@ pub struct BladeTable {
     /// Gain g of the perturbation aerodynamic damping (src/rotor/transient.rs); 0 disables.
     #[serde(default)]
     pub perturbation_damping_gain: f64,
+    /// Its delay in revolutions (default 1).
+    #[serde(default = "one")]
+    pub perturbation_damping_delay_revs: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -173,6 +180,12 @@ impl RotorSpec {
             if n == 0 {
                 return Err(bad(k, "expected at least one element"));
             }
+        }
+        if self.blade.perturbation_damping_delay_revs == 0 {
+            return Err(bad(
+                "blade.perturbation_damping_delay_revs",
+                "expected at least 1 revolution",
+            ));
         }
         let b = &self.bearing;
         for (k, v) in [

@@ -43,6 +43,9 @@ pub struct DampingParams {
     /// Structural time step [s], exactly `T / steps_per_rev`.
     pub h_s: f64,
     pub steps_per_rev: usize,
+    /// Delay in revolutions k (the term uses `v_n(t - kT)`; 1 is the brief's choice, a
+    /// longer delay reaches modes close to an integer /rev, see docs/rotor_model.md).
+    pub delay_revs: usize,
 }
 
 /// Ring buffer of the converged normal velocity of every load point over one revolution, and
@@ -53,9 +56,9 @@ pub struct PerturbationDamping {
     first_point: Vec<usize>,
     /// Reference arc length of every load point (NPTS_M per element).
     s_m: Vec<f64>,
-    /// `(steps_per_rev + 1)` slots x points: the slot of step k is overwritten at every
-    /// evaluation of step k (the last one is at the converged state) while the slot of step
-    /// `k - steps_per_rev` is still intact.
+    /// `(delay + 1)` slots x points (delay = delay_revs steps_per_rev steps): the slot of step
+    /// k is overwritten at every evaluation of step k (the last one is at the converged state)
+    /// while the slot of step `k - delay` is still intact.
     ring: Vec<f64>,
     /// Step index held by each slot (i64::MIN: empty).
     stamp: Vec<i64>,
@@ -71,7 +74,7 @@ impl PerturbationDamping {
             first_point[*id] = s_m.len();
             s_m.extend_from_slice(s);
         }
-        let slots = p.steps_per_rev + 1;
+        let slots = p.delay_revs.max(1) * p.steps_per_rev + 1;
         PerturbationDamping {
             ring: vec![0.0; slots * s_m.len()],
             stamp: vec![i64::MIN; slots],
@@ -127,18 +130,23 @@ impl PerturbationDamping {
         (0..3).map(|i| p.r[i][2] * v[i]).sum()
     }
 
+    /// Delay in steps (delay_revs x steps_per_rev).
+    pub fn delay_steps(&self) -> usize {
+        self.p.delay_revs.max(1) * self.p.steps_per_rev
+    }
+
     /// Store `vn` as the value of point `i` at step `k`; return the value stored for step
-    /// `k - steps_per_rev` (None when that step was never evaluated, e.g. in the first
-    /// revolution).
+    /// `k - delay_steps` (None when that step was never evaluated, e.g. in the first
+    /// revolutions).
     pub fn record(&mut self, k: i64, i: usize, vn: f64) -> Option<f64> {
-        let slots = (self.p.steps_per_rev + 1) as i64;
+        let slots = self.delay_steps() as i64 + 1;
         let np = self.s_m.len();
         let w = k.rem_euclid(slots) as usize;
         if self.stamp[w] != k {
             self.stamp[w] = k;
         }
         self.ring[w * np + i] = vn;
-        let k_old = k - self.p.steps_per_rev as i64;
+        let k_old = k - self.delay_steps() as i64;
         let r = k_old.rem_euclid(slots) as usize;
         (self.stamp[r] == k_old).then(|| self.ring[r * np + i])
     }
@@ -214,6 +222,7 @@ pub fn blade_load<L: DistributedLoad + 'static>(
         omega_rad_s: [0.0, 0.0, om],
         h_s: 2.0 * std::f64::consts::PI / om / steps_per_rev as f64,
         steps_per_rev,
+        delay_revs: spec.blade.perturbation_damping_delay_revs,
     };
     Ok(Box::new(Damped {
         inner: airloads,
@@ -234,6 +243,7 @@ mod tests {
             omega_rad_s: [0.0, 0.0, 3.0],
             h_s: 0.01,
             steps_per_rev: n,
+            delay_revs: 1,
         }
     }
 
@@ -271,6 +281,18 @@ mod tests {
                     assert_eq!(old, Some((100 * (k - n as i64) + i as i64) as f64));
                 }
             }
+        }
+        // a delay of 3 revolutions
+        let mut d = PerturbationDamping::from_layout(
+            &[(0, [0.0; 4])],
+            DampingParams {
+                delay_revs: 3,
+                ..params(n, 1.0)
+            },
+        );
+        for k in 0..8 * n as i64 {
+            let old = d.record(k, 1, k as f64);
+            assert_eq!(old, (k >= 3 * n as i64).then(|| (k - 3 * n as i64) as f64));
         }
         // a skipped step leaves no stale value one revolution later
         let mut d = PerturbationDamping::from_layout(&[(0, [0.0; 4])], params(n, 1.0));
