@@ -42,6 +42,16 @@ pub struct BladeTable {
     /// Built-in twist `[[r_m, deg], ...]`.
     #[serde(default)]
     pub twist_deg: Vec<[f64; 2]>,
+    /// Gain g of the perturbation aerodynamic damping (src/rotor/transient.rs); 0 disables.
+    #[serde(default)]
+    pub perturbation_damping_gain: f64,
+    /// Its delay in revolutions (default 1).
+    #[serde(default = "one")]
+    pub perturbation_damping_delay_revs: usize,
+}
+
+fn one() -> usize {
+    1
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -196,6 +206,12 @@ impl RotorSpec {
                 return Err(bad(k, "expected at least one element"));
             }
         }
+        if self.blade.perturbation_damping_delay_revs == 0 {
+            return Err(bad(
+                "blade.perturbation_damping_delay_revs",
+                "expected at least 1 revolution",
+            ));
+        }
         let b = &self.bearing;
         for (k, v) in [
             ("bearing.lag_stiffness_Nm_per_rad", b.lag_k),
@@ -221,6 +237,10 @@ impl RotorSpec {
                 self.damper_attachment.horn_mass_kg,
             ),
             ("blade.damping_mu_s", self.blade.damping_mu_s),
+            (
+                "blade.perturbation_damping_gain",
+                self.blade.perturbation_damping_gain,
+            ),
         ] {
             nonneg(k, v)?;
         }

@@ -69,6 +69,7 @@ pub mod deck;
 pub mod expand;
 pub mod fan;
 pub mod sim;
+pub mod transient;
 
 use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};

@@ -250,17 +250,23 @@ pub fn build_sim(
             omega: om,
         }))
     });
-    model.add_distributed_load(
+    let airloads = BladeAirloads {
+        full,
+        mean,
+        root_r_m: spec.blade.root_r_m,
+        t_ramp,
+        scale: scale.clone(),
+        washout: washout.clone(),
+    };
+    let load = super::transient::blade_load(
+        airloads,
+        &model,
         names::BLADE,
-        Box::new(BladeAirloads {
-            full,
-            mean,
-            root_r_m: spec.blade.root_r_m,
-            t_ramp,
-            scale: scale.clone(),
-            washout: washout.clone(),
-        }),
+        spec,
+        record,
+        opts.steps_per_rev,
     )?;
+    model.add_distributed_load(names::BLADE, load)?;
     // initial state: rotating static equilibrium under the mean loads and the collective
     let mut st = State::from_model(&model);
     let sopts = StaticOptions {
