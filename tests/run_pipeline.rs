@@ -283,11 +283,12 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
 
 #[test]
 fn periodicity_of_the_linear_model_decays_at_the_lag_mode_damping_rate() {
-    // Linear dashpot on the lag hinge: a linear SDOF, transient ~ exp(-zeta w t). Per
-    // revolution the measure falls by exp(-zeta w T) once the transient dominates:
-    // w^2 = (e S Omega^2 + k)/I, zeta w = c a^2/(2 I).
+    // Linear dashpot on the lag hinge: a linear SDOF whose transient decays as exp(-s t) with
+    // s = c a^2 / (2 I), so the measure falls by exp(-s T) per revolution. The per-revolution
+    // maximum samples the envelope of a 0.29/rev oscillation (within a factor ~0.8), so the
+    // rate is taken from a least-squares fit of log(measure) over 30 revolutions.
     let out = tmp("decay");
-    ok(&run_sdof(&example(), &out, &["--damper", "linear", "--revs", "12"]));
+    ok(&run_sdof(&example(), &out, &["--damper", "linear", "--revs", "40"]));
     let s = summary(&out);
     let h: Vec<f64> = s["models"]["linear"]["periodicity"]["history"]
         .as_array()
@@ -295,36 +296,54 @@ fn periodicity_of_the_linear_model_decays_at_the_lag_mode_damping_rate() {
         .iter()
         .map(|x| x.as_f64().unwrap())
         .collect();
+    assert_eq!(h.len(), 39);
     let (i, c, a) = (2087.0, 68000.0, 0.175);
     let period = 2.0 * std::f64::consts::PI / 27.0;
     let expect = (-c * a * a / (2.0 * i) * period).exp();
-    let ratio = (h[10] / h[6]).powf(0.25);
+    let pts: Vec<(f64, f64)> = (8..39).map(|k| (k as f64, h[k].ln())).collect();
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    let ratio = slope.exp();
     assert!(
-        (ratio - expect).abs() < 0.02,
+        (ratio - expect).abs() < 0.01 * expect,
         "decay per revolution {ratio} vs analytic {expect} (history {h:?})"
     );
     let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
-fn a_record_without_damper_force_runs_without_metrics() {
-    let out = tmp("nodamper");
-    let rec = out.join("nodamper.mcap");
-    with_damper(Vec::new(), &rec);
+fn a_damper_channel_too_coarse_to_compare_runs_without_metrics() {
+    // Flight records always carry a damper force (FORMATS: the column is required), but one
+    // with 8 azimuths per revolution cannot give harmonics 0-10/rev: the run goes on, the
+    // metrics are absent with a note saying why.
+    let out = tmp("coarse");
+    let rec = out.join("coarse.mcap");
+    let damper = (0..8)
+        .map(|k| DamperSample {
+            revolution: 0,
+            azimuth_deg: 45.0 * k as f64,
+            force_N: 1000.0 * (45.0 * k as f64).to_radians().sin(),
+            stroke_m: None,
+        })
+        .collect();
+    with_damper(damper, &rec);
     let o = run_sdof(&rec, &out.join("o"), &["--damper", "nonlinear", "--revs", "2"]);
     ok(&o);
     let s = summary(&out.join("o"));
     assert_eq!(s["measured"]["available"], Value::Bool(false));
-    assert!(s["measured"]["note"]
-        .as_str()
-        .unwrap()
-        .contains("no measured damper force"));
+    let note = s["measured"]["note"].as_str().unwrap();
+    assert!(note.contains("8 azimuths") && note.contains("no comparison metrics"), "{note}");
     let m = &s["models"]["nonlinear"];
     assert_eq!(m["status"], "ok");
     assert!(m["metrics"]["rms_error"].is_null());
     assert!(m["metrics"]["note"].is_string());
     assert!(s["closest"].is_null());
-    assert!(String::from_utf8_lossy(&o.stdout).contains("no measured damper force"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("no comparison metrics"));
     let _ = std::fs::remove_dir_all(&out);
 }
 
