@@ -154,7 +154,10 @@ fn all_three_models_write_every_output() {
     }
     // The physical damper has relief-valve limits; the dashpots have none.
     let lim = &s["models"]["physical"]["relief_valve_limits"];
-    assert!(lim["within"].is_boolean() && lim["margin_n"].is_number(), "{lim}");
+    assert!(
+        lim["within"].is_boolean() && lim["margin_n"].is_number(),
+        "{lim}"
+    );
     assert_eq!(
         s["models"]["linear"]["relief_valve_limits"]["applies"],
         Value::Bool(false)
@@ -190,7 +193,10 @@ fn all_three_models_write_every_output() {
     }
     let units = ["_deg", "_N", "_m", "_m_s", "_Pa", "_m3_s", "_rad"];
     for c in &h {
-        assert!(units.iter().any(|u| c.ends_with(u)), "column {c} has no unit");
+        assert!(
+            units.iter().any(|u| c.ends_with(u)),
+            "column {c} has no unit"
+        );
     }
     assert_eq!(cols[0].len(), 256);
     assert_eq!(cols[0][0], 0.0);
@@ -237,7 +243,11 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
     // First run: the model's own last revolution becomes the "measurement" of a copy of the
     // record (same azimuth grid), then the run is repeated against it (deterministic).
     let out = tmp("known");
-    ok(&run_sdof(&example(), &out, &["--damper", "linear", "--revs", "3"]));
+    ok(&run_sdof(
+        &example(),
+        &out,
+        &["--damper", "linear", "--revs", "3"],
+    ));
     let (_, cols) = read_csv(&out.join("linear/last_rev.csv"));
     let r = FlightRecord::read(&example()).unwrap();
     let az = r.azimuths_deg().to_vec();
@@ -256,7 +266,11 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
     let same = out.join("same.mcap");
     with_damper(make(0.0), &same);
     let o2 = tmp("known-same");
-    ok(&run_sdof(&same, &o2, &["--damper", "linear", "--revs", "3"]));
+    ok(&run_sdof(
+        &same,
+        &o2,
+        &["--damper", "linear", "--revs", "3"],
+    ));
     let m = &summary(&o2)["models"]["linear"]["metrics"];
     assert!(m["rms_error"].as_f64().unwrap() < 1e-6, "{m}");
     assert!((m["correlation"].as_f64().unwrap() - 1.0).abs() < 1e-12);
@@ -268,10 +282,17 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
     let shifted = out.join("shifted.mcap");
     with_damper(make(-250.0), &shifted);
     let o3 = tmp("known-shift");
-    ok(&run_sdof(&shifted, &o3, &["--damper", "linear", "--revs", "3"]));
+    ok(&run_sdof(
+        &shifted,
+        &o3,
+        &["--damper", "linear", "--revs", "3"],
+    ));
     let s = summary(&o3);
     let m = &s["models"]["linear"]["metrics"];
-    assert!((m["rms_error"].as_f64().unwrap() - 250.0).abs() < 1e-6, "{m}");
+    assert!(
+        (m["rms_error"].as_f64().unwrap() - 250.0).abs() < 1e-6,
+        "{m}"
+    );
     assert!(m["peak_to_peak_error"].as_f64().unwrap().abs() < 1e-6);
     assert!((m["correlation"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     let res = &s["models"]["linear"]["residual"];
@@ -288,7 +309,11 @@ fn periodicity_of_the_linear_model_decays_at_the_lag_mode_damping_rate() {
     // maximum samples the envelope of a 0.29/rev oscillation (within a factor ~0.8), so the
     // rate is taken from a least-squares fit of log(measure) over 30 revolutions.
     let out = tmp("decay");
-    ok(&run_sdof(&example(), &out, &["--damper", "linear", "--revs", "40"]));
+    ok(&run_sdof(
+        &example(),
+        &out,
+        &["--damper", "linear", "--revs", "40"],
+    ));
     let s = summary(&out);
     let h: Vec<f64> = s["models"]["linear"]["periodicity"]["history"]
         .as_array()
@@ -332,12 +357,19 @@ fn a_damper_channel_too_coarse_to_compare_runs_without_metrics() {
         })
         .collect();
     with_damper(damper, &rec);
-    let o = run_sdof(&rec, &out.join("o"), &["--damper", "nonlinear", "--revs", "2"]);
+    let o = run_sdof(
+        &rec,
+        &out.join("o"),
+        &["--damper", "nonlinear", "--revs", "2"],
+    );
     ok(&o);
     let s = summary(&out.join("o"));
     assert_eq!(s["measured"]["available"], Value::Bool(false));
     let note = s["measured"]["note"].as_str().unwrap();
-    assert!(note.contains("8 azimuths") && note.contains("no comparison metrics"), "{note}");
+    assert!(
+        note.contains("8 azimuths") && note.contains("no comparison metrics"),
+        "{note}"
+    );
     let m = &s["models"]["nonlinear"];
     assert_eq!(m["status"], "ok");
     assert!(m["metrics"]["rms_error"].is_null());
@@ -371,15 +403,26 @@ fn bad_inputs_are_named() {
 
     // A damper deck without the requested model's table.
     let deck = out.join("only_linear.toml");
-    std::fs::write(&deck, "[damper]\nmodel = \"linear\"\n[damper.linear]\nc_N_s_per_m = 1.0\n")
-        .unwrap();
+    std::fs::write(
+        &deck,
+        "[damper]\nmodel = \"linear\"\n[damper.linear]\nc_N_s_per_m = 1.0\n",
+    )
+    .unwrap();
     let o = run_sdof(
         &example(),
         &out.join("o"),
-        &["--damper", "physical", "--damper-deck", deck.to_str().unwrap()],
+        &[
+            "--damper",
+            "physical",
+            "--damper-deck",
+            deck.to_str().unwrap(),
+        ],
     );
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("only_linear.toml") && e.contains("damper.physical"), "{e}");
+    assert!(
+        e.contains("only_linear.toml") && e.contains("damper.physical"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }

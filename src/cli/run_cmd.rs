@@ -179,7 +179,11 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     eprintln!(
         "rotorsim run: {} model(s) {}, {} revolutions x {} steps{}",
         models.len(),
-        models.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
+        models
+            .iter()
+            .map(|m| m.name())
+            .collect::<Vec<_>>()
+            .join(", "),
         args.revs,
         args.steps_per_rev,
         if sdof {
@@ -224,7 +228,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     } else {
         let msg = format!("model(s) failed: {}", failed.join("; "));
         out.mark_incomplete(&msg)?;
-        bail!("{msg} (the other models' outputs are written in {})", out.path().display())
+        bail!(
+            "{msg} (the other models' outputs are written in {})",
+            out.path().display()
+        )
     }
 }
 
@@ -248,9 +255,7 @@ pub fn write_outputs(
     let mut failed = Vec::new();
     for (o, f) in outcomes.iter().zip(&figs) {
         match (&o.result, f) {
-            (Err(e), _) | (Ok(_), Some(Err(e))) => {
-                failed.push(format!("{}: {e}", o.model.name()))
-            }
+            (Err(e), _) | (Ok(_), Some(Err(e))) => failed.push(format!("{}: {e}", o.model.name())),
             (Ok(r), _) => summary::write_last_rev(out, r)?,
         }
     }
@@ -264,7 +269,10 @@ pub fn write_outputs(
         .collect();
     let rank = summary::ranking(&metrics);
     let json = summary::summary_json(info, outcomes, &figs, measured, rank.as_ref());
-    out.write("summary.json", serde_json::to_string_pretty(&json)?.as_bytes())?;
+    out.write(
+        "summary.json",
+        serde_json::to_string_pretty(&json)?.as_bytes(),
+    )?;
     let html = run::report::report_html(info, outcomes, &figs, measured, rank.as_ref());
     out.write("report.html", html.as_bytes())?;
     let ok: Vec<&run::ModelRun> = outcomes

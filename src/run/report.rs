@@ -66,7 +66,11 @@ pub fn unreproduced(items: &[(&ModelRun, &ModelFigures)], measured: &Measured) -
     }
     let mut out = Vec::new();
     let ptp = {
-        let lo = measured.force_n.iter().cloned().fold(f64::INFINITY, f64::min);
+        let lo = measured
+            .force_n
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min);
         let hi = measured
             .force_n
             .iter()
@@ -150,12 +154,7 @@ pub fn unreproduced(items: &[(&ModelRun, &ModelFigures)], measured: &Measured) -
         let dir = if smin > 0.0 { "lags" } else { "leads" };
         let gains: Vec<String> = res
             .iter()
-            .map(|r| {
-                format!(
-                    "{} {:.0} -> {:.0} N",
-                    r.0, r.2, r.1.rms_at_best_shift_n
-                )
-            })
+            .map(|r| format!("{} {:.0} -> {:.0} N", r.0, r.2, r.1.rms_at_best_shift_n))
             .collect();
         out.push(format!(
             "Phase: the measurement {dir} every model, by {:.1} to {:.1} deg of azimuth (shift minimizing the RMS error; RMS error at that shift: {}).",
@@ -287,9 +286,9 @@ pub fn report_html(
             m.map_or("-".into(), |m| fmt(m.peak_to_peak_error, 0)),
             m.map_or("-".into(), |m| fmt(m.correlation, 3)),
             super::fmt_measure(r.last_measure()),
-            fmt(r.wall_s, 1),
-            fmt(t.total_s - t.hydraulics_s, 1),
-            fmt(t.hydraulics_s, 1),
+            fmt(r.wall_s, 2),
+            fmt(t.total_s - t.hydraulics_s, 2),
+            fmt(t.hydraulics_s, 2),
         ]);
     }
     rep.table(
@@ -312,12 +311,9 @@ pub fn report_html(
     if let Ok(m) = measured {
         // Harmonics table: amplitude per harmonic, measured then models.
         let mut hrows = Vec::new();
-        let hm = crate::analysis::harmonics::harmonics(
-            &m.azimuth_deg,
-            &m.force_n,
-            super::N_HARMONICS,
-        )
-        .unwrap_or_default();
+        let hm =
+            crate::analysis::harmonics::harmonics(&m.azimuth_deg, &m.force_n, super::N_HARMONICS)
+                .unwrap_or_default();
         let mut row = vec![format!("{syn}measured")];
         row.extend(hm.iter().map(|h| fmt(h.amplitude, 0)));
         hrows.push(row);
@@ -343,7 +339,12 @@ pub fn report_html(
 
     // Figures.
     rep.heading(2, "Damper force and motion (paper Figs. 16-17)");
-    let mut pf = channel_plot(&runs, "Damper force (cf. Fig. 16)", "force [N]", &[("damper_force_N", "")]);
+    let mut pf = channel_plot(
+        &runs,
+        "Damper force (cf. Fig. 16)",
+        "force [N]",
+        &[("damper_force_N", "")],
+    );
     if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
         pf = pf
             .dashed("relief-valve limit (max)", &[0.0, 360.0], &[hi, hi])
@@ -354,7 +355,12 @@ pub fn report_html(
         &mut rep,
         "Damper stroke (top) and stroke rate (bottom), last revolution (cf. Fig. 17).",
         &[
-            channel_plot(&runs, "Damper stroke", "stroke [m]", &[("damper_stroke_m", "")]),
+            channel_plot(
+                &runs,
+                "Damper stroke",
+                "stroke [m]",
+                &[("damper_stroke_m", "")],
+            ),
             channel_plot(
                 &runs,
                 "Damper stroke rate",
@@ -369,7 +375,9 @@ pub fn report_html(
         .filter(|r| r.channel("p0_Pa").is_some())
         .collect();
     if phys.is_empty() {
-        rep.paragraph("No physical damper run: no internal hydraulic channels to show (Figs. 18-21).");
+        rep.paragraph(
+            "No physical damper run: no internal hydraulic channels to show (Figs. 18-21).",
+        );
     } else {
         rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
         svg(

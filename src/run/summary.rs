@@ -75,7 +75,9 @@ impl Measured {
     /// still runs, without metrics).
     pub fn from_record(record: &FlightRecord) -> Result<Measured, String> {
         if record.damper().is_empty() {
-            return Err("the flight record has no measured damper force: no comparison metrics".into());
+            return Err(
+                "the flight record has no measured damper force: no comparison metrics".into(),
+            );
         }
         let avg = record.damper_average().map_err(|e| {
             format!("the record's damper channel cannot be averaged over revolutions ({e}): no comparison metrics")
@@ -437,7 +439,11 @@ mod tests {
             },
         )
         .unwrap();
-        assert!((r.best_shift_deg - 10.0).abs() < 0.051, "{}", r.best_shift_deg);
+        assert!(
+            (r.best_shift_deg - 10.0).abs() < 0.051,
+            "{}",
+            r.best_shift_deg
+        );
         assert!(r.rms_at_best_shift_n < 1e-3);
         assert_eq!(r.dominant[0].0, 1);
         // |2 sin 5 deg| = 0.1743: residual 1/rev amplitude.
