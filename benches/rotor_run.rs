@@ -27,7 +27,7 @@ fn time_model(
     let mut sim = match build() {
         Ok(s) => s,
         Err(e) => {
-            println!("{name:<24} not available: {e:#}");
+            println!("{name:<28} not available: {e:#}");
             return;
         }
     };
@@ -35,7 +35,7 @@ fn time_model(
     let r = match drive(sim.as_mut(), model, revs, &|_, _| {}) {
         Ok(r) => r,
         Err(e) => {
-            println!("{name:<24} failed: {e:#}");
+            println!("{name:<28} failed: {e:#}");
             return;
         }
     };
@@ -44,7 +44,7 @@ fn time_model(
     let per_step = t.total_s / steps;
     let hyd = t.hydraulics_s / t.total_s.max(1e-300);
     println!(
-        "{name:<24} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.3} ms/step ({:.2} Newton it/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
+        "{name:<28} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.4} ms/step ({:.2} Newton it/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
         t.total_s,
         1e3 * per_step,
         t.iterations as f64 / steps,

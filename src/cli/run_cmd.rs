@@ -318,6 +318,14 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                     t.total_s - t.hydraulics_s,
                     t.hydraulics_s
                 );
+                if !r.converged() {
+                    println!(
+                        "warning: {}: the periodicity measure {} at the last revolution did not fall below {:.0e}; the solution is not periodic yet (more --revs)",
+                        r.label,
+                        fmt_measure(r.last_measure()),
+                        run::PERIODICITY_TOL
+                    );
+                }
             }
             Err(e) => println!("{:<22} FAILED: {e}", o.model.name()),
         }
