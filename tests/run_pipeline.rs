@@ -479,3 +479,30 @@ fn lag_hinge_double_matches_the_analytic_forced_response() {
     let hf = harmonics(&run.azimuth_deg, f, 2).unwrap();
     assert!((hf[1].amplitude - 68000.0 * w * amp).abs() < 1e-3 * hf[1].amplitude);
 }
+
+#[test]
+fn a_failed_model_is_reported_and_the_others_are_written() {
+    // RK4 with one sub-step per structural step is beyond the explicit stability limit of the
+    // physical damper's oil column: that model fails, the dashpots do not need sub-steps.
+    let out = tmp("failed");
+    let o = run_sdof(&example(), &out, &["--revs", "2", "--substeps", "1"]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("physical") && e.contains("revolution 1"), "{e}");
+    let marker = std::fs::read_to_string(out.join("INCOMPLETE")).unwrap();
+    assert!(marker.contains("physical"), "{marker}");
+    let s = summary(&out);
+    assert_eq!(s["models"]["physical"]["status"], "failed");
+    assert!(s["models"]["physical"]["error"]
+        .as_str()
+        .unwrap()
+        .contains("t = "));
+    for m in ["linear", "nonlinear"] {
+        assert_eq!(s["models"][m]["status"], "ok");
+        assert!(out.join(m).join("last_rev.csv").exists());
+    }
+    assert!(!out.join("physical").exists());
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("physical model FAILED"));
+    let _ = std::fs::remove_dir_all(&out);
+}
