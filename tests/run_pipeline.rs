@@ -218,7 +218,10 @@ fn all_three_models_write_every_output() {
     assert!(html.contains("TEST DOUBLE"));
     assert!(html.contains("<svg"));
     assert!(html.contains("comes closest"));
-    assert!(!html.contains("http://") || !html.contains("src=\"http"));
+    // Self-contained: nothing loaded from elsewhere.
+    for ext in ["src=\"http", "href=\"http", "<link", "<script"] {
+        assert!(!html.contains(ext), "{ext}");
+    }
 
     // MCAP: one message per step of the last revolution per model, plus the measurement.
     let bytes = std::fs::read(out.join("result.mcap")).unwrap();
