@@ -65,6 +65,11 @@ pub trait ForcedResponse: Send {
     fn timing(&self) -> Timing;
 }
 
+pub mod deck;
+pub mod expand;
+pub mod fan;
+pub mod sim;
+
 use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use std::path::Path;
@@ -96,18 +101,25 @@ impl Default for RunOptions {
 pub struct RotorDeck {
     /// File the deck was read from (relative paths inside it resolve against its folder).
     pub path: std::path::PathBuf,
+    /// The parsed tables.
+    pub spec: deck::RotorSpec,
 }
 
 impl RotorDeck {
     pub fn from_file(path: &Path) -> anyhow::Result<Self> {
-        anyhow::bail!(
-            "{}: rotor decks are not available yet (issue #6)",
-            path.display()
-        )
+        let spec = deck::RotorSpec::from_file(path)?;
+        Ok(RotorDeck {
+            path: path.to_path_buf(),
+            spec,
+        })
     }
     /// The deck's `[damper]` table.
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
         Ok(DamperDeck::from_file(&self.path)?)
+    }
+    /// The generated multibody model deck (TOML text, docs/model_deck.md).
+    pub fn expand(&self, opts: &expand::ExpandOptions) -> String {
+        expand::expand(&self.spec, opts)
     }
 }
 
@@ -120,6 +132,12 @@ pub fn build(
     record: &FlightRecord,
     opts: &RunOptions,
 ) -> anyhow::Result<Box<dyn ForcedResponse>> {
-    let _ = (rotor, damper, model, record, opts);
-    anyhow::bail!("rotor model not available yet (issue #6)")
+    Ok(Box::new(sim::build_sim(
+        &rotor.spec,
+        &rotor.path,
+        damper,
+        model,
+        record,
+        opts,
+    )?))
 }

@@ -12,7 +12,7 @@ use super::statics::rotating_kin;
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
 use crate::structure::model::Model;
 use crate::structure::rotation::*;
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::DMatrix;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -159,12 +159,20 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     let nsp = if b.nrows() == 0 {
         DMatrix::identity(nn, nn)
     } else {
-        let btb = b.transpose() * &b;
-        let eig = SymmetricEigen::new(btb);
-        let mx = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
-        let cols: Vec<usize> = (0..nn)
-            .filter(|&i| eig.eigenvalues[i] <= 1e-10 * mx)
-            .collect();
+        // Right singular vectors of B padded to a square matrix: the columns with zero singular
+        // value span the null space (eigen solvers of B^T B failed to converge on the rotor
+        // model's 480-dof B^T B, which has many exactly-zero rows).
+        let mut bp = DMatrix::<f64>::zeros(nn.max(b.nrows()), nn);
+        bp.view_mut((0, 0), (b.nrows(), nn)).copy_from(&b);
+        let svd = bp.svd(false, true);
+        let vt = svd
+            .v_t
+            .ok_or_else(|| fail("SVD of the constraint gradient failed".into()))?;
+        let sv = &svd.singular_values;
+        let mx = sv.iter().cloned().fold(0.0, f64::max);
+        let evals: Vec<f64> = sv.iter().map(|v| v * v).collect();
+        let mx = mx * mx;
+        let cols: Vec<usize> = (0..nn).filter(|&i| evals[i] <= 1e-10 * mx).collect();
         if nn - cols.len() != b.nrows() {
             return Err(fail(format!(
                 "constraint gradient has rank {} for {} constraints (redundant or singular constraint set)",
@@ -172,7 +180,7 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
                 b.nrows()
             )));
         }
-        DMatrix::from_fn(nn, cols.len(), |i, j| eig.eigenvectors[(i, cols[j])])
+        DMatrix::from_fn(nn, cols.len(), |i, j| vt[(cols[j], i)])
     };
     let nr = nsp.ncols();
     let kr = nsp.transpose() * &k * &nsp;

@@ -114,6 +114,10 @@ pub struct BeamDeck {
     pub sections: Option<Vec<SectionProps>>,
     #[serde(default)]
     pub damping_mu_s: f64,
+    /// Built-in twist of a straight beam about its axis, `[[s_m, deg], ...]` (piecewise linear
+    /// in the arc length from the first node, constant beyond the ends; positive about +e1).
+    #[serde(default)]
+    pub twist_deg: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -290,6 +294,22 @@ fn table(t: &Option<Vec<[f64; 2]>>) -> TimeTable {
     }
 }
 
+/// Twist table `[[s_m, deg]]` as a piecewise-linear function of s (strictly increasing s).
+fn twist_table(t: &[[f64; 2]]) -> Result<TimeTable, String> {
+    if t.is_empty() {
+        return Err("expected at least one [s_m, deg] pair".into());
+    }
+    if t.iter().any(|p| !p[0].is_finite() || !p[1].is_finite()) {
+        return Err("values must be finite".into());
+    }
+    if t.windows(2).any(|w| w[1][0] <= w[0][0]) {
+        return Err("s_m must be strictly increasing".into());
+    }
+    Ok(TimeTable {
+        points: t.iter().map(|p| (p[0], p[1])).collect(),
+    })
+}
+
 /// Parse a deck and build the model.
 pub fn load_deck(path: &Path) -> Result<(Deck, Model), DeckError> {
     let file = path.display().to_string();
@@ -347,7 +367,33 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
         if b.elements == 0 {
             return Err(inv(format!("{key}.elements"), "must be at least 1".into()));
         }
+        if b.twist_deg.is_some() && b.arc.is_some() {
+            return Err(inv(
+                format!("{key}.twist_deg"),
+                "only straight beams (`start_m`, `end_m`) take a twist table".into(),
+            ));
+        }
         let res = match (&b.arc, b.start_m, b.end_m) {
+            (None, Some(a), Some(e)) if b.twist_deg.is_some() => {
+                let tw = twist_table(b.twist_deg.as_deref().unwrap_or_default())
+                    .map_err(|msg| inv(format!("{key}.twist_deg"), msg))?;
+                let d = sub(e, a);
+                let len = dot(d, d).sqrt();
+                let r = frame_from_axis(d, b.e2_direction);
+                let curve = move |s: f64| {
+                    let r_tw = mm(&r, &exp_map([tw.eval(s).to_radians(), 0.0, 0.0]));
+                    (add(a, fmul(s / len, d)), r_tw)
+                };
+                m.add_beam(
+                    &b.name,
+                    b.elements,
+                    len,
+                    &curve,
+                    &sec,
+                    b.damping_mu_s,
+                    first,
+                )
+            }
             (None, Some(a), Some(e)) => m.add_straight_beam(
                 &b.name,
                 b.elements,

@@ -1,0 +1,224 @@
+//! Rotor deck schema (docs/rotor_deck.md). Unknown keys are errors naming the file, line and
+//! key; the `[damper]` table is read separately by [`crate::hydraulics::DamperDeck`].
+use crate::structure::section::SectionProps;
+use serde::Deserialize;
+use std::path::Path;
+
+/// The whole rotor deck file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorSpec {
+    pub rotor: RotorTable,
+    pub blade: BladeTable,
+    pub retention: RetentionTable,
+    pub bearing: BearingTable,
+    pub pitch_control: PitchControlTable,
+    pub damper_attachment: DamperAttachment,
+    /// Read by `DamperDeck` (kept opaque here).
+    #[serde(default)]
+    pub damper: Option<toml::Value>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorTable {
+    pub omega_rad_s: f64,
+    pub radius_m: f64,
+    pub blades: usize,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BladeTable {
+    /// Section table (relative paths: against the deck's folder), `s_m = r - root_r_m`.
+    pub sections_csv: String,
+    pub elements: usize,
+    pub root_r_m: f64,
+    #[serde(default)]
+    pub damping_mu_s: f64,
+    /// Built-in twist `[[r_m, deg], ...]`.
+    #[serde(default)]
+    pub twist_deg: Vec<[f64; 2]>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Segment {
+    pub elements: usize,
+    pub section: SectionProps,
+    #[serde(default)]
+    pub damping_mu_s: f64,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RetentionTable {
+    pub hinge_r_m: f64,
+    pub horn_r_m: f64,
+    pub segment1: Segment,
+    pub segment2: Segment,
+    pub segment3: Segment,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingTable {
+    #[serde(rename = "lag_stiffness_Nm_per_rad")]
+    pub lag_k: f64,
+    #[serde(rename = "flap_stiffness_Nm_per_rad")]
+    pub flap_k: f64,
+    #[serde(rename = "pitch_stiffness_Nm_per_rad")]
+    pub pitch_k: f64,
+    #[serde(rename = "lag_damping_Nms_per_rad", default)]
+    pub lag_c: f64,
+    #[serde(rename = "flap_damping_Nms_per_rad", default)]
+    pub flap_c: f64,
+    #[serde(rename = "pitch_damping_Nms_per_rad", default)]
+    pub pitch_c: f64,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PitchControlTable {
+    /// Pitch-link attachment on the horn (spherical joint), hub frame [m].
+    pub horn_tip_m: [f64; 3],
+    pub horn_mass_kg: f64,
+    pub link_length_m: f64,
+    pub link_elements: usize,
+    pub link_section: SectionProps,
+    /// Cyclic and airload harmonics ramp in over this many revolutions (forced response).
+    #[serde(default = "two")]
+    pub cyclic_ramp_revs: f64,
+}
+
+fn two() -> f64 {
+    2.0
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamperAttachment {
+    /// Distance of the damper line from the lag hinge axis [m] (stroke = arm x lag angle).
+    pub arm_m: f64,
+    /// Pin-to-pin length at zero lag [m] (zero stroke).
+    pub reference_length_m: f64,
+    /// Height of the damper line above the hinge plane [m].
+    #[serde(default)]
+    pub height_m: f64,
+    pub arm_mass_kg: f64,
+    pub horn_mass_kg: f64,
+}
+
+impl RotorSpec {
+    /// Parse deck text; `file` names it in errors (toml reports line and column).
+    pub fn from_str(text: &str, file: &str) -> anyhow::Result<Self> {
+        let spec: RotorSpec = toml::from_str(text)
+            .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.to_string().trim_end()))?;
+        spec.validate(file)?;
+        Ok(spec)
+    }
+
+    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+        Self::from_str(&text, &file)
+    }
+
+    fn validate(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: &str| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
+        let pos = |key: &str, v: f64| -> anyhow::Result<()> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(bad(key, &format!("expected a positive number, found {v}")))
+            }
+        };
+        let nonneg = |key: &str, v: f64| -> anyhow::Result<()> {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(bad(
+                    key,
+                    &format!("expected a non-negative number, found {v}"),
+                ))
+            }
+        };
+        pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
+        pos("rotor.radius_m", self.rotor.radius_m)?;
+        let r = &self.retention;
+        pos("retention.hinge_r_m", r.hinge_r_m)?;
+        if !(r.horn_r_m > r.hinge_r_m && r.horn_r_m < self.blade.root_r_m) {
+            return Err(bad(
+                "retention.horn_r_m",
+                "expected hinge_r_m < horn_r_m < blade.root_r_m",
+            ));
+        }
+        if self.blade.root_r_m >= self.rotor.radius_m {
+            return Err(bad("blade.root_r_m", "expected less than rotor.radius_m"));
+        }
+        for (k, n) in [
+            ("blade.elements", self.blade.elements),
+            ("retention.segment1.elements", r.segment1.elements),
+            ("retention.segment2.elements", r.segment2.elements),
+            ("retention.segment3.elements", r.segment3.elements),
+            (
+                "pitch_control.link_elements",
+                self.pitch_control.link_elements,
+            ),
+        ] {
+            if n == 0 {
+                return Err(bad(k, "expected at least one element"));
+            }
+        }
+        let b = &self.bearing;
+        for (k, v) in [
+            ("bearing.lag_stiffness_Nm_per_rad", b.lag_k),
+            ("bearing.flap_stiffness_Nm_per_rad", b.flap_k),
+            ("bearing.pitch_stiffness_Nm_per_rad", b.pitch_k),
+            ("bearing.lag_damping_Nms_per_rad", b.lag_c),
+            ("bearing.flap_damping_Nms_per_rad", b.flap_c),
+            ("bearing.pitch_damping_Nms_per_rad", b.pitch_c),
+            (
+                "pitch_control.horn_mass_kg",
+                self.pitch_control.horn_mass_kg,
+            ),
+            (
+                "pitch_control.cyclic_ramp_revs",
+                self.pitch_control.cyclic_ramp_revs,
+            ),
+            (
+                "damper_attachment.arm_mass_kg",
+                self.damper_attachment.arm_mass_kg,
+            ),
+            (
+                "damper_attachment.horn_mass_kg",
+                self.damper_attachment.horn_mass_kg,
+            ),
+            ("blade.damping_mu_s", self.blade.damping_mu_s),
+        ] {
+            nonneg(k, v)?;
+        }
+        pos(
+            "pitch_control.link_length_m",
+            self.pitch_control.link_length_m,
+        )?;
+        pos("damper_attachment.arm_m", self.damper_attachment.arm_m)?;
+        pos(
+            "damper_attachment.reference_length_m",
+            self.damper_attachment.reference_length_m,
+        )?;
+        let h = self.pitch_control.horn_tip_m;
+        if (h[1].powi(2) + h[2].powi(2)).sqrt() < 1e-3 {
+            return Err(bad(
+                "pitch_control.horn_tip_m",
+                "the horn tip must lie off the pitch axis (y or z offset)",
+            ));
+        }
+        let tw = &self.blade.twist_deg;
+        if tw.windows(2).any(|w| w[1][0] <= w[0][0]) {
+            return Err(bad("blade.twist_deg", "r_m must be strictly increasing"));
+        }
+        Ok(())
+    }
+}

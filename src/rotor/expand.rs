@@ -1,0 +1,430 @@
+//! Rotor deck -> multibody model deck (docs/model_deck.md), printed by `rotorsim expand` and
+//! parsed back by [`crate::rotor::build`] and `rotorsim modes --rotor`, so that the printed deck
+//! is exactly the model that runs.
+//!
+//! Layout (hub frame, blade along +x, rotation about +z, y toward the leading edge), paper
+//! Fig. 15: hub node driven at Omega (prescribed revolute `shaft`); segment 1 (`seg1`) from the
+//! axis to the hinge; elastomeric bearing = revolute joints `lag` (axis -z: positive aft),
+//! `flap` (axis -y: positive up), `pitch` (axis +x: positive nose up) through the massless
+//! nodes `bearing_lag`, `bearing_flap`; segments 2 and 3 (`seg2`, `seg3`, sharing the horn
+//! node); blade (`blade`) clamped to segment 3; pitch horn (rigid body on the horn node) with a
+//! spherical joint to the pitch link (`pitch_link`), universal joint at the swashplate node
+//! whose prescribed vertical motion in the hub frame gives the pitch; damper between
+//! `damper_hub_end` (rigid to the hub) and `damper_blade_end` (rigid to `bearing_lag`, so the
+//! stroke is `arm x lag angle`).
+use super::deck::{RotorSpec, Segment};
+use crate::structure::section::SectionProps;
+use std::fmt::Write as _;
+
+/// Blade-pitch controls [deg]: `theta = th0 + th1c cos psi + th1s sin psi` (bearing pitch; the
+/// blade twist is zero where the record quotes the collective).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Controls {
+    pub th0_deg: f64,
+    pub th1c_deg: f64,
+    pub th1s_deg: f64,
+}
+
+impl Controls {
+    /// From a flight record's `controls_deg`: collective, lateral cyclic = th1c (cos psi),
+    /// longitudinal cyclic = th1s (sin psi) (docs/rotor_model.md, conventions).
+    pub fn from_record(c: &crate::flight::record::ControlsDeg) -> Self {
+        Controls {
+            th0_deg: c.collective,
+            th1c_deg: c.lateral_cyclic,
+            th1s_deg: c.longitudinal_cyclic,
+        }
+    }
+}
+
+/// Node and element names of the expanded model.
+pub mod names {
+    pub const HUB: &str = "hub";
+    pub const SHAFT: &str = "shaft";
+    pub const LAG: &str = "lag";
+    pub const FLAP: &str = "flap";
+    pub const PITCH: &str = "pitch";
+    pub const SWASH_DRIVE: &str = "swashplate_drive";
+    pub const DAMPER_HUB_END: &str = "damper_hub_end";
+    pub const DAMPER_BLADE_END: &str = "damper_blade_end";
+    pub const BLADE: &str = "blade";
+}
+
+/// Smooth ramp 0 -> 1 over `t_ramp` (0.5 (1 - cos(pi t / t_ramp))): zero rate at both ends so
+/// that the initial velocities stay consistent with the constraints.
+pub fn ramp(t: f64, t_ramp: f64) -> f64 {
+    if t_ramp <= 0.0 || t >= t_ramp {
+        1.0
+    } else if t <= 0.0 {
+        0.0
+    } else {
+        0.5 * (1.0 - (std::f64::consts::PI * t / t_ramp).cos())
+    }
+}
+
+/// Geometry helpers derived from the deck.
+impl RotorSpec {
+    /// Bearing pitch [rad] at time t (cyclic ramped in over `cyclic_ramp_revs`).
+    pub fn pitch_rad(&self, c: &Controls, t: f64) -> f64 {
+        let om = self.rotor.omega_rad_s;
+        let tr = self.pitch_control.cyclic_ramp_revs * 2.0 * std::f64::consts::PI / om;
+        let psi = om * t;
+        (c.th0_deg + ramp(t, tr) * (c.th1c_deg * psi.cos() + c.th1s_deg * psi.sin())).to_radians()
+    }
+
+    /// Vertical swashplate displacement [m] (hub frame) that holds the horn tip at the position
+    /// it has when the bearing is pitched by `theta` about the pitch axis (x through the hinge).
+    pub fn swash_z(&self, theta: f64) -> f64 {
+        let h = self.pitch_control.horn_tip_m;
+        h[1] * theta.sin() + h[2] * theta.cos() - h[2]
+    }
+
+    fn hub_end(&self) -> [f64; 3] {
+        let d = &self.damper_attachment;
+        [
+            self.retention.hinge_r_m - d.reference_length_m,
+            d.arm_m,
+            d.height_m,
+        ]
+    }
+    fn blade_end(&self) -> [f64; 3] {
+        let d = &self.damper_attachment;
+        [self.retention.hinge_r_m, d.arm_m, d.height_m]
+    }
+    fn swash_point(&self) -> [f64; 3] {
+        let h = self.pitch_control.horn_tip_m;
+        [h[0], h[1], h[2] - self.pitch_control.link_length_m]
+    }
+}
+
+fn f(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn v3(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2]))
+}
+
+fn section(p: &SectionProps) -> String {
+    let mut s = format!(
+        "{{ EA_N = {}, GA2_N = {}, GA3_N = {}, GJ_Nm2 = {}, EI2_Nm2 = {}, EI3_Nm2 = {}, m_kg_per_m = {}, I1_kgm = {}, I2_kgm = {}, I3_kgm = {}",
+        f(p.ea), f(p.ga2), f(p.ga3), f(p.gj), f(p.ei2), f(p.ei3), f(p.m), f(p.i1), f(p.i2), f(p.i3)
+    );
+    for (k, v) in [
+        ("cm2_m", p.cm2),
+        ("cm3_m", p.cm3),
+        ("sc2_m", p.sc2),
+        ("sc3_m", p.sc3),
+        ("ca2_m", p.ca2),
+        ("ca3_m", p.ca3),
+    ] {
+        if v != 0.0 {
+            let _ = write!(s, ", {k} = {}", f(v));
+        }
+    }
+    s.push_str(" }");
+    s
+}
+
+fn point_inertia(m: f64, r: f64) -> String {
+    // small sphere of radius r: 2/5 m r^2
+    let i = 0.4 * m * r * r;
+    format!(
+        "[[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]",
+        f(i),
+        f(i),
+        f(i)
+    )
+}
+
+/// Options of the expansion.
+#[derive(Clone, Debug, Default)]
+pub struct ExpandOptions {
+    pub controls: Controls,
+    /// Revolutions covered by the swashplate displacement table of the printed deck (the
+    /// forced response replaces it with the exact law at every step).
+    pub table_revs: usize,
+    /// Extra lag-hinge spring and damper (linearised damper for modal analyses).
+    pub lag_extra_k: f64,
+    pub lag_extra_c: f64,
+    /// `[modes] speeds_rad_s`.
+    pub speeds_rad_s: Vec<f64>,
+    /// Note printed in place of the `[[hydraulic]]` damper table.
+    pub damper_note: Option<String>,
+}
+
+/// Last node index of a beam of `n` cubic elements.
+pub fn last(n: usize) -> usize {
+    3 * n
+}
+
+/// The model deck text. Relative paths (section CSV) resolve against the rotor deck's folder.
+pub fn expand(spec: &RotorSpec, opts: &ExpandOptions) -> String {
+    let mut s = String::new();
+    let r = &spec.retention;
+    let e = r.hinge_r_m;
+    let om = spec.rotor.omega_rad_s;
+    let period = 2.0 * std::f64::consts::PI / om;
+    let pc = &spec.pitch_control;
+    let b = &spec.blade;
+    let n1 = last(r.segment1.elements);
+    let n2 = last(r.segment2.elements);
+    let n3 = last(r.segment3.elements);
+    let nb = last(b.elements);
+    let npl = last(pc.link_elements);
+    let c = &opts.controls;
+    let _ = writeln!(
+        s,
+        "# Multibody model deck generated by `rotorsim expand` from a rotor deck (docs/rotor_deck.md).\n\
+         # Paths are relative to the rotor deck's folder: save this deck next to it.\n\
+         # Controls: th0 = {} deg, th1c = {} deg, th1s = {} deg (cyclic ramped in over {} revolutions).\n\
+         title = \"rotor: single blade, root retention, elastomeric bearing, pitch link, damper\"\n",
+        c.th0_deg, c.th1c_deg, c.th1s_deg, pc.cyclic_ramp_revs
+    );
+    let node = |s: &mut String, name: &str, p: [f64; 3]| {
+        let _ = writeln!(s, "[[node]]\nname = \"{name}\"\nposition_m = {}\n", v3(p));
+    };
+    node(&mut s, names::HUB, [0.0; 3]);
+    node(&mut s, "bearing_lag", [e, 0.0, 0.0]);
+    node(&mut s, "bearing_flap", [e, 0.0, 0.0]);
+    node(&mut s, "swashplate", spec.swash_point());
+    node(&mut s, names::DAMPER_HUB_END, spec.hub_end());
+    node(&mut s, names::DAMPER_BLADE_END, spec.blade_end());
+    let seg =
+        |s: &mut String, name: &str, g: &Segment, a: [f64; 3], z: [f64; 3], start: Option<&str>| {
+            let _ = writeln!(s, "[[beam]]\nname = \"{name}\"\nelements = {}", g.elements);
+            if let Some(n) = start {
+                let _ = writeln!(s, "start_node = \"{n}\"");
+            }
+            let _ = writeln!(
+                s,
+                "start_m = {}\nend_m = {}\nsection = {}\ndamping_mu_s = {}\n",
+                v3(a),
+                v3(z),
+                section(&g.section),
+                f(g.damping_mu_s)
+            );
+        };
+    seg(
+        &mut s,
+        "seg1",
+        &r.segment1,
+        [0.0; 3],
+        [e, 0.0, 0.0],
+        Some(names::HUB),
+    );
+    seg(
+        &mut s,
+        "seg2",
+        &r.segment2,
+        [e, 0.0, 0.0],
+        [r.horn_r_m, 0.0, 0.0],
+        None,
+    );
+    let seg2_end = format!("seg2.n{n2}");
+    seg(
+        &mut s,
+        "seg3",
+        &r.segment3,
+        [r.horn_r_m, 0.0, 0.0],
+        [b.root_r_m, 0.0, 0.0],
+        Some(&seg2_end),
+    );
+    let _ = writeln!(
+        s,
+        "[[beam]]\nname = \"{}\"\nelements = {}\nstart_m = {}\nend_m = {}\nsections_csv = \"{}\"\ndamping_mu_s = {}",
+        names::BLADE,
+        b.elements,
+        v3([b.root_r_m, 0.0, 0.0]),
+        v3([spec.rotor.radius_m, 0.0, 0.0]),
+        b.sections_csv,
+        f(b.damping_mu_s)
+    );
+    if !b.twist_deg.is_empty() {
+        let pts: Vec<String> = b
+            .twist_deg
+            .iter()
+            .map(|p| format!("[{}, {}]", f(p[0] - b.root_r_m), f(p[1])))
+            .collect();
+        let _ = writeln!(s, "twist_deg = [{}]", pts.join(", "));
+    }
+    s.push('\n');
+    let sp = spec.swash_point();
+    let _ = writeln!(
+        s,
+        "[[beam]]\nname = \"pitch_link\"\nelements = {}\nstart_m = {}\nend_m = {}\ne2_direction = [0.0, 1.0, 0.0]\nsection = {}\n",
+        pc.link_elements,
+        v3(sp),
+        v3(pc.horn_tip_m),
+        section(&pc.link_section)
+    );
+    // rigid bodies
+    let horn_node = [r.horn_r_m, 0.0, 0.0];
+    let h = pc.horn_tip_m;
+    let _ = writeln!(
+        s,
+        "[[rigid_body]]\nname = \"pitch_horn\"\nnode = \"{seg2_end}\"\nmass_kg = {}\ncm_offset_m = {}\ninertia_kgm2 = {}\n",
+        f(pc.horn_mass_kg),
+        v3([0.5 * (h[0] - horn_node[0]), 0.5 * h[1], 0.5 * h[2]]),
+        point_inertia(pc.horn_mass_kg, 0.05)
+    );
+    let da = &spec.damper_attachment;
+    let _ = writeln!(
+        s,
+        "[[rigid_body]]\nname = \"damper_arm\"\nnode = \"{}\"\nmass_kg = {}\ninertia_kgm2 = {}\n",
+        names::DAMPER_BLADE_END,
+        f(da.arm_mass_kg),
+        point_inertia(da.arm_mass_kg, 0.05)
+    );
+    let _ = writeln!(
+        s,
+        "[[rigid_body]]\nname = \"damper_horn\"\nnode = \"{}\"\nmass_kg = {}\ninertia_kgm2 = {}\n",
+        names::DAMPER_HUB_END,
+        f(da.horn_mass_kg),
+        point_inertia(da.horn_mass_kg, 0.05)
+    );
+    // joints
+    let _ = writeln!(
+        s,
+        "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_b = \"{}\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
+        names::SHAFT,
+        names::HUB,
+        f(om)
+    );
+    let bg = &spec.bearing;
+    let rev = |s: &mut String,
+               name: &str,
+               a: &str,
+               bn: &str,
+               axis: [f64; 3],
+               xd: [f64; 3],
+               k: f64,
+               c: f64| {
+        let _ = writeln!(
+            s,
+            "[[joint]]\nname = \"{name}\"\ntype = \"revolute\"\nnode_a = \"{a}\"\nnode_b = \"{bn}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}\n",
+            v3(axis),
+            v3(xd),
+            f(k),
+            f(c)
+        );
+    };
+    rev(
+        &mut s,
+        names::LAG,
+        &format!("seg1.n{n1}"),
+        "bearing_lag",
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        bg.lag_k + opts.lag_extra_k,
+        bg.lag_c + opts.lag_extra_c,
+    );
+    rev(
+        &mut s,
+        names::FLAP,
+        "bearing_lag",
+        "bearing_flap",
+        [0.0, -1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        bg.flap_k,
+        bg.flap_c,
+    );
+    rev(
+        &mut s,
+        names::PITCH,
+        "bearing_flap",
+        "seg2.n0",
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        bg.pitch_k,
+        bg.pitch_c,
+    );
+    let clamp = |s: &mut String, name: &str, a: &str, bn: &str| {
+        let _ = writeln!(
+            s,
+            "[[joint]]\nname = \"{name}\"\ntype = \"clamp\"\nnode_a = \"{a}\"\nnode_b = \"{bn}\"\n"
+        );
+    };
+    clamp(
+        &mut s,
+        "blade_root",
+        &format!("seg3.n{n3}"),
+        &format!("{}.n0", names::BLADE),
+    );
+    clamp(
+        &mut s,
+        "damper_hub_mount",
+        names::HUB,
+        names::DAMPER_HUB_END,
+    );
+    clamp(
+        &mut s,
+        "damper_arm_mount",
+        "bearing_lag",
+        names::DAMPER_BLADE_END,
+    );
+    // swashplate: vertical displacement in the hub frame, table over `table_revs`
+    let npts = 64 * opts.table_revs.max(1);
+    let mut table = vec![];
+    if c.th1c_deg == 0.0 && c.th1s_deg == 0.0 {
+        table.push(format!(
+            "[0.0, {}]",
+            f(spec.swash_z(c.th0_deg.to_radians()))
+        ));
+    } else {
+        for k in 0..=npts {
+            let t = period * opts.table_revs.max(1) as f64 * k as f64 / npts as f64;
+            table.push(format!(
+                "[{}, {}]",
+                f(t),
+                f(spec.swash_z(spec.pitch_rad(c, t)))
+            ));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "# Swashplate: z(t) = horn_y sin(theta) + horn_z (cos(theta) - 1), theta = th0 + ramp (th1c cos psi + th1s sin psi)\n\
+         [[joint]]\nname = \"{}\"\ntype = \"prescribed\"\nnode_a = \"{}\"\nnode_b = \"swashplate\"\ndisplacement_m = [0.0, 0.0, 1.0]\ndisplacement_table = [{}]\n",
+        names::SWASH_DRIVE,
+        names::HUB,
+        table.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "[[joint]]\nname = \"pitch_link_lower\"\ntype = \"universal\"\nnode_a = \"swashplate\"\nnode_b = \"pitch_link.n0\"\naxis = [0.0, 0.0, 1.0]\n"
+    );
+    let _ = writeln!(
+        s,
+        "[[joint]]\nname = \"pitch_link_upper\"\ntype = \"spherical\"\nnode_a = \"{seg2_end}\"\nnode_b = \"pitch_link.n{npl}\"\nposition_m = {}\n",
+        v3(pc.horn_tip_m)
+    );
+    match &opts.damper_note {
+        Some(n) => {
+            for l in n.lines() {
+                let _ = writeln!(s, "# {l}");
+            }
+            s.push('\n');
+        }
+        None => {}
+    }
+    let _ = writeln!(
+        s,
+        "[[sensor]]\nname = \"tip\"\nnode = \"{}.n{nb}\"\n\n[[sensor]]\nname = \"lag\"\njoint = \"lag\"\n\n[[sensor]]\nname = \"flap\"\njoint = \"flap\"\n\n[[sensor]]\nname = \"pitch\"\njoint = \"pitch\"\n",
+        names::BLADE
+    );
+    let _ = writeln!(
+        s,
+        "[static]\nload_steps = 4\nomega_rad_s = [0.0, 0.0, {}]\n\n[dynamic]\ntime_step_s = {}\nend_time_s = {}\ninitial_omega_rad_s = [0.0, 0.0, {}]\nstart_from_static = true\n",
+        f(om),
+        f(period / 256.0),
+        f(period),
+        f(om)
+    );
+    let sp: Vec<String> = opts.speeds_rad_s.iter().map(|v| f(*v)).collect();
+    let _ = writeln!(
+        s,
+        "[modes]\ncount = 14\naxis = [0.0, 0.0, 1.0]\nspeeds_rad_s = [{}]",
+        sp.join(", ")
+    );
+    s
+}

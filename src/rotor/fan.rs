@@ -1,0 +1,1 @@
+//! Rotating natural frequencies of a rotor deck (fan plot).
