@@ -509,3 +509,55 @@ fn a_failed_model_is_reported_and_the_others_are_written() {
     assert!(html.contains("physical model FAILED"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn short_run_of_the_uh60a_rotor_with_the_three_dampers() {
+    // The real rotor model (src/rotor), 2 revolutions at 128 steps (50 RK4 sub-steps keep the
+    // physical damper's sub-step at the 256 x 25 value): the pipeline end to end on it.
+    let out = tmp("uh60a");
+    let rotor = repo().join("rotors/uh60a.toml");
+    let o = rotorsim(&[
+        "run",
+        "--rotor",
+        rotor.to_str().unwrap(),
+        "--flight",
+        example().to_str().unwrap(),
+        "--revs",
+        "2",
+        "--steps-per-rev",
+        "128",
+        "--substeps",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let s = summary(&out);
+    assert_eq!(s["rotor_model"], "UH-60A multibody rotor");
+    for m in ["linear", "nonlinear", "physical"] {
+        let j = &s["models"][m];
+        assert_eq!(j["status"], "ok", "{m}: {j}");
+        assert_eq!(j["steps"], 256);
+        assert_eq!(j["periodicity"]["history"].as_array().unwrap().len(), 1);
+        assert!(j["metrics"]["rms_error"].as_f64().unwrap().is_finite());
+        // The damper works against the lag motion: force and stroke rate are anti-correlated.
+        let (h, cols) = read_csv(&out.join(m).join("last_rev.csv"));
+        assert_eq!(cols[0].len(), 128);
+        let (f, v) = (&cols[1], &cols[3]);
+        let fv: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
+        assert!(fv < 0.0, "{m}: damper force does positive work");
+        // The blade moves: tip flap and lag are not zero.
+        for ch in ["tip_flap_m", "tip_lag_m"] {
+            let i = h.iter().position(|x| x == ch).unwrap();
+            assert!(cols[i].iter().any(|x| x.abs() > 1e-4), "{m} {ch}");
+        }
+    }
+    let (h, _) = read_csv(&out.join("physical/last_rev.csv"));
+    for want in ["p0_Pa", "p1_Pa", "q_orifice_m3_s", "x_valve0_m", "q_valve1_m3_s"] {
+        assert!(h.iter().any(|x| x == want), "{want} missing from {h:?}");
+    }
+    assert!(!std::fs::read_to_string(out.join("report.html"))
+        .unwrap()
+        .contains("TEST DOUBLE"));
+    let _ = std::fs::remove_dir_all(&out);
+}

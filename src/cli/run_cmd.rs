@@ -320,10 +320,9 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                 );
                 if !r.converged() {
                     println!(
-                        "warning: {}: the periodicity measure {} at the last revolution did not fall below {:.0e}; the solution is not periodic yet (more --revs)",
+                        "warning: {}: {}",
                         r.label,
-                        fmt_measure(r.last_measure()),
-                        run::PERIODICITY_TOL
+                        summary::periodicity_statement(r)
                     );
                 }
             }

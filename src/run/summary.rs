@@ -374,11 +374,22 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
             "periodic: the measure fell to {m:.2e} (< {PERIODICITY_TOL:.0e}) at revolution {}",
             r.revolutions
         ),
-        Some(m) => format!(
-            "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance; run more revolutions",
-            super::fmt_measure(Some(m)),
-            r.revolutions
-        ),
+        Some(m) => {
+            // Name the channel that holds the measure up, and how far the damper force got.
+            let last = r.periodicity.history.last().cloned().unwrap_or_default();
+            let worst = last
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(i, v)| format!("{} {:.2e}", r.periodicity.channels[i], v))
+                .unwrap_or_default();
+            format!(
+                "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance (largest: {worst}; damper force {}); run more revolutions",
+                super::fmt_measure(Some(m)),
+                r.revolutions,
+                super::fmt_measure(last.first().copied())
+            )
+        }
         None => "periodicity not measured".into(),
     }
 }
