@@ -553,7 +553,13 @@ fn short_run_of_the_uh60a_rotor_with_the_three_dampers() {
         }
     }
     let (h, _) = read_csv(&out.join("physical/last_rev.csv"));
-    for want in ["p0_Pa", "p1_Pa", "q_orifice_m3_s", "x_valve0_m", "q_valve1_m3_s"] {
+    for want in [
+        "p0_Pa",
+        "p1_Pa",
+        "q_orifice_m3_s",
+        "x_valve0_m",
+        "q_valve1_m3_s",
+    ] {
         assert!(h.iter().any(|x| x == want), "{want} missing from {h:?}");
     }
     assert!(!std::fs::read_to_string(out.join("report.html"))

@@ -376,15 +376,28 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
         ),
         Some(m) => {
             // Name the channel that holds the measure up, and how far the damper force got.
-            let last = r.periodicity.history.last().cloned().unwrap_or_default();
-            let worst = last
+            let hist = &r.periodicity.history;
+            let last = hist.last().cloned().unwrap_or_default();
+            let iw = last
                 .iter()
                 .enumerate()
                 .max_by(|a, b| a.1.total_cmp(b.1))
-                .map(|(i, v)| format!("{} {:.2e}", r.periodicity.channels[i], v))
-                .unwrap_or_default();
+                .map_or(0, |(i, _)| i);
+            let worst = format!(
+                "{} {}",
+                r.periodicity.channels.get(iw).map_or("", |s| s.as_str()),
+                super::fmt_measure(last.get(iw).copied())
+            );
+            // Is that channel still decaying? Compare with 10 revolutions earlier.
+            let advice = match hist.len().checked_sub(11).map(|k| hist[k][iw]) {
+                Some(before) if last[iw] > 0.5 * before => format!(
+                    "it is not decaying ({} ten revolutions earlier): more revolutions alone will not make this solution periodic",
+                    super::fmt_measure(Some(before))
+                ),
+                _ => "run more revolutions".into(),
+            };
             format!(
-                "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance (largest: {worst}; damper force {}); run more revolutions",
+                "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance (largest: {worst}; damper force {}); {advice}",
                 super::fmt_measure(Some(m)),
                 r.revolutions,
                 super::fmt_measure(last.first().copied())
