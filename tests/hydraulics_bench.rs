@@ -109,7 +109,8 @@ fn physical_text() -> String {
 fn deck_errors_name_file_and_key() {
     let good = physical_text();
     // Other top-level tables are ignored.
-    let with_rotor = format!("[rotor]\nblades = 4\nwhatever = \"x\"\n\n{good}");
+    // (the shipped deck already has [rotor], [blade], ...: add one more unknown table)
+    let with_rotor = format!("[other_tool]\nblades = 4\nwhatever = \"x\"\n\n{good}");
     DamperDeck::from_toml_str(&with_rotor, "rotor.toml").unwrap();
     let e = deck_err(&good.replace("A0_m2 = 1.6e-3\n", ""));
     assert!(

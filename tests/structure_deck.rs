@@ -96,7 +96,7 @@ fn compound_pendulum_on_revolute_and_spherical_joints() {
 
 #[test]
 fn actuator_pitches_a_beam_deck_follows_the_rigid_body_estimate() {
-    let (deck, m) = load_deck(&example("actuator_pitch_beam.toml")).unwrap();
+    let (deck, m) = load_deck(&example("actuator_pitch_beam_structure_only.toml")).unwrap();
     let st = State::from_model(&m);
     let mut s = DynamicSolver::new(
         m,

@@ -1,5 +1,7 @@
 //! `rotorsim modes` (issue #3): natural frequencies and mode shapes of a model deck, about the
 //! static equilibrium, optionally in a frame rotating at each of `[modes] speeds_rad_s` (fan).
+//! `rotorsim modes --rotor DECK --speeds 0:1.2:0.1` (issue #6): fan plot of a rotor deck with
+//! the digitized UH-60A reference over it (src/rotor/fan.rs).
 use crate::io::{csv_string, OutDir};
 use crate::solver::modal::{modes, ModalOptions, Mode};
 use crate::solver::statics::check_constraints;
@@ -10,8 +12,23 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ModesArgs {
-    /// Model deck (TOML, see docs/model_deck.md).
-    pub deck: PathBuf,
+    /// Model deck (TOML, see docs/model_deck.md); or give --rotor.
+    #[arg(required_unless_present = "rotor", conflicts_with = "rotor")]
+    pub deck: Option<PathBuf>,
+    /// Rotor deck (docs/rotor_deck.md): fan plot over the speeds of --speeds.
+    #[arg(long)]
+    pub rotor: Option<PathBuf>,
+    /// Rotor speeds as fractions of the nominal Omega, START:STOP:STEP (inclusive) or a
+    /// comma-separated list.
+    #[arg(long, default_value = "0:1.2:0.1")]
+    pub speeds: String,
+    /// Digitized reference fan plot drawn over the model's (default: the UH-60A fan plot of
+    /// ../shared/data/uh60a/raw/ next to the source tree, when present).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Modes per speed (rotor decks).
+    #[arg(long, default_value_t = 14)]
+    pub count: usize,
     /// Output directory (modes.csv, mode_shapes.csv, fan.csv).
     #[arg(long)]
     pub out: PathBuf,
@@ -36,8 +53,15 @@ fn mode_rows(ms: &[Mode]) -> Vec<Vec<f64>> {
 }
 
 pub fn run(args: ModesArgs) -> anyhow::Result<()> {
-    let (deck, mut model) = load_deck(&args.deck)?;
-    let file = args.deck.display().to_string();
+    if let Some(r) = &args.rotor {
+        return run_rotor(r, &args);
+    }
+    let path = args
+        .deck
+        .clone()
+        .ok_or_else(|| anyhow::anyhow!("give a model deck or --rotor"))?;
+    let (deck, mut model) = load_deck(&path)?;
+    let file = path.display().to_string();
     let st0 = State::from_model(&model);
     check_constraints(&mut model, &st0).map_err(|e| anyhow::anyhow!("deck {file}: {e}"))?;
     let out = OutDir::create(&args.out)?;
@@ -146,5 +170,202 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
         out.write("fan.svg", plot.to_svg(900, 600)?.as_bytes())?;
     }
     out.finish()?;
+    Ok(())
+}
+
+/// Parse `START:STOP:STEP` (inclusive, rounded to the step) or `a,b,c`.
+pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
+    let bad = |m: &str| {
+        anyhow::anyhow!(
+            "--speeds `{s}`: {m} (expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0)"
+        )
+    };
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| bad(&format!("`{t}` is not a number")))
+    };
+    let v: Vec<f64> = if s.contains(':') {
+        let p: Vec<&str> = s.split(':').collect();
+        if p.len() != 3 {
+            return Err(bad("three fields needed"));
+        }
+        let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
+        if h.is_nan() || h <= 0.0 || b < a {
+            return Err(bad("STEP must be positive and STOP >= START"));
+        }
+        let n = ((b - a) / h + 1e-9).floor() as usize;
+        (0..=n)
+            .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
+            .collect()
+    } else {
+        s.split(',').map(num).collect::<Result<_, _>>()?
+    };
+    if v.is_empty() || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+        return Err(bad("fractions must be finite and non-negative"));
+    }
+    Ok(v)
+}
+
+/// Default digitized UH-60A fan plot: `data/fanplot_uh60a_bowen-davies-PhD.txt` next to the
+/// rotor deck (shipped copy, rotors/data/), else ../shared next to the source tree.
+pub fn default_reference(rotor_deck: &std::path::Path) -> PathBuf {
+    const NAME: &str = "fanplot_uh60a_bowen-davies-PhD.txt";
+    let local = rotor_deck
+        .parent()
+        .map(|d| d.join("data").join(NAME))
+        .unwrap_or_default();
+    if local.exists() {
+        return local;
+    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/uh60a/raw")
+        .join(NAME)
+}
+
+fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
+    use crate::rotor::fan::{fan, read_reference, TRACKED};
+    let deck = crate::rotor::RotorDeck::from_file(path)?;
+    let fractions = parse_speeds(&args.speeds)?;
+    let reference = match &args.reference {
+        Some(p) => Some(read_reference(p)?),
+        None => {
+            let p = default_reference(path);
+            if p.exists() {
+                Some(read_reference(&p)?)
+            } else {
+                None
+            }
+        }
+    };
+    let out = OutDir::create(&args.out)?;
+    let pts = match fan(&deck, &fractions, args.count.max(5)) {
+        Ok(p) => p,
+        Err(e) => {
+            out.mark_incomplete(&e.to_string())?;
+            return Err(e);
+        }
+    };
+    let om_n = deck.spec.rotor.omega_rad_s;
+    // fan.csv: tracked modes, then all modes sorted by frequency
+    let mut h: Vec<String> = vec!["speed_fraction".into(), "omega_rad_s".into()];
+    h.extend(TRACKED.iter().map(|t| format!("{t}_Hz")));
+    h.push("lag_hinge_k_Nm_per_rad".into());
+    h.push("lag_hinge_c_Nms_per_rad".into());
+    h.extend((1..=args.count.max(5)).map(|i| format!("mode{i}_Hz")));
+    let hs: Vec<&str> = h.iter().map(|s| s.as_str()).collect();
+    let rows: Vec<Vec<f64>> = pts
+        .iter()
+        .map(|p| {
+            let mut r = vec![p.fraction, p.omega_rad_s];
+            r.extend(p.tracked_hz);
+            r.push(p.lag_k_nm_per_rad);
+            r.push(p.lag_c_nms_per_rad);
+            r.extend(p.modes.iter().map(|m| m.freq_hz));
+            r.resize(hs.len(), f64::NAN);
+            r
+        })
+        .collect();
+    out.write("fan.csv", csv_string(&hs, &rows).as_bytes())?;
+    // modes.csv: every mode at every speed with its fractions
+    let mh = [
+        "speed_fraction",
+        "mode",
+        "freq_Hz",
+        "freq_per_rev",
+        "damping_ratio",
+        "flap_fraction",
+        "lag_fraction",
+        "torsion_fraction",
+        "axial_fraction",
+    ];
+    let mut mrows = vec![];
+    for p in &pts {
+        for (i, m) in p.modes.iter().enumerate() {
+            let per_rev = if p.omega_rad_s > 0.0 {
+                m.omega_rad_s / p.omega_rad_s
+            } else {
+                f64::NAN
+            };
+            mrows.push(vec![
+                p.fraction,
+                (i + 1) as f64,
+                m.freq_hz,
+                per_rev,
+                m.damping_ratio,
+                m.fractions[0],
+                m.fractions[1],
+                m.fractions[2],
+                m.fractions[3],
+            ]);
+        }
+    }
+    out.write("modes.csv", csv_string(&mh, &mrows).as_bytes())?;
+    // comparison with the reference at the speeds it has
+    let mut cmp = vec![];
+    println!(
+        "rotor {}: damper as lag-hinge spring/damper (stroke = arm x lag)",
+        path.display()
+    );
+    println!(
+        "{:>6} {:>9} {:>10} {:>10} {:>8}",
+        "x", "mode", "model_Hz", "ref_Hz", "err_%"
+    );
+    if let Some(rf) = &reference {
+        for p in &pts {
+            if let Some((_, r)) = rf.iter().find(|(x, _)| (x - p.fraction).abs() < 1e-6) {
+                for (k, (&m, &re)) in p.tracked_hz.iter().zip(r.iter()).enumerate() {
+                    cmp.push((p.fraction, k, m, re, 100.0 * (m - re) / re));
+                }
+            }
+        }
+        let ch = [
+            "speed_fraction",
+            "mode_index",
+            "model_Hz",
+            "reference_Hz",
+            "error_pct",
+        ];
+        let crow: Vec<Vec<f64>> = cmp
+            .iter()
+            .map(|c| vec![c.0, c.1 as f64, c.2, c.3, c.4])
+            .collect();
+        let mut text = csv_string(&ch, &crow);
+        text.push_str("# mode_index: 0 lag1, 1 flap1, 2 flap2, 3 flap3, 4 torsion1\n");
+        out.write("fan_comparison.csv", text.as_bytes())?;
+        for c in &cmp {
+            println!(
+                "{:>6.2} {:>9} {:>10.4} {:>10.4} {:>8.2}",
+                c.0, TRACKED[c.1], c.2, c.3, c.4
+            );
+        }
+    }
+    // fan.svg
+    let x: Vec<f64> = pts.iter().map(|p| p.fraction).collect();
+    let mut plot = crate::report::plot::Plot::new(
+        "UH-60A fan plot: model (lines) and digitized reference (points, Bowen-Davies 2015)",
+        "rotor speed Omega / Omega_nominal [-]",
+        "frequency [Hz]",
+    );
+    for (k, t) in TRACKED.iter().enumerate() {
+        let y: Vec<f64> = pts.iter().map(|p| p.tracked_hz[k]).collect();
+        plot = plot.line(&format!("model {t}"), &x, &y);
+    }
+    if let Some(rf) = &reference {
+        let rx: Vec<f64> = rf.iter().map(|r| r.0).collect();
+        for (k, t) in TRACKED.iter().enumerate() {
+            let ry: Vec<f64> = rf.iter().map(|r| r.1[k]).collect();
+            plot = plot.points(&format!("reference {t}"), &rx, &ry);
+        }
+    }
+    let xmax = x.iter().cloned().fold(0.0, f64::max).max(1e-3);
+    for n in 1..=6 {
+        let xx = [0.0, xmax];
+        let yy = [0.0, n as f64 * xmax * om_n / (2.0 * std::f64::consts::PI)];
+        plot = plot.dashed(&format!("{n}/rev"), &xx, &yy);
+    }
+    out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
+    out.finish()?;
+    println!("wrote {}", args.out.display());
     Ok(())
 }
