@@ -40,9 +40,17 @@ fn main() -> anyhow::Result<()> {
         sim.channels(&mut ch);
         cur.push(ch[0]);
         if cur.len() == spr {
-            let (lo, hi) = cur.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
+            let (lo, hi) = cur
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+                    (a.0.min(v), a.1.max(v))
+                });
             let dmax = if prev.len() == spr {
-                cur.iter().zip(&prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / (hi - lo)
+                cur.iter()
+                    .zip(&prev)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max)
+                    / (hi - lo)
             } else {
                 f64::NAN
             };
