@@ -391,7 +391,7 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
             // Is that channel still decaying? Compare with 10 revolutions earlier.
             let advice = match hist.len().checked_sub(11).map(|k| hist[k][iw]) {
                 Some(before) if last[iw] > 0.5 * before => format!(
-                    "it is not decaying ({} ten revolutions earlier): more revolutions alone will not make this solution periodic",
+                    "it decays slowly or not at all ({} ten revolutions earlier): more revolutions alone will hardly make this solution periodic",
                     super::fmt_measure(Some(before))
                 ),
                 _ => "run more revolutions".into(),
