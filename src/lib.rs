@@ -10,5 +10,6 @@ pub mod hydraulics;
 pub mod io;
 pub mod report;
 pub mod rotor;
+pub mod run;
 pub mod solver;
 pub mod structure;

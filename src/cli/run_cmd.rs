@@ -1,13 +1,340 @@
-//! `rotorsim run` (issue #6).
+//! `rotorsim run` (issue #6): forced response of a rotor to a flight record with one or all
+//! damper models, to a periodic solution; writes summary.json, <model>/last_rev.csv,
+//! report.html and result.mcap (docs/run.md).
+use crate::flight::FlightRecord;
+use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
+use crate::io::OutDir;
+use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
+use crate::run::sdof::{LagHingeSdof, SdofParams};
+use crate::run::summary::{self, Measured, ModelFigures, RunInfo};
+use crate::run::{self, fmt_measure, ModelOutcome, Progress, Silent};
+use anyhow::{bail, Context};
 use clap::Args;
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
 
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RunArgs {
-    /// Arguments of a command that is not available yet.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// Rotor deck (docs/rotor_deck.md).
+    #[arg(long, default_value = "rotors/uh60a.toml")]
+    pub rotor: PathBuf,
+    /// Flight record: MCAP file or CSV stem (FORMATS.md).
+    #[arg(long, default_value = "flightdata/c8534like")]
+    pub flight: PathBuf,
+    /// Damper model: linear, nonlinear, physical, or all (the three in parallel).
+    #[arg(long, default_value = "all")]
+    pub damper: String,
+    /// Damper deck overriding the rotor deck's [damper] table (e.g. from `diagnose --write-deck`).
+    #[arg(long)]
+    pub damper_deck: Option<PathBuf>,
+    /// Rotor revolutions to run; the last one is reported.
+    #[arg(long, default_value_t = 75)]
+    pub revs: usize,
+    /// Structural steps per revolution.
+    #[arg(long, default_value_t = 256)]
+    pub steps_per_rev: usize,
+    /// Hydraulic sub-steps per structural step.
+    #[arg(long, default_value_t = 25)]
+    pub substeps: usize,
+    /// Hydraulic sub-step scheme: rk4 or implicit.
+    #[arg(long, default_value = "rk4")]
+    pub scheme: String,
+    /// Rotor model: uh60a (the multibody model of the rotor deck) or sdof (a rigid blade on a
+    /// lag hinge: a fast TEST DOUBLE of the pipeline, not the rotor model).
+    #[arg(long, default_value = "uh60a")]
+    pub model: String,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
-pub fn run(_args: RunArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`rotorsim run` is not available yet (tracked in issue #6)")
+fn parse_models(s: &str) -> anyhow::Result<Vec<DamperModel>> {
+    Ok(match s {
+        "all" => vec![
+            DamperModel::Linear,
+            DamperModel::Nonlinear,
+            DamperModel::Physical,
+        ],
+        _ => vec![s.parse().map_err(|e: String| {
+            anyhow::anyhow!("--damper: {e} (or all for the three in parallel)")
+        })?],
+    })
+}
+
+/// Progress bars, one per model, on a terminal.
+struct Bars {
+    bars: Vec<ProgressBar>,
+}
+
+impl Bars {
+    fn new(models: &[DamperModel], revs: usize) -> Self {
+        let mp = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
+        let style = ProgressStyle::with_template(
+            "{prefix:>10} [{bar:30}] rev {pos}/{len} {msg} ({elapsed})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
+        let bars = models
+            .iter()
+            .map(|m| {
+                let b = mp.add(ProgressBar::new(revs as u64));
+                b.set_style(style.clone());
+                b.set_prefix(m.name());
+                b.set_message("starting");
+                b
+            })
+            .collect();
+        Bars { bars }
+    }
+}
+
+impl Progress for Bars {
+    fn revolution(&self, i: usize, rev: usize, _revs: usize, m: Option<f64>) {
+        let b = &self.bars[i];
+        b.set_position(rev as u64);
+        b.set_message(format!("periodicity {}", fmt_measure(m)));
+    }
+    fn finished(&self, i: usize, ok: bool, message: &str) {
+        let b = &self.bars[i];
+        if ok {
+            b.finish_with_message(message.to_string());
+        } else {
+            b.abandon_with_message(format!("FAILED: {message}"));
+        }
+    }
+}
+
+pub fn run(args: RunArgs) -> anyhow::Result<()> {
+    let t0 = Instant::now();
+    let models = parse_models(&args.damper)?;
+    let scheme: Scheme = args
+        .scheme
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("--scheme: {e}"))?;
+    if args.revs < 2 {
+        bail!(
+            "--revs must be at least 2 (periodicity compares consecutive revolutions), got {}",
+            args.revs
+        );
+    }
+    if args.steps_per_rev < 8 || args.substeps == 0 {
+        bail!(
+            "--steps-per-rev must be >= 8 and --substeps >= 1 (got {} and {})",
+            args.steps_per_rev,
+            args.substeps
+        );
+    }
+    let sdof = match args.model.as_str() {
+        "uh60a" => false,
+        "sdof" => true,
+        m => bail!("--model: unknown rotor model '{m}' (expected uh60a or sdof)"),
+    };
+    let record = FlightRecord::read(&args.flight)
+        .with_context(|| format!("reading flight record {}", args.flight.display()))?;
+    let rotor = if sdof {
+        None
+    } else {
+        Some(RotorDeck::from_file(&args.rotor)?)
+    };
+    let deck = match (&args.damper_deck, &rotor) {
+        (Some(p), _) => DamperDeck::from_file(p)?,
+        (None, Some(r)) => r.damper()?,
+        (None, None) => DamperDeck::from_file(&args.rotor)?,
+    };
+    for m in &models {
+        deck.require(*m)?;
+    }
+    let hydraulics = IntegratorOptions {
+        scheme,
+        substeps: args.substeps,
+    };
+    let opts = RunOptions {
+        steps_per_rev: args.steps_per_rev,
+        hydraulics,
+        ..RunOptions::default()
+    };
+    let sdof_params = if sdof {
+        Some(SdofParams::from_record(&record)?)
+    } else {
+        None
+    };
+    let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
+        match (&rotor, &sdof_params) {
+            (Some(r), _) => crate::rotor::build(r, &deck, m, &record, &opts),
+            (None, Some(p)) => Ok(Box::new(LagHingeSdof::new(
+                p.clone(),
+                &deck,
+                m,
+                hydraulics,
+                args.steps_per_rev,
+            )?)),
+            (None, None) => unreachable!("one rotor model is selected"),
+        }
+    };
+    let measured = Measured::from_record(&record);
+    let out = OutDir::create(&args.out)?;
+    let tty = std::io::stderr().is_terminal();
+    eprintln!(
+        "rotorsim run: {} model(s) {}, {} revolutions x {} steps{}",
+        models.len(),
+        models
+            .iter()
+            .map(|m| m.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        args.revs,
+        args.steps_per_rev,
+        if sdof {
+            " (lag-hinge TEST DOUBLE, --model sdof)"
+        } else {
+            ""
+        }
+    );
+    let outcomes = if tty {
+        let bars = Bars::new(&models, args.revs);
+        run::run_models(&models, args.revs, &build, &bars)
+    } else {
+        run::run_models(&models, args.revs, &build, &Silent)
+    };
+    let info = RunInfo {
+        rotor: args.rotor.display().to_string(),
+        rotor_model: if sdof {
+            "lag-hinge sdof test double".into()
+        } else {
+            "UH-60A multibody rotor".into()
+        },
+        flight: args.flight.display().to_string(),
+        damper_deck: args
+            .damper_deck
+            .as_ref()
+            .unwrap_or(&args.rotor)
+            .display()
+            .to_string(),
+        revs: args.revs,
+        steps_per_rev: args.steps_per_rev,
+        substeps: args.substeps,
+        scheme: args.scheme.clone(),
+        synthetic: record.meta.synthetic,
+        counter: record.meta.counter.clone(),
+        wall_s: t0.elapsed().as_secs_f64(),
+    };
+    let failed = write_outputs(&out, &info, &outcomes, &measured)?;
+    print_summary(&out, &outcomes, &measured);
+    if failed.is_empty() {
+        out.finish()?;
+        Ok(())
+    } else {
+        let msg = format!("model(s) failed: {}", failed.join("; "));
+        out.mark_incomplete(&msg)?;
+        bail!(
+            "{msg} (the other models' outputs are written in {})",
+            out.path().display()
+        )
+    }
+}
+
+/// Writes every output; returns the failures ("model: error").
+pub fn write_outputs(
+    out: &OutDir,
+    info: &RunInfo,
+    outcomes: &[ModelOutcome],
+    measured: &Result<Measured, String>,
+) -> anyhow::Result<Vec<String>> {
+    let meas = measured.as_ref().ok();
+    let figs: Vec<Option<Result<ModelFigures, String>>> = outcomes
+        .iter()
+        .map(|o| {
+            o.result
+                .as_ref()
+                .ok()
+                .map(|r| summary::figures(r, meas).map_err(|e| format!("{e:#}")))
+        })
+        .collect();
+    let mut failed = Vec::new();
+    for (o, f) in outcomes.iter().zip(&figs) {
+        match (&o.result, f) {
+            (Err(e), _) | (Ok(_), Some(Err(e))) => failed.push(format!("{}: {e}", o.model.name())),
+            (Ok(r), _) => summary::write_last_rev(out, r)?,
+        }
+    }
+    let metrics: Vec<(String, &crate::analysis::compare::Metrics)> = outcomes
+        .iter()
+        .zip(&figs)
+        .filter_map(|(o, f)| {
+            let m = f.as_ref()?.as_ref().ok()?.metrics.as_ref()?;
+            Some((o.model.name().to_string(), m))
+        })
+        .collect();
+    let rank = summary::ranking(&metrics);
+    let json = summary::summary_json(info, outcomes, &figs, measured, rank.as_ref());
+    out.write(
+        "summary.json",
+        serde_json::to_string_pretty(&json)?.as_bytes(),
+    )?;
+    let html = run::report::report_html(info, outcomes, &figs, measured, rank.as_ref());
+    out.write("report.html", html.as_bytes())?;
+    let ok: Vec<&run::ModelRun> = outcomes
+        .iter()
+        .filter_map(|o| o.result.as_ref().ok())
+        .collect();
+    let mcap = run::mcap_out::mcap_bytes(&ok, meas, info.synthetic)?;
+    out.write("result.mcap", &mcap)?;
+    Ok(failed)
+}
+
+fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Measured, String>) {
+    for o in outcomes {
+        match &o.result {
+            Ok(r) => {
+                let cmp = measured.as_ref().ok().and_then(|m| {
+                    let f = r.channel("damper_force_N")?;
+                    crate::analysis::compare::compare(
+                        crate::analysis::compare::Periodic {
+                            psi_deg: &r.azimuth_deg,
+                            value: f,
+                        },
+                        crate::analysis::compare::Periodic {
+                            psi_deg: &m.azimuth_deg,
+                            value: &m.force_n,
+                        },
+                        run::N_HARMONICS,
+                    )
+                    .ok()
+                });
+                let t = r.timing;
+                println!(
+                    "{:<22} periodicity {} ({}){}  wall {:.1} s (structure {:.1} s, hydraulics {:.1} s)",
+                    r.label,
+                    fmt_measure(r.last_measure()),
+                    if r.converged() { "periodic" } else { "NOT below 1e-3" },
+                    cmp.map(|m| format!(
+                        "  RMS error {:.0} N, correlation {:.3}",
+                        m.rms_error, m.correlation
+                    ))
+                    .unwrap_or_default(),
+                    r.wall_s,
+                    t.total_s - t.hydraulics_s,
+                    t.hydraulics_s
+                );
+                if !r.converged() {
+                    println!(
+                        "warning: {}: {}",
+                        r.label,
+                        summary::periodicity_statement(r)
+                    );
+                }
+            }
+            Err(e) => println!("{:<22} FAILED: {e}", o.model.name()),
+        }
+    }
+    if let Err(note) = measured {
+        println!("note: {note}");
+    }
+    println!(
+        "summary: {}  report: {}",
+        out.file("summary.json").display(),
+        out.file("report.html").display()
+    );
 }

@@ -1,0 +1,505 @@
+//! DIR/report.html: the periodic solution as in the paper (Figs. 16-22), periodicity
+//! convergence, the metrics table and plain statements of which damper model comes closest and
+//! what none of them reproduces. Self-contained (inline SVG).
+use super::summary::{periodicity_statement, Measured, ModelFigures, Ranking, RunInfo};
+use super::{ModelOutcome, ModelRun, PERIODICITY_TOL};
+use crate::analysis::compare::PeriodicInterp;
+use crate::report::html::HtmlReport;
+use crate::report::plot::{stacked_svg, Plot};
+
+const W: u32 = 900;
+const H: u32 = 380;
+
+fn svg(rep: &mut HtmlReport, caption: &str, plots: &[Plot]) {
+    match stacked_svg(plots, W, H) {
+        Ok(s) => {
+            rep.svg(caption, &s);
+        }
+        Err(e) => {
+            rep.notice(&format!("figure '{caption}' could not be drawn: {e}"));
+        }
+    }
+}
+
+/// A plot of `channel` vs azimuth for every run that has it.
+fn channel_plot(runs: &[&ModelRun], title: &str, ylabel: &str, channels: &[(&str, &str)]) -> Plot {
+    let mut p = Plot::new(title, "azimuth [deg]", ylabel).x_range(0.0, 360.0);
+    let multi = runs.len() > 1;
+    for r in runs {
+        for (ch, name) in channels {
+            if let Some(v) = r.channel(ch) {
+                let label = match (multi, name.is_empty()) {
+                    (true, true) => r.label.clone(),
+                    (true, false) => format!("{} {name}", r.label),
+                    (false, true) => ch.to_string(),
+                    (false, false) => name.to_string(),
+                };
+                p = p.line(&label, &r.azimuth_deg, v);
+            }
+        }
+    }
+    p
+}
+
+fn fmt(x: f64, prec: usize) -> String {
+    if x.is_finite() {
+        format!("{x:.prec$}")
+    } else {
+        "n/a".into()
+    }
+}
+
+/// What none of the models reproduces, read from the residuals (observations, not causes).
+pub fn unreproduced(items: &[(&ModelRun, &ModelFigures)], measured: &Measured) -> Vec<String> {
+    let res: Vec<(&str, &super::summary::Residual, f64)> = items
+        .iter()
+        .filter_map(|(r, f)| {
+            Some((
+                r.model.as_str(),
+                f.residual.as_ref()?,
+                f.metrics.as_ref()?.rms_error,
+            ))
+        })
+        .collect();
+    if res.is_empty() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let ptp = {
+        let lo = measured
+            .force_n
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min);
+        let hi = measured
+            .force_n
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
+        hi - lo
+    };
+    let best_rms = res.iter().map(|r| r.2).fold(f64::INFINITY, f64::min);
+    out.push(format!(
+        "Even the closest model leaves an RMS error of {best_rms:.0} N, {:.0}% of the measured peak-to-peak force ({ptp:.0} N).",
+        100.0 * best_rms / ptp
+    ));
+    // Residual harmonics: those in every model's top three.
+    let common: Vec<usize> = res[0]
+        .1
+        .dominant
+        .iter()
+        .map(|d| d.0)
+        .filter(|n| res.iter().all(|r| r.1.dominant.iter().any(|d| d.0 == *n)))
+        .collect();
+    for n in &common {
+        let amps: Vec<String> = res
+            .iter()
+            .map(|r| format!("{} {:.0} N", r.0, r.1.harmonics[*n].amplitude))
+            .collect();
+        out.push(format!(
+            "Residual harmonic {n}/rev is among the three largest for every model (amplitude: {}); measured {n}/rev amplitude {:.0} N.",
+            amps.join(", "),
+            crate::analysis::harmonics::harmonics(&measured.azimuth_deg, &measured.force_n, *n)
+                .map(|h| h[*n].amplitude)
+                .unwrap_or(f64::NAN)
+        ));
+    }
+    // Peak asymmetry.
+    let am = res[0].1.asymmetry_measured;
+    let (amin, amax) = res.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, r| {
+        (a.0.min(r.1.asymmetry_model), a.1.max(r.1.asymmetry_model))
+    });
+    if am < amin * 0.95 || am > amax * 1.05 {
+        out.push(format!(
+            "Peak asymmetry: the measured max/|min| force ratio is {am:.2}; the models give {amin:.2} to {amax:.2}."
+        ));
+    } else {
+        out.push(format!(
+            "Peak asymmetry is reproduced within the models' spread (measured max/|min| {am:.2}, models {amin:.2} to {amax:.2})."
+        ));
+    }
+    // Dwell near zero.
+    let dm = res[0].1.dwell_measured;
+    let dmax = res
+        .iter()
+        .map(|r| r.1.dwell_model)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let dmin = res
+        .iter()
+        .map(|r| r.1.dwell_model)
+        .fold(f64::INFINITY, f64::min);
+    if dm > dmax * 1.2 + 0.005 {
+        out.push(format!(
+            "Dwell near zero: the measured force stays within 5% of its peak of zero over {:.1}% of the revolution, the models over {:.1}% to {:.1}% only.",
+            100.0 * dm,
+            100.0 * dmin,
+            100.0 * dmax
+        ));
+    } else {
+        out.push(format!(
+            "No excess dwell near zero: the measured force is within 5% of its peak of zero over {:.1}% of the revolution, the models {:.1}% to {:.1}%.",
+            100.0 * dm,
+            100.0 * dmin,
+            100.0 * dmax
+        ));
+    }
+    // Phase.
+    let shifts: Vec<f64> = res.iter().map(|r| r.1.best_shift_deg).collect();
+    let (smin, smax) = shifts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, s| {
+            (a.0.min(*s), a.1.max(*s))
+        });
+    if smin > 1.0 || smax < -1.0 {
+        let dir = if smin > 0.0 { "lags" } else { "leads" };
+        let gains: Vec<String> = res
+            .iter()
+            .map(|r| format!("{} {:.0} -> {:.0} N", r.0, r.2, r.1.rms_at_best_shift_n))
+            .collect();
+        out.push(format!(
+            "Phase: the measurement {dir} every model, by {:.1} to {:.1} deg of azimuth (shift minimizing the RMS error; RMS error at that shift: {}).",
+            smin.abs().min(smax.abs()),
+            smin.abs().max(smax.abs()),
+            gains.join(", ")
+        ));
+    } else {
+        out.push(format!(
+            "Phase: no consistent lag; the best azimuth shifts of the models are {:.1} to {:.1} deg.",
+            smin, smax
+        ));
+    }
+    out
+}
+
+/// The HTML report.
+#[allow(clippy::too_many_arguments)]
+pub fn report_html(
+    info: &RunInfo,
+    outcomes: &[ModelOutcome],
+    figs: &[Option<Result<ModelFigures, String>>],
+    measured: &Result<Measured, String>,
+    rank: Option<&Ranking>,
+) -> String {
+    let mut rep = HtmlReport::new(&format!(
+        "rotorsim run: {} with {}",
+        info.rotor_model, info.flight
+    ));
+    let syn = if info.synthetic { "SYNTHETIC " } else { "" };
+    if info.synthetic {
+        rep.notice("SYNTHETIC flight record: the measured damper force shown here is synthetic data (the record's `synthetic` flag is set), not a flight-test measurement.");
+    }
+    if info.rotor_model.contains("sdof") {
+        rep.notice("Rotor model: the lag-hinge single-degree-of-freedom TEST DOUBLE (--model sdof), not the UH-60A multibody rotor model.");
+    }
+    rep.paragraph(&format!(
+        "Rotor deck {}, damper deck {}, flight record {}{}; {} revolutions of {} steps, hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
+        info.rotor,
+        info.damper_deck,
+        info.flight,
+        info.counter.as_ref().map(|c| format!(" (counter {c})")).unwrap_or_default(),
+        info.revs,
+        info.steps_per_rev,
+        info.scheme,
+        info.substeps,
+        info.wall_s
+    ));
+    let ok: Vec<(&ModelRun, &ModelFigures)> = outcomes
+        .iter()
+        .zip(figs)
+        .filter_map(|(o, f)| match (&o.result, f) {
+            (Ok(r), Some(Ok(f))) => Some((r, f)),
+            _ => None,
+        })
+        .collect();
+    for (o, f) in outcomes.iter().zip(figs) {
+        match (&o.result, f) {
+            (Err(e), _) | (Ok(_), Some(Err(e))) => {
+                rep.notice(&format!("The {} model FAILED: {e}", o.model.name()));
+            }
+            _ => {}
+        }
+    }
+    let runs: Vec<&ModelRun> = ok.iter().map(|x| x.0).collect();
+
+    // Conclusions first.
+    rep.heading(2, "Result");
+    match (measured, rank) {
+        (Ok(m), Some(r)) => {
+            rep.paragraph(&format!(
+                "Against the {syn}measured damper force (average of {} revolutions, compared on its own {} azimuths): {}.",
+                m.revolutions,
+                m.azimuth_deg.len(),
+                r.statement
+            ));
+            rep.paragraph("What none of the models reproduces (observations on the residual model - measured; input to the diagnosis, `rotorsim diagnose`):");
+            rep.list(&unreproduced(&ok, m));
+        }
+        (Err(note), _) => {
+            rep.paragraph(&format!("No comparison with a measurement: {note}."));
+        }
+        (Ok(_), None) => {
+            rep.paragraph("No model completed, so there is no comparison.");
+        }
+    }
+    let per: Vec<String> = runs
+        .iter()
+        .map(|r| format!("{}: {}", r.label, periodicity_statement(r)))
+        .collect();
+    rep.paragraph("Periodicity (largest change of the damper force and the blade tip motion from one revolution to the next, relative to the peak-to-peak):");
+    rep.list(&per);
+    let lim: Vec<String> = ok
+        .iter()
+        .filter_map(|(r, f)| {
+            f.limits.map(|c| {
+                format!(
+                    "{}: force {:.0} to {:.0} N, relief-valve limits {:.0} to {:.0} N: {} (margin {:.0} N, {:.1}%)",
+                    r.label,
+                    f.force.min,
+                    f.force.max,
+                    c.min_limit_n,
+                    c.max_limit_n,
+                    if c.within { "within" } else { "EXCEEDED" },
+                    c.margin_n,
+                    100.0 * c.margin_rel
+                )
+            })
+        })
+        .collect();
+    if !lim.is_empty() {
+        rep.paragraph("Relief-valve limits (cracking forces; the dashpot models have none):");
+        rep.list(&lim);
+    }
+
+    // Metrics table.
+    rep.heading(2, "Metrics");
+    let mut rows = Vec::new();
+    for (r, f) in &ok {
+        let m = f.metrics.as_ref();
+        let t = r.timing;
+        rows.push(vec![
+            r.label.clone(),
+            fmt(f.force.min, 0),
+            fmt(f.force.max, 0),
+            fmt(f.force.peak_to_peak, 0),
+            fmt(f.force.rms, 0),
+            m.map_or("-".into(), |m| fmt(m.rms_error, 0)),
+            m.map_or("-".into(), |m| fmt(m.peak_to_peak_error, 0)),
+            m.map_or("-".into(), |m| fmt(m.correlation, 3)),
+            super::fmt_measure(r.last_measure()),
+            fmt(r.wall_s, 2),
+            fmt(t.total_s - t.hydraulics_s, 2),
+            fmt(t.hydraulics_s, 2),
+        ]);
+    }
+    rep.table(
+        &[
+            "model",
+            "F min [N]",
+            "F max [N]",
+            "F p-p [N]",
+            "F RMS [N]",
+            "RMS error [N]",
+            "p-p error [N]",
+            "correlation",
+            "periodicity (last rev)",
+            "wall [s]",
+            "structure [s]",
+            "hydraulics [s]",
+        ],
+        &rows,
+    );
+    if let Ok(m) = measured {
+        // Harmonics table: amplitude per harmonic, measured then models.
+        let mut hrows = Vec::new();
+        let hm =
+            crate::analysis::harmonics::harmonics(&m.azimuth_deg, &m.force_n, super::N_HARMONICS)
+                .unwrap_or_default();
+        let mut row = vec![format!("{syn}measured")];
+        row.extend(hm.iter().map(|h| fmt(h.amplitude, 0)));
+        hrows.push(row);
+        for (r, f) in &ok {
+            if let Some(mt) = &f.metrics {
+                let mut row = vec![r.label.clone()];
+                row.extend(mt.harmonics_model.iter().map(|h| fmt(h.amplitude, 0)));
+                hrows.push(row);
+            }
+            if let Some(res) = &f.residual {
+                let mut row = vec![format!("{} residual", r.label)];
+                row.extend(res.harmonics.iter().map(|h| fmt(h.amplitude, 0)));
+                hrows.push(row);
+            }
+        }
+        let hdr: Vec<String> = (0..=super::N_HARMONICS)
+            .map(|n| format!("{n}/rev [N]"))
+            .collect();
+        let mut h: Vec<&str> = vec!["damper force amplitude"];
+        h.extend(hdr.iter().map(|s| s.as_str()));
+        rep.table(&h, &hrows);
+    }
+
+    // Figures.
+    rep.heading(2, "Damper force and motion (paper Figs. 16-17)");
+    let mut pf = channel_plot(
+        &runs,
+        "Damper force (cf. Fig. 16)",
+        "force [N]",
+        &[("damper_force_N", "")],
+    );
+    if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
+        pf = pf
+            .dashed("relief-valve limit (max)", &[0.0, 360.0], &[hi, hi])
+            .dashed("relief-valve limit (min)", &[0.0, 360.0], &[lo, lo]);
+    }
+    svg(&mut rep, "Damper force over the last revolution.", &[pf]);
+    svg(
+        &mut rep,
+        "Damper stroke (top) and stroke rate (bottom), last revolution (cf. Fig. 17).",
+        &[
+            channel_plot(
+                &runs,
+                "Damper stroke",
+                "stroke [m]",
+                &[("damper_stroke_m", "")],
+            ),
+            channel_plot(
+                &runs,
+                "Damper stroke rate",
+                "stroke rate [m/s]",
+                &[("damper_stroke_rate_m_s", "")],
+            ),
+        ],
+    );
+    let phys: Vec<&ModelRun> = runs
+        .iter()
+        .copied()
+        .filter(|r| r.channel("p0_Pa").is_some())
+        .collect();
+    if phys.is_empty() {
+        rep.paragraph(
+            "No physical damper run: no internal hydraulic channels to show (Figs. 18-21).",
+        );
+    } else {
+        rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
+        svg(
+            &mut rep,
+            "Chamber pressures (cf. Fig. 18).",
+            &[channel_plot(
+                &phys,
+                "Chamber pressures",
+                "pressure [Pa]",
+                &[("p0_Pa", "p0"), ("p1_Pa", "p1")],
+            )],
+        );
+        svg(
+            &mut rep,
+            "Volumetric flow through the orifice, positive from chamber 0 to 1 (cf. Fig. 19).",
+            &[channel_plot(
+                &phys,
+                "Orifice flow",
+                "flow [m^3/s]",
+                &[("q_orifice_m3_s", "")],
+            )],
+        );
+        let mut valve = vec![channel_plot(
+            &phys,
+            "Relief valve displacements",
+            "displacement [m]",
+            &[("x_valve0_m", "valve 0"), ("x_valve1_m", "valve 1")],
+        )];
+        if phys.iter().any(|r| r.channel("v_valve0_m_s").is_some()) {
+            valve.push(channel_plot(
+                &phys,
+                "Relief valve velocities",
+                "velocity [m/s]",
+                &[("v_valve0_m_s", "valve 0"), ("v_valve1_m_s", "valve 1")],
+            ));
+        }
+        svg(
+            &mut rep,
+            "Relief valve poppet displacement (top) and velocity (bottom) (cf. Fig. 20).",
+            &valve,
+        );
+        svg(
+            &mut rep,
+            "Volumetric flow through the relief valves (cf. Fig. 21).",
+            &[channel_plot(
+                &phys,
+                "Relief valve flows",
+                "flow [m^3/s]",
+                &[("q_valve0_m3_s", "valve 0"), ("q_valve1_m3_s", "valve 1")],
+            )],
+        );
+    }
+
+    if let Ok(m) = measured {
+        rep.heading(2, "The damper models over the measurement (paper Fig. 22)");
+        let mut p = Plot::new(
+            &format!("Damper force: models and {syn}measurement (cf. Fig. 22)"),
+            "azimuth [deg]",
+            "force [N]",
+        )
+        .x_range(0.0, 360.0);
+        for r in &runs {
+            if let Some(f) = r.channel("damper_force_N") {
+                p = p.line(&r.label, &r.azimuth_deg, f);
+            }
+        }
+        p = p.points(
+            &format!("{syn}measured (avg of {} revs)", m.revolutions),
+            &m.azimuth_deg,
+            &m.force_n,
+        );
+        let mut pr = Plot::new(
+            &format!("Residual: model - {syn}measured, at the measured azimuths"),
+            "azimuth [deg]",
+            "force error [N]",
+        )
+        .x_range(0.0, 360.0);
+        for r in &runs {
+            if let Some(f) = r.channel("damper_force_N") {
+                if let Ok(ip) = PeriodicInterp::new(crate::analysis::compare::Periodic {
+                    psi_deg: &r.azimuth_deg,
+                    value: f,
+                }) {
+                    let e: Vec<f64> = m
+                        .azimuth_deg
+                        .iter()
+                        .zip(&m.force_n)
+                        .map(|(p, y)| ip.at(*p) - y)
+                        .collect();
+                    pr = pr.line(&r.label, &m.azimuth_deg, &e);
+                }
+            }
+        }
+        svg(
+            &mut rep,
+            &format!("Damper force of the three models over the {syn}measured force (top); residual (bottom)."),
+            &[p, pr],
+        );
+    }
+
+    rep.heading(2, "Periodicity convergence");
+    let mut pc = Plot::new(
+        "Periodicity measure per revolution",
+        "revolution",
+        "log10(measure)",
+    );
+    for r in &runs {
+        let h = r.measure_history();
+        let x: Vec<f64> = (2..=r.revolutions).map(|k| k as f64).collect();
+        let y: Vec<f64> = h.iter().map(|m| m.max(1e-16).log10()).collect();
+        pc = pc.line(&r.label, &x, &y);
+    }
+    if let Some(r) = runs.first() {
+        let t = PERIODICITY_TOL.log10();
+        pc = pc.dashed("tolerance 1e-3", &[1.0, r.revolutions as f64], &[t, t]);
+    }
+    svg(
+        &mut rep,
+        "log10 of the largest relative change from one revolution to the next (damper force, tip flap, lag and twist); the dashed line is the 1e-3 tolerance.",
+        &[pc],
+    );
+    rep.heading(2, "Conventions");
+    rep.paragraph("Azimuth: FORMATS.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
+    rep.finish()
+}

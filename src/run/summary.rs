@@ -1,0 +1,477 @@
+//! Per-model figures of a run: damper force statistics, relief-valve limit check, comparison
+//! with the measured damper force (metrics of `crate::analysis::compare` on the measurement's
+//! own azimuths) and a residual analysis; written as DIR/summary.json and DIR/<model>/last_rev.csv.
+use super::{ModelOutcome, ModelRun, N_HARMONICS, PERIODICITY_TOL};
+use crate::analysis::compare::{compare, Metrics, Periodic, PeriodicInterp};
+use crate::analysis::harmonics::{harmonics, Harmonic};
+use crate::flight::FlightRecord;
+use crate::io::{csv_from_columns, OutDir};
+use serde_json::{json, Value};
+
+/// Statistics of a signal over the last revolution.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Stats {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+    pub peak_to_peak: f64,
+    pub rms: f64,
+}
+
+impl Stats {
+    pub fn of(v: &[f64]) -> Stats {
+        let n = v.len().max(1) as f64;
+        let min = v.iter().cloned().fold(f64::INFINITY, f64::min);
+        let max = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let mean = v.iter().sum::<f64>() / n;
+        let rms = (v.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+        Stats {
+            min,
+            max,
+            mean,
+            peak_to_peak: max - min,
+            rms,
+        }
+    }
+}
+
+/// Relief-valve limit check of a model with force limits.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct LimitCheck {
+    pub min_limit_n: f64,
+    pub max_limit_n: f64,
+    /// min and max force stay within [min_limit, max_limit].
+    pub within: bool,
+    /// Smallest distance to a limit [N]: min(max_limit - max, min - min_limit); negative when a
+    /// limit is exceeded (by that much).
+    pub margin_n: f64,
+    /// `margin_n` relative to the larger limit magnitude.
+    pub margin_rel: f64,
+}
+
+pub fn limit_check(force: &Stats, limits: (f64, f64)) -> LimitCheck {
+    let (lo, hi) = limits;
+    let margin = (hi - force.max).min(force.min - lo);
+    LimitCheck {
+        min_limit_n: lo,
+        max_limit_n: hi,
+        within: force.min >= lo && force.max <= hi,
+        margin_n: margin,
+        margin_rel: margin / lo.abs().max(hi.abs()),
+    }
+}
+
+/// The measured damper force: the record's revolutions averaged azimuth by azimuth.
+#[derive(Debug, Clone)]
+pub struct Measured {
+    pub azimuth_deg: Vec<f64>,
+    pub force_n: Vec<f64>,
+    pub revolutions: usize,
+    pub synthetic: bool,
+}
+
+impl Measured {
+    /// The record's averaged damper force, or a note why there is none (not an error: the run
+    /// still runs, without metrics).
+    pub fn from_record(record: &FlightRecord) -> Result<Measured, String> {
+        if record.damper().is_empty() {
+            return Err(
+                "the flight record has no measured damper force: no comparison metrics".into(),
+            );
+        }
+        let avg = record.damper_average().map_err(|e| {
+            format!("the record's damper channel cannot be averaged over revolutions ({e}): no comparison metrics")
+        })?;
+        if avg.force_N.len() < 2 * N_HARMONICS + 1 {
+            return Err(format!(
+                "the record's damper channel has {} azimuths per revolution, fewer than the {} that harmonics 0-{N_HARMONICS}/rev need: no comparison metrics",
+                avg.force_N.len(),
+                2 * N_HARMONICS + 1
+            ));
+        }
+        Ok(Measured {
+            azimuth_deg: avg.azimuth_deg,
+            force_n: avg.force_N,
+            revolutions: record.damper_revolutions().len(),
+            synthetic: record.meta.synthetic,
+        })
+    }
+}
+
+/// What the residual (model - measured, on the measured azimuths) shows.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Residual {
+    /// Harmonics 0..=10/rev of the residual.
+    pub harmonics: Vec<Harmonic>,
+    /// The three largest residual harmonics (n, amplitude [N]).
+    pub dominant: Vec<(usize, f64)>,
+    /// Peak asymmetry max / |min| of the force: measured and model.
+    pub asymmetry_measured: f64,
+    pub asymmetry_model: f64,
+    /// Fraction of the revolution with |F| below 5% of the peak |F|: measured and model.
+    pub dwell_measured: f64,
+    pub dwell_model: f64,
+    /// Azimuth shift s [deg] of the model, model(psi - s), that minimizes the RMS error
+    /// (searched in [-45, 45] deg, 0.1 deg steps); s > 0: the measurement lags the model.
+    pub best_shift_deg: f64,
+    /// RMS error at the best shift [N].
+    pub rms_at_best_shift_n: f64,
+}
+
+/// Fraction of samples with |F| below 5% of the peak |F|.
+fn dwell(v: &[f64]) -> f64 {
+    let peak = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if peak == 0.0 {
+        return 1.0;
+    }
+    v.iter().filter(|x| x.abs() < 0.05 * peak).count() as f64 / v.len() as f64
+}
+
+fn asymmetry(v: &[f64]) -> f64 {
+    let max = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let min = v.iter().cloned().fold(f64::INFINITY, f64::min);
+    max / min.abs()
+}
+
+/// Residual analysis of `model` (one revolution) against `meas`.
+pub fn residual(model: Periodic<'_>, meas: Periodic<'_>) -> anyhow::Result<Residual> {
+    let interp = PeriodicInterp::new(model)?;
+    let on_meas: Vec<f64> = meas.psi_deg.iter().map(|p| interp.at(*p)).collect();
+    let r: Vec<f64> = on_meas.iter().zip(meas.value).map(|(a, b)| a - b).collect();
+    let h = harmonics(meas.psi_deg, &r, N_HARMONICS)?;
+    let mut dom: Vec<(usize, f64)> = h.iter().map(|h| (h.n, h.amplitude)).collect();
+    dom.sort_by(|a, b| b.1.total_cmp(&a.1));
+    dom.truncate(3);
+    let rms_shift = |s: f64| {
+        let se: f64 = meas
+            .psi_deg
+            .iter()
+            .zip(meas.value)
+            .map(|(p, y)| (interp.at(p - s) - y).powi(2))
+            .sum();
+        (se / meas.value.len() as f64).sqrt()
+    };
+    let (mut best_s, mut best) = (0.0, rms_shift(0.0));
+    for k in -450..=450 {
+        let s = k as f64 * 0.1;
+        let e = rms_shift(s);
+        if e < best {
+            best = e;
+            best_s = s;
+        }
+    }
+    Ok(Residual {
+        harmonics: h,
+        dominant: dom,
+        asymmetry_measured: asymmetry(meas.value),
+        asymmetry_model: asymmetry(&on_meas),
+        dwell_measured: dwell(meas.value),
+        dwell_model: dwell(&on_meas),
+        best_shift_deg: best_s,
+        rms_at_best_shift_n: best,
+    })
+}
+
+/// Everything computed for one successful model.
+#[derive(Debug, Clone)]
+pub struct ModelFigures {
+    pub force: Stats,
+    pub limits: Option<LimitCheck>,
+    pub metrics: Option<Metrics>,
+    pub residual: Option<Residual>,
+}
+
+pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<ModelFigures> {
+    let f = run
+        .channel("damper_force_N")
+        .ok_or_else(|| anyhow::anyhow!("{}: no damper_force_N channel", run.label))?;
+    let force = Stats::of(f);
+    let limits = run.force_limits_n.map(|l| limit_check(&force, l));
+    let (metrics, residual) = match measured {
+        Some(m) => {
+            let model = Periodic {
+                psi_deg: &run.azimuth_deg,
+                value: f,
+            };
+            let meas = Periodic {
+                psi_deg: &m.azimuth_deg,
+                value: &m.force_n,
+            };
+            (
+                Some(compare(model, meas, N_HARMONICS)?),
+                Some(residual(model, meas)?),
+            )
+        }
+        None => (None, None),
+    };
+    Ok(ModelFigures {
+        force,
+        limits,
+        metrics,
+        residual,
+    })
+}
+
+/// The model that comes closest (smallest RMS error) and how it ranks against the others.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Ranking {
+    /// (model, RMS error [N], correlation), best first.
+    pub order: Vec<(String, f64, f64)>,
+    pub statement: String,
+}
+
+pub fn ranking(items: &[(String, &Metrics)]) -> Option<Ranking> {
+    let mut order: Vec<(String, f64, f64)> = items
+        .iter()
+        .filter(|(_, m)| m.rms_error.is_finite())
+        .map(|(n, m)| (n.clone(), m.rms_error, m.correlation))
+        .collect();
+    if order.is_empty() {
+        return None;
+    }
+    order.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let best = &order[0];
+    let statement = if order.len() == 1 {
+        format!(
+            "only the {} model was compared: RMS error {:.0} N, correlation {:.3}",
+            best.0, best.1, best.2
+        )
+    } else {
+        let next = &order[1];
+        format!(
+            "the {} model comes closest: RMS error {:.0} N against {:.0} N for the {} model ({:.0}% lower), correlation {:.3} against {:.3}",
+            best.0,
+            best.1,
+            next.1,
+            next.0,
+            100.0 * (1.0 - best.1 / next.1),
+            best.2,
+            next.2
+        )
+    };
+    Some(Ranking { order, statement })
+}
+
+/// Run-level facts written into summary.json.
+#[derive(Debug, Clone)]
+pub struct RunInfo {
+    pub rotor: String,
+    pub rotor_model: String,
+    pub flight: String,
+    pub damper_deck: String,
+    pub revs: usize,
+    pub steps_per_rev: usize,
+    pub substeps: usize,
+    pub scheme: String,
+    pub synthetic: bool,
+    pub counter: Option<String>,
+    pub wall_s: f64,
+}
+
+/// summary.json as a JSON value.
+pub fn summary_json(
+    info: &RunInfo,
+    outcomes: &[ModelOutcome],
+    figs: &[Option<Result<ModelFigures, String>>],
+    measured: &Result<Measured, String>,
+    rank: Option<&Ranking>,
+) -> Value {
+    let mut models = serde_json::Map::new();
+    for (o, f) in outcomes.iter().zip(figs) {
+        let v = match (&o.result, f) {
+            (Err(e), _) => json!({"status": "failed", "error": e}),
+            (Ok(r), Some(Err(e))) => json!({"status": "failed", "label": r.label, "error": e}),
+            (Ok(r), Some(Ok(f))) => model_json(r, f, measured),
+            (Ok(r), None) => json!({"status": "failed", "label": r.label, "error": "no figures"}),
+        };
+        models.insert(o.model.name().to_string(), v);
+    }
+    let meas = match measured {
+        Ok(m) => json!({
+            "available": true,
+            "source": "record damper channel, revolutions averaged azimuth by azimuth",
+            "revolutions_averaged": m.revolutions,
+            "samples_per_revolution": m.azimuth_deg.len(),
+            "synthetic": m.synthetic,
+        }),
+        Err(note) => json!({"available": false, "note": note}),
+    };
+    json!({
+        "rotorsim_version": env!("CARGO_PKG_VERSION"),
+        "rotor": info.rotor,
+        "rotor_model": info.rotor_model,
+        "flight_record": info.flight,
+        "synthetic": info.synthetic,
+        "record_counter": info.counter,
+        "damper_deck": info.damper_deck,
+        "options": {
+            "revs": info.revs,
+            "steps_per_rev": info.steps_per_rev,
+            "substeps": info.substeps,
+            "scheme": info.scheme,
+            "periodicity_tolerance": PERIODICITY_TOL,
+            "harmonics_max_per_rev": N_HARMONICS,
+        },
+        "wall_time_s": info.wall_s,
+        "measured": meas,
+        "closest": rank.map(|r| json!({"model": r.order[0].0, "statement": r.statement, "order": r.order})),
+        "models": models,
+    })
+}
+
+fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String>) -> Value {
+    let t = r.timing;
+    let steps = t.steps.max(1) as f64;
+    let last = r.last_measure();
+    let converged = r.converged();
+    let limits = match (&f.limits, r.force_limits_n) {
+        (Some(c), _) => serde_json::to_value(c).unwrap_or(Value::Null),
+        _ => json!({"applies": false, "note": "this model has no force limits"}),
+    };
+    let metrics = match (&f.metrics, measured) {
+        (Some(m), _) => serde_json::to_value(m).unwrap_or(Value::Null),
+        (None, Err(note)) => json!({"note": note}),
+        (None, Ok(_)) => Value::Null,
+    };
+    json!({
+        "status": "ok",
+        "label": r.label,
+        "revolutions": r.revolutions,
+        "steps_per_rev": r.steps_per_rev,
+        "period_s": r.period_s,
+        "periodicity": {
+            "channels": r.periodicity.channels,
+            "floors": r.periodicity.floors,
+            "history_by_channel": r.periodicity.history,
+            "history": r.measure_history(),
+            "last": last,
+            "tolerance": PERIODICITY_TOL,
+            "converged": converged,
+            "statement": periodicity_statement(r),
+        },
+        "damper_force_N": f.force,
+        "relief_valve_limits": limits,
+        "wall_time_s": {
+            "total": r.wall_s,
+            "build": r.build_s,
+            "steps": t.total_s,
+            "structure": t.total_s - t.hydraulics_s,
+            "hydraulics": t.hydraulics_s,
+        },
+        "steps": t.steps,
+        "newton_iterations": t.iterations,
+        "cost_per_step_s": t.total_s / steps,
+        "metrics": metrics,
+        "residual": f.residual,
+        "channels": r.channel_names,
+    })
+}
+
+/// Plain statement of the periodicity at the last revolution.
+pub fn periodicity_statement(r: &ModelRun) -> String {
+    match r.last_measure() {
+        Some(m) if m < PERIODICITY_TOL => format!(
+            "periodic: the measure fell to {m:.2e} (< {PERIODICITY_TOL:.0e}) at revolution {}",
+            r.revolutions
+        ),
+        Some(m) => {
+            // Name the channel that holds the measure up, and how far the damper force got.
+            let hist = &r.periodicity.history;
+            let last = hist.last().cloned().unwrap_or_default();
+            let iw = last
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .map_or(0, |(i, _)| i);
+            let worst = format!(
+                "{} {}",
+                r.periodicity.channels.get(iw).map_or("", |s| s.as_str()),
+                super::fmt_measure(last.get(iw).copied())
+            );
+            // Is that channel still decaying? Compare with 10 revolutions earlier.
+            let advice = match hist.len().checked_sub(11).map(|k| hist[k][iw]) {
+                Some(before) if last[iw] > 0.5 * before => format!(
+                    "it decays slowly or not at all ({} ten revolutions earlier): more revolutions alone will hardly make this solution periodic",
+                    super::fmt_measure(Some(before))
+                ),
+                _ => "run more revolutions".into(),
+            };
+            format!(
+                "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance (largest: {worst}; damper force {}); {advice}",
+                super::fmt_measure(Some(m)),
+                r.revolutions,
+                super::fmt_measure(last.first().copied())
+            )
+        }
+        None => "periodicity not measured".into(),
+    }
+}
+
+/// DIR/<model>/last_rev.csv: azimuth_deg then every channel (units in the names).
+pub fn write_last_rev(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
+    let mut header: Vec<&str> = vec!["azimuth_deg"];
+    header.extend(r.channel_names.iter().map(|s| s.as_str()));
+    let mut cols: Vec<&[f64]> = vec![&r.azimuth_deg];
+    cols.extend(r.last_rev.iter().map(|c| c.as_slice()));
+    out.write(
+        &format!("{}/last_rev.csv", r.model),
+        csv_from_columns(&header, &cols).as_bytes(),
+    )?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_of_a_sine() {
+        let v: Vec<f64> = (0..360)
+            .map(|i| 2.0 * (i as f64).to_radians().sin() + 1.0)
+            .collect();
+        let s = Stats::of(&v);
+        assert!((s.mean - 1.0).abs() < 1e-12);
+        assert!((s.peak_to_peak - 4.0).abs() < 1e-12);
+        assert!((s.rms - 3.0f64.sqrt()).abs() < 1e-12); // sqrt(1 + 4/2)
+    }
+
+    #[test]
+    fn limit_margin_sign() {
+        let s = Stats::of(&[-90.0, 110.0]);
+        let c = limit_check(&s, (-100.0, 100.0));
+        assert!(!c.within);
+        assert_eq!(c.margin_n, -10.0);
+        let c = limit_check(&Stats::of(&[-90.0, 95.0]), (-100.0, 100.0));
+        assert!(c.within);
+        assert_eq!(c.margin_n, 5.0);
+    }
+
+    #[test]
+    fn residual_finds_a_known_shift_and_asymmetry() {
+        let psi: Vec<f64> = (0..256).map(|i| i as f64 * 360.0 / 256.0).collect();
+        let model: Vec<f64> = psi.iter().map(|p| p.to_radians().sin()).collect();
+        // Measurement lags the model by 10 deg.
+        let meas: Vec<f64> = psi.iter().map(|p| (p - 10.0).to_radians().sin()).collect();
+        let r = residual(
+            Periodic {
+                psi_deg: &psi,
+                value: &model,
+            },
+            Periodic {
+                psi_deg: &psi,
+                value: &meas,
+            },
+        )
+        .unwrap();
+        assert!(
+            (r.best_shift_deg - 10.0).abs() < 0.051,
+            "{}",
+            r.best_shift_deg
+        );
+        assert!(r.rms_at_best_shift_n < 1e-3);
+        assert_eq!(r.dominant[0].0, 1);
+        // |2 sin 5 deg| = 0.1743: residual 1/rev amplitude.
+        assert!((r.harmonics[1].amplitude - 2.0 * 5f64.to_radians().sin()).abs() < 1e-9);
+        assert!((r.asymmetry_measured - 1.0).abs() < 1e-3);
+    }
+}
