@@ -11,7 +11,8 @@ use std::path::PathBuf;
 pub struct DynamicArgs {
     /// Model deck (TOML, see docs/model_deck.md) with a [dynamic] table.
     pub deck: PathBuf,
-    /// Output directory (sensors.csv time histories, summary.json).
+    /// Output directory (sensors.csv time histories, summary.json; with [[hydraulic]] elements
+    /// also plots.svg and one SVG per paper figure 9-12 of each device).
     #[arg(long)]
     pub out: PathBuf,
 }
@@ -82,6 +83,20 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
     }
     out.write("sensors.csv", csv_string(&hs, &rows).as_bytes())?;
     let elapsed = started.elapsed().as_secs_f64();
+    let hydraulics: Vec<serde_json::Value> = deck
+        .hydraulic_probes
+        .iter()
+        .map(|(name, p)| {
+            serde_json::json!({
+                "name": name,
+                "trial_steps": p.trials(),
+                "hydraulics_wall_time_s": p.hydraulics_seconds(),
+            })
+        })
+        .collect();
+    if !deck.hydraulic_probes.is_empty() {
+        write_hydraulic_plots(&out, &deck.hydraulic_probes, &hs, &rows)?;
+    }
     let summary = serde_json::json!({
         "deck": file,
         "time_step_s": h,
@@ -91,6 +106,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
         "rho_inf": dy.rho_inf,
         "complete": failure.is_none(),
         "error": failure.as_ref().map(|e| e.to_string()),
+        "hydraulics": hydraulics,
     });
     out.write(
         "summary.json",
@@ -110,5 +126,96 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
         solver.total_iterations as f64 / solver.steps.max(1) as f64
     );
     out.finish()?;
+    Ok(())
+}
+
+/// Column of `header` named `name`, if any.
+fn column(header: &[&str], rows: &[Vec<f64>], name: &str) -> Option<Vec<f64>> {
+    let i = header.iter().position(|h| *h == name)?;
+    Some(rows.iter().map(|r| r[i]).collect())
+}
+
+/// plots.svg (all panels) and, per device, the paper's Figs. 9-12: force; stroke and stroke
+/// rate; chamber pressures; flows (every `*_m3_s` channel that is not identically zero).
+fn write_hydraulic_plots(
+    out: &OutDir,
+    probes: &[(String, std::sync::Arc<crate::structure::HydraulicProbe>)],
+    header: &[&str],
+    rows: &[Vec<f64>],
+) -> anyhow::Result<()> {
+    use crate::report::plot::{stacked_svg, Plot};
+    let t = column(header, rows, "t_s").unwrap_or_else(|| rows.iter().map(|r| r[0]).collect());
+    let mut all = vec![];
+    for (name, probe) in probes {
+        let col = |c: &str| column(header, rows, &format!("{name}.{c}"));
+        let mut figs: Vec<(&str, Vec<Plot>)> = vec![];
+        if let Some(f) = col("force_N") {
+            figs.push((
+                "fig9_force",
+                vec![Plot::new(
+                    &format!("{name}: device force (Eq. 8)"),
+                    "time [s]",
+                    "force [N]",
+                )
+                .line("force_N", &t, &f)],
+            ));
+        }
+        if let (Some(d), Some(v)) = (col("stroke_m"), col("stroke_rate_m_s")) {
+            figs.push((
+                "fig10_stroke_rate",
+                vec![
+                    Plot::new(
+                        &format!("{name}: piston displacement"),
+                        "time [s]",
+                        "stroke [m]",
+                    )
+                    .line("stroke_m", &t, &d),
+                    Plot::new(
+                        &format!("{name}: piston velocity"),
+                        "time [s]",
+                        "stroke rate [m/s]",
+                    )
+                    .line("stroke_rate_m_s", &t, &v),
+                ],
+            ));
+        }
+        if let (Some(p0), Some(p1)) = (col("p0_Pa"), col("p1_Pa")) {
+            figs.push((
+                "fig11_pressures",
+                vec![Plot::new(
+                    &format!("{name}: chamber pressures"),
+                    "time [s]",
+                    "pressure [Pa]",
+                )
+                .line("p0_Pa", &t, &p0)
+                .line("p1_Pa", &t, &p1)],
+            ));
+        }
+        let mut flows = Plot::new(
+            &format!("{name}: volumetric flow rates"),
+            "time [s]",
+            "flow [m^3/s]",
+        );
+        for c in probe
+            .channel_names()
+            .iter()
+            .filter(|c| c.ends_with("_m3_s"))
+        {
+            if let Some(q) = col(c).filter(|q| q.iter().any(|v| *v != 0.0)) {
+                flows = flows.line(c, &t, &q);
+            }
+        }
+        if !flows.series.is_empty() {
+            figs.push(("fig12_flows", vec![flows]));
+        }
+        for (fig, plots) in figs {
+            let svg = stacked_svg(&plots, 900, 320)?;
+            out.write(&format!("{name}_{fig}.svg"), svg.as_bytes())?;
+            all.extend(plots);
+        }
+    }
+    if !all.is_empty() {
+        out.write("plots.svg", stacked_svg(&all, 900, 300)?.as_bytes())?;
+    }
     Ok(())
 }

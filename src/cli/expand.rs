@@ -1,6 +1,7 @@
 //! `rotorsim expand --rotor DECK` (issue #6): print the multibody model deck generated from a
 //! rotor deck (docs/rotor_deck.md -> docs/model_deck.md).
-use crate::rotor::expand::{Controls, ExpandOptions};
+use crate::hydraulics::DamperModel;
+use crate::rotor::expand::{Controls, ExpandOptions, HydraulicRef};
 use crate::rotor::RotorDeck;
 use clap::Args;
 use std::path::PathBuf;
@@ -16,6 +17,13 @@ pub struct ExpandArgs {
     /// Revolutions covered by the swashplate displacement table.
     #[arg(long, default_value_t = 2)]
     pub revs: usize,
+    /// Damper model of the `[[hydraulic]]` table: linear, nonlinear or physical (default: the
+    /// deck's `[damper] model`).
+    #[arg(long)]
+    pub damper: Option<String>,
+    /// Hydraulic sub-steps per structural step.
+    #[arg(long, default_value_t = 25)]
+    pub substeps: usize,
 }
 
 pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
@@ -26,18 +34,25 @@ pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
         Some(p) => Controls::from_record(&crate::flight::FlightRecord::read(p)?.meta.controls_deg),
         None => Controls::default(),
     };
-    let note = format!(
-        "Damper ({} model by default, table [damper] of {}): acts between `damper_hub_end` and\n\
-         `damper_blade_end`, reference length {} m (zero stroke); added by `rotorsim run` as a\n\
-         step element (no [[hydraulic]] table in model decks yet).",
-        damper.model.name(),
-        args.rotor.display(),
-        deck.spec.damper_attachment.reference_length_m
-    );
+    let deck_name = args
+        .rotor
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let model = match &args.damper {
+        Some(m) => m.parse::<DamperModel>().map_err(anyhow::Error::msg)?,
+        None => damper.model,
+    };
+    damper.require(model)?;
     let text = deck.expand(&ExpandOptions {
         controls,
         table_revs: args.revs.max(1),
-        damper_note: Some(note),
+        hydraulic: Some(HydraulicRef {
+            deck: deck_name,
+            model: model.name().into(),
+            scheme: "rk4".into(),
+            substeps: args.substeps,
+        }),
         ..Default::default()
     });
     print!("{text}");

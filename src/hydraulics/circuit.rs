@@ -467,6 +467,8 @@ const DAMPER_CHANNELS: &[&str] = &[
     "q_valve1_m3_s",
     "q_check0_m3_s",
     "q_check1_m3_s",
+    "v_valve0_m_s",
+    "v_valve1_m_s",
 ];
 
 const ACTUATOR_CHANNELS: &[&str] = &[
@@ -481,6 +483,8 @@ const ACTUATOR_CHANNELS: &[&str] = &[
     "q_check1_m3_s",
     "q_entrance0_m3_s",
     "q_entrance1_m3_s",
+    "v_valve0_m_s",
+    "v_valve1_m_s",
 ];
 
 impl CircuitDevice {
@@ -619,8 +623,14 @@ impl Device for CircuitDevice {
             fl.entrance[0],
             fl.entrance[1],
         ];
-        for (o, v) in out.iter_mut().zip(vals) {
+        // valve (poppet) velocities are appended after the other channels of either layout
+        let n = self.channel_names().len() - 2;
+        for (o, v) in out.iter_mut().take(n).zip(vals) {
             *o = v;
+        }
+        if out.len() >= n + 2 {
+            out[n] = y[IV0];
+            out[n + 1] = y[IV1];
         }
     }
 

@@ -111,7 +111,7 @@ pub struct DamperAttachment {
 
 impl RotorSpec {
     /// Parse deck text; `file` names it in errors (toml reports line and column).
-    pub fn from_str(text: &str, file: &str) -> anyhow::Result<Self> {
+    pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
         let spec: RotorSpec = toml::from_str(text)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.to_string().trim_end()))?;
         spec.validate(file)?;
@@ -122,7 +122,7 @@ impl RotorSpec {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
-        Self::from_str(&text, &file)
+        Self::parse(&text, &file)
     }
 
     fn validate(&self, file: &str) -> anyhow::Result<()> {

@@ -149,8 +149,20 @@ pub struct ExpandOptions {
     pub lag_extra_c: f64,
     /// `[modes] speeds_rad_s`.
     pub speeds_rad_s: Vec<f64>,
-    /// Note printed in place of the `[[hydraulic]]` damper table.
-    pub damper_note: Option<String>,
+    /// The damper as a `[[hydraulic]]` table (None: left out, e.g. when the caller adds the
+    /// coupling element itself or represents the damper by a linearised lag-hinge spring).
+    pub hydraulic: Option<HydraulicRef>,
+}
+
+/// `[[hydraulic]]` damper table of the expanded deck.
+#[derive(Clone, Debug)]
+pub struct HydraulicRef {
+    /// Device deck path relative to the rotor deck's folder (the rotor deck itself holds the
+    /// `[damper]` table).
+    pub deck: String,
+    pub model: String,
+    pub scheme: String,
+    pub substeps: usize,
 }
 
 /// Last node index of a beam of `n` cubic elements.
@@ -398,14 +410,39 @@ pub fn expand(spec: &RotorSpec, opts: &ExpandOptions) -> String {
         "[[joint]]\nname = \"pitch_link_upper\"\ntype = \"spherical\"\nnode_a = \"{seg2_end}\"\nnode_b = \"pitch_link.n{npl}\"\nposition_m = {}\n",
         v3(pc.horn_tip_m)
     );
-    match &opts.damper_note {
-        Some(n) => {
-            for l in n.lines() {
-                let _ = writeln!(s, "# {l}");
-            }
-            s.push('\n');
+    match &opts.hydraulic {
+        Some(h) => {
+            let _ = writeln!(
+                s,
+                "# Damper (paper Eqs. 9-16): stroke = arm x lag angle, positive when lag aft lengthens it
+                 [[hydraulic]]
+name = \"damper\"
+node_a = \"{}\"
+node_b = \"{}\"
+deck = \"{}\"
+model = \"{}\"
+scheme = \"{}\"
+substeps = {}
+reference_length_m = {}
+",
+                names::DAMPER_HUB_END,
+                names::DAMPER_BLADE_END,
+                h.deck,
+                h.model,
+                h.scheme,
+                h.substeps,
+                f(spec.damper_attachment.reference_length_m)
+            );
         }
-        None => {}
+        None => {
+            let _ = writeln!(
+                s,
+                "# Damper: not included here (added by the caller between `{}` and `{}`)
+",
+                names::DAMPER_HUB_END,
+                names::DAMPER_BLADE_END
+            );
+        }
     }
     let _ = writeln!(
         s,

@@ -5,152 +5,19 @@ use super::expand::{expand, names, ramp, Controls, ExpandOptions};
 use super::{ForcedResponse, RunOptions, Timing, BASE_CHANNELS};
 use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
 use crate::flight::FlightRecord;
-use crate::hydraulics::{DamperDeck, DamperModel, Device};
+use crate::hydraulics::{DamperDeck, DamperModel};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, State};
 use crate::structure::beam::SectionLoad;
 use crate::structure::deck::parse_deck;
+use crate::structure::hydraulic::{HydraulicForceElement, HydraulicProbe};
 use crate::structure::kin::TimeTable;
-use crate::structure::model::{
-    DistributedLoad, Element, ElementError, ElementOutput, LoadPoint, Model, StepElement,
-};
+use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
 use crate::structure::rotation::*;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
-
-/// Committed damper quantities shared between the element (inside the model) and the
-/// simulation (channels).
-#[derive(Debug, Default)]
-pub struct DamperProbe {
-    pub force_n: f64,
-    pub stroke_m: f64,
-    pub stroke_rate_m_s: f64,
-    pub channels: Vec<f64>,
-    pub hydraulics_s: f64,
-}
-
-/// Damper between two nodes (paper Eqs. 9-16 coupling): the stroke is the change of the
-/// distance between the end points from `l0`; the device integrates over the structural step
-/// with the stroke moving linearly from `d_i` to `d_f` and returns the step-mean force `F_m`
-/// (Eq. 13), applied along the current line of the damper.
-pub struct DamperElement {
-    name: String,
-    nodes: [usize; 2],
-    l0: f64,
-    device: Box<dyn Device>,
-    probe: Arc<Mutex<DamperProbe>>,
-    trial: Option<(f64, f64, f64)>,
-    hyd_s: f64,
-}
-
-impl DamperElement {
-    pub fn new(name: &str, nodes: [usize; 2], l0: f64, device: Box<dyn Device>) -> Self {
-        let n = device.channel_names().len();
-        DamperElement {
-            name: name.into(),
-            nodes,
-            l0,
-            device,
-            probe: Arc::new(Mutex::new(DamperProbe {
-                channels: vec![0.0; n],
-                ..Default::default()
-            })),
-            trial: None,
-            hyd_s: 0.0,
-        }
-    }
-    pub fn probe(&self) -> Arc<Mutex<DamperProbe>> {
-        self.probe.clone()
-    }
-}
-
-fn len(d: [f64; 3]) -> f64 {
-    dot(d, d).sqrt()
-}
-
-impl StepElement for DamperElement {
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn nodes(&self) -> [usize; 2] {
-        self.nodes
-    }
-    fn evaluate(
-        &mut self,
-        t_i: f64,
-        dt: f64,
-        x_i: [[f64; 3]; 2],
-        x_f: [[f64; 3]; 2],
-        out: &mut ElementOutput,
-    ) -> Result<(), ElementError> {
-        let df = sub(x_f[1], x_f[0]);
-        let l = len(df);
-        let d_f = l - self.l0;
-        if dt <= 0.0 {
-            // static analyses: a damper carries no static force
-            *out = ElementOutput::default();
-            return Ok(());
-        }
-        let d_i = len(sub(x_i[1], x_i[0])) - self.l0;
-        let t0 = Instant::now();
-        let r = self.device.trial_step(t_i, dt, d_i, d_f);
-        self.hyd_s += t0.elapsed().as_secs_f64();
-        let sf = r.map_err(|e| ElementError {
-            element: self.name.clone(),
-            msg: e.to_string(),
-        })?;
-        let n = fmul(1.0 / l, df);
-        let fm = sf.force_mean;
-        let k = sf.dforce_dstroke;
-        // force on node 1 (blade end) = F n, on node 0 = -F n
-        let mut jac = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                let dij = if i == j { 1.0 } else { 0.0 };
-                jac[i][j] = k * n[i] * n[j] + fm * (dij - n[i] * n[j]) / l;
-            }
-        }
-        out.force = [fmul(-fm, n), fmul(fm, n)];
-        for i in 0..3 {
-            for j in 0..3 {
-                // d f1 / d x1 = jac, d f1 / d x0 = -jac, f0 = -f1
-                out.jac[1][1][i][j] = jac[i][j];
-                out.jac[1][0][i][j] = -jac[i][j];
-                out.jac[0][1][i][j] = -jac[i][j];
-                out.jac[0][0][i][j] = jac[i][j];
-            }
-        }
-        self.trial = Some((sf.force_end, d_f, (d_f - d_i) / dt));
-        Ok(())
-    }
-    fn commit(&mut self) {
-        self.device.commit();
-        if let Some((f, d, v)) = self.trial.take() {
-            if let Ok(mut p) = self.probe.lock() {
-                p.force_n = f;
-                p.stroke_m = d;
-                p.stroke_rate_m_s = v;
-                p.hydraulics_s = self.hyd_s;
-                let n = p.channels.len();
-                self.device.channels(&mut p.channels[..n]);
-            }
-        }
-    }
-    fn sensors(&self) -> Vec<(String, f64)> {
-        let p = self
-            .probe
-            .lock()
-            .map(|p| (p.force_n, p.stroke_m, p.stroke_rate_m_s));
-        let (f, d, v) = p.unwrap_or_default();
-        vec![
-            ("force_N".into(), f),
-            ("stroke_m".into(), d),
-            ("stroke_rate_m_s".into(), v),
-        ]
-    }
-}
 
 /// Airloads of the record on the blade: mean + ramp(t) (periodic part), follower section loads
 /// (FORMATS: normal along +z, chord force along -y, moment about +x; the beam reference line
@@ -207,6 +74,9 @@ fn joint_id(m: &Model, name: &str) -> anyhow::Result<usize> {
         .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no joint `{name}`"))
 }
 
+/// Newton tolerance of the rotor simulation (relative to the predictor residual).
+pub const RTOL: f64 = 1e-7;
+
 /// The rotor forced-response simulation.
 pub struct RotorSim {
     label: String,
@@ -215,7 +85,9 @@ pub struct RotorSim {
     controls: Controls,
     period: f64,
     h: f64,
-    probe: Arc<Mutex<DamperProbe>>,
+    probe: Arc<HydraulicProbe>,
+    /// Scratch for the probe's values (channels() must not allocate).
+    scratch: Mutex<Vec<f64>>,
     dev_names: Vec<String>,
     physical: bool,
     limits: Option<(f64, f64)>,
@@ -292,13 +164,12 @@ pub fn build_sim(
         .collect();
     let n_hub_end = model.node_id(names::DAMPER_HUB_END)?;
     let n_blade_end = model.node_id(names::DAMPER_BLADE_END)?;
-    let elem = DamperElement::new(
-        "damper",
-        [n_hub_end, n_blade_end],
-        spec.damper_attachment.reference_length_m,
-        device,
-    );
+    // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
+    // the step mean F_m is unstable with generalized-alpha for stiff devices).
+    let elem = HydraulicForceElement::new("damper", n_hub_end, n_blade_end, device)
+        .with_reference_length(spec.damper_attachment.reference_length_m);
     let probe = elem.probe();
+    let scratch = Mutex::new(vec![0.0; probe.channel_names().len()]);
     model.add_step_element(Box::new(elem))?;
     // airloads
     let full = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
@@ -353,6 +224,10 @@ pub fn build_sim(
     let tip_ref = model.nodes[tip].x0;
     let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
     let mut solver = DynamicSolver::new(model, st, h, opts.rho_inf)?;
+    // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
+    // the hydraulic force is only piecewise smooth (valve seat contact), and its
+    // finite-difference tangent stalls Newton near 1e-8 ||r_0|| at some valve events (measured).
+    solver.newton.rtol = RTOL;
     solver.init_accelerations()?;
     let physical = model_kind == DamperModel::Physical;
     Ok(RotorSim {
@@ -363,6 +238,7 @@ pub fn build_sim(
         period,
         h,
         probe,
+        scratch,
         dev_names,
         physical,
         limits: if physical {
@@ -458,13 +334,13 @@ impl ForcedResponse for RotorSim {
         v
     }
     fn channels(&self, out: &mut [f64]) {
-        if let Ok(p) = self.probe.lock() {
-            out[0] = p.force_n;
-            out[1] = p.stroke_m;
-            out[2] = p.stroke_rate_m_s;
+        if let Ok(mut buf) = self.scratch.lock() {
+            // probe layout: force_N, stroke_m, stroke_rate_m_s, device channels
+            self.probe.read_into(&mut buf);
+            out[..3].copy_from_slice(&buf[..3]);
             if self.physical {
-                let n = p.channels.len().min(out.len().saturating_sub(6));
-                out[6..6 + n].copy_from_slice(&p.channels[..n]);
+                let n = (buf.len() - 3).min(out.len().saturating_sub(6));
+                out[6..6 + n].copy_from_slice(&buf[3..3 + n]);
             }
         }
         let st = &self.solver.state;
@@ -480,10 +356,9 @@ impl ForcedResponse for RotorSim {
         self.limits
     }
     fn timing(&self) -> Timing {
-        let hyd = self.probe.lock().map(|p| p.hydraulics_s).unwrap_or(0.0);
         Timing {
             total_s: self.total_s,
-            hydraulics_s: hyd,
+            hydraulics_s: self.probe.hydraulics_seconds(),
             steps: self.solver.steps,
             iterations: self.solver.total_iterations,
         }

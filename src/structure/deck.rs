@@ -1,14 +1,20 @@
 //! Model deck (TOML), documented in docs/model_deck.md. Unknown keys are rejected; every
 //! reference (node, beam, joint) is checked and reported with the deck file and the key.
 use super::beam::BeamLoad;
+use super::hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
 use super::joint::{AngleLaw, JointKind};
 use super::kin::TimeTable;
 use super::model::{frame_from_axis, Element, Model, SensorKind};
 use super::rigid::{PointLoad, RigidBody};
 use super::rotation::*;
 use super::section::{SectionProps, SectionTable};
+use crate::hydraulics::{
+    actuator_from_toml_str, CircuitDevice, DamperDeck, DamperModel, Device, IntegratorOptions,
+    PiecewiseLinear, Scheme,
+};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -49,12 +55,51 @@ pub struct Deck {
     pub distributed_loads: Vec<DistDeck>,
     #[serde(default, rename = "sensor")]
     pub sensors: Vec<SensorDeck>,
+    #[serde(default, rename = "hydraulic")]
+    pub hydraulics: Vec<HydraulicDeck>,
     #[serde(default, rename = "static")]
     pub statics: StaticDeck,
     #[serde(default)]
     pub dynamic: DynamicDeck,
     #[serde(default)]
     pub modes: ModesDeck,
+    /// Probes of the `[[hydraulic]]` elements (name, probe), filled when the model is built.
+    #[serde(skip)]
+    pub hydraulic_probes: Vec<(String, Arc<HydraulicProbe>)>,
+}
+
+/// `[[hydraulic]]`: a hydraulic device (actuator, damper or dashpot) between two nodes
+/// (paper Eqs. 9-16, [`HydraulicForceElement`]).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HydraulicDeck {
+    pub name: String,
+    /// First attachment node, or `"ground"` (then `position_m` is the ground point).
+    pub node_a: String,
+    /// Ground attachment point when `node_a = "ground"`.
+    #[serde(default)]
+    pub position_m: Option<[f64; 3]>,
+    pub node_b: String,
+    /// Device deck (TOML with an `[actuator]` or a `[damper]` table), relative to the model deck.
+    pub deck: String,
+    /// Damper model (`physical`, `linear`, `nonlinear`; default: the damper deck's own).
+    #[serde(default)]
+    pub model: Option<String>,
+    /// Sub-step scheme of the hydraulic states: `rk4` (default) or `implicit`.
+    #[serde(default)]
+    pub scheme: Option<String>,
+    /// Sub-steps per structural step (default 25).
+    #[serde(default)]
+    pub substeps: Option<usize>,
+    /// Actuator throttle schedule `[[t_s, factor], ...]` scaling both entrance orifice areas.
+    #[serde(default)]
+    pub orifice_area_table: Option<Vec<[f64; 2]>>,
+    /// Length at zero stroke (default: the initial distance of the attachment points).
+    #[serde(default)]
+    pub reference_length_m: Option<f64>,
+    /// Step force applied along e_m: `end` (default, force at t_f) or `mean` (the paper's F_m).
+    #[serde(default)]
+    pub applied_force: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -323,15 +368,18 @@ pub fn load_deck(path: &Path) -> Result<(Deck, Model), DeckError> {
 
 /// Parse deck text (`file` names it in errors; relative CSV paths resolve against `base`).
 pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), DeckError> {
-    let deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
+    let mut deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
         file: file.into(),
         msg: e.to_string().trim_end().to_string(),
     })?;
-    let model = build(&deck, file, base)?;
+    let (model, probes) = build(&deck, file, base)?;
+    deck.hydraulic_probes = probes;
     Ok((deck, model))
 }
 
-fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
+type Probes = Vec<(String, Arc<HydraulicProbe>)>;
+
+fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError> {
     let inv = |key: String, msg: String| DeckError::Invalid {
         file: file.into(),
         key,
@@ -544,6 +592,14 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
         )
         .map_err(|e| inv(format!("{key}.beam"), e.to_string()))?;
     }
+    let mut probes = vec![];
+    for (i, h) in d.hydraulics.iter().enumerate() {
+        let key = format!("hydraulic[{i}] `{}`", h.name);
+        let (elem, probe) = hydraulic_element(&mut m, h, &key, file, base)?;
+        m.add_step_element(Box::new(elem))
+            .map_err(|e| inv(key, e.to_string()))?;
+        probes.push((h.name.clone(), probe));
+    }
     for (i, s) in d.sensors.iter().enumerate() {
         let key = format!("sensor[{i}] `{}`", s.name);
         let kind = match (&s.node, &s.joint, &s.beam) {
@@ -590,5 +646,187 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<Model, DeckError> {
             "not connected to any element or joint (it would have no mass and no stiffness)".into(),
         ));
     }
-    Ok(m)
+    Ok((m, probes))
+}
+
+/// Builds the element of one `[[hydraulic]]` table (creating and clamping its ground node).
+fn hydraulic_element(
+    m: &mut Model,
+    h: &HydraulicDeck,
+    key: &str,
+    file: &str,
+    base: &Path,
+) -> Result<(HydraulicForceElement, Arc<HydraulicProbe>), DeckError> {
+    let inv = |k: &str, msg: String| DeckError::Invalid {
+        file: file.into(),
+        key: format!("{key}.{k}"),
+        msg,
+    };
+    let node = |m: &Model, k: &str, name: &str| {
+        m.node_id(name).map_err(|_| {
+            inv(
+                k,
+                format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)"),
+            )
+        })
+    };
+    if h.name.is_empty() {
+        return Err(inv("name", "must not be empty".into()));
+    }
+    let b = node(m, "node_b", &h.node_b)?;
+    let a = match (h.node_a.as_str(), h.position_m) {
+        ("ground", Some(p)) => {
+            if !p.iter().all(|x| x.is_finite()) {
+                return Err(inv("position_m", format!("{p:?} is not a finite point")));
+            }
+            let id = m
+                .add_node(&format!("{}.ground", h.name), p, ident())
+                .map_err(|e| inv("name", e.to_string()))?;
+            m.clamp(&format!("{}.ground_clamp", h.name), id)
+                .map_err(|e| inv("name", e.to_string()))?;
+            id
+        }
+        ("ground", None) => {
+            return Err(inv(
+                "position_m",
+                "required with node_a = \"ground\": the ground attachment point [x, y, z] in m"
+                    .into(),
+            ))
+        }
+        (n, None) => node(m, "node_a", n)?,
+        (_, Some(_)) => {
+            return Err(inv(
+                "position_m",
+                "only allowed with node_a = \"ground\" (a node's position is its own)".into(),
+            ))
+        }
+    };
+    if a == b {
+        return Err(inv("node_b", "the device connects a node to itself".into()));
+    }
+    let scheme = match h.scheme.as_deref() {
+        None => Scheme::Rk4,
+        Some(s) => s.parse::<Scheme>().map_err(|e| inv("scheme", e))?,
+    };
+    let substeps = h.substeps.unwrap_or(IntegratorOptions::default().substeps);
+    if substeps == 0 {
+        return Err(inv("substeps", "must be at least 1".into()));
+    }
+    let opts = IntegratorOptions { scheme, substeps };
+    let pb = PathBuf::from(&h.deck);
+    let path = if pb.is_absolute() { pb } else { base.join(pb) };
+    let dfile = path.display().to_string();
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| inv("deck", format!("cannot read device deck {dfile}: {e}")))?;
+    let root: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        inv(
+            "deck",
+            format!(
+                "device deck {dfile} is not valid TOML: {}",
+                e.to_string().trim_end()
+            ),
+        )
+    })?;
+    let device: Box<dyn Device> = match (root.contains_key("actuator"), root.contains_key("damper"))
+    {
+        (true, true) => {
+            return Err(inv(
+                "deck",
+                format!(
+                "device deck {dfile} has both [actuator] and [damper]: give one device per deck"
+            ),
+            ))
+        }
+        (false, false) => {
+            return Err(inv(
+                "deck",
+                format!("device deck {dfile} has neither an [actuator] nor a [damper] table"),
+            ))
+        }
+        (true, false) => {
+            if let Some(md) = h.model.as_deref().filter(|md| *md != "physical") {
+                return Err(inv(
+                    "model",
+                    format!("`{md}`: an actuator deck ({dfile}) has only the physical model"),
+                ));
+            }
+            let params =
+                actuator_from_toml_str(&text, &dfile).map_err(|e| inv("deck", e.to_string()))?;
+            let mut dev = CircuitDevice::new(params.to_circuit(), opts);
+            if let Some(tab) = &h.orifice_area_table {
+                let sch = PiecewiseLinear::new(
+                    tab.iter().map(|p| p[0]).collect(),
+                    tab.iter().map(|p| p[1]).collect(),
+                )
+                .map_err(|e| {
+                    inv(
+                        "orifice_area_table",
+                        format!("expected [[t_s, factor], ...] with increasing times: {e}"),
+                    )
+                })?;
+                if let Some(p) = tab.iter().find(|p| p[1] < 0.0) {
+                    return Err(inv(
+                        "orifice_area_table",
+                        format!(
+                            "factor {} at t = {} s is negative (areas scale by factors >= 0)",
+                            p[1], p[0]
+                        ),
+                    ));
+                }
+                dev.set_orifice_area_schedule(sch);
+            }
+            Box::new(dev)
+        }
+        (false, true) => {
+            if h.orifice_area_table.is_some() {
+                return Err(inv(
+                    "orifice_area_table",
+                    format!("only for actuator decks ([actuator]); {dfile} is a damper deck"),
+                ));
+            }
+            let dd =
+                DamperDeck::from_toml_str(&text, &dfile).map_err(|e| inv("deck", e.to_string()))?;
+            let model = match h.model.as_deref() {
+                None => dd.model,
+                Some(s) => s.parse::<DamperModel>().map_err(|e| inv("model", e))?,
+            };
+            dd.build(model, opts)
+                .map_err(|e| inv("model", e.to_string()))?
+        }
+    };
+    let applied = match h.applied_force.as_deref() {
+        None | Some("end") => AppliedForce::End,
+        Some("mean") => AppliedForce::Mean,
+        Some(o) => {
+            return Err(inv(
+                "applied_force",
+                format!("unknown `{o}` (expected end or mean)"),
+            ))
+        }
+    };
+    let mut elem =
+        HydraulicForceElement::new(h.name.clone(), a, b, device).with_applied_force(applied);
+    let l0 = {
+        let d = sub(m.nodes[b].x0, m.nodes[a].x0);
+        dot(d, d).sqrt()
+    };
+    if l0 <= 0.0 {
+        return Err(inv(
+            "node_b",
+            "the attachment points coincide: the device has no direction".into(),
+        ));
+    }
+    let l_ref = match h.reference_length_m {
+        Some(l) if l > 0.0 && l.is_finite() => l,
+        Some(l) => {
+            return Err(inv(
+                "reference_length_m",
+                format!("{l}: expected a positive length in m"),
+            ))
+        }
+        None => l0,
+    };
+    elem = elem.with_reference_length(l_ref);
+    let probe = elem.probe();
+    Ok((elem, probe))
 }

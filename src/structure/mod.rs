@@ -3,6 +3,7 @@
 #![allow(clippy::needless_range_loop)]
 pub mod beam;
 pub mod deck;
+pub mod hydraulic;
 pub mod joint;
 pub mod kin;
 pub mod model;
@@ -12,6 +13,7 @@ pub mod rotation;
 pub mod section;
 
 pub use beam::{Beam, BeamLoad, SectionLoad};
+pub use hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
 pub use joint::{AngleLaw, Joint, JointKind};
 pub use kin::{EvalCtx, NodeKin, Seed, TimeTable};
 pub use model::{

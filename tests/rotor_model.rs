@@ -1,0 +1,181 @@
+//! UH-60A rotor forced response (issue #6): the model builds with each damper model, runs two
+//! revolutions under the shipped flight record, and the damper coupling obeys its conventions
+//! (FORMATS: stroke positive in extension, force positive pushing the ends apart).
+//! Run: `cargo test --release --test rotor_model`.
+use rotorsim::flight::FlightRecord;
+use rotorsim::hydraulics::DamperModel;
+use rotorsim::rotor::sim::{build_sim, relief_limits, RotorSim};
+use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions, BASE_CHANNELS};
+use std::path::PathBuf;
+
+fn repo(p: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+struct Run {
+    sim: RotorSim,
+    /// Per step: channels, lag angle [rad].
+    rows: Vec<(Vec<f64>, f64)>,
+}
+
+fn run(model: DamperModel, revs: usize, spr: usize) -> Run {
+    let deck = RotorDeck::from_file(&repo("rotors/uh60a.toml")).unwrap();
+    let damper = deck.damper().unwrap();
+    let rec = FlightRecord::read(&repo("flightdata/c8534like.meta.json")).unwrap();
+    let opts = RunOptions {
+        steps_per_rev: spr,
+        ..Default::default()
+    };
+    let mut sim = build_sim(&deck.spec, &deck.path, &damper, model, &rec, &opts).unwrap();
+    let n = sim.channel_names().len();
+    let mut rows = vec![];
+    for _ in 0..revs * spr {
+        sim.step().unwrap();
+        let mut ch = vec![0.0; n];
+        sim.channels(&mut ch);
+        rows.push((ch, sim.lag_angle_rad()));
+    }
+    Run { sim, rows }
+}
+
+/// Exact stroke of the attachment geometry for a lag angle z (aft positive): the blade end sits
+/// at `arm` from the lag axis, the damper line is radial with length l0 at zero lag.
+fn exact_stroke(arm: f64, l0: f64, z: f64) -> f64 {
+    ((l0 + arm * z.sin()).powi(2) + (arm * z.cos() - arm).powi(2)).sqrt() - l0
+}
+
+fn check_common(r: &Run, label: &str) {
+    let deck = RotorDeck::from_file(&repo("rotors/uh60a.toml")).unwrap();
+    let arm = deck.spec.damper_attachment.arm_m;
+    let l0 = deck.spec.damper_attachment.reference_length_m;
+    assert_eq!(r.sim.label(), label);
+    assert_eq!(
+        &r.sim.channel_names()[..6],
+        &BASE_CHANNELS.map(String::from)[..]
+    );
+    let period = r.sim.period_s();
+    assert!((period - 2.0 * std::f64::consts::PI / 27.0).abs() < 1e-12);
+    assert!((r.sim.azimuth_deg() - 720.0).abs() < 1e-6);
+    let mut max_lag: f64 = 0.0;
+    for (ch, lag) in &r.rows {
+        assert!(ch.iter().all(|v| v.is_finite()));
+        // stroke = arm x lag angle, lag aft lengthens the damper; the geometric stroke of the
+        // hinge lag alone is `exact_stroke`, the rest (~3e-5 m) is the elastic stretch and
+        // bending of the hub arm (segment 1) under the centrifugal force and lag moment
+        let d = ch[1];
+        let g = exact_stroke(arm, l0, *lag);
+        assert!(d * lag > 0.0, "{label}: stroke {d} vs lag {lag}");
+        assert!((d - g).abs() < 5e-5, "{label}: stroke {d} vs geometry {g}");
+        assert!((d - arm * lag).abs() < 0.01 * (arm * lag).abs() + 1e-6);
+        // tip lag (aft, hub frame) has the sign of the hinge lag angle and roughly its size
+        let tip_lag = ch[4];
+        let rigid = (8.1786 - 0.381) * lag;
+        assert!(
+            tip_lag * lag > 0.0,
+            "{label}: tip lag {tip_lag} vs hinge lag {lag}"
+        );
+        assert!((tip_lag - rigid).abs() < 0.25 * rigid.abs());
+        max_lag = max_lag.max(lag.abs());
+    }
+    // mean lag aft of a few degrees (drag against the lag spring and centrifugal stiffness)
+    assert!(max_lag > 0.01 && max_lag < 0.2, "{label}: lag {max_lag}");
+    let t = r.sim.timing();
+    assert_eq!(t.steps, r.rows.len());
+    assert!(t.iterations >= t.steps && t.total_s > 0.0);
+}
+
+#[test]
+fn uh60a_linear_damper_two_revolutions() {
+    let r = run(DamperModel::Linear, 2, 256);
+    check_common(&r, "linear");
+    let c = RotorDeck::from_file(&repo("rotors/uh60a.toml"))
+        .unwrap()
+        .damper()
+        .unwrap()
+        .linear_c_n_s_per_m
+        .unwrap();
+    let mut fmax: f64 = 0.0;
+    for (ch, _) in &r.rows {
+        // F = -c d_dot (FORMATS: a damper resists the motion)
+        assert!((ch[0] + c * ch[2]).abs() <= 1e-9 * (c * ch[2]).abs() + 1e-9);
+        fmax = fmax.max(ch[0].abs());
+    }
+    assert!(fmax > 100.0, "damper force stays below {fmax} N");
+    assert_eq!(r.sim.force_limits_n(), None);
+}
+
+#[test]
+fn uh60a_nonlinear_damper_two_revolutions() {
+    let r = run(DamperModel::Nonlinear, 2, 256);
+    check_common(&r, "nonlinear");
+    for (ch, _) in &r.rows {
+        if ch[2].abs() > 1e-3 {
+            assert!(ch[0] * ch[2] < 0.0, "force {} at rate {}", ch[0], ch[2]);
+        }
+    }
+}
+
+#[test]
+fn uh60a_physical_damper_two_revolutions() {
+    let r = run(DamperModel::Physical, 2, 256);
+    check_common(&r, "physical");
+    let names = r.sim.channel_names();
+    for c in [
+        "p0_Pa",
+        "p1_Pa",
+        "q_orifice_m3_s",
+        "x_valve0_m",
+        "x_valve1_m",
+        "v_valve0_m_s",
+        "v_valve1_m_s",
+        "q_valve0_m3_s",
+        "q_valve1_m3_s",
+    ] {
+        assert!(names.iter().any(|n| n == c), "missing channel {c}");
+    }
+    let ip0 = names.iter().position(|n| n == "p0_Pa").unwrap();
+    let ip1 = names.iter().position(|n| n == "p1_Pa").unwrap();
+    let deck = RotorDeck::from_file(&repo("rotors/uh60a.toml"))
+        .unwrap()
+        .damper()
+        .unwrap();
+    let p = deck.physical.clone().unwrap();
+    // the force channel is Eq. (8) of the chamber pressures
+    for (ch, _) in &r.rows {
+        let f8 = ch[ip0] * p.chambers[0].area - ch[ip1] * p.chambers[1].area;
+        assert!((ch[0] - f8).abs() < 1e-6 * (1.0 + f8.abs()));
+    }
+    // resists the motion: force and stroke rate anti-correlated over the run
+    let n = r.rows.len() as f64;
+    let (mf, mv) = r
+        .rows
+        .iter()
+        .fold((0.0, 0.0), |a, (c, _)| (a.0 + c[0] / n, a.1 + c[2] / n));
+    let (mut sfv, mut sff, mut svv) = (0.0, 0.0, 0.0);
+    for (c, _) in &r.rows {
+        sfv += (c[0] - mf) * (c[2] - mv);
+        sff += (c[0] - mf).powi(2);
+        svv += (c[2] - mv).powi(2);
+    }
+    let corr = sfv / (sff * svv).sqrt();
+    assert!(corr < -0.5, "force/rate correlation {corr}");
+    // relief limits from the cracking pressures (+/-3200 lb class for the shipped deck)
+    let (lo, hi) = r.sim.force_limits_n().unwrap();
+    assert_eq!(Some((lo, hi)), relief_limits(&deck));
+    assert!(hi > 13000.0 && hi < 15500.0 && lo < -13000.0 && lo > -15500.0);
+    let t = r.sim.timing();
+    assert!(t.hydraulics_s > 0.0 && t.hydraulics_s < t.total_s);
+}
+
+#[test]
+fn rotor_deck_unknown_key_names_file_line_key() {
+    let text = std::fs::read_to_string(repo("rotors/uh60a.toml"))
+        .unwrap()
+        .replace("arm_m = 0.175", "arm_m = 0.175\narm_lenght_m = 0.2");
+    let e = rotorsim::rotor::deck::RotorSpec::parse(&text, "x/uh60a.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x/uh60a.toml"), "{e}");
+    assert!(e.contains("arm_lenght_m"), "{e}");
+    assert!(e.contains("line"), "{e}");
+}
