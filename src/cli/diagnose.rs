@@ -95,7 +95,7 @@ impl DiagnoseArgs {
 
 /// Stderr progress of a rotor run, every 5 revolutions.
 fn progress_line(what: &str, rev: usize, revs: usize, m: Option<f64>) {
-    if rev % 5 == 0 || rev == revs {
+    if rev.is_multiple_of(5) || rev == revs {
         eprintln!(
             "rotorsim diagnose: {what}: revolution {rev}/{revs}, periodicity {}",
             fmt_measure(m)
@@ -307,9 +307,7 @@ fn rotor_check(
             .as_ref()
             .map_err(|e| anyhow::anyhow!("rotor check, {which} deck: {e}"))?;
         let figs = summary::figures(run, Some(meas))?;
-        let metrics = figs
-            .metrics
-            .context("rotor check: no comparison metrics")?;
+        let metrics = figs.metrics.context("rotor check: no comparison metrics")?;
         parts.push((which, run, deck_label, command, metrics));
     }
     let (b, e) = (&parts[0].4, &parts[1].4);
@@ -323,9 +321,17 @@ fn rotor_check(
             "periodicity after {} revolutions: baseline {} ({}), extended {} ({})",
             opts.revs,
             fmt_measure(rb.last_measure()),
-            if rb.converged() { "periodic" } else { "NOT periodic" },
+            if rb.converged() {
+                "periodic"
+            } else {
+                "NOT periodic"
+            },
             fmt_measure(re.last_measure()),
-            if re.converged() { "periodic" } else { "NOT periodic" }
+            if re.converged() {
+                "periodic"
+            } else {
+                "NOT periodic"
+            }
         )
     };
     let statement = if cause == "none" {
@@ -344,7 +350,13 @@ fn rotor_check(
             e.correlation
         )
     };
-    let side = |p: &(&str, &ModelRun, String, String, crate::analysis::compare::Metrics)| {
+    let side = |p: &(
+        &str,
+        &ModelRun,
+        String,
+        String,
+        crate::analysis::compare::Metrics,
+    )| {
         json!({
             "damper_deck": p.2,
             "command": p.3,
@@ -456,7 +468,10 @@ fn rotor_check(
 fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Result<(), PlotError> {
     r.heading(2, "Rotor-level check (before / after)");
     r.paragraph(&c.statement);
-    r.table(&["metric", "baseline deck", "extended deck", "change"], &c.rows);
+    r.table(
+        &["metric", "baseline deck", "extended deck", "change"],
+        &c.rows,
+    );
     r.paragraph(&format!(
         "Commands (equivalent): {} ; {}. Outputs of each run: rotor_check/baseline/ and rotor_check/extended/ (summary.json, report.html, last_rev.csv).",
         c.json["baseline"]["command"].as_str().unwrap_or(""),
@@ -475,7 +490,10 @@ fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Resu
             _ => p.dashed(name, x, y),
         };
     }
-    r.svg("rotor-level damper force: measured, baseline and extended deck", &p.to_svg(800, 420)?);
+    r.svg(
+        "rotor-level damper force: measured, baseline and extended deck",
+        &p.to_svg(800, 420)?,
+    );
     Ok(())
 }
 
@@ -665,7 +683,10 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     }
     if let Some(c) = &check {
         println!("{}", c.statement);
-        println!("{:<40} {:>14} {:>14}  change", "rotor check", "baseline", "extended");
+        println!(
+            "{:<40} {:>14} {:>14}  change",
+            "rotor check", "baseline", "extended"
+        );
         for row in &c.rows {
             println!("{:<40} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
         }

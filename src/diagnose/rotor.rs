@@ -111,7 +111,10 @@ pub fn flight_measurement(
         bail!("{name}: some damper samples lack a stroke");
     }
     if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
-        bail!("{name}: damper samples not in time order at sample {}", i + 1);
+        bail!(
+            "{name}: damper samples not in time order at sample {}",
+            i + 1
+        );
     }
     let revs = rec.damper_revolutions();
     if revs.windows(2).any(|w| w[1] != w[0] + 1) {
@@ -155,7 +158,10 @@ pub fn mean_and_amplitude(v: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
             (l.min(*x), h.max(*x))
         });
-    (v.iter().sum::<f64>() / v.len().max(1) as f64, 0.5 * (hi - lo))
+    (
+        v.iter().sum::<f64>() / v.len().max(1) as f64,
+        0.5 * (hi - lo),
+    )
 }
 
 /// The two rotor runs of the rotor-level check: physical damper with the baseline deck and with
