@@ -224,6 +224,7 @@ fn rotor_check(
     extended_path: &Path,
     cause: &str,
 ) -> anyhow::Result<RotorCheck> {
+    debug_assert_ne!(cause, "none");
     let rotor_path = args
         .rotor
         .as_ref()
@@ -334,10 +335,7 @@ fn rotor_check(
             }
         )
     };
-    let statement = if cause == "none" {
-        format!("No extension was chosen (cause none): the extended deck is the baseline deck, so the rotor-level comparison cannot change (RMS error {:.1} N both; {periodic_note}).", b.rms_error)
-    } else {
-        format!(
+    let statement = format!(
             "Rotor level (UH-60A rotor model, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
             opts.revs,
             if improved { "lowers" } else { "does NOT lower" },
@@ -348,8 +346,7 @@ fn rotor_check(
             e.peak_to_peak_error,
             b.correlation,
             e.correlation
-        )
-    };
+    );
     let side = |p: &(
         &str,
         &ModelRun,
@@ -468,6 +465,9 @@ fn rotor_check(
 fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Result<(), PlotError> {
     r.heading(2, "Rotor-level check (before / after)");
     r.paragraph(&c.statement);
+    if c.rows.is_empty() {
+        return Ok(());
+    }
     r.table(
         &["metric", "baseline deck", "extended deck", "change"],
         &c.rows,
@@ -606,6 +606,15 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     // The rotor-level before/after runs the deck as written (what `rotorsim run --damper-deck`
     // reads).
     let check = match &record {
+        Some(_) if args.rotor_check && d.cause == "none" => Some(RotorCheck {
+            json: json!({
+                "statement": "No extension was chosen (cause none): the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.",
+                "skipped": true,
+            }),
+            rows: vec![],
+            statement: "Rotor-level check skipped: no extension was chosen (cause none), the extended deck is the baseline deck.".into(),
+            curves: vec![],
+        }),
         Some((rec, fl)) if args.rotor_check => {
             let deck_path = args.write_deck.clone().unwrap_or(deck_file);
             Some(rotor_check(
