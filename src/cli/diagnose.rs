@@ -336,12 +336,13 @@ fn rotor_check(
         )
     };
     let statement = format!(
-            "Rotor level (UH-60A rotor model, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
+            "Rotor level (UH-60A rotor model, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}{}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
             opts.revs,
-            if improved { "lowers" } else { "does NOT lower" },
+            if improved { "lowers" } else { "does NOT improve: it raises" },
             b.rms_error,
             e.rms_error,
             gain,
+            if improved { "" } else { ", no rotor-level gain" },
             b.peak_to_peak_error,
             e.peak_to_peak_error,
             b.correlation,
