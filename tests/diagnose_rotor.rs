@@ -158,3 +158,57 @@ fn record_without_stroke_needs_a_rotor_deck_and_enough_revolutions() {
     .to_string();
     assert!(e.contains("--rotor-check needs a flight record"), "{e}");
 }
+
+#[test]
+fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
+    let dir = tmp("check");
+    let out = dir.join("out");
+    let deck = dir.join("extended.toml");
+    diagnose(DiagnoseArgs {
+        rotor: Some(root().join("rotors/uh60a.toml")),
+        flight: Some(root().join("flightdata/c8534like")),
+        write_deck: Some(deck.clone()),
+        rotor_check: true,
+        check_revs: 2,
+        steps_per_rev: 128,
+        substeps: 50,
+        ..DiagnoseArgs::new(out.clone())
+    })
+    .unwrap();
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
+            .unwrap();
+    // The record has stroke: the existing stroke-driven path, stated as measured.
+    assert_eq!(j["stroke_source"]["kind"], "measured");
+    assert_ne!(j["cause"], "none");
+    let c = &j["rotor_check"];
+    assert_eq!(c["revs"], 2);
+    assert!(c["statement"].as_str().unwrap().contains("Rotor level"));
+    assert!(c["extended"]["command"]
+        .as_str()
+        .unwrap()
+        .contains(&format!("--damper-deck {}", deck.display())));
+    // Each side's metrics are those of its own summary.json (what `rotorsim run` writes).
+    for side in ["baseline", "extended"] {
+        let s: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("rotor_check/{side}/summary.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            s["models"]["physical"]["metrics"]["rms_error"],
+            c[side]["metrics"]["rms_error"]
+        );
+        assert!(!out.join(format!("rotor_check/{side}/INCOMPLETE")).exists());
+    }
+    // The change is the difference of the two, and the gain its relative form.
+    let b = c["baseline"]["metrics"]["rms_error"].as_f64().unwrap();
+    let e = c["extended"]["metrics"]["rms_error"].as_f64().unwrap();
+    assert!(b.is_finite() && e.is_finite() && b > 0.0);
+    assert!((c["change"]["rms_error_N"].as_f64().unwrap() - (e - b)).abs() < 1e-9 * b);
+    assert!((c["change"]["gain"].as_f64().unwrap() - (1.0 - e / b)).abs() < 1e-12);
+    assert_eq!(c["change"]["improved"], e < b);
+    // The decks differ (mount compliance in series), so the two runs do too.
+    assert_ne!(b, e);
+    let html = std::fs::read_to_string(out.join("diagnosis.html")).unwrap();
+    assert!(html.contains("Rotor-level check (before / after)"));
+}
