@@ -21,10 +21,8 @@ fn args(out: PathBuf) -> DiagnoseArgs {
         measured: vec![],
         rotor: Some(root().join("flightdata/damper_nominal.toml")),
         flight: Some(root().join("flightdata/c8534like")),
-        out,
         write_deck: None,
-        fit_cycles: 3,
-        max_substep: 3.0e-5,
+        ..DiagnoseArgs::new(out)
     }
 }
 
@@ -86,7 +84,7 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
 }
 
 #[test]
-fn flight_record_without_stroke_says_the_rotor_run_is_not_available() {
+fn flight_record_without_stroke_needs_a_rotor_deck_for_the_rotor_run() {
     let dir = tmp("nostroke");
     let src = root().join("flightdata");
     for ext in ["meta.json", "airloads.csv"] {
@@ -109,7 +107,7 @@ fn flight_record_without_stroke_says_the_rotor_run_is_not_available() {
     .unwrap_err()
     .to_string();
     assert!(
-        e.contains("no damper stroke") && e.contains("not available yet"),
+        e.contains("no damper stroke") && e.contains("needs a rotor deck"),
         "{e}"
     );
 }

@@ -1,13 +1,22 @@
 //! `rotorsim diagnose` (issue #7): find what the damper model gets wrong in measured data, name
 //! the cause, extend the model and measure the gain on held-out data.
-use crate::diagnose::data::periodic_derivative;
+use crate::diagnose::rotor::{
+    flight_measurement, mean_and_amplitude, periodic_stroke, rotor_check_runs, run_physical,
+    RotorRunOptions,
+};
 use crate::diagnose::{self, DiagnoseOptions, Measurement};
 use crate::flight::FlightRecord;
 use crate::hydraulics::bench::read_bench_csv;
 use crate::hydraulics::DamperDeck;
 use crate::io::{write_atomic, OutDir};
+use crate::report::html::HtmlReport;
+use crate::report::plot::{Plot, PlotError};
+use crate::rotor::RotorDeck;
+use crate::run::summary::{self, Measured, RunInfo};
+use crate::run::{fmt_measure, ModelOutcome, ModelRun};
 use anyhow::{bail, Context};
 use clap::Args;
+use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -36,55 +45,457 @@ pub struct DiagnoseArgs {
     /// Largest RK4 sub-step of the hydraulic model [s].
     #[arg(long, default_value_t = 3.0e-5)]
     pub max_substep: f64,
+    /// Flight record without damper stroke: revolutions of the rotor run (physical damper,
+    /// baseline deck) whose last, periodic revolution gives the simulated stroke.
+    #[arg(long, default_value_t = 40)]
+    pub revs: usize,
+    /// Rotor runs (simulated stroke, --rotor-check): structural steps per revolution.
+    #[arg(long, default_value_t = 256)]
+    pub steps_per_rev: usize,
+    /// Rotor runs (simulated stroke, --rotor-check): hydraulic RK4 sub-steps per structural step.
+    #[arg(long, default_value_t = 25)]
+    pub substeps: usize,
+    /// Flight records: also run the rotor (--rotor must be a rotor deck) with the physical
+    /// damper of the baseline deck and of the extended deck, in parallel, and compare both with
+    /// the record's damper force (the rotor-level before/after; DIR/rotor_check/).
+    #[arg(long)]
+    pub rotor_check: bool,
+    /// Revolutions of each rotor run of --rotor-check (as `rotorsim run --revs`).
+    #[arg(long, default_value_t = 75)]
+    pub check_revs: usize,
 }
 
-fn flight_measurement(rec: &FlightRecord, path: &Path) -> anyhow::Result<Measurement> {
-    if !rec.has_stroke() {
-        bail!(
-            "{}: the record has no damper stroke; diagnosing the damper through the full rotor run is not available yet (the rotor run, issue #6, does not exist): give a record with damper_stroke_m",
-            path.display()
+impl DiagnoseArgs {
+    /// Arguments with the command-line defaults (no data given).
+    pub fn new(out: PathBuf) -> Self {
+        DiagnoseArgs {
+            deck: None,
+            measured: vec![],
+            rotor: None,
+            flight: None,
+            out,
+            write_deck: None,
+            fit_cycles: 3,
+            max_substep: 3.0e-5,
+            revs: 40,
+            steps_per_rev: 256,
+            substeps: 25,
+            rotor_check: false,
+            check_revs: 75,
+        }
+    }
+    fn rotor_opts(&self, revs: usize) -> RotorRunOptions {
+        RotorRunOptions {
+            revs,
+            steps_per_rev: self.steps_per_rev,
+            substeps: self.substeps,
+        }
+    }
+}
+
+/// Stderr progress of a rotor run, every 5 revolutions.
+fn progress_line(what: &str, rev: usize, revs: usize, m: Option<f64>) {
+    if rev.is_multiple_of(5) || rev == revs {
+        eprintln!(
+            "rotorsim diagnose: {what}: revolution {rev}/{revs}, periodicity {}",
+            fmt_measure(m)
         );
     }
-    let omega_deg = rec.meta.rotor_speed_deg_s();
-    let s = rec.damper();
-    let mut t = Vec::with_capacity(s.len());
-    let mut d = Vec::with_capacity(s.len());
-    let mut f = Vec::with_capacity(s.len());
-    for x in s {
-        t.push((x.revolution as f64 * 360.0 + x.azimuth_deg) / omega_deg);
-        d.push(x.stroke_m.unwrap_or(f64::NAN));
-        f.push(x.force_N);
-    }
-    if d.iter().any(|v| !v.is_finite()) {
-        bail!("{}: some damper samples lack a stroke", path.display());
-    }
-    if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
-        bail!(
-            "{}: damper samples not in time order at sample {}",
-            path.display(),
-            i + 1
-        );
-    }
-    let revs = rec.damper_revolutions();
-    if revs.windows(2).any(|w| w[1] != w[0] + 1) {
-        bail!(
-            "{}: damper revolutions have gaps ({revs:?}); the stroke-driven replay needs a continuous record",
-            path.display()
-        );
-    }
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    // The record is periodic over whole revolutions: periodic derivative of the stroke.
-    let v = periodic_derivative(&d, dt);
-    Ok(Measurement {
-        name: path
-            .file_name()
-            .map_or("flight".into(), |s| s.to_string_lossy().into_owned()),
-        time_s: t,
-        stroke_m: d,
-        force_n: f,
-        velocity_m_s: v,
-        period_s: 360.0 / omega_deg,
+}
+
+/// JSON facts of a rotor run made by the diagnosis.
+fn run_json(r: &ModelRun, opts: &RotorRunOptions) -> Value {
+    json!({
+        "revolutions": r.revolutions,
+        "steps_per_rev": r.steps_per_rev,
+        "substeps": opts.substeps,
+        "scheme": "rk4",
+        "periodicity_last": r.last_measure(),
+        "periodic": r.converged(),
+        "periodicity_statement": summary::periodicity_statement(r),
+        "wall_time_s": r.wall_s,
     })
+}
+
+/// A record without stroke: the stroke of the rotor model with the baseline (physical) damper,
+/// after `opts.revs` revolutions, at the record's azimuths.
+fn simulated_measurement(
+    rec: &FlightRecord,
+    fl: &Path,
+    rotor_path: &Path,
+    deck: &DamperDeck,
+    opts: &RotorRunOptions,
+) -> anyhow::Result<(Measurement, Value, String)> {
+    let rotor = RotorDeck::from_file(rotor_path).with_context(|| {
+        format!(
+            "{}: the record has no damper stroke, so the stroke is simulated by the full rotor run, which needs a rotor deck: --rotor {} is not one",
+            fl.display(),
+            rotor_path.display()
+        )
+    })?;
+    eprintln!(
+        "rotorsim diagnose: {} has no damper stroke: running the rotor {} (physical damper, baseline deck) for {} revolutions x {} steps to simulate it",
+        fl.display(),
+        rotor_path.display(),
+        opts.revs,
+        opts.steps_per_rev
+    );
+    let cb = |rev: usize, m: Option<f64>| progress_line("stroke run", rev, opts.revs, m);
+    let run = run_physical(&rotor, deck, rec, opts, &cb)
+        .context("simulating the damper stroke by the rotor run")?;
+    let interp = periodic_stroke(&run)?;
+    let m = flight_measurement(rec, fl, Some(&interp))?;
+    let d = run.channel("damper_stroke_m").unwrap_or_default();
+    let (mean, amp) = mean_and_amplitude(d);
+    let periodic = run.converged();
+    let statement = format!(
+        "The stroke is SIMULATED, not measured: the record has no damper stroke, so the damper is driven by the periodic stroke of the rotor model ({}, physical damper of the baseline deck, last of {} revolutions, {}; mean {:.2} mm, amplitude {:.2} mm), interpolated at the record's azimuths, and compared with the record's measured force. Any error of the rotor model's stroke (amplitude, phase, mean) shows up as a damper discrepancy: a named cause is a cause of the force-vs-simulated-stroke mismatch, not necessarily of the damper alone.",
+        rotor_path.display(),
+        run.revolutions,
+        summary::periodicity_statement(&run),
+        1e3 * mean,
+        1e3 * amp
+    );
+    let mut info = json!({
+        "kind": "simulated",
+        "statement": statement,
+        "rotor": rotor_path.display().to_string(),
+        "damper_model": "physical",
+        "stroke_mean_m": mean,
+        "stroke_amplitude_m": amp,
+    });
+    info["rotor_run"] = run_json(&run, opts);
+    if !periodic {
+        info["warning"] = json!(format!(
+            "the rotor run is NOT periodic after {} revolutions: the simulated stroke is not yet the periodic one; run more revolutions (--revs)",
+            run.revolutions
+        ));
+    }
+    Ok((m, info, statement))
+}
+
+/// The rotor-level before/after: JSON object, HTML rows, console lines.
+struct RotorCheck {
+    json: Value,
+    /// (metric, baseline, extended, change) rows.
+    rows: Vec<Vec<String>>,
+    statement: String,
+    /// Last revolution of each model and the measurement, for the figure.
+    curves: Vec<(String, Vec<f64>, Vec<f64>)>,
+}
+
+fn harmonic_rows(
+    rows: &mut Vec<Vec<String>>,
+    b: &crate::analysis::compare::Metrics,
+    e: &crate::analysis::compare::Metrics,
+) {
+    for n in 1..=4usize {
+        let (hb, he, hm) = (
+            &b.harmonics_model[n],
+            &e.harmonics_model[n],
+            &b.harmonics_measured[n],
+        );
+        rows.push(vec![
+            format!("{n}/rev amplitude [N] (measured {:.0})", hm.amplitude),
+            format!("{:.0}", hb.amplitude),
+            format!("{:.0}", he.amplitude),
+            format!("{:+.0}", he.amplitude - hb.amplitude),
+        ]);
+        rows.push(vec![
+            format!("{n}/rev phase [deg] (measured {:.1})", hm.phase_deg),
+            format!("{:.1}", hb.phase_deg),
+            format!("{:.1}", he.phase_deg),
+            format!(
+                "{:+.1}",
+                (he.phase_deg - hb.phase_deg + 180.0).rem_euclid(360.0) - 180.0
+            ),
+        ]);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn rotor_check(
+    args: &DiagnoseArgs,
+    out: &OutDir,
+    rec: &FlightRecord,
+    fl: &Path,
+    base: &DamperDeck,
+    base_label: &str,
+    extended_path: &Path,
+    cause: &str,
+) -> anyhow::Result<RotorCheck> {
+    debug_assert_ne!(cause, "none");
+    let rotor_path = args
+        .rotor
+        .as_ref()
+        .context("--rotor-check needs --rotor ROTOR (a rotor deck)")?;
+    let rotor = RotorDeck::from_file(rotor_path).with_context(|| {
+        format!(
+            "--rotor-check runs the rotor: --rotor {} must be a rotor deck",
+            rotor_path.display()
+        )
+    })?;
+    let extended = DamperDeck::from_file(extended_path)?;
+    let opts = args.rotor_opts(args.check_revs);
+    opts.check()?;
+    let measured = Measured::from_record(rec);
+    let meas = measured
+        .as_ref()
+        .map_err(|e| anyhow::anyhow!("--rotor-check: {e}"))?;
+    eprintln!(
+        "rotorsim diagnose: rotor check: {} revolutions x {} steps, physical damper, baseline deck and extended deck in parallel",
+        opts.revs, opts.steps_per_rev
+    );
+    let revs = opts.revs;
+    let cb = |which: &str, rev: usize, m: Option<f64>| {
+        progress_line(&format!("rotor check {which}"), rev, revs, m)
+    };
+    let runs = rotor_check_runs(&rotor, base, &extended, rec, &opts, &cb);
+    // Each run's own outputs, exactly as `rotorsim run --damper physical` writes them.
+    let cmd = |deck: Option<&Path>| {
+        format!(
+            "rotorsim run --rotor {} --flight {} --damper physical{} --revs {} --steps-per-rev {} --substeps {} --scheme rk4",
+            rotor_path.display(),
+            fl.display(),
+            deck.map(|p| format!(" --damper-deck {}", p.display()))
+                .unwrap_or_default(),
+            opts.revs,
+            opts.steps_per_rev,
+            opts.substeps
+        )
+    };
+    let base_deck_arg = args.deck.as_deref();
+    let mut parts = Vec::new();
+    for (which, res, deck_label, command) in [
+        (
+            "baseline",
+            &runs.baseline,
+            base_label.to_string(),
+            cmd(base_deck_arg),
+        ),
+        (
+            "extended",
+            &runs.extended,
+            extended_path.display().to_string(),
+            cmd(Some(extended_path)),
+        ),
+    ] {
+        let sub = OutDir::create(&out.file("rotor_check").join(which))?;
+        let outcome = ModelOutcome {
+            model: crate::hydraulics::DamperModel::Physical,
+            result: res.clone(),
+        };
+        let info = RunInfo {
+            rotor: rotor_path.display().to_string(),
+            rotor_model: "UH-60A multibody rotor".into(),
+            flight: fl.display().to_string(),
+            damper_deck: deck_label.clone(),
+            revs: opts.revs,
+            steps_per_rev: opts.steps_per_rev,
+            substeps: opts.substeps,
+            scheme: "rk4".into(),
+            synthetic: rec.meta.synthetic,
+            counter: rec.meta.counter.clone(),
+            wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
+        };
+        let failed = super::run_cmd::write_outputs(&sub, &info, &[outcome], &measured)?;
+        if failed.is_empty() {
+            sub.finish()?;
+        } else {
+            sub.mark_incomplete(&failed.join("; "))?;
+        }
+        let run = res
+            .as_ref()
+            .map_err(|e| anyhow::anyhow!("rotor check, {which} deck: {e}"))?;
+        let figs = summary::figures(run, Some(meas))?;
+        let metrics = figs.metrics.context("rotor check: no comparison metrics")?;
+        parts.push((which, run, deck_label, command, metrics));
+    }
+    let (b, e) = (&parts[0].4, &parts[1].4);
+    let gain = 1.0 - e.rms_error / b.rms_error;
+    let improved = e.rms_error < b.rms_error;
+    let (rb, re) = (parts[0].1, parts[1].1);
+    let periodic_note = if rb.converged() && re.converged() {
+        format!("both runs periodic after {} revolutions", opts.revs)
+    } else {
+        format!(
+            "periodicity after {} revolutions: baseline {} ({}), extended {} ({})",
+            opts.revs,
+            fmt_measure(rb.last_measure()),
+            if rb.converged() {
+                "periodic"
+            } else {
+                "NOT periodic"
+            },
+            fmt_measure(re.last_measure()),
+            if re.converged() {
+                "periodic"
+            } else {
+                "NOT periodic"
+            }
+        )
+    };
+    let statement = format!(
+            "Rotor level (UH-60A rotor model, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}{}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
+            opts.revs,
+            if improved { "lowers" } else { "does NOT improve: it raises" },
+            b.rms_error,
+            e.rms_error,
+            gain,
+            if improved { "" } else { ", no rotor-level gain" },
+            b.peak_to_peak_error,
+            e.peak_to_peak_error,
+            b.correlation,
+            e.correlation
+    );
+    let side = |p: &(
+        &str,
+        &ModelRun,
+        String,
+        String,
+        crate::analysis::compare::Metrics,
+    )| {
+        json!({
+            "damper_deck": p.2,
+            "command": p.3,
+            "summary": format!("rotor_check/{}/summary.json", p.0),
+            "run": run_json(p.1, &opts),
+            "metrics": p.4,
+        })
+    };
+    let json = json!({
+        "statement": statement,
+        "rotor": rotor_path.display().to_string(),
+        "flight": fl.display().to_string(),
+        "damper_model": "physical",
+        "revs": opts.revs,
+        "steps_per_rev": opts.steps_per_rev,
+        "substeps": opts.substeps,
+        "scheme": "rk4",
+        "wall_time_s": runs.wall_s,
+        "baseline": side(&parts[0]),
+        "extended": side(&parts[1]),
+        "change": {
+            "rms_error_N": e.rms_error - b.rms_error,
+            "gain": gain,
+            "improved": improved,
+            "peak_to_peak_error_N": e.peak_to_peak_error - b.peak_to_peak_error,
+            "correlation": e.correlation - b.correlation,
+        },
+    });
+    let f = |x: f64| format!("{x:.1}");
+    let mut rows = vec![
+        vec![
+            "RMS error [N]".into(),
+            f(b.rms_error),
+            f(e.rms_error),
+            format!("{:+.1} (gain {:.3})", e.rms_error - b.rms_error, gain),
+        ],
+        vec![
+            "RMS error / measured RMS".into(),
+            format!("{:.3}", b.rms_error_rel),
+            format!("{:.3}", e.rms_error_rel),
+            format!("{:+.3}", e.rms_error_rel - b.rms_error_rel),
+        ],
+        vec![
+            "max |error| [N]".into(),
+            f(b.max_abs_error),
+            f(e.max_abs_error),
+            format!("{:+.1}", e.max_abs_error - b.max_abs_error),
+        ],
+        vec![
+            format!("peak-to-peak [N] (measured {:.0})", b.peak_to_peak_measured),
+            format!("{:.0}", b.peak_to_peak_model),
+            format!("{:.0}", e.peak_to_peak_model),
+            format!("{:+.0}", e.peak_to_peak_model - b.peak_to_peak_model),
+        ],
+        vec![
+            "peak-to-peak error [N]".into(),
+            format!("{:+.0}", b.peak_to_peak_error),
+            format!("{:+.0}", e.peak_to_peak_error),
+            String::new(),
+        ],
+        vec![
+            format!("mean [N] (measured {:.0})", b.mean_measured),
+            format!("{:.0}", b.mean_model),
+            format!("{:.0}", e.mean_model),
+            format!("{:+.0}", e.mean_model - b.mean_model),
+        ],
+        vec![
+            "correlation".into(),
+            format!("{:.4}", b.correlation),
+            format!("{:.4}", e.correlation),
+            format!("{:+.4}", e.correlation - b.correlation),
+        ],
+    ];
+    harmonic_rows(&mut rows, b, e);
+    rows.push(vec![
+        "periodicity (last revolution)".into(),
+        fmt_measure(rb.last_measure()),
+        fmt_measure(re.last_measure()),
+        String::new(),
+    ]);
+    rows.push(vec![
+        "wall time [s]".into(),
+        format!("{:.1}", rb.wall_s),
+        format!("{:.1}", re.wall_s),
+        format!("both in parallel {:.1}", runs.wall_s),
+    ]);
+    let mut curves = vec![(
+        "measured (revolution average)".to_string(),
+        meas.azimuth_deg.clone(),
+        meas.force_n.clone(),
+    )];
+    for p in &parts {
+        if let Some(fz) = p.1.channel("damper_force_N") {
+            curves.push((
+                format!("{} deck", p.0),
+                p.1.azimuth_deg.clone(),
+                fz.to_vec(),
+            ));
+        }
+    }
+    Ok(RotorCheck {
+        json,
+        rows,
+        statement,
+        curves,
+    })
+}
+
+fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Result<(), PlotError> {
+    r.heading(2, "Rotor-level check (before / after)");
+    r.paragraph(&c.statement);
+    if c.rows.is_empty() {
+        return Ok(());
+    }
+    r.table(
+        &["metric", "baseline deck", "extended deck", "change"],
+        &c.rows,
+    );
+    r.paragraph(&format!(
+        "Commands (equivalent): {} ; {}. Outputs of each run: rotor_check/baseline/ and rotor_check/extended/ (summary.json, report.html, last_rev.csv).",
+        c.json["baseline"]["command"].as_str().unwrap_or(""),
+        c.json["extended"]["command"].as_str().unwrap_or("")
+    ));
+    let syn = if synthetic { " (SYNTHETIC record)" } else { "" };
+    let mut p = Plot::new(
+        &format!("Damper force over the last revolution{syn}"),
+        "azimuth [deg]",
+        "damper force [N]",
+    );
+    for (i, (name, x, y)) in c.curves.iter().enumerate() {
+        p = match i {
+            0 => p.points(name, x, y),
+            1 => p.line(name, x, y),
+            _ => p.dashed(name, x, y),
+        };
+    }
+    r.svg(
+        "rotor-level damper force: measured, baseline and extended deck",
+        &p.to_svg(800, 420)?,
+    );
+    Ok(())
 }
 
 pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
@@ -94,6 +505,12 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     if !(args.max_substep > 0.0 && args.max_substep.is_finite()) {
         bail!("--max-substep must be a positive number of seconds");
     }
+    if args.rotor_check && args.flight.is_none() {
+        bail!("--rotor-check needs a flight record (--rotor ROTOR --flight RECORD): it compares rotor runs with the record's damper force");
+    }
+    let mut stroke_info: Option<Value> = None;
+    let mut record: Option<(FlightRecord, PathBuf)> = None;
+    let mut deck_label = String::new();
     let (deck, data, source) = match (&args.flight, args.measured.is_empty()) {
         (Some(fl), true) => {
             let deck_path = args
@@ -102,15 +519,43 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
                 .or(args.rotor.clone())
                 .context("--flight needs --rotor ROTOR (or --deck DECK) for the baseline damper")?;
             let deck = DamperDeck::from_file(&deck_path)?;
+            deck_label = deck_path.display().to_string();
             let rec = FlightRecord::read(fl)?;
-            let m = flight_measurement(&rec, fl)?;
             let synth = if rec.meta.synthetic { " SYNTHETIC record (labelled synthetic in its metadata)." } else { "" };
-            let src = format!(
-                "Flight record {} (stroke-driven replay of the damper, Omega = {} rad/s), baseline deck {}.{synth}",
-                fl.display(),
-                rec.meta.rotor_speed_rad_s,
-                deck_path.display()
-            );
+            let (m, src) = if rec.has_stroke() {
+                let m = flight_measurement(&rec, fl, None)?;
+                stroke_info = Some(json!({
+                    "kind": "measured",
+                    "statement": "The stroke is the record's measured damper stroke (stroke-driven replay).",
+                }));
+                let src = format!(
+                    "Flight record {} (stroke-driven replay of the damper, Omega = {} rad/s), baseline deck {}.{synth}",
+                    fl.display(),
+                    rec.meta.rotor_speed_rad_s,
+                    deck_path.display()
+                );
+                (m, src)
+            } else {
+                let rotor_path = args.rotor.clone().with_context(|| {
+                    format!(
+                        "{}: the record has no damper stroke: the stroke is simulated by the full rotor run, which needs --rotor ROTOR (a rotor deck)",
+                        fl.display()
+                    )
+                })?;
+                let opts = args.rotor_opts(args.revs);
+                opts.check()?;
+                let (m, info, statement) =
+                    simulated_measurement(&rec, fl, &rotor_path, &deck, &opts)?;
+                stroke_info = Some(info);
+                let src = format!(
+                    "Flight record {} WITHOUT damper stroke (Omega = {} rad/s), baseline deck {}. {statement}{synth}",
+                    fl.display(),
+                    rec.meta.rotor_speed_rad_s,
+                    deck_path.display()
+                );
+                (m, src)
+            };
+            record = Some((rec, fl.clone()));
             (deck, vec![m], src)
         }
         (None, false) => {
@@ -149,22 +594,68 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     let outcome = diagnose::diagnose(&deck, &data, &opts)?;
     let d = &outcome.diagnosis;
     let out = OutDir::create(&args.out)?;
-    out.write(
-        "diagnosis.json",
-        serde_json::to_string_pretty(d)?.as_bytes(),
-    )?;
-    let html = diagnose::report::html(d, &outcome.curves, &source)?;
-    out.write("diagnosis.html", html.as_bytes())?;
     let deck_text = format!(
         "# Extended damper deck written by `rotorsim diagnose` (cause: {}), from {}\n{}",
         d.cause,
         deck.source,
         outcome.extended.to_toml()
     );
-    out.write("extended_deck.toml", deck_text.as_bytes())?;
+    let deck_file = out.write("extended_deck.toml", deck_text.as_bytes())?;
     if let Some(p) = &args.write_deck {
         write_atomic(p, deck_text.as_bytes())?;
     }
+    // The rotor-level before/after runs the deck as written (what `rotorsim run --damper-deck`
+    // reads).
+    let check = match &record {
+        Some(_) if args.rotor_check && d.cause == "none" => Some(RotorCheck {
+            json: json!({
+                "statement": "No extension was chosen (cause none): the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.",
+                "skipped": true,
+            }),
+            rows: vec![],
+            statement: "Rotor-level check skipped: no extension was chosen (cause none), the extended deck is the baseline deck.".into(),
+            curves: vec![],
+        }),
+        Some((rec, fl)) if args.rotor_check => {
+            let deck_path = args.write_deck.clone().unwrap_or(deck_file);
+            Some(rotor_check(
+                &args,
+                &out,
+                rec,
+                fl,
+                &deck,
+                &deck_label,
+                &deck_path,
+                &d.cause,
+            )?)
+        }
+        _ => None,
+    };
+    // diagnosis.json: the FORMATS.md keys and the existing extras, plus new keys only.
+    let mut json = serde_json::to_value(d)?;
+    if let Some(obj) = json.as_object_mut() {
+        if let Some(s) = &stroke_info {
+            obj.insert("stroke_source".into(), s.clone());
+        }
+        if let Some(c) = &check {
+            obj.insert("rotor_check".into(), c.json.clone());
+        }
+    }
+    out.write(
+        "diagnosis.json",
+        serde_json::to_string_pretty(&json)?.as_bytes(),
+    )?;
+    let synthetic = record.as_ref().is_some_and(|(r, _)| r.meta.synthetic);
+    let html = diagnose::report::html_with(d, &outcome.curves, &source, |r| {
+        if let Some(w) = stroke_info.as_ref().and_then(|s| s.get("warning")) {
+            r.notice(w.as_str().unwrap_or_default());
+        }
+        match &check {
+            Some(c) => rotor_check_html(r, c, synthetic),
+            None => Ok(()),
+        }
+    })?;
+    out.write("diagnosis.html", html.as_bytes())?;
     out.finish()?;
     println!("cause: {}", d.cause);
     for (k, v) in &d.parameters {
@@ -191,6 +682,24 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     }
     for l in &d.limitations {
         println!("limitation: {l}");
+    }
+    if let Some(s) = &stroke_info {
+        if s["kind"] == "simulated" {
+            println!("stroke: {}", s["statement"].as_str().unwrap_or_default());
+            if let Some(w) = s.get("warning") {
+                println!("warning: {}", w.as_str().unwrap_or_default());
+            }
+        }
+    }
+    if let Some(c) = &check {
+        println!("{}", c.statement);
+        println!(
+            "{:<40} {:>14} {:>14}  change",
+            "rotor check", "baseline", "extended"
+        );
+        for row in &c.rows {
+            println!("{:<40} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
+        }
     }
     println!(
         "wrote {}/diagnosis.json and diagnosis.html",

@@ -7,6 +7,7 @@ pub mod data;
 pub mod evidence;
 pub mod fit;
 pub mod report;
+pub mod rotor;
 
 pub use candidates::Cause;
 pub use data::{check_measurements, Measurement};

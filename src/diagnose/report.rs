@@ -6,6 +6,17 @@ use crate::report::plot::{Plot, PlotError};
 
 /// HTML report of a diagnosis; `source` describes the data (and says synthetic where it is).
 pub fn html(d: &Diagnosis, curves: &[Curves], source: &str) -> Result<String, PlotError> {
+    html_with(d, curves, source, |_| Ok(()))
+}
+
+/// As [`html`], with extra sections (e.g. the rotor-level check) after the headline and the
+/// limitations.
+pub fn html_with(
+    d: &Diagnosis,
+    curves: &[Curves],
+    source: &str,
+    extra: impl FnOnce(&mut HtmlReport) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
     let mut r = HtmlReport::new("rotorsim diagnosis");
     r.heading(1, &format!("Diagnosis: {}", d.cause));
     r.paragraph(source);
@@ -28,6 +39,7 @@ pub fn html(d: &Diagnosis, curves: &[Curves], source: &str) -> Result<String, Pl
     for l in &d.limitations {
         r.notice(l);
     }
+    extra(&mut r)?;
     r.heading(2, "Evidence");
     r.list(&d.evidence);
     r.heading(2, "Candidates (ranked by BIC)");

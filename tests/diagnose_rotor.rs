@@ -1,0 +1,214 @@
+//! `rotorsim diagnose --rotor ROTOR --flight RECORD` for a record WITHOUT damper stroke: the
+//! stroke is simulated by the full rotor run (UH-60A rotor model, physical damper of the rotor
+//! deck) and the damper is diagnosed stroke-driven on it. Short run (few revolutions, coarse
+//! steps) so the test stays fast; the periodicity statement then says it is not periodic.
+use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
+use rotorsim::flight::{DamperSample, FlightRecord};
+use std::path::{Path, PathBuf};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rotorsim-diagrot-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// flightdata/c8534like with the damper stroke removed (same airloads, controls and force).
+fn record_without_stroke(dir: &Path) -> (PathBuf, FlightRecord) {
+    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    assert!(rec.has_stroke());
+    let damper: Vec<DamperSample> = rec
+        .damper()
+        .iter()
+        .map(|s| DamperSample {
+            stroke_m: None,
+            ..*s
+        })
+        .collect();
+    let stripped = FlightRecord::new(
+        rec.meta.clone(),
+        rec.stations_r_over_r().to_vec(),
+        rec.revolutions().to_vec(),
+        rec.azimuths_deg().to_vec(),
+        rec.normal_n_per_m().to_vec(),
+        rec.chord_n_per_m().to_vec(),
+        rec.moment_n_m_per_m().to_vec(),
+        damper,
+    )
+    .unwrap();
+    let stem = dir.join("nostroke");
+    stripped.write_csv(&stem).unwrap();
+    let back = FlightRecord::read(&stem).unwrap();
+    assert!(!back.has_stroke(), "the copy must have no stroke column");
+    (stem, rec)
+}
+
+#[test]
+fn record_without_stroke_is_diagnosed_through_the_rotor_run() {
+    let dir = tmp("sim");
+    let (stem, original) = record_without_stroke(&dir);
+    let out = dir.join("out");
+    let revs = 4;
+    diagnose(DiagnoseArgs {
+        rotor: Some(root().join("rotors/uh60a.toml")),
+        flight: Some(stem.clone()),
+        revs,
+        steps_per_rev: 128,
+        // Same hydraulic sub-step as 256 x 25 (64 steps per revolution do not converge) (3.6e-5 s, the explicit RK4 limit of the damper).
+        substeps: 50,
+        ..DiagnoseArgs::new(out.clone())
+    })
+    .unwrap();
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
+            .unwrap();
+    // FORMATS.md keys are all there.
+    for k in [
+        "cause",
+        "parameters",
+        "baseline_rms_N",
+        "extended_rms_N",
+        "gain",
+        "validation",
+        "candidates",
+        "evidence",
+    ] {
+        assert!(j.get(k).is_some(), "missing key {k}");
+    }
+    // A cause or `none`, from the candidate library.
+    let cause = j["cause"].as_str().unwrap();
+    let known: Vec<&str> = j["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["cause"].as_str().unwrap())
+        .collect();
+    assert!(
+        cause == "none" || cause.split('+').all(|c| known.contains(&c)),
+        "cause {cause} not among {known:?}"
+    );
+    assert!(j["baseline_rms_N"].as_f64().unwrap().is_finite());
+    // The stroke is stated to be simulated, by which run.
+    let s = &j["stroke_source"];
+    assert_eq!(s["kind"], "simulated");
+    let st = s["statement"].as_str().unwrap();
+    assert!(
+        st.contains("SIMULATED, not measured") && st.contains("uh60a.toml"),
+        "{st}"
+    );
+    assert_eq!(s["rotor_run"]["revolutions"], revs);
+    assert_eq!(s["rotor_run"]["steps_per_rev"], 128);
+    // The simulated stroke moves (a lag damper on a forced rotor), in millimetres.
+    let amp = s["stroke_amplitude_m"].as_f64().unwrap();
+    assert!(amp > 1e-4 && amp < 0.05, "stroke amplitude {amp} m");
+    // 4 revolutions are not enough to be periodic: it must say so.
+    if s["rotor_run"]["periodic"] == false {
+        assert!(s["warning"].as_str().unwrap().contains("NOT periodic"));
+    }
+    // The measured force is the record's, at its own samples (the simulated stroke is
+    // interpolated at the record's azimuths): the test's peak force is the record's.
+    let peak = original
+        .damper()
+        .iter()
+        .fold(0.0f64, |m, s| m.max(s.force_N.abs()));
+    let tp = j["tests"][0]["peak_force_N"].as_f64().unwrap();
+    assert!((tp - peak).abs() <= 1e-6 * peak, "{tp} vs {peak}");
+    let html = std::fs::read_to_string(out.join("diagnosis.html")).unwrap();
+    assert!(html.contains("SIMULATED, not measured"));
+    assert!(!out.join("INCOMPLETE").exists());
+}
+
+#[test]
+fn record_without_stroke_needs_a_rotor_deck_and_enough_revolutions() {
+    let dir = tmp("err");
+    let (stem, _) = record_without_stroke(&dir);
+    // No --rotor: the baseline deck alone cannot simulate the stroke.
+    let e = diagnose(DiagnoseArgs {
+        deck: Some(root().join("flightdata/damper_nominal.toml")),
+        flight: Some(stem.clone()),
+        ..DiagnoseArgs::new(dir.join("out"))
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("no damper stroke") && e.contains("--rotor ROTOR"),
+        "{e}"
+    );
+    let e = diagnose(DiagnoseArgs {
+        rotor: Some(root().join("rotors/uh60a.toml")),
+        flight: Some(stem),
+        revs: 1,
+        ..DiagnoseArgs::new(dir.join("out"))
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--revs must be at least 2"), "{e}");
+    // --rotor-check without a flight record.
+    let e = diagnose(DiagnoseArgs {
+        deck: Some(root().join("flightdata/damper_nominal.toml")),
+        measured: vec![root().join("nonexistent.csv")],
+        rotor_check: true,
+        ..DiagnoseArgs::new(dir.join("out"))
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--rotor-check needs a flight record"), "{e}");
+}
+
+#[test]
+fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
+    let dir = tmp("check");
+    let out = dir.join("out");
+    let deck = dir.join("extended.toml");
+    diagnose(DiagnoseArgs {
+        rotor: Some(root().join("rotors/uh60a.toml")),
+        flight: Some(root().join("flightdata/c8534like")),
+        write_deck: Some(deck.clone()),
+        rotor_check: true,
+        check_revs: 2,
+        steps_per_rev: 128,
+        substeps: 50,
+        ..DiagnoseArgs::new(out.clone())
+    })
+    .unwrap();
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
+            .unwrap();
+    // The record has stroke: the existing stroke-driven path, stated as measured.
+    assert_eq!(j["stroke_source"]["kind"], "measured");
+    assert_ne!(j["cause"], "none");
+    let c = &j["rotor_check"];
+    assert_eq!(c["revs"], 2);
+    assert!(c["statement"].as_str().unwrap().contains("Rotor level"));
+    assert!(c["extended"]["command"]
+        .as_str()
+        .unwrap()
+        .contains(&format!("--damper-deck {}", deck.display())));
+    // Each side's metrics are those of its own summary.json (what `rotorsim run` writes).
+    for side in ["baseline", "extended"] {
+        let s: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("rotor_check/{side}/summary.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            s["models"]["physical"]["metrics"]["rms_error"],
+            c[side]["metrics"]["rms_error"]
+        );
+        assert!(!out.join(format!("rotor_check/{side}/INCOMPLETE")).exists());
+    }
+    // The change is the difference of the two, and the gain its relative form.
+    let b = c["baseline"]["metrics"]["rms_error"].as_f64().unwrap();
+    let e = c["extended"]["metrics"]["rms_error"].as_f64().unwrap();
+    assert!(b.is_finite() && e.is_finite() && b > 0.0);
+    assert!((c["change"]["rms_error_N"].as_f64().unwrap() - (e - b)).abs() < 1e-9 * b);
+    assert!((c["change"]["gain"].as_f64().unwrap() - (1.0 - e / b)).abs() < 1e-12);
+    assert_eq!(c["change"]["improved"], e < b);
+    // The decks differ (mount compliance in series), so the two runs do too.
+    assert_ne!(b, e);
+    let html = std::fs::read_to_string(out.join("diagnosis.html")).unwrap();
+    assert!(html.contains("Rotor-level check (before / after)"));
+}
