@@ -432,3 +432,29 @@ fn series_mount_deck_key_wraps_the_damper() {
         assert!((x - y).abs() < 0.5, "{x} vs {y}");
     }
 }
+
+/// A stiff mount in series with a dashpot whose force has a sharp kink (steep below 1 mm/s,
+/// flat above, like a relief-limited damper): the inner solve must reach force balance,
+/// `F = k (d_h - d)`, at every step, including where a plain secant stalls on the kink.
+#[test]
+fn series_mount_balances_force_across_a_kinked_device_law() {
+    let table = rotorsim::hydraulics::dashpot::MonotoneTable::new(
+        vec![0.0, 0.001, 0.4],
+        vec![0.0, 14000.0, 14500.0],
+    )
+    .unwrap();
+    let k = 5.0e7;
+    let mut dev = SeriesMount::new(Box::new(NonlinearDashpot::new(table)), k);
+    let (a, w) = (4.0e-3, 27.0);
+    let n = 256;
+    let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+    let mut worst: f64 = 0.0;
+    for i in 0..3 * n {
+        let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+        let d1 = a * (w * t1).sin();
+        let sf = dev.trial_step(t0, dt, a * (w * t0).sin(), d1).unwrap();
+        dev.commit();
+        worst = worst.max((sf.force_end - k * (dev.device_stroke() - d1)).abs());
+    }
+    assert!(worst <= 0.1 + 1e-9, "largest force mismatch {worst} N");
+}

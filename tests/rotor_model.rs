@@ -252,10 +252,14 @@ fn expand_prints_a_model_deck_that_loads_back() {
 
 #[test]
 fn transient_table_is_checked_and_runs() {
-    let base = std::fs::read_to_string(repo("rotors/uh60a.toml")).unwrap();
-    // the shipped deck enables it
-    assert!(base.contains("[transient]"));
-    let bad = base.replace("washout_alpha = 0.2", "washout_alpha = 1.5");
+    let shipped = std::fs::read_to_string(repo("rotors/uh60a.toml")).unwrap();
+    // the shipped deck leaves it off (it uses the [blade] perturbation damping instead)
+    let spec = rotorsim::rotor::deck::RotorSpec::parse(&shipped, "t.toml").unwrap();
+    assert!(spec.transient.is_none());
+    let base = format!(
+        "{shipped}\n[transient]\nlift_slope_per_rad = 5.73\nchord_m = 0.527\nwashout_alpha = 0.2\n"
+    );
+    let bad = base.replace("\nwashout_alpha = 0.2", "\nwashout_alpha = 1.5");
     let e = rotorsim::rotor::deck::RotorSpec::parse(&bad, "t.toml")
         .unwrap_err()
         .to_string();

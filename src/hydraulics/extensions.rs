@@ -360,8 +360,68 @@ impl Device for SeriesMount {
             s0 = s1;
         }
         let _ = s0;
-        // The device force is only piecewise smooth (valve and seat switching): a secant that
-        // stalls within 1 N of force balance is accepted at its best iterate.
+        // The device force is only piecewise smooth (valve and seat switching), where a secant
+        // can stall. Fall back to a bracketed Illinois (regula falsi) solve: the residual
+        // g(x) = x - d_f - F(x)/k is continuous and, for a passive device (dF/dx <= 0),
+        // increasing with slope >= 1, so a bracket is found by stepping against g.
+        let g = |me: &mut Self, x: f64| -> Result<(f64, StepForce), HydraulicError> {
+            let sf = me.inner.trial_step(t_i, dt, dh_i, x)?;
+            Ok((x - d_f - sf.force_end / me.k, sf))
+        };
+        let (xb, _) = best;
+        let (gb, sb) = g(self, xb)?;
+        if gb.abs() <= tol {
+            return Ok(accept(self, xb, sb));
+        }
+        let (mut a, mut ga, mut b, mut gbr) = (xb, gb, xb, gb);
+        let mut step = 2.0 * gb.abs().max(tol);
+        for _ in 0..60 {
+            let x = if gb > 0.0 { b - step } else { a + step };
+            let (gx, _) = g(self, x)?;
+            if gb > 0.0 {
+                (a, ga) = (x, gx);
+                if gx <= 0.0 {
+                    break;
+                }
+            } else {
+                (b, gbr) = (x, gx);
+                if gx >= 0.0 {
+                    break;
+                }
+            }
+            step *= 2.0;
+        }
+        if ga <= 0.0 && gbr >= 0.0 {
+            let mut side = 0i8;
+            for _ in 0..MOUNT_MAX_ITER {
+                let x = if gbr - ga > 0.0 {
+                    (a * gbr - b * ga) / (gbr - ga)
+                } else {
+                    0.5 * (a + b)
+                };
+                let (gx, sx) = g(self, x)?;
+                if gx.abs() <= tol || (b - a).abs() <= 4.0 * f64::EPSILON * x.abs().max(1e-3) {
+                    return Ok(accept(self, x, sx));
+                }
+                if gx < 0.0 {
+                    (a, ga) = (x, gx);
+                    if side == -1 {
+                        gbr *= 0.5;
+                    }
+                    side = -1;
+                } else {
+                    (b, gbr) = (x, gx);
+                    if side == 1 {
+                        ga *= 0.5;
+                    }
+                    side = 1;
+                }
+                if gx.abs() < best.1 {
+                    best = (x, gx.abs());
+                }
+            }
+        }
+        // Last resort: a stall within 1 N of force balance is accepted at its best iterate.
         if best.1 * self.k <= 1.0 {
             let sf = self.inner.trial_step(t_i, dt, dh_i, best.0)?;
             return Ok(accept(self, best.0, sf));

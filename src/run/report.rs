@@ -252,15 +252,13 @@ pub fn report_html(
         .filter_map(|(r, f)| {
             f.limits.map(|c| {
                 format!(
-                    "{}: force {:.0} to {:.0} N, relief-valve limits {:.0} to {:.0} N: {} (margin {:.0} N, {:.1}%)",
+                    "{}: force {:.0} to {:.0} N, relief-valve cracking forces {:.0} to {:.0} N: {}",
                     r.label,
                     f.force.min,
                     f.force.max,
                     c.min_limit_n,
                     c.max_limit_n,
-                    if c.within { "within" } else { "EXCEEDED" },
-                    c.margin_n,
-                    100.0 * c.margin_rel
+                    c.statement()
                 )
             })
         })
