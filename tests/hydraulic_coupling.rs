@@ -154,6 +154,14 @@ fn cantilever_with_device(
     device: Box<dyn Device>,
     anchor: [f64; 3],
 ) -> (Model, Arc<Mutex<Vec<Rec>>>, Arc<HydraulicProbe>) {
+    cantilever_with_device_applying(device, anchor, AppliedForce::End)
+}
+
+fn cantilever_with_device_applying(
+    device: Box<dyn Device>,
+    anchor: [f64; 3],
+    applied: AppliedForce,
+) -> (Model, Arc<Mutex<Vec<Rec>>>, Arc<HydraulicProbe>) {
     let (mut m, tip, load) = cantilever(4, 0.8, &section());
     m.add_element(Element::Rigid(RigidBody {
         name: "tip_mass".into(),
@@ -178,7 +186,7 @@ fn cantilever_with_device(
         )
         .unwrap();
     m.clamp("anchor_clamp", g).unwrap();
-    let inner = HydraulicForceElement::new("act", g, tip, device);
+    let inner = HydraulicForceElement::new("act", g, tip, device).with_applied_force(applied);
     let probe = inner.probe();
     let log = Arc::new(Mutex::new(vec![]));
     m.add_step_element(Box::new(Recorder {
@@ -240,6 +248,43 @@ fn work_identity(log: &[Rec]) -> (f64, usize) {
         n += 1;
     }
     (worst, n)
+}
+
+/// The paper's step-mean force F_m of Eq. (13) (`AppliedForce::Mean`): its work over every step,
+/// `F_m (d_f - d_i)`, equals the work of the applied nodal forces to round-off.
+#[test]
+fn discrete_work_identity_holds_for_the_paper_step_mean_force() {
+    let opts = IntegratorOptions {
+        scheme: Scheme::Rk4,
+        substeps: 48,
+    };
+    let cases: Vec<(&str, Box<dyn Device>, [f64; 3])> = vec![
+        (
+            "actuator, oblique",
+            Box::new(actuator(opts, 0.02, 0.04)),
+            [-0.2, 0.1, -0.3],
+        ),
+        (
+            "nonlinear dashpot",
+            damper_deck().build(DamperModel::Nonlinear, opts).unwrap(),
+            [0.0, 0.4, -0.1],
+        ),
+    ];
+    for (what, dev, anchor) in cases {
+        let (m, log, _) = cantilever_with_device_applying(dev, anchor, AppliedForce::Mean);
+        let st = State::from_model(&m);
+        let mut s = DynamicSolver::new(m, st, 1e-4, 0.8).unwrap();
+        s.init_accelerations().unwrap();
+        for _ in 0..300 {
+            s.step().unwrap();
+        }
+        let log = log.lock().unwrap();
+        let (worst, n) = work_identity(&log);
+        let fmax = log.iter().map(|r| r.force_mean.abs()).fold(0.0, f64::max);
+        assert_eq!(n, 300);
+        assert!(fmax > 1.0, "{what}: the device must work");
+        assert!(worst <= 8.0, "{what}: work identity error {worst} eps");
+    }
 }
 
 #[test]
