@@ -437,7 +437,7 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
             // Is that channel still decaying? Compare with 10 revolutions earlier.
             let advice = match hist.len().checked_sub(11).map(|k| hist[k][iw]) {
                 Some(before) if last[iw] > 0.5 * before => format!(
-                    "it decays slowly or not at all ({} ten revolutions earlier): more revolutions alone will hardly make this solution periodic",
+                    "it has not halved over the last ten revolutions ({} ten revolutions earlier): run more revolutions (with delayed perturbation damping the decay starts only after its delay, docs/rotor_model.md) or check the transient damping of the rotor deck",
                     super::fmt_measure(Some(before))
                 ),
                 _ => "run more revolutions".into(),
