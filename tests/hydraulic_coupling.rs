@@ -250,59 +250,29 @@ fn work_identity(log: &[Rec]) -> (f64, usize) {
     (worst, n)
 }
 
-/// The paper's step-mean force F_m of Eq. (13) (`AppliedForce::Mean`): its work over every step,
-/// `F_m (d_f - d_i)`, equals the work of the applied nodal forces to round-off.
-#[test]
-fn discrete_work_identity_holds_for_the_paper_step_mean_force() {
-    let opts = IntegratorOptions {
-        scheme: Scheme::Rk4,
-        substeps: 48,
-    };
-    let cases: Vec<(&str, Box<dyn Device>, [f64; 3])> = vec![
-        (
-            "actuator, oblique",
-            Box::new(actuator(opts, 0.02, 0.04)),
-            [-0.2, 0.1, -0.3],
-        ),
-        (
-            "nonlinear dashpot",
-            damper_deck().build(DamperModel::Nonlinear, opts).unwrap(),
-            [0.0, 0.4, -0.1],
-        ),
-    ];
-    for (what, dev, anchor) in cases {
-        let (m, log, _) = cantilever_with_device_applying(dev, anchor, AppliedForce::Mean);
-        let st = State::from_model(&m);
-        let mut s = DynamicSolver::new(m, st, 1e-4, 0.8).unwrap();
-        s.init_accelerations().unwrap();
-        for _ in 0..300 {
-            s.step().unwrap();
-        }
-        let log = log.lock().unwrap();
-        let (worst, n) = work_identity(&log);
-        let fmax = log.iter().map(|r| r.force_mean.abs()).fold(0.0, f64::max);
-        assert_eq!(n, 300);
-        assert!(fmax > 1.0, "{what}: the device must work");
-        assert!(worst <= 8.0, "{what}: work identity error {worst} eps");
-    }
-}
-
+/// Over every step the applied force's work `F_s (d_f - d_i)` equals the work of the nodal
+/// forces to round-off, for the default end-of-step force and for the paper's step-mean force
+/// F_m of Eq. (13) (`AppliedForce::Mean`).
 #[test]
 fn discrete_work_identity_holds_to_round_off_over_every_step() {
     let opts = IntegratorOptions {
         scheme: Scheme::Rk4,
         substeps: 48,
     };
-    let cases: Vec<(&str, Box<dyn Device>, [f64; 3])> = vec![
+    let end = AppliedForce::End;
+    let mean = AppliedForce::Mean;
+    let cases: Vec<(&str, Box<dyn Device>, [f64; 3], AppliedForce)> = vec![
         (
             "actuator, vertical",
             Box::new(actuator(opts, 0.02, 0.04)),
             [0.0, 0.0, -0.4],
+            end,
         ),
         (
             "actuator, oblique",
             Box::new(actuator(opts, 0.02, 0.04)),
             [-0.2, 0.1, -0.3],
+            end,
         ),
         (
             "physical damper",
@@ -316,19 +286,40 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
                 )
                 .unwrap(),
             [0.1, -0.4, 0.0],
+            end,
         ),
         (
             "nonlinear dashpot",
             damper_deck().build(DamperModel::Nonlinear, opts).unwrap(),
             [0.0, 0.4, -0.1],
+            end,
+        ),
+        (
+            "actuator, oblique, step-mean F_m",
+            Box::new(actuator(opts, 0.02, 0.04)),
+            [-0.2, 0.1, -0.3],
+            mean,
+        ),
+        (
+            "nonlinear dashpot, step-mean F_m",
+            damper_deck().build(DamperModel::Nonlinear, opts).unwrap(),
+            [0.0, 0.4, -0.1],
+            mean,
         ),
     ];
-    for (what, dev, anchor) in cases {
-        let (m, log, probe) = cantilever_with_device(dev, anchor);
+    for (what, dev, anchor, applied) in cases {
+        let (m, log, probe) = cantilever_with_device_applying(dev, anchor, applied);
         let st = State::from_model(&m);
         let mut s = DynamicSolver::new(m, st, 1e-4, 0.8).unwrap();
         s.init_accelerations().unwrap();
-        for _ in 0..500 {
+        // F_m: 300 steps (0.03 s); later its Newton iterates stop short of the 1e-12 m
+        // x_i check of `work_identity` (the paper's force is not the solver's, docs/coupling.md)
+        let steps = if applied == AppliedForce::Mean {
+            300
+        } else {
+            500
+        };
+        for _ in 0..steps {
             s.step().unwrap();
         }
         let log = log.lock().unwrap();
@@ -340,7 +331,7 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
             probe.trials(),
             1e3 * probe.hydraulics_seconds()
         );
-        assert_eq!(n, 500);
+        assert_eq!(n, steps);
         assert!(fmax > 1.0 && dmax > 1e-6, "{what}: the device must work");
         assert!(worst <= 8.0, "{what}: work identity error {worst} eps");
         assert!(probe.trials() >= 500);
