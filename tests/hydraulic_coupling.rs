@@ -153,13 +153,6 @@ fn section() -> SectionTable {
 fn cantilever_with_device(
     device: Box<dyn Device>,
     anchor: [f64; 3],
-) -> (Model, Arc<Mutex<Vec<Rec>>>, Arc<HydraulicProbe>) {
-    cantilever_with_device_applying(device, anchor, AppliedForce::End)
-}
-
-fn cantilever_with_device_applying(
-    device: Box<dyn Device>,
-    anchor: [f64; 3],
     applied: AppliedForce,
 ) -> (Model, Arc<Mutex<Vec<Rec>>>, Arc<HydraulicProbe>) {
     let (mut m, tip, load) = cantilever(4, 0.8, &section());
@@ -261,7 +254,9 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
     };
     let end = AppliedForce::End;
     let mean = AppliedForce::Mean;
-    let cases: Vec<(&str, Box<dyn Device>, [f64; 3], AppliedForce)> = vec![
+    // (what, device, ground point relative to the tip, applied step force)
+    type Case = (&'static str, Box<dyn Device>, [f64; 3], AppliedForce);
+    let cases: Vec<Case> = vec![
         (
             "actuator, vertical",
             Box::new(actuator(opts, 0.02, 0.04)),
@@ -308,7 +303,7 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
         ),
     ];
     for (what, dev, anchor, applied) in cases {
-        let (m, log, probe) = cantilever_with_device_applying(dev, anchor, applied);
+        let (m, log, probe) = cantilever_with_device(dev, anchor, applied);
         let st = State::from_model(&m);
         let mut s = DynamicSolver::new(m, st, 1e-4, 0.8).unwrap();
         s.init_accelerations().unwrap();
