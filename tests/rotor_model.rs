@@ -249,37 +249,3 @@ fn expand_prints_a_model_deck_that_loads_back() {
             < 1e-12
     );
 }
-
-#[test]
-fn transient_table_is_checked_and_runs() {
-    let shipped = std::fs::read_to_string(repo("rotors/uh60a.toml")).unwrap();
-    // the shipped deck leaves it off (it uses the [blade] perturbation damping instead)
-    let spec = rotorsim::rotor::deck::RotorSpec::parse(&shipped, "t.toml").unwrap();
-    assert!(spec.transient.is_none());
-    let base = format!(
-        "{shipped}\n[transient]\nlift_slope_per_rad = 5.73\nchord_m = 0.527\nwashout_alpha = 0.2\n"
-    );
-    let bad = base.replace("\nwashout_alpha = 0.2", "\nwashout_alpha = 1.5");
-    let e = rotorsim::rotor::deck::RotorSpec::parse(&bad, "t.toml")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("t.toml") && e.contains("transient.washout_alpha"),
-        "{e}"
-    );
-    let good = base.clone();
-    let spec = rotorsim::rotor::deck::RotorSpec::parse(&good, "t.toml").unwrap();
-    assert!(spec.transient.is_some());
-    let deck = RotorDeck::from_file(&repo("rotors/uh60a.toml")).unwrap();
-    let damper = deck.damper().unwrap();
-    let rec = FlightRecord::read(&repo("flightdata/c8534like.meta.json")).unwrap();
-    let opts = RunOptions {
-        steps_per_rev: 64,
-        ..Default::default()
-    };
-    let mut sim = build_sim(&spec, &deck.path, &damper, DamperModel::Linear, &rec, &opts).unwrap();
-    for _ in 0..64 {
-        sim.step().unwrap();
-    }
-    assert!((sim.azimuth_deg() - 360.0).abs() < 1e-9);
-}

@@ -14,9 +14,6 @@ pub struct RotorSpec {
     pub bearing: BearingTable,
     pub pitch_control: PitchControlTable,
     pub damper_attachment: DamperAttachment,
-    /// Transient damping of the forced response (optional).
-    #[serde(default)]
-    pub transient: Option<TransientTable>,
     /// Read by `DamperDeck` (kept opaque here).
     #[serde(default)]
     pub damper: Option<toml::Value>,
@@ -120,28 +117,6 @@ pub struct DamperAttachment {
     pub height_m: f64,
     pub arm_mass_kg: f64,
     pub horn_mass_kg: f64,
-}
-
-/// Washout aerodynamic damping of the forced response: quasi-steady lift damping
-/// `-c_a(r) (w - w_bar)`, `c_a = rho a c Omega r / 2`, acting on the deviation of the section's
-/// normal velocity w (rotating frame) from its running average `w_bar` at the same azimuth over
-/// past revolutions (`w_bar <- (1 - alpha) w_bar + alpha w` once per revolution). It vanishes on
-/// the periodic solution, so the periodic response is that of the recorded airloads alone.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TransientTable {
-    #[serde(rename = "lift_slope_per_rad")]
-    pub lift_slope: f64,
-    pub chord_m: f64,
-    /// Air density when the flight record gives none [kg/m^3].
-    #[serde(default = "rho_std")]
-    pub density_kg_m3: f64,
-    /// Weight of the newest revolution in the running average (0 < alpha <= 1).
-    pub washout_alpha: f64,
-}
-
-fn rho_std() -> f64 {
-    1.225
 }
 
 impl RotorSpec {
@@ -259,14 +234,6 @@ impl RotorSpec {
                 "pitch_control.horn_tip_m",
                 "the horn tip must lie off the pitch axis (y or z offset)",
             ));
-        }
-        if let Some(t) = &self.transient {
-            pos("transient.lift_slope_per_rad", t.lift_slope)?;
-            pos("transient.chord_m", t.chord_m)?;
-            pos("transient.density_kg_m3", t.density_kg_m3)?;
-            if !(t.washout_alpha > 0.0 && t.washout_alpha <= 1.0) {
-                return Err(bad("transient.washout_alpha", "expected 0 < alpha <= 1"));
-            }
         }
         let tw = &self.blade.twist_deg;
         if tw.windows(2).any(|w| w[1][0] <= w[0][0]) {

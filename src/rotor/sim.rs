@@ -19,36 +19,6 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Running average of the section normal velocities per azimuth slot (washout damping).
-pub struct Washout {
-    /// (beam element index, s_m) of every load point, in `update_distributed_loads` order.
-    points: Vec<(usize, f64)>,
-    /// `w_bar[slot * points.len() + i]` [m/s].
-    w_bar: Vec<f64>,
-    slots: usize,
-    h: f64,
-    alpha: f64,
-    /// `c_a / r` [N s/m^3]: `rho a c Omega / 2`.
-    ca_per_r: f64,
-    omega: f64,
-}
-
-impl Washout {
-    fn slot(&self, t: f64) -> usize {
-        ((t / self.h).round() as i64).rem_euclid(self.slots as i64) as usize
-    }
-    fn index(&self, element: usize, s_m: f64) -> Option<usize> {
-        self.points
-            .iter()
-            .position(|&(e, s)| e == element && s == s_m)
-    }
-    /// Normal velocity of a section in the rotating (hub) frame [m/s].
-    fn normal_velocity(&self, x: [f64; 3], r: &[[f64; 3]; 3], v: [f64; 3]) -> f64 {
-        let vr = sub(v, cross([0.0, 0.0, self.omega], x));
-        vr[0] * r[0][2] + vr[1] * r[1][2] + vr[2] * r[2][2]
-    }
-}
-
 /// Airloads of the record on the blade: mean + ramp(t) (periodic part), follower section loads
 /// (FORMATS: normal along +z, chord force along -y, moment about +x; the beam reference line
 /// is taken as the quarter chord).
@@ -59,7 +29,6 @@ pub struct BladeAirloads {
     t_ramp: f64,
     /// Load scale (static load stepping of the initial equilibrium; 1 in the dynamics).
     scale: Arc<AtomicU64>,
-    washout: Option<Arc<Mutex<Washout>>>,
 }
 
 impl DistributedLoad for BladeAirloads {
@@ -79,18 +48,8 @@ impl DistributedLoad for BladeAirloads {
             }
         };
         let k = f64::from_bits(self.scale.load(Ordering::Relaxed));
-        let mut damp = 0.0;
-        if let Some(wo) = &self.washout {
-            if let Ok(wo) = wo.lock() {
-                if let Some(i) = wo.index(p.element, p.s_m) {
-                    let w = wo.normal_velocity(p.x, &p.r, p.v);
-                    let wb = wo.w_bar[wo.slot(p.t) * wo.points.len() + i];
-                    damp = -wo.ca_per_r * r * (w - wb);
-                }
-            }
-        }
         SectionLoad {
-            force: [0.0, -k * l.chord_N_per_m, k * l.normal_N_per_m + damp],
+            force: [0.0, -k * l.chord_N_per_m, k * l.normal_N_per_m],
             moment: [k * l.moment_N_m_per_m, 0.0, 0.0],
             follower: true,
         }
@@ -142,7 +101,6 @@ pub struct RotorSim {
     twist_ref: f64,
     total_s: f64,
     relaxed_steps: usize,
-    washout: Option<Arc<Mutex<Washout>>>,
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -228,35 +186,12 @@ pub fn build_sim(
     )?;
     let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
     let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
-    let washout = spec.transient.as_ref().map(|tr| {
-        let ids = model.beams.get(names::BLADE).cloned().unwrap_or_default();
-        let mut points = vec![];
-        for &ei in &ids {
-            if let Element::Beam(b) = &model.elements[ei] {
-                for g in b.gm.iter() {
-                    points.push((ei, g.s_m));
-                }
-            }
-        }
-        let rho = record.meta.density_kg_m3.unwrap_or(tr.density_kg_m3);
-        let n = points.len();
-        Arc::new(Mutex::new(Washout {
-            points,
-            w_bar: vec![0.0; n * opts.steps_per_rev],
-            slots: opts.steps_per_rev,
-            h,
-            alpha: tr.washout_alpha,
-            ca_per_r: 0.5 * rho * tr.lift_slope * tr.chord_m * om,
-            omega: om,
-        }))
-    });
     let airloads = BladeAirloads {
         full,
         mean,
         root_r_m: spec.blade.root_r_m,
         t_ramp,
         scale: scale.clone(),
-        washout: washout.clone(),
     };
     let load = super::transient::blade_load(
         airloads,
@@ -328,7 +263,6 @@ pub fn build_sim(
         twist_ref,
         total_s: 0.0,
         relaxed_steps: 0,
-        washout,
     })
 }
 
@@ -375,33 +309,6 @@ impl RotorSim {
     }
 }
 
-impl RotorSim {
-    /// Fold the converged normal velocities of this azimuth slot into the running average.
-    fn update_washout(&mut self) {
-        let Some(wo) = &self.washout else { return };
-        let Ok(mut wo) = wo.lock() else { return };
-        let st = &self.solver.state;
-        let slot = wo.slot(st.t);
-        let n = wo.points.len();
-        let a = wo.alpha;
-        let mut i = 0;
-        while i < n {
-            let ei = wo.points[i].0;
-            if let Element::Beam(b) = &self.solver.model.elements[ei] {
-                let k = b.nodes.map(|j| st.node_kin(j));
-                for (x, r, v, _) in b.load_points(&k) {
-                    let w = wo.normal_velocity(x, &r, v);
-                    let cell = &mut wo.w_bar[slot * n + i];
-                    *cell += a * (w - *cell);
-                    i += 1;
-                }
-            } else {
-                i += 1;
-            }
-        }
-    }
-}
-
 impl ForcedResponse for RotorSim {
     fn label(&self) -> &str {
         &self.label
@@ -437,9 +344,6 @@ impl ForcedResponse for RotorSim {
                 self.solver.newton.rtol = RTOL;
                 self.relaxed_steps += 1;
             }
-        }
-        if r.is_ok() {
-            self.update_washout();
         }
         self.total_s += t0.elapsed().as_secs_f64();
         r.map_err(|e| {
