@@ -45,6 +45,34 @@ pub struct BladeTable {
     /// Its delay in revolutions (default 1).
     #[serde(default = "one")]
     pub perturbation_damping_delay_revs: usize,
+    /// Section frame in which the record's airloads are applied (default `deformed`).
+    #[serde(default)]
+    pub airload_frame: AirloadFrame,
+}
+
+/// Section frame of the replayed airloads. The in-plane load is the small difference of two
+/// large projections (`N sin(theta) + C cos(theta)` aft), so a pitch difference between the frame
+/// the loads were measured in and the model's frame moves the lag moment by `N d(theta)` per
+/// unit span (docs/rotor_model.md, "Airload frame").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AirloadFrame {
+    /// FORMATS: the deformed (follower) section frame of the model, elastic twist included.
+    #[default]
+    Deformed,
+    /// The deformed frame turned about the section axis to the rigid pitch, bearing pitch from
+    /// the controls plus the built-in twist: the frame of a blade rigid in torsion and control
+    /// (for records whose loads are given in that frame, such as the shipped synthetic one).
+    ControlPitch,
+}
+
+impl AirloadFrame {
+    pub fn name(self) -> &'static str {
+        match self {
+            AirloadFrame::Deformed => "deformed",
+            AirloadFrame::ControlPitch => "control_pitch",
+        }
+    }
 }
 
 fn one() -> usize {

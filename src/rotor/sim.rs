@@ -1,6 +1,6 @@
 //! The forced-response simulation of the rotor: expanded model + damper element + airload
 //! replay + swashplate law, marched by the generalized-alpha solver (see docs/rotor_model.md).
-use super::deck::RotorSpec;
+use super::deck::{AirloadFrame, RotorSpec};
 use super::expand::{expand, names, ramp, Controls, ExpandOptions};
 use super::{ForcedResponse, RunOptions, Timing, BASE_CHANNELS};
 use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
@@ -8,7 +8,7 @@ use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonError, State};
-use crate::structure::beam::SectionLoad;
+use crate::structure::beam::{SectionLoad, NPTS_M};
 use crate::structure::deck::parse_deck;
 use crate::structure::hydraulic::{HydraulicForceElement, HydraulicProbe};
 use crate::structure::kin::TimeTable;
@@ -29,6 +29,71 @@ pub struct BladeAirloads {
     t_ramp: f64,
     /// Load scale (static load stepping of the initial equilibrium; 1 in the dynamics).
     scale: Arc<AtomicU64>,
+    /// `Some` for [`AirloadFrame::ControlPitch`].
+    control_pitch: Option<ControlPitch>,
+}
+
+/// What [`AirloadFrame::ControlPitch`] needs: the commanded bearing pitch and the reference
+/// (built-in) pitch at every load point of the blade.
+struct ControlPitch {
+    spec: RotorSpec,
+    controls: Controls,
+    /// Per model element id: (s_m, reference section pitch [rad]) at its load points.
+    reference: std::collections::HashMap<usize, [(f64, f64); NPTS_M]>,
+}
+
+impl ControlPitch {
+    fn new(
+        spec: &RotorSpec,
+        controls: Controls,
+        model: &Model,
+        beam: &str,
+    ) -> anyhow::Result<Self> {
+        let kin = model.reference_state();
+        let mut reference = std::collections::HashMap::new();
+        let ids = model
+            .beams
+            .get(beam)
+            .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no beam `{beam}`"))?;
+        for &ei in ids {
+            if let Element::Beam(b) = &model.elements[ei] {
+                let pts = b.load_points(&b.nodes.map(|i| kin[i]));
+                reference.insert(
+                    ei,
+                    std::array::from_fn(|q| (b.gm[q].s_m, section_pitch(&pts[q].1))),
+                );
+            }
+        }
+        Ok(ControlPitch {
+            spec: spec.clone(),
+            controls,
+            reference,
+        })
+    }
+
+    /// Rigid pitch minus the model's section pitch at `p` [rad]: the turn about the section
+    /// axis from the deformed frame to the control-pitch frame.
+    fn correction(&self, p: &LoadPoint) -> f64 {
+        let reference = self.reference.get(&p.element).and_then(|pts| {
+            pts.iter()
+                .find(|(s, _)| *s == p.s_m)
+                .map(|(_, theta)| *theta)
+        });
+        match reference {
+            Some(theta_ref) => {
+                theta_ref + self.spec.pitch_rad(&self.controls, p.t) - section_pitch(&p.r)
+            }
+            None => 0.0,
+        }
+    }
+}
+
+/// Pitch of a section about its own axis relative to the hub plane [rad] (nose up positive):
+/// for `R = Rz(-zeta) Ry(-beta) Rx(theta)` the section axis 2 has the vertical component
+/// `sin(theta) cos(beta)` and axis 1 `sin(beta)`; rotation about the shaft (z) leaves both.
+pub fn section_pitch(r: &[[f64; 3]; 3]) -> f64 {
+    let cb = (1.0 - r[2][0] * r[2][0]).max(1e-12).sqrt();
+    (r[2][1] / cb).clamp(-1.0, 1.0).asin()
 }
 
 impl DistributedLoad for BladeAirloads {
@@ -48,8 +113,20 @@ impl DistributedLoad for BladeAirloads {
             }
         };
         let k = f64::from_bits(self.scale.load(Ordering::Relaxed));
+        // Control-pitch frame: the loads turned by d about the section axis, so that the
+        // normal and chord directions are those of the rigid pitch (docs/rotor_model.md).
+        let (fy, fz) = match &self.control_pitch {
+            None => (-l.chord_N_per_m, l.normal_N_per_m),
+            Some(c) => {
+                let (sd, cd) = c.correction(p).sin_cos();
+                (
+                    -l.normal_N_per_m * sd - l.chord_N_per_m * cd,
+                    l.normal_N_per_m * cd - l.chord_N_per_m * sd,
+                )
+            }
+        };
         SectionLoad {
-            force: [0.0, -k * l.chord_N_per_m, k * l.normal_N_per_m],
+            force: [0.0, k * fy, k * fz],
             moment: [k * l.moment_N_m_per_m, 0.0, 0.0],
             follower: true,
         }
@@ -192,6 +269,12 @@ pub fn build_sim(
         root_r_m: spec.blade.root_r_m,
         t_ramp,
         scale: scale.clone(),
+        control_pitch: match spec.blade.airload_frame {
+            AirloadFrame::Deformed => None,
+            AirloadFrame::ControlPitch => {
+                Some(ControlPitch::new(spec, controls, &model, names::BLADE)?)
+            }
+        },
     };
     let load = super::transient::blade_load(
         airloads,
@@ -390,6 +473,119 @@ impl ForcedResponse for RotorSim {
             hydraulics_s: self.probe.hydraulics_seconds(),
             steps: self.solver.steps,
             iterations: self.solver.total_iterations,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rot(axis: usize, a: f64) -> [[f64; 3]; 3] {
+        let mut th = [0.0; 3];
+        th[axis] = a;
+        exp_map(th)
+    }
+
+    /// `R = Rz(psi) Rz(-zeta) Ry(-beta) Rx(theta)`: hub azimuth, lag aft, flap up, pitch.
+    fn section(psi: f64, zeta: f64, beta: f64, theta: f64) -> [[f64; 3]; 3] {
+        let r = mm(&rot(2, psi), &rot(2, -zeta));
+        mm(&mm(&r, &rot(1, -beta)), &rot(0, theta))
+    }
+
+    #[test]
+    fn section_pitch_recovers_the_pitch_under_azimuth_lag_and_flap() {
+        for (psi, zeta, beta, theta) in [
+            (0.0, 0.0, 0.0, 0.2),
+            (1.3, 0.08, 0.05, 0.25),
+            (4.0, -0.1, 0.2, -0.3),
+            (5.5, 0.3, -0.15, 0.6),
+        ] {
+            let got = section_pitch(&section(psi, zeta, beta, theta));
+            assert!((got - theta).abs() < 1e-14, "{got} vs {theta}");
+        }
+    }
+
+    fn uh60a() -> (RotorSpec, Model, Controls) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors/uh60a.toml");
+        let spec = RotorSpec::from_file(&path).unwrap();
+        let controls = Controls {
+            th0_deg: 11.0,
+            th1c_deg: 2.0,
+            th1s_deg: -8.0,
+        };
+        let xo = ExpandOptions {
+            controls,
+            table_revs: 1,
+            ..Default::default()
+        };
+        let model = expanded_model(&spec, &xo, &path).unwrap();
+        (spec, model, controls)
+    }
+
+    /// Built-in twist of the deck (linear table, constant outside), degrees.
+    fn table_twist(spec: &RotorSpec, r: f64) -> f64 {
+        let t = &spec.blade.twist_deg;
+        let tab = TimeTable {
+            points: t.iter().map(|p| (p[0], p[1])).collect(),
+        };
+        tab.eval(r)
+    }
+
+    #[test]
+    fn reference_pitch_is_the_built_in_twist() {
+        let (spec, model, controls) = uh60a();
+        let cp = ControlPitch::new(&spec, controls, &model, names::BLADE).unwrap();
+        assert_eq!(cp.reference.len(), spec.blade.elements);
+        let mut n = 0;
+        for pts in cp.reference.values() {
+            for &(s, theta) in pts {
+                let r = spec.blade.root_r_m + s;
+                // the model interpolates the nodal twist over each cubic element (0.566 m):
+                // compare on the elements where the table is linear (1.95 - 5.91 m)
+                if !(1.96..5.9).contains(&r) {
+                    continue;
+                }
+                let want = table_twist(&spec, r).to_radians();
+                assert!((theta - want).abs() < 1e-6, "r = {r}: {theta} vs {want}");
+                n += 1;
+            }
+        }
+        assert!(n > 20, "{n} load points checked");
+    }
+
+    /// With any elastic twist phi, the control-pitch frame applies the record's loads in the
+    /// rigid-pitch directions: in the hub frame the in-plane (lead) component is
+    /// `-(N sin(theta) + C cos(theta))` and the vertical `N cos(theta) - C sin(theta)`.
+    #[test]
+    fn control_pitch_frame_removes_the_elastic_twist_from_the_load_directions() {
+        let (spec, model, controls) = uh60a();
+        let cp = ControlPitch::new(&spec, controls, &model, names::BLADE).unwrap();
+        let (&ei, pts) = cp.reference.iter().next().unwrap();
+        let (s, theta_ref) = pts[1];
+        let (nf, cf) = (3000.0, -250.0);
+        for (t, phi) in [(0.0, 0.0), (0.01, -0.02), (0.1, 0.03), (0.2, -0.05)] {
+            let theta_rigid = theta_ref + spec.pitch_rad(&controls, t);
+            let psi = spec.rotor.omega_rad_s * t;
+            let r = section(psi, 0.0, 0.0, theta_rigid + phi);
+            let p = LoadPoint {
+                t,
+                element: ei,
+                s_m: s,
+                x: [0.0; 3],
+                r,
+                v: [0.0; 3],
+                w: [0.0; 3],
+            };
+            let d = cp.correction(&p);
+            assert!((d + phi).abs() < 1e-12, "correction {d} vs {}", -phi);
+            // the load as BladeAirloads builds it, then into the hub frame
+            let (sd, cd) = d.sin_cos();
+            let f_sec = [0.0, -nf * sd - cf * cd, nf * cd - cf * sd];
+            let f_hub = mtv(&rot(2, psi), mv(&r, f_sec));
+            let (st, ct) = theta_rigid.sin_cos();
+            assert!((f_hub[1] + nf * st + cf * ct).abs() < 1e-9, "{f_hub:?}");
+            assert!((f_hub[2] - (nf * ct - cf * st)).abs() < 1e-9, "{f_hub:?}");
         }
     }
 }
