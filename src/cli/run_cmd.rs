@@ -41,8 +41,10 @@ pub struct RunArgs {
     /// Hydraulic sub-step scheme: rk4 or implicit.
     #[arg(long, default_value = "rk4")]
     pub scheme: String,
-    /// Rotor model: uh60a (the multibody model of the rotor deck) or sdof (a rigid blade on a
-    /// lag hinge: a fast TEST DOUBLE of the pipeline, not the rotor model).
+    /// Rotor model: uh60a (the multibody model of the rotor deck), rigid (the rotor deck's blade
+    /// rigid on its lag hinge, airloads projected with the control pitch: the reduced model of
+    /// docs/rotor_model.md, "Rigid-blade reduction") or sdof (a fast TEST DOUBLE of the
+    /// pipeline, not a rotor model).
     #[arg(long, default_value = "uh60a")]
     pub model: String,
     /// Output directory.
@@ -126,10 +128,11 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             args.substeps
         );
     }
-    let sdof = match args.model.as_str() {
-        "uh60a" => false,
-        "sdof" => true,
-        m => bail!("--model: unknown rotor model '{m}' (expected uh60a or sdof)"),
+    let (sdof, rigid) = match args.model.as_str() {
+        "uh60a" => (false, false),
+        "rigid" => (false, true),
+        "sdof" => (true, false),
+        m => bail!("--model: unknown rotor model '{m}' (expected uh60a, rigid or sdof)"),
     };
     let record = FlightRecord::read(&args.flight)
         .with_context(|| format!("reading flight record {}", args.flight.display()))?;
@@ -155,21 +158,25 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         hydraulics,
         ..RunOptions::default()
     };
-    let sdof_params = if sdof {
-        Some(SdofParams::from_record(&record)?)
-    } else {
-        None
+    let sdof_params = match (&rotor, sdof, rigid) {
+        (_, true, _) => Some(SdofParams::from_record(&record)?),
+        (Some(r), _, true) => Some(
+            SdofParams::from_rotor(&r.spec, &r.path, &record)
+                .with_context(|| format!("rigid-blade reduction of {}", r.path.display()))?,
+        ),
+        _ => None,
     };
     let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
         match (&rotor, &sdof_params) {
-            (Some(r), _) => crate::rotor::build(r, &deck, m, &record, &opts),
-            (None, Some(p)) => Ok(Box::new(LagHingeSdof::new(
-                p.clone(),
-                &deck,
-                m,
-                hydraulics,
-                args.steps_per_rev,
-            )?)),
+            (_, Some(p)) => {
+                let mut sim =
+                    LagHingeSdof::new(p.clone(), &deck, m, hydraulics, args.steps_per_rev)?;
+                if rigid {
+                    sim.set_label(format!("{} (rigid)", m.name()));
+                }
+                Ok(Box::new(sim))
+            }
+            (Some(r), None) => crate::rotor::build(r, &deck, m, &record, &opts),
             (None, None) => unreachable!("one rotor model is selected"),
         }
     };
@@ -188,6 +195,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         args.steps_per_rev,
         if sdof {
             " (lag-hinge TEST DOUBLE, --model sdof)"
+        } else if rigid {
+            " (rigid-blade reduction of the rotor deck, --model rigid)"
         } else {
             ""
         }
@@ -202,6 +211,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         rotor: args.rotor.display().to_string(),
         rotor_model: if sdof {
             "lag-hinge sdof test double".into()
+        } else if rigid {
+            "rigid-blade reduction of the rotor deck (lag hinge, control-pitch airloads)".into()
         } else {
             "UH-60A multibody rotor".into()
         },

@@ -1,20 +1,25 @@
-//! A test double of the rotor model: one rigid blade on a lag hinge in the rotating frame, with
-//! a real damper [`Device`]. It is NOT the UH-60A rotor model (that is `crate::rotor`); it lets
-//! the run pipeline be tested end to end in milliseconds and is offered as `--model sdof`.
+//! One rigid blade on a lag hinge in the rotating frame, with a real damper [`Device`]. Two
+//! parameter sets: [`SdofParams::from_record`], a test double of the run pipeline driven by the
+//! chord force alone (`--model sdof`, not a rotor model), and [`SdofParams::from_rotor`], the
+//! rigid-blade reduction of a rotor deck with the airloads projected by the control pitch
+//! (`--model rigid`, docs/rotor_model.md).
 //!
 //! Equation of motion (lag angle `zeta`, positive aft, i.e. against the rotation, FORMATS):
 //!
-//! `I zeta'' + (e S Omega^2 + k) zeta = M(psi) + a F`
+//! `I zeta'' + c zeta' + (e S Omega^2 + k) zeta = M(psi) + a F`
 //!
 //! with `I`, `S` the second and first mass moments of the blade about the hinge, `e` the hinge
-//! offset (centrifugal lag stiffness `e S Omega^2`), `k` the lag spring, `a` the damper arm
+//! offset (centrifugal lag stiffness `e S Omega^2`), `k` and `c` the lag spring and damping
+//! (c = 0 in the test double), `a` the damper arm
 //! (stroke `d = a zeta`, so aft lag lengthens the damper) and `F` the damper force (FORMATS:
 //! positive pushes the ends apart, so its generalized force on `zeta` is `a F`). `M(psi)` is the
-//! aerodynamic lag moment about the hinge, a sum of harmonics 0..2/rev.
+//! aerodynamic lag moment about the hinge, a sum of harmonics (0..2/rev in the test double,
+//! 0..16/rev in the reduction).
 //!
 //! Time integration: trapezoidal rule (average acceleration) with the forces averaged over the
 //! step, which is what the device returns (`F_m` of Eq. 13):
-//! `I (w1 - w0)/h = M(t + h/2) - k_t (z0 + z1)/2 + a F_m`, `z1 = z0 + h (w0 + w1)/2`,
+//! `I (w1 - w0)/h = M(t + h/2) - c (w0 + w1)/2 - k_t (z0 + z1)/2 + a F_m`,
+//! `z1 = z0 + h (w0 + w1)/2`,
 //! solved by Newton on `z1` with the device's `dF_m/dd_f` (Eq. 16 estimate for the physical
 //! damper) in the tangent.
 use crate::analysis::harmonics::{harmonics, Harmonic};
@@ -44,6 +49,8 @@ pub struct SdofParams {
     pub damper_arm_m: f64,
     /// Lag moment harmonics about the hinge [N m] (n = 0, 1, 2, ...; psi in the record's sense).
     pub moment: Vec<Harmonic>,
+    /// Viscous lag damping of the hinge (elastomer) [N m s/rad].
+    pub lag_damping_n_m_s_per_rad: f64,
 }
 
 impl SdofParams {
@@ -62,7 +69,96 @@ impl SdofParams {
             lag_spring_n_m_per_rad: 20400.0,
             damper_arm_m: 0.175,
             moment,
+            lag_damping_n_m_s_per_rad: 0.0,
         }
+    }
+
+    /// The rigid-blade reduction of a rotor deck (`rotorsim run --model rigid`): the blade of
+    /// the deck taken rigid on its lag hinge, no flap (so no Coriolis coupling), driven by the
+    /// record's airloads projected into the hub plane with the rigid pitch of the controls and
+    /// the built-in twist (the control-pitch frame of docs/rotor_model.md):
+    ///
+    /// `M(psi) = integral over the blade of (N sin(theta) + C cos(theta)) (r - e) dr`,
+    /// `theta = th0 + th1c cos(psi) + th1s sin(psi) + twist(r)`,
+    ///
+    /// N, C from the replay (revolution average, radial taper to the root cut-out and the tip),
+    /// harmonics 0..=16. `I`, `S` about the hinge from the section table plus the retention
+    /// segments outboard of the hinge (segments 2 and 3); lag spring and damping of the bearing;
+    /// damper arm of the attachment.
+    pub fn from_rotor(
+        spec: &crate::rotor::deck::RotorSpec,
+        deck_path: &std::path::Path,
+        record: &FlightRecord,
+    ) -> anyhow::Result<Self> {
+        use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
+        use crate::structure::section::SectionTable;
+        let e = spec.retention.hinge_r_m;
+        let (r0, radius) = (spec.blade.root_r_m, spec.rotor.radius_m);
+        let csv = deck_path
+            .parent()
+            .unwrap_or(std::path::Path::new(""))
+            .join(&spec.blade.sections_csv);
+        let table = SectionTable::from_csv(&csv)?;
+        // mass moments: trapezoid on a fine grid (the table is piecewise linear)
+        let (mut s1, mut i2) = (0.0, 0.0);
+        let n = 4000;
+        let ds = (radius - r0) / n as f64;
+        for k in 0..=n {
+            let s = k as f64 * ds;
+            let w = if k == 0 || k == n { 0.5 * ds } else { ds };
+            let m = table.at(s).m;
+            let x = r0 + s - e;
+            s1 += w * m * x;
+            i2 += w * m * x * x;
+        }
+        for (seg, a, b) in [
+            (&spec.retention.segment2, e, spec.retention.horn_r_m),
+            (&spec.retention.segment3, spec.retention.horn_r_m, r0),
+        ] {
+            let m = seg.section.m;
+            s1 += m * ((b - e).powi(2) - (a - e).powi(2)) / 2.0;
+            i2 += m * ((b - e).powi(3) - (a - e).powi(3)) / 3.0;
+        }
+        let replay = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
+        let controls = crate::rotor::expand::Controls::from_record(&record.meta.controls_deg);
+        let twist = crate::structure::kin::TimeTable {
+            points: spec.blade.twist_deg.iter().map(|p| (p[0], p[1])).collect(),
+        };
+        let psi: Vec<f64> = (0..256).map(|k| k as f64 * 360.0 / 256.0).collect();
+        let nr = 800;
+        let dr = (radius - e) / nr as f64;
+        let mut moment = Vec::with_capacity(psi.len());
+        for &p in &psi {
+            let pr = p.to_radians();
+            let th_c =
+                (controls.th0_deg + controls.th1c_deg * pr.cos() + controls.th1s_deg * pr.sin())
+                    .to_radians();
+            let mut m = 0.0;
+            for k in 0..=nr {
+                let r = e + k as f64 * dr;
+                let w = if k == 0 || k == nr { 0.5 * dr } else { dr };
+                let l = replay.at_azimuth(p, r / record.meta.radius_m);
+                let tw = if spec.blade.twist_deg.is_empty() {
+                    0.0
+                } else {
+                    twist.eval(r).to_radians()
+                };
+                let (st, ct) = (th_c + tw).sin_cos();
+                m += w * (l.normal_N_per_m * st + l.chord_N_per_m * ct) * (r - e);
+            }
+            moment.push(m);
+        }
+        Ok(SdofParams {
+            omega_rad_s: spec.rotor.omega_rad_s,
+            hinge_offset_m: e,
+            radius_m: radius,
+            inertia_kg_m2: i2,
+            first_moment_kg_m: s1,
+            lag_spring_n_m_per_rad: spec.bearing.lag_k,
+            damper_arm_m: spec.damper_attachment.arm_m,
+            moment: harmonics(&psi, &moment, 16)?,
+            lag_damping_n_m_s_per_rad: spec.bearing.lag_c,
+        })
     }
 
     /// As [`SdofParams::uh60a_like`], driven by harmonics 0..=2/rev of the record's lag moment
@@ -215,6 +311,11 @@ impl LagHingeSdof {
         })
     }
 
+    /// Replace the label ("<model> (sdof)" by default).
+    pub fn set_label(&mut self, label: String) {
+        self.label = label;
+    }
+
     /// Lag angle [rad] and rate [rad/s].
     pub fn state(&self) -> (f64, f64) {
         (self.zeta, self.zeta_dot)
@@ -238,10 +339,11 @@ impl ForcedResponse for LagHingeSdof {
     fn step(&mut self) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let (h, t) = (self.dt, self.time_s());
-        let (i, kt, a) = (
+        let (i, kt, a, c) = (
             self.p.inertia_kg_m2,
             self.p.stiffness(),
             self.p.damper_arm_m,
+            self.p.lag_damping_n_m_s_per_rad,
         );
         let m_mid = self.p.moment_at(self.p.omega_rad_s * (t + 0.5 * h));
         let (z0, w0) = (self.zeta, self.zeta_dot);
@@ -256,8 +358,10 @@ impl ForcedResponse for LagHingeSdof {
             hyd += th.elapsed().as_secs_f64();
             self.timing.iterations += 1;
             let w1 = 2.0 * (z1 - z0) / h - w0;
-            let r = i * (w1 - w0) / h + kt * 0.5 * (z0 + z1) - m_mid - a * sf.force_mean;
-            let drdz = 2.0 * i / (h * h) + 0.5 * kt - a * a * sf.dforce_dstroke;
+            let r = i * (w1 - w0) / h + c * 0.5 * (w0 + w1) + kt * 0.5 * (z0 + z1)
+                - m_mid
+                - a * sf.force_mean;
+            let drdz = 2.0 * i / (h * h) + c / h + 0.5 * kt - a * a * sf.dforce_dstroke;
             let dz = -r / drdz;
             if !dz.is_finite() {
                 bail!("lag-hinge model: non-finite Newton update at t = {t} s, iteration {it}, residual {r:e} N m");
