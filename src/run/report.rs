@@ -233,6 +233,18 @@ pub fn report_html(
             ));
             rep.paragraph("What none of the models reproduces (observations on the residual model - measured; input to the diagnosis, `rotorsim diagnose`):");
             rep.list(&unreproduced(&ok, m));
+            let strokes: Vec<String> = ok
+                .iter()
+                .filter_map(|(r, f)| {
+                    f.stroke
+                        .as_ref()
+                        .map(|s| format!("{}: {}", r.label, s.statement))
+                })
+                .collect();
+            if !strokes.is_empty() {
+                rep.paragraph(&format!("The record carries the damper stroke: the rotor's part of the force error (the stroke) and the damper's (its 1/rev dynamic stiffness K* = -F1/d1 for the stroke it gets; storage K' = Re K*, loss K'' = Im K*), against the {syn}record:"));
+                rep.list(&strokes);
+            }
         }
         (Err(note), _) => {
             rep.paragraph(&format!("No comparison with a measurement: {note}."));

@@ -55,11 +55,13 @@ pub struct LimitCheck {
 }
 
 impl LimitCheck {
-    /// Adds the valve-open test from the force and the valve displacement channels.
-    pub fn with_valves(mut self, force: &[f64], x_valve0: &[f64], x_valve1: &[f64]) -> Self {
+    /// Adds the valve-open test from the force and the valve displacement channels, and the
+    /// valve velocities where there are any: a poppet on its seat (x = 0) that moves off it
+    /// (v > 0) has cracked within the step, its pressure force is past the preload.
+    pub fn with_valves(mut self, force: &[f64], x: [&[f64]; 2], v: Option<[&[f64]; 2]>) -> Self {
+        let open = |k: usize, i: usize| x[k][i] > 0.0 || v.is_some_and(|v| v[k][i] > 0.0);
         let ok = force.iter().enumerate().all(|(i, &f)| {
-            (f <= self.max_limit_n || x_valve0[i] > 0.0)
-                && (f >= self.min_limit_n || x_valve1[i] > 0.0)
+            (f <= self.max_limit_n || open(0, i)) && (f >= self.min_limit_n || open(1, i))
         });
         self.excess_only_with_valve_open = Some(ok);
         self
@@ -74,7 +76,7 @@ impl LimitCheck {
             )
         } else if self.excess_only_with_valve_open == Some(true) {
             format!(
-                "limited by the relief valves: up to {:.0} N ({:.1}%) beyond the cracking force, only while the valve is open (its spring-regulated pressure rise)",
+                "limited by the relief valves: up to {:.0} N ({:.1}%) beyond the cracking force, only while the valve is open or lifting off its seat (its spring-regulated pressure rise)",
                 -self.margin_n,
                 -100.0 * self.margin_rel
             )
@@ -106,6 +108,8 @@ pub fn limit_check(force: &Stats, limits: (f64, f64)) -> LimitCheck {
 pub struct Measured {
     pub azimuth_deg: Vec<f64>,
     pub force_n: Vec<f64>,
+    /// The record's averaged damper stroke, when it has one.
+    pub stroke_m: Option<Vec<f64>>,
     pub revolutions: usize,
     pub synthetic: bool,
 }
@@ -132,10 +136,127 @@ impl Measured {
         Ok(Measured {
             azimuth_deg: avg.azimuth_deg,
             force_n: avg.force_N,
+            stroke_m: avg.stroke_m,
             revolutions: record.damper_revolutions().len(),
             synthetic: record.meta.synthetic,
         })
     }
+}
+
+/// One harmonic as amplitude and phase (`x = A cos(n psi - phase)`).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct AmplitudePhase {
+    pub amplitude: f64,
+    pub phase_deg: f64,
+}
+
+/// 1/rev dynamic stiffness of the damper in the rotor, `K* = -F1/d1` (complex 1/rev harmonics
+/// of force and stroke): a spring `F = -k d` gives `K* = k`, a dashpot `F = -c d'` gives
+/// `K* = i c Omega`. Storage `K' = Re K*`, loss `K'' = Im K*` [N/m].
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+#[allow(non_snake_case)]
+pub struct DynamicStiffness {
+    pub magnitude_N_per_m: f64,
+    pub phase_deg: f64,
+    pub storage_N_per_m: f64,
+    pub loss_N_per_m: f64,
+}
+
+impl DynamicStiffness {
+    fn of(force: &Harmonic, stroke: &Harmonic) -> Self {
+        // complex amplitude of A cos(psi - phi): A exp(-i phi)
+        let mag = force.amplitude / stroke.amplitude;
+        let ph = (stroke.phase_deg - force.phase_deg + 180.0).to_radians();
+        let (s, c) = ph.sin_cos();
+        let phase_deg = s.atan2(c).to_degrees();
+        DynamicStiffness {
+            magnitude_N_per_m: mag,
+            phase_deg,
+            storage_N_per_m: mag * c,
+            loss_N_per_m: mag * s,
+        }
+    }
+}
+
+/// The model's damper stroke against the record's, and the damper's 1/rev dynamic stiffness in
+/// the rotor (model and record): separates what the rotor (stroke) and what the damper (force for
+/// that stroke) contribute to the force error.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StrokeCheck {
+    pub mean_model_m: f64,
+    pub mean_measured_m: f64,
+    pub rev1_model: AmplitudePhase,
+    pub rev1_measured: AmplitudePhase,
+    /// RMS of (model - measured) stroke at the measured azimuths [m].
+    pub rms_error_m: f64,
+    pub stiffness_1rev_model: DynamicStiffness,
+    pub stiffness_1rev_measured: DynamicStiffness,
+    pub statement: String,
+}
+
+/// Stroke comparison and 1/rev dynamic stiffness (model run vs the record's averages).
+pub fn stroke_check(run: &ModelRun, meas: &Measured) -> anyhow::Result<Option<StrokeCheck>> {
+    let (Some(ms), Some(d), Some(f)) = (
+        meas.stroke_m.as_ref(),
+        run.channel("damper_stroke_m"),
+        run.channel("damper_force_N"),
+    ) else {
+        return Ok(None);
+    };
+    let on = |v: &[f64]| -> anyhow::Result<Vec<f64>> {
+        let i = PeriodicInterp::new(Periodic {
+            psi_deg: &run.azimuth_deg,
+            value: v,
+        })?;
+        Ok(meas.azimuth_deg.iter().map(|p| i.at(*p)).collect())
+    };
+    let (d_mod, f_mod) = (on(d)?, on(f)?);
+    let az = &meas.azimuth_deg;
+    let hd = harmonics(az, &d_mod, 1)?;
+    let hdm = harmonics(az, ms, 1)?;
+    let hf = harmonics(az, &f_mod, 1)?;
+    let hfm = harmonics(az, &meas.force_n, 1)?;
+    let ap = |h: &Harmonic| AmplitudePhase {
+        amplitude: h.amplitude,
+        phase_deg: h.phase_deg,
+    };
+    let rms = (d_mod
+        .iter()
+        .zip(ms)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        / ms.len() as f64)
+        .sqrt();
+    let (km, kr) = (
+        DynamicStiffness::of(&hf[1], &hd[1]),
+        DynamicStiffness::of(&hfm[1], &hdm[1]),
+    );
+    let mut dphi = hd[1].phase_deg - hdm[1].phase_deg;
+    dphi -= 360.0 * (dphi / 360.0).round();
+    let statement = format!(
+        "stroke: mean {:.2} mm (record {:.2}), 1/rev {:.3} mm ({:+.1}% of the record's {:.3} mm), {:.1} deg {} the record's; damper 1/rev dynamic stiffness in the rotor: storage {:.3e} N/m (record {:.3e}), loss {:.3e} N/m (record {:.3e})",
+        1e3 * hd[0].cos,
+        1e3 * hdm[0].cos,
+        1e3 * hd[1].amplitude,
+        100.0 * (hd[1].amplitude / hdm[1].amplitude - 1.0),
+        1e3 * hdm[1].amplitude,
+        dphi.abs(),
+        if dphi > 0.0 { "later than" } else { "earlier than" },
+        km.storage_N_per_m,
+        kr.storage_N_per_m,
+        km.loss_N_per_m,
+        kr.loss_N_per_m,
+    );
+    Ok(Some(StrokeCheck {
+        mean_model_m: hd[0].cos,
+        mean_measured_m: hdm[0].cos,
+        rev1_model: ap(&hd[1]),
+        rev1_measured: ap(&hdm[1]),
+        rms_error_m: rms,
+        stiffness_1rev_model: km,
+        stiffness_1rev_measured: kr,
+        statement,
+    }))
 }
 
 /// What the residual (model - measured, on the measured azimuths) shows.
@@ -219,6 +340,8 @@ pub struct ModelFigures {
     pub limits: Option<LimitCheck>,
     pub metrics: Option<Metrics>,
     pub residual: Option<Residual>,
+    /// When the record has a stroke: the model's stroke against it.
+    pub stroke: Option<StrokeCheck>,
 }
 
 pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<ModelFigures> {
@@ -228,11 +351,19 @@ pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<Mo
     let force = Stats::of(f);
     let limits = run.force_limits_n.map(|l| {
         let c = limit_check(&force, l);
+        let v = match (run.channel("v_valve0_m_s"), run.channel("v_valve1_m_s")) {
+            (Some(v0), Some(v1)) => Some([v0, v1]),
+            _ => None,
+        };
         match (run.channel("x_valve0_m"), run.channel("x_valve1_m")) {
-            (Some(x0), Some(x1)) => c.with_valves(f, x0, x1),
+            (Some(x0), Some(x1)) => c.with_valves(f, [x0, x1], v),
             _ => c,
         }
     });
+    let stroke = match measured {
+        Some(m) => stroke_check(run, m)?,
+        None => None,
+    };
     let (metrics, residual) = match measured {
         Some(m) => {
             let model = Periodic {
@@ -255,6 +386,7 @@ pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<Mo
         limits,
         metrics,
         residual,
+        stroke,
     })
 }
 
@@ -409,6 +541,7 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "cost_per_step_s": t.total_s / steps,
         "metrics": metrics,
         "residual": f.residual,
+        "stroke_check": f.stroke,
         "channels": r.channel_names,
     })
 }
@@ -470,6 +603,34 @@ pub fn write_last_rev(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
 mod tests {
     use super::*;
 
+    /// `K* = -F1/d1` on analytic laws, stroke `d = D cos(psi - 40 deg)`: a spring `F = -k d`
+    /// gives `K* = k`; a dashpot `F = -c d'` (d' = -D Omega sin(psi - 40 deg)) gives `i c Omega`;
+    /// their sum gives both parts.
+    #[test]
+    fn dynamic_stiffness_of_spring_and_dashpot() {
+        let (dd, om, k, c) = (0.004, 27.0, 3.0e5, 1.2e5);
+        let psi: Vec<f64> = (0..256).map(|i| i as f64 * 360.0 / 256.0).collect();
+        let ph = 40f64.to_radians();
+        let d: Vec<f64> = psi
+            .iter()
+            .map(|p| dd * (p.to_radians() - ph).cos())
+            .collect();
+        let v: Vec<f64> = psi
+            .iter()
+            .map(|p| -dd * om * (p.to_radians() - ph).sin())
+            .collect();
+        let hd = harmonics(&psi, &d, 1).unwrap();
+        for (kk, cc) in [(k, 0.0), (0.0, c), (k, c)] {
+            let f: Vec<f64> = d.iter().zip(&v).map(|(d, v)| -kk * d - cc * v).collect();
+            let hf = harmonics(&psi, &f, 1).unwrap();
+            let s = DynamicStiffness::of(&hf[1], &hd[1]);
+            assert!((s.storage_N_per_m - kk).abs() < 1e-6 * k, "{s:?}");
+            assert!((s.loss_N_per_m - cc * om).abs() < 1e-6 * k, "{s:?}");
+            let mag = (kk * kk + (cc * om).powi(2)).sqrt();
+            assert!((s.magnitude_N_per_m - mag).abs() < 1e-6 * mag);
+        }
+    }
+
     #[test]
     fn stats_of_a_sine() {
         let v: Vec<f64> = (0..360)
@@ -497,15 +658,22 @@ mod tests {
         let f = [-90.0, 110.0, 50.0];
         let c = limit_check(&Stats::of(&f), (-100.0, 100.0));
         // valve 0 (positive force side) open at the excess sample
-        let open = c.with_valves(&f, &[0.0, 1e-4, 0.0], &[0.0, 0.0, 0.0]);
+        let z = [0.0; 3];
+        let open = c.with_valves(&f, [&[0.0, 1e-4, 0.0], &z], None);
         assert_eq!(open.excess_only_with_valve_open, Some(true));
         assert!(open
             .statement()
             .starts_with("limited by the relief valves: up to 10 N"));
         // only the wrong valve open: a real exceedance
-        let wrong = c.with_valves(&f, &[0.0, 0.0, 0.0], &[0.0, 1e-4, 0.0]);
+        let wrong = c.with_valves(&f, [&z, &[0.0, 1e-4, 0.0]], None);
         assert_eq!(wrong.excess_only_with_valve_open, Some(false));
         assert!(wrong.statement().starts_with("EXCEEDED by 10 N"));
+        // valve 0 on its seat but lifting off it (cracking within the step)
+        let lifting = c.with_valves(&f, [&z, &z], Some([&[0.0, 3e-5, 0.0], &z]));
+        assert_eq!(lifting.excess_only_with_valve_open, Some(true));
+        // on its seat and not moving, or closing: an exceedance
+        let seated = c.with_valves(&f, [&z, &z], Some([&[0.0, -3e-5, 0.0], &z]));
+        assert_eq!(seated.excess_only_with_valve_open, Some(false));
     }
 
     #[test]
