@@ -63,6 +63,10 @@ pub struct DiagnoseArgs {
     /// Revolutions of each rotor run of --rotor-check (as `rotorsim run --revs`).
     #[arg(long, default_value_t = 75)]
     pub check_revs: usize,
+    /// Rotor model of the rotor runs: uh60a (the multibody model of the rotor deck) or rigid
+    /// (its rigid-blade reduction, as `rotorsim run --model rigid`; seconds instead of minutes).
+    #[arg(long, default_value = "uh60a")]
+    pub rotor_model: String,
 }
 
 impl DiagnoseArgs {
@@ -82,6 +86,7 @@ impl DiagnoseArgs {
             substeps: 25,
             rotor_check: false,
             check_revs: 75,
+            rotor_model: "uh60a".into(),
         }
     }
     fn rotor_opts(&self, revs: usize) -> RotorRunOptions {
@@ -89,6 +94,15 @@ impl DiagnoseArgs {
             revs,
             steps_per_rev: self.steps_per_rev,
             substeps: self.substeps,
+            rigid: self.rotor_model == "rigid",
+        }
+    }
+    /// Label of the rotor model of the rotor runs (summary.json `rotor_model`).
+    fn rotor_model_label(&self) -> &'static str {
+        if self.rotor_model == "rigid" {
+            "rigid-blade reduction of the rotor deck (lag hinge, control-pitch airloads)"
+        } else {
+            "UH-60A multibody rotor"
         }
     }
 }
@@ -213,6 +227,56 @@ fn harmonic_rows(
     }
 }
 
+/// Stroke and damper 1/rev dynamic stiffness rows (records with a stroke): what the rotor
+/// (stroke) and what the damper (force for that stroke) contribute.
+fn stroke_rows(rows: &mut Vec<Vec<String>>, b: &summary::StrokeCheck, e: &summary::StrokeCheck) {
+    let mm = |v: f64| format!("{:.3}", 1e3 * v);
+    rows.push(vec![
+        format!(
+            "1/rev stroke [mm] (measured {})",
+            mm(b.rev1_measured.amplitude)
+        ),
+        mm(b.rev1_model.amplitude),
+        mm(e.rev1_model.amplitude),
+        format!(
+            "{:+.3}",
+            1e3 * (e.rev1_model.amplitude - b.rev1_model.amplitude)
+        ),
+    ]);
+    rows.push(vec![
+        format!(
+            "1/rev stroke phase [deg] (measured {:.1})",
+            b.rev1_measured.phase_deg
+        ),
+        format!("{:.1}", b.rev1_model.phase_deg),
+        format!("{:.1}", e.rev1_model.phase_deg),
+        format!("{:+.1}", e.rev1_model.phase_deg - b.rev1_model.phase_deg),
+    ]);
+    let (kb, ke, km) = (
+        &b.stiffness_1rev_model,
+        &e.stiffness_1rev_model,
+        &b.stiffness_1rev_measured,
+    );
+    rows.push(vec![
+        format!(
+            "damper 1/rev storage K' [N/m] (measured {:.3e})",
+            km.storage_N_per_m
+        ),
+        format!("{:.3e}", kb.storage_N_per_m),
+        format!("{:.3e}", ke.storage_N_per_m),
+        format!("{:+.3e}", ke.storage_N_per_m - kb.storage_N_per_m),
+    ]);
+    rows.push(vec![
+        format!(
+            "damper 1/rev loss K'' [N/m] (measured {:.3e})",
+            km.loss_N_per_m
+        ),
+        format!("{:.3e}", kb.loss_N_per_m),
+        format!("{:.3e}", ke.loss_N_per_m),
+        format!("{:+.3e}", ke.loss_N_per_m - kb.loss_N_per_m),
+    ]);
+}
+
 #[allow(clippy::too_many_arguments)]
 fn rotor_check(
     args: &DiagnoseArgs,
@@ -254,8 +318,9 @@ fn rotor_check(
     // Each run's own outputs, exactly as `rotorsim run --damper physical` writes them.
     let cmd = |deck: Option<&Path>| {
         format!(
-            "rotorsim run --rotor {} --flight {} --damper physical{} --revs {} --steps-per-rev {} --substeps {} --scheme rk4",
+            "rotorsim run --rotor {}{} --flight {} --damper physical{} --revs {} --steps-per-rev {} --substeps {} --scheme rk4",
             rotor_path.display(),
+            if opts.rigid { " --model rigid" } else { "" },
             fl.display(),
             deck.map(|p| format!(" --damper-deck {}", p.display()))
                 .unwrap_or_default(),
@@ -266,6 +331,7 @@ fn rotor_check(
     };
     let base_deck_arg = args.deck.as_deref();
     let mut parts = Vec::new();
+    let mut strokes = Vec::new();
     for (which, res, deck_label, command) in [
         (
             "baseline",
@@ -287,7 +353,7 @@ fn rotor_check(
         };
         let info = RunInfo {
             rotor: rotor_path.display().to_string(),
-            rotor_model: "UH-60A multibody rotor".into(),
+            rotor_model: args.rotor_model_label().into(),
             flight: fl.display().to_string(),
             damper_deck: deck_label.clone(),
             revs: opts.revs,
@@ -309,6 +375,7 @@ fn rotor_check(
             .map_err(|e| anyhow::anyhow!("rotor check, {which} deck: {e}"))?;
         let figs = summary::figures(run, Some(meas))?;
         let metrics = figs.metrics.context("rotor check: no comparison metrics")?;
+        strokes.push(figs.stroke);
         parts.push((which, run, deck_label, command, metrics));
     }
     let (b, e) = (&parts[0].4, &parts[1].4);
@@ -336,7 +403,8 @@ fn rotor_check(
         )
     };
     let statement = format!(
-            "Rotor level (UH-60A rotor model, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}{}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
+            "Rotor level ({}, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}{}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
+            args.rotor_model_label(),
             opts.revs,
             if improved { "lowers" } else { "does NOT improve: it raises" },
             b.rms_error,
@@ -354,18 +422,21 @@ fn rotor_check(
         String,
         String,
         crate::analysis::compare::Metrics,
-    )| {
+    ),
+                st: &Option<summary::StrokeCheck>| {
         json!({
             "damper_deck": p.2,
             "command": p.3,
             "summary": format!("rotor_check/{}/summary.json", p.0),
             "run": run_json(p.1, &opts),
             "metrics": p.4,
+            "stroke_check": st,
         })
     };
     let json = json!({
         "statement": statement,
         "rotor": rotor_path.display().to_string(),
+        "rotor_model": args.rotor_model_label(),
         "flight": fl.display().to_string(),
         "damper_model": "physical",
         "revs": opts.revs,
@@ -373,8 +444,8 @@ fn rotor_check(
         "substeps": opts.substeps,
         "scheme": "rk4",
         "wall_time_s": runs.wall_s,
-        "baseline": side(&parts[0]),
-        "extended": side(&parts[1]),
+        "baseline": side(&parts[0], &strokes[0]),
+        "extended": side(&parts[1], &strokes[1]),
         "change": {
             "rms_error_N": e.rms_error - b.rms_error,
             "gain": gain,
@@ -429,6 +500,9 @@ fn rotor_check(
         ],
     ];
     harmonic_rows(&mut rows, b, e);
+    if let (Some(sb), Some(se)) = (&strokes[0], &strokes[1]) {
+        stroke_rows(&mut rows, sb, se);
+    }
     rows.push(vec![
         "periodicity (last revolution)".into(),
         fmt_measure(rb.last_measure()),
@@ -504,6 +578,12 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     }
     if !(args.max_substep > 0.0 && args.max_substep.is_finite()) {
         bail!("--max-substep must be a positive number of seconds");
+    }
+    if !matches!(args.rotor_model.as_str(), "uh60a" | "rigid") {
+        bail!(
+            "--rotor-model: unknown rotor model '{}' (expected uh60a or rigid)",
+            args.rotor_model
+        );
     }
     if args.rotor_check && args.flight.is_none() {
         bail!("--rotor-check needs a flight record (--rotor ROTOR --flight RECORD): it compares rotor runs with the record's damper force");
@@ -694,11 +774,11 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(c) = &check {
         println!("{}", c.statement);
         println!(
-            "{:<40} {:>14} {:>14}  change",
+            "{:<52} {:>14} {:>14}  change",
             "rotor check", "baseline", "extended"
         );
         for row in &c.rows {
-            println!("{:<40} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
+            println!("{:<52} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
         }
     }
     println!(

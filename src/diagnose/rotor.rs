@@ -24,6 +24,9 @@ pub struct RotorRunOptions {
     pub steps_per_rev: usize,
     /// Hydraulic RK4 sub-steps per structural step (paper: 25).
     pub substeps: usize,
+    /// Run the rigid-blade reduction of the rotor deck (`rotorsim run --model rigid`) instead of
+    /// the multibody rotor model.
+    pub rigid: bool,
 }
 
 impl RotorRunOptions {
@@ -67,14 +70,29 @@ pub fn run_physical(
     opts.check()?;
     damper.require(DamperModel::Physical)?;
     let t0 = Instant::now();
-    let mut sim = crate::rotor::build(
-        rotor,
-        damper,
-        DamperModel::Physical,
-        record,
-        &opts.run_options(),
-    )
-    .context("building the rotor model with the physical damper")?;
+    let mut sim: Box<dyn crate::rotor::ForcedResponse> = if opts.rigid {
+        let p = crate::run::sdof::SdofParams::from_rotor(&rotor.spec, &rotor.path, record)
+            .context("rigid-blade reduction of the rotor deck")?;
+        let ro = opts.run_options();
+        let mut s = crate::run::sdof::LagHingeSdof::new(
+            p,
+            damper,
+            DamperModel::Physical,
+            ro.hydraulics,
+            ro.steps_per_rev,
+        )?;
+        s.set_label("physical (rigid)".into());
+        Box::new(s)
+    } else {
+        crate::rotor::build(
+            rotor,
+            damper,
+            DamperModel::Physical,
+            record,
+            &opts.run_options(),
+        )
+        .context("building the rotor model with the physical damper")?
+    };
     let build_s = t0.elapsed().as_secs_f64();
     let mut run = drive(sim.as_mut(), DamperModel::Physical, opts.revs, progress)?;
     run.build_s = build_s;
