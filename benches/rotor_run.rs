@@ -2,8 +2,9 @@
 //! each damper model on the UH-60A rotor (rotors/uh60a.toml, flightdata/c8534like, 256 steps per
 //! revolution, RK4 with 25 sub-steps), with the structure/hydraulics split from `timing()`.
 //! Runs a few revolutions per model (ROTORSIM_BENCH_REVS, default 3), one model at a time on
-//! one thread, and extrapolates to the default 75-revolution run. The lag-hinge test double is
-//! timed too, for scale.
+//! one thread, and extrapolates to the default 75-revolution run. Wall and CPU time of the
+//! thread (CPU time is insensitive to other processes sharing the cores). The rigid-blade
+//! reduction (`--model rigid`) and the lag-hinge test double are timed too, for scale.
 //!
 //! `cargo bench --bench rotor_run`
 use rotorsim::flight::FlightRecord;
@@ -16,6 +17,27 @@ use std::time::Instant;
 
 const DEFAULT_REVS: usize = 75;
 const STEPS: usize = 256;
+
+/// CPU time of the calling thread [s] (CLOCK_THREAD_CPUTIME_ID).
+fn cpu_s() -> f64 {
+    let mut ts = Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes one timespec to a valid pointer.
+    unsafe { clock_gettime(3, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+#[repr(C)]
+struct Timespec {
+    tv_sec: i64,
+    tv_nsec: i64,
+}
+
+extern "C" {
+    fn clock_gettime(clk: i32, tp: *mut Timespec) -> i32;
+}
 
 fn time_model(
     name: &str,
@@ -32,6 +54,7 @@ fn time_model(
         }
     };
     let build_s = t0.elapsed().as_secs_f64();
+    let c0 = cpu_s();
     let r = match drive(sim.as_mut(), model, revs, &|_, _| {}) {
         Ok(r) => r,
         Err(e) => {
@@ -39,14 +62,16 @@ fn time_model(
             return;
         }
     };
+    let cpu = cpu_s() - c0;
     let t = r.timing;
     let steps = t.steps.max(1) as f64;
     let per_step = t.total_s / steps;
     let hyd = t.hydraulics_s / t.total_s.max(1e-300);
     println!(
-        "{name:<28} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.4} ms/step ({:.2} Newton it/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
+        "{name:<30} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.4} ms/step wall, {:9.4} ms/step CPU ({:.2} Newton it/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
         t.total_s,
         1e3 * per_step,
+        1e3 * cpu / steps,
         t.iterations as f64 / steps,
         100.0 * (1.0 - hyd),
         100.0 * hyd,
@@ -85,6 +110,24 @@ fn main() {
         });
     }
     let deck = DamperDeck::from_file(&rotor_path).expect("damper table");
+    let rotor = RotorDeck::from_file(&rotor_path).expect("rotor deck");
+    let pr = SdofParams::from_rotor(&rotor.spec, &rotor.path, &record).expect("reduction");
+    for m in models {
+        time_model(
+            &format!("rigid-blade reduction {}", m.name()),
+            m,
+            revs,
+            || {
+                Ok(Box::new(LagHingeSdof::new(
+                    pr.clone(),
+                    &deck,
+                    m,
+                    opts.hydraulics,
+                    STEPS,
+                )?))
+            },
+        );
+    }
     let p = SdofParams::from_record(&record).expect("lag moment");
     for m in models {
         time_model(&format!("sdof test double {}", m.name()), m, revs, || {
