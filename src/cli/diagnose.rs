@@ -230,51 +230,56 @@ fn harmonic_rows(
 /// Stroke and damper 1/rev dynamic stiffness rows (records with a stroke): what the rotor
 /// (stroke) and what the damper (force for that stroke) contribute.
 fn stroke_rows(rows: &mut Vec<Vec<String>>, b: &summary::StrokeCheck, e: &summary::StrokeCheck) {
-    let mm = |v: f64| format!("{:.3}", 1e3 * v);
-    rows.push(vec![
-        format!(
-            "1/rev stroke [mm] (measured {})",
-            mm(b.rev1_measured.amplitude)
-        ),
-        mm(b.rev1_model.amplitude),
-        mm(e.rev1_model.amplitude),
-        format!(
-            "{:+.3}",
-            1e3 * (e.rev1_model.amplitude - b.rev1_model.amplitude)
-        ),
-    ]);
-    rows.push(vec![
-        format!(
-            "1/rev stroke phase [deg] (measured {:.1})",
-            b.rev1_measured.phase_deg
-        ),
-        format!("{:.1}", b.rev1_model.phase_deg),
-        format!("{:.1}", e.rev1_model.phase_deg),
-        format!("{:+.1}", e.rev1_model.phase_deg - b.rev1_model.phase_deg),
-    ]);
+    // (label, measured, baseline, extended, scientific notation)
     let (kb, ke, km) = (
         &b.stiffness_1rev_model,
         &e.stiffness_1rev_model,
         &b.stiffness_1rev_measured,
     );
-    rows.push(vec![
-        format!(
-            "damper 1/rev storage K' [N/m] (measured {:.3e})",
-            km.storage_N_per_m
+    let table: [(&str, f64, f64, f64, bool); 4] = [
+        (
+            "1/rev stroke [mm]",
+            1e3 * b.rev1_measured.amplitude,
+            1e3 * b.rev1_model.amplitude,
+            1e3 * e.rev1_model.amplitude,
+            false,
         ),
-        format!("{:.3e}", kb.storage_N_per_m),
-        format!("{:.3e}", ke.storage_N_per_m),
-        format!("{:+.3e}", ke.storage_N_per_m - kb.storage_N_per_m),
-    ]);
-    rows.push(vec![
-        format!(
-            "damper 1/rev loss K'' [N/m] (measured {:.3e})",
-            km.loss_N_per_m
+        (
+            "1/rev stroke phase [deg]",
+            b.rev1_measured.phase_deg,
+            b.rev1_model.phase_deg,
+            e.rev1_model.phase_deg,
+            false,
         ),
-        format!("{:.3e}", kb.loss_N_per_m),
-        format!("{:.3e}", ke.loss_N_per_m),
-        format!("{:+.3e}", ke.loss_N_per_m - kb.loss_N_per_m),
-    ]);
+        (
+            "damper 1/rev storage K' [N/m]",
+            km.storage_N_per_m,
+            kb.storage_N_per_m,
+            ke.storage_N_per_m,
+            true,
+        ),
+        (
+            "damper 1/rev loss K'' [N/m]",
+            km.loss_N_per_m,
+            kb.loss_N_per_m,
+            ke.loss_N_per_m,
+            true,
+        ),
+    ];
+    for (label, m, vb, ve, sci) in table {
+        let f = |v: f64, sign: bool| match (sci, sign) {
+            (true, false) => format!("{v:.3e}"),
+            (true, true) => format!("{v:+.3e}"),
+            (false, false) => format!("{v:.3}"),
+            (false, true) => format!("{v:+.3}"),
+        };
+        rows.push(vec![
+            format!("{label} (measured {})", f(m, false)),
+            f(vb, false),
+            f(ve, false),
+            f(ve - vb, true),
+        ]);
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
