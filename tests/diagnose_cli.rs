@@ -2,18 +2,9 @@
 //! keys, the written deck through `rotorsim bench`, and the clear errors.
 use rotorsim::cli::bench::{run as bench, BenchArgs};
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
-use std::path::{Path, PathBuf};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rotorsim-diag-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::PathBuf;
+mod support;
+use support::{assert_diagnosis_keys, read_json, root, tmp};
 
 fn args(out: PathBuf) -> DiagnoseArgs {
     DiagnoseArgs {
@@ -35,21 +26,8 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
         ..args(dir.join("out"))
     })
     .unwrap();
-    let j: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/diagnosis.json")).unwrap())
-            .unwrap();
-    for k in [
-        "cause",
-        "parameters",
-        "baseline_rms_N",
-        "extended_rms_N",
-        "gain",
-        "validation",
-        "candidates",
-        "evidence",
-    ] {
-        assert!(j.get(k).is_some(), "missing key {k}");
-    }
+    let j = read_json(&dir.join("out/diagnosis.json"));
+    assert_diagnosis_keys(&j);
     for k in ["method", "baseline_rms_N", "extended_rms_N"] {
         assert!(j["validation"].get(k).is_some(), "missing validation.{k}");
     }

@@ -5,17 +5,8 @@
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
 use rotorsim::flight::{DamperSample, FlightRecord};
 use std::path::{Path, PathBuf};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rotorsim-diagrot-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod support;
+use support::{assert_diagnosis_keys, read_json, root, tmp};
 
 /// flightdata/c8534like with the damper stroke removed (same airloads, controls and force).
 fn record_without_stroke(dir: &Path) -> (PathBuf, FlightRecord) {
@@ -63,22 +54,8 @@ fn record_without_stroke_is_diagnosed_through_the_rotor_run() {
         ..DiagnoseArgs::new(out.clone())
     })
     .unwrap();
-    let j: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
-            .unwrap();
-    // FORMATS.md keys are all there.
-    for k in [
-        "cause",
-        "parameters",
-        "baseline_rms_N",
-        "extended_rms_N",
-        "gain",
-        "validation",
-        "candidates",
-        "evidence",
-    ] {
-        assert!(j.get(k).is_some(), "missing key {k}");
-    }
+    let j = read_json(&out.join("diagnosis.json"));
+    assert_diagnosis_keys(&j);
     // A cause or `none`, from the candidate library.
     let cause = j["cause"].as_str().unwrap();
     let known: Vec<&str> = j["candidates"]
@@ -175,9 +152,7 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
         ..DiagnoseArgs::new(out.clone())
     })
     .unwrap();
-    let j: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
-            .unwrap();
+    let j = read_json(&out.join("diagnosis.json"));
     // The record has stroke: the existing stroke-driven path, stated as measured.
     assert_eq!(j["stroke_source"]["kind"], "measured");
     assert_ne!(j["cause"], "none");
@@ -190,10 +165,7 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
         .contains(&format!("--damper-deck {}", deck.display())));
     // Each side's metrics are those of its own summary.json (what `rotorsim run` writes).
     for side in ["baseline", "extended"] {
-        let s: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(out.join(format!("rotor_check/{side}/summary.json"))).unwrap(),
-        )
-        .unwrap();
+        let s = read_json(&out.join(format!("rotor_check/{side}/summary.json")));
         assert_eq!(
             s["models"]["physical"]["metrics"]["rms_error"],
             c[side]["metrics"]["rms_error"]
@@ -231,9 +203,7 @@ fn extended_deck_improves_the_rigid_rotor_comparison_of_the_shipped_record() {
         ..DiagnoseArgs::new(out.clone())
     })
     .unwrap();
-    let j: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
-            .unwrap();
+    let j = read_json(&out.join("diagnosis.json"));
     assert_eq!(j["cause"], "mount_compliance");
     let c = &j["rotor_check"];
     assert!(c["rotor_model"].as_str().unwrap().contains("rigid-blade"));

@@ -7,6 +7,7 @@ use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::sim::{build_sim, relief_limits, RotorSim};
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions, BASE_CHANNELS};
 use std::path::PathBuf;
+mod support;
 
 fn repo(p: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
@@ -120,17 +121,7 @@ fn uh60a_physical_damper_two_revolutions() {
     let r = run(DamperModel::Physical, 2, 256);
     check_common(&r, "physical");
     let names = r.sim.channel_names();
-    for c in [
-        "p0_Pa",
-        "p1_Pa",
-        "q_orifice_m3_s",
-        "x_valve0_m",
-        "x_valve1_m",
-        "v_valve0_m_s",
-        "v_valve1_m_s",
-        "q_valve0_m3_s",
-        "q_valve1_m3_s",
-    ] {
+    for c in support::PHYSICAL_CHANNELS {
         assert!(names.iter().any(|n| n == c), "missing channel {c}");
     }
     let ip0 = names.iter().position(|n| n == "p0_Pa").unwrap();

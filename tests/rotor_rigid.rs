@@ -8,11 +8,8 @@ use rotorsim::hydraulics::{DamperModel, IntegratorOptions};
 use rotorsim::rotor::RotorDeck;
 use rotorsim::run::drive;
 use rotorsim::run::sdof::{LagHingeSdof, SdofParams};
-use std::path::Path;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+mod support;
+use support::root;
 
 fn setup() -> (RotorDeck, FlightRecord, SdofParams) {
     let deck = RotorDeck::from_file(&root().join("rotors/uh60a.toml")).unwrap();

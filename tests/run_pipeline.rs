@@ -10,12 +10,8 @@ fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rotorsim-run-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod support;
+use support::tmp;
 
 fn rotorsim(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rotorsim"))
@@ -52,7 +48,7 @@ fn ok(o: &Output) {
 }
 
 fn summary(out: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    support::read_json(&out.join("summary.json"))
 }
 
 fn example() -> PathBuf {
@@ -178,17 +174,7 @@ fn all_three_models_write_every_output() {
             "damper_stroke_rate_m_s"
         ]
     );
-    for want in [
-        "p0_Pa",
-        "p1_Pa",
-        "q_orifice_m3_s",
-        "x_valve0_m",
-        "x_valve1_m",
-        "v_valve0_m_s",
-        "v_valve1_m_s",
-        "q_valve0_m3_s",
-        "q_valve1_m3_s",
-    ] {
+    for want in support::PHYSICAL_CHANNELS {
         assert!(h.iter().any(|x| x == want), "{want} missing from {h:?}");
     }
     let units = ["_deg", "_N", "_m", "_m_s", "_Pa", "_m3_s", "_rad"];
