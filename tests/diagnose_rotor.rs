@@ -242,3 +242,34 @@ fn unknown_rotor_model_is_refused_by_name() {
         "{msg}"
     );
 }
+
+/// A record without stroke, its stroke simulated by the rigid-blade reduction (the record's own
+/// blade model, `--rotor-model rigid`): the diagnosis finds the mount compliance it finds with
+/// the measured stroke (5.028e7 N/m, docs/diagnosis.md), the recalibration beside it taking up
+/// the reduction's 2.7% smaller 1/rev stroke. Measured: mount_compliance+recalibration,
+/// 5.018e7 N/m, held-out gain 0.694.
+#[test]
+fn record_without_stroke_through_the_rigid_reduction_finds_the_mount() {
+    let dir = tmp("nostroke-rigid");
+    let (fl, _) = record_without_stroke(&dir);
+    let out = dir.join("out");
+    diagnose(DiagnoseArgs {
+        rotor: Some(root().join("rotors/uh60a.toml")),
+        flight: Some(fl),
+        rotor_model: "rigid".into(),
+        revs: 75,
+        ..DiagnoseArgs::new(out.clone())
+    })
+    .unwrap();
+    let j = read_json(&out.join("diagnosis.json"));
+    assert_eq!(j["stroke_source"]["kind"], "simulated");
+    assert_eq!(j["stroke_source"]["rotor_model"], "rigid");
+    assert!(
+        j["cause"].as_str().unwrap().contains("mount_compliance"),
+        "{}",
+        j["cause"]
+    );
+    let k = j["parameters"]["mount_stiffness_N_per_m"].as_f64().unwrap();
+    assert!((k / 5.028e7 - 1.0).abs() < 0.02, "mount stiffness {k}");
+    assert!(j["gain"].as_f64().unwrap() > 0.5);
+}

@@ -163,7 +163,12 @@ fn simulated_measurement(
     let (mean, amp) = mean_and_amplitude(d);
     let periodic = run.converged();
     let statement = format!(
-        "The stroke is SIMULATED, not measured: the record has no damper stroke, so the damper is driven by the periodic stroke of the rotor model ({}, physical damper of the baseline deck, last of {} revolutions, {}; mean {:.2} mm, amplitude {:.2} mm), interpolated at the record's azimuths, and compared with the record's measured force. Any error of the rotor model's stroke (amplitude, phase, mean) shows up as a damper discrepancy: a named cause is a cause of the force-vs-simulated-stroke mismatch, not necessarily of the damper alone.",
+        "The stroke is SIMULATED, not measured: the record has no damper stroke, so the damper is driven by the periodic stroke of the rotor model ({} of {}, physical damper of the baseline deck, last of {} revolutions, {}; mean {:.2} mm, amplitude {:.2} mm), interpolated at the record's azimuths, and compared with the record's measured force. Any error of the rotor model's stroke (amplitude, phase, mean) shows up as a damper discrepancy: a named cause is a cause of the force-vs-simulated-stroke mismatch, not necessarily of the damper alone.",
+        if opts.rigid {
+            "rigid-blade reduction"
+        } else {
+            "multibody model"
+        },
         rotor_path.display(),
         run.revolutions,
         summary::periodicity_statement(&run),
@@ -174,6 +179,7 @@ fn simulated_measurement(
         "kind": "simulated",
         "statement": statement,
         "rotor": rotor_path.display().to_string(),
+        "rotor_model": if opts.rigid { "rigid" } else { "uh60a" },
         "damper_model": "physical",
         "stroke_mean_m": mean,
         "stroke_amplitude_m": amp,
