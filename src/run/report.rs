@@ -191,6 +191,9 @@ pub fn report_html(
     if info.rotor_model.contains("sdof") {
         rep.notice("Rotor model: the lag-hinge single-degree-of-freedom TEST DOUBLE (--model sdof), not the UH-60A multibody rotor model.");
     }
+    if info.rotor_model.contains("rigid-blade") {
+        rep.notice("Rotor model: the rigid-blade reduction of the rotor deck (--model rigid): the blade rigid on its lag hinge, no flap, no elastic bending or twist, airloads projected with the control pitch (docs/rotor_model.md). For damper comparisons on records of rigid-blade generators; blade loads need the multibody model.");
+    }
     rep.paragraph(&format!(
         "Rotor deck {}, damper deck {}, flight record {}{}; {} revolutions of {} steps, hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
         info.rotor,
