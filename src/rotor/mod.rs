@@ -33,6 +33,34 @@ pub const BASE_CHANNELS: [&str; 6] = [
     "tip_twist_rad",
 ];
 
+/// Eq. (5) of a relief valve seen at the damper: off its seat the poppet balances
+/// `A_front p_k - A_back p_other = F_p + k x + c v + m a`, so with `A_back/A_front = A_other/A_k`
+/// (the shipped dampers) the damper force beyond the cracking force is
+/// `(A_k / A_front) (k x + c v + m a)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReliefRegulation {
+    /// `A_k / A_front` [-].
+    pub area_ratio: f64,
+    /// Poppet spring k [N/m] and dashpot c [N s/m].
+    pub k_n_per_m: f64,
+    pub c_n_s_per_m: f64,
+}
+
+impl ReliefRegulation {
+    /// Per valve from the circuit's areas and relief valves (None without both valves).
+    pub fn of(params: &crate::hydraulics::circuit::CircuitParams) -> Option<[Self; 2]> {
+        let a = [params.chambers[0].area, params.chambers[1].area];
+        let r = |k: usize| {
+            params.relief[k].map(|v| ReliefRegulation {
+                area_ratio: a[k] / v.a_front,
+                k_n_per_m: v.k,
+                c_n_s_per_m: v.c,
+            })
+        };
+        Some([r(0)?, r(1)?])
+    }
+}
+
 /// One time-marching forced-response simulation of a rotor blade with one damper model.
 pub trait ForcedResponse: Send {
     /// Model label: "linear", "nonlinear" or "physical".
@@ -60,6 +88,11 @@ pub trait ForcedResponse: Send {
     /// Force limits of the device [N] (min, max) where it has them (physical damper: the
     /// relief-valve limits), else None.
     fn force_limits_n(&self) -> Option<(f64, f64)> {
+        None
+    }
+    /// Relief-valve regulation (physical damper): per valve, what turns the poppet's spring and
+    /// damping forces into damper force beyond the cracking force (Eq. 5); else None.
+    fn relief_regulation(&self) -> Option<[ReliefRegulation; 2]> {
         None
     }
     fn timing(&self) -> Timing;

@@ -170,6 +170,7 @@ pub struct RotorSim {
     dev_names: Vec<String>,
     physical: bool,
     limits: Option<(f64, f64)>,
+    regulation: Option<[super::ReliefRegulation; 2]>,
     swash: usize,
     hub: usize,
     tip: usize,
@@ -338,6 +339,14 @@ pub fn build_sim(
         } else {
             None
         },
+        regulation: if physical {
+            damper
+                .physical
+                .as_ref()
+                .and_then(super::ReliefRegulation::of)
+        } else {
+            None
+        },
         swash,
         hub,
         tip,
@@ -466,6 +475,9 @@ impl ForcedResponse for RotorSim {
     }
     fn force_limits_n(&self) -> Option<(f64, f64)> {
         self.limits
+    }
+    fn relief_regulation(&self) -> Option<[super::ReliefRegulation; 2]> {
+        self.regulation
     }
     fn timing(&self) -> Timing {
         Timing {

@@ -54,6 +54,8 @@ pub struct ModelRun {
     /// `last_rev[c][i]`: channel `c` at sample `i` of the last revolution.
     pub last_rev: Vec<Vec<f64>>,
     pub force_limits_n: Option<(f64, f64)>,
+    /// Relief-valve regulation of the device (physical damper), for the limit check.
+    pub relief_regulation: Option<[crate::rotor::ReliefRegulation; 2]>,
     pub timing: Timing,
     /// Wall time of the whole run of this model, construction included [s].
     pub wall_s: f64,
@@ -193,6 +195,7 @@ pub fn drive(
         azimuth_deg: azimuth,
         last_rev: samples,
         force_limits_n: sim.force_limits_n(),
+        relief_regulation: sim.relief_regulation(),
         timing,
         wall_s: t_start.elapsed().as_secs_f64(),
         build_s: 0.0,

@@ -433,6 +433,13 @@ impl ForcedResponse for LagHingeSdof {
         self.limits
     }
 
+    fn relief_regulation(&self) -> Option<[crate::rotor::ReliefRegulation; 2]> {
+        match &self.dev {
+            Holder::Circuit(c) => crate::rotor::ReliefRegulation::of(c.params()),
+            Holder::Other(_) => None,
+        }
+    }
+
     fn timing(&self) -> Timing {
         self.timing
     }

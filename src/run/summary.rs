@@ -52,6 +52,23 @@ pub struct LimitCheck {
     /// excess is the valve's own regulation (poppet spring and damping: the pressure rises as
     /// the valve opens, Eq. 5) and the valve is limiting the force. None without valve channels.
     pub excess_only_with_valve_open: Option<bool>,
+    /// Eq. (5) account of the excess (valve positions and velocities and the valves'
+    /// regulation known).
+    pub regulation: Option<RegulationCheck>,
+}
+
+/// The force beyond a cracking force explained by the relief valve's own Eq. (5): off its seat
+/// the valve adds `(A_k/A_front)(k x + c v + m a)` to the cracking force.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct RegulationCheck {
+    /// At the sample of the largest excess beyond a cracking force: the excess [N] and its
+    /// spring part `(A_k/A_front) k x` and poppet-damping part `(A_k/A_front) c v` [N].
+    pub excess_n: f64,
+    pub spring_n: f64,
+    pub damping_n: f64,
+    /// Largest |F - (cracking + spring + damping part)| over all samples beyond a cracking
+    /// force [N]: what Eq. (5) without the poppet inertia leaves.
+    pub unexplained_n: f64,
 }
 
 impl LimitCheck {
@@ -66,6 +83,46 @@ impl LimitCheck {
         self.excess_only_with_valve_open = Some(ok);
         self
     }
+    /// Adds the Eq. (5) account of the force beyond the cracking forces: valve k's spring and
+    /// damping parts at every sample beyond limit k (`reg`: the valves' regulation).
+    pub fn with_regulation(
+        mut self,
+        force: &[f64],
+        x: [&[f64]; 2],
+        v: [&[f64]; 2],
+        reg: &[crate::rotor::ReliefRegulation; 2],
+    ) -> Self {
+        let mut worst: Option<RegulationCheck> = None;
+        let mut unexplained = 0.0f64;
+        for (i, &f) in force.iter().enumerate() {
+            // side k: excess beyond its cracking force, positive outward
+            let (k, excess) = if f > self.max_limit_n {
+                (0, f - self.max_limit_n)
+            } else if f < self.min_limit_n {
+                (1, self.min_limit_n - f)
+            } else {
+                continue;
+            };
+            let r = &reg[k];
+            let spring = r.area_ratio * r.k_n_per_m * x[k][i];
+            let damping = r.area_ratio * r.c_n_s_per_m * v[k][i];
+            unexplained = unexplained.max((excess - spring - damping).abs());
+            if worst.is_none_or(|w| excess > w.excess_n) {
+                worst = Some(RegulationCheck {
+                    excess_n: excess,
+                    spring_n: spring,
+                    damping_n: damping,
+                    unexplained_n: 0.0,
+                });
+            }
+        }
+        self.regulation = worst.map(|w| RegulationCheck {
+            unexplained_n: unexplained,
+            ..w
+        });
+        self
+    }
+
     /// Human statement of the check.
     pub fn statement(&self) -> String {
         if self.within {
@@ -75,8 +132,14 @@ impl LimitCheck {
                 100.0 * self.margin_rel
             )
         } else if self.excess_only_with_valve_open == Some(true) {
+            let eq5 = self.regulation.map_or(String::new(), |r| {
+                format!(
+                    "; Eq. (5) of the valve accounts for it: at the peak, poppet spring {:.0} N + poppet damping {:.0} N of the {:.0} N, at most {:.0} N left over any sample (poppet inertia)",
+                    r.spring_n, r.damping_n, r.excess_n, r.unexplained_n
+                )
+            });
             format!(
-                "limited by the relief valves: up to {:.0} N ({:.1}%) beyond the cracking force, only while the valve is open or lifting off its seat (its spring-regulated pressure rise)",
+                "limited by the relief valves: up to {:.0} N ({:.1}%) beyond the cracking force, only while the valve is open or lifting off its seat (its regulated pressure rise){eq5}",
                 -self.margin_n,
                 -100.0 * self.margin_rel
             )
@@ -100,6 +163,7 @@ pub fn limit_check(force: &Stats, limits: (f64, f64)) -> LimitCheck {
         margin_n: margin,
         margin_rel: margin / lo.abs().max(hi.abs()),
         excess_only_with_valve_open: None,
+        regulation: None,
     }
 }
 
@@ -356,7 +420,13 @@ pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<Mo
             _ => None,
         };
         match (run.channel("x_valve0_m"), run.channel("x_valve1_m")) {
-            (Some(x0), Some(x1)) => c.with_valves(f, [x0, x1], v),
+            (Some(x0), Some(x1)) => {
+                let c = c.with_valves(f, [x0, x1], v);
+                match (v, &run.relief_regulation) {
+                    (Some(v), Some(reg)) => c.with_regulation(f, [x0, x1], v, reg),
+                    _ => c,
+                }
+            }
             _ => c,
         }
     });
@@ -651,6 +721,33 @@ mod tests {
         let c = limit_check(&Stats::of(&[-90.0, 95.0]), (-100.0, 100.0));
         assert!(c.within);
         assert_eq!(c.margin_n, 5.0);
+    }
+
+    /// Forces built from Eq. (5), `F = F_crack + (A/A_front)(k x + c v)`, plus 5 N at one sample:
+    /// the parts at the peak are recovered and 5 N is left unexplained.
+    #[test]
+    fn regulation_splits_the_excess_into_spring_and_poppet_damping() {
+        let reg = crate::rotor::ReliefRegulation {
+            area_ratio: 80.0,
+            k_n_per_m: 2.0e4,
+            c_n_s_per_m: 200.0,
+        };
+        let x = [0.0, 2.0e-5, 1.0e-5];
+        let v = [0.0, 0.01, 0.002];
+        let eq5 = |i: usize| 100.0 + 80.0 * (2.0e4 * x[i] + 200.0 * v[i]);
+        let f = [50.0, eq5(1), eq5(2) + 5.0];
+        let z = [0.0; 3];
+        let c = limit_check(&Stats::of(&f), (-100.0, 100.0))
+            .with_valves(&f, [&x, &z], Some([&v, &z]))
+            .with_regulation(&f, [&x, &z], [&v, &z], &[reg, reg]);
+        let r = c.regulation.unwrap();
+        assert!((r.excess_n - (eq5(1) - 100.0)).abs() < 1e-9);
+        assert!((r.spring_n - 80.0 * 2.0e4 * 2.0e-5).abs() < 1e-9); // 32 N
+        assert!((r.damping_n - 80.0 * 200.0 * 0.01).abs() < 1e-9); // 160 N
+        assert!((r.unexplained_n - 5.0).abs() < 1e-9);
+        assert!(c
+            .statement()
+            .contains("poppet spring 32 N + poppet damping 160 N"));
     }
 
     #[test]
