@@ -100,7 +100,7 @@ impl DiagnoseArgs {
     /// Label of the rotor model of the rotor runs (summary.json `rotor_model`).
     fn rotor_model_label(&self) -> &'static str {
         if self.rotor_model == "rigid" {
-            "rigid-blade reduction of the rotor deck (lag hinge, control-pitch airloads)"
+            crate::run::sdof::RIGID_LABEL
         } else {
             "UH-60A multibody rotor"
         }

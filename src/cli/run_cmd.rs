@@ -5,7 +5,7 @@ use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
 use crate::io::OutDir;
 use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
-use crate::run::sdof::{LagHingeSdof, SdofParams};
+use crate::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams, RIGID_LABEL};
 use crate::run::summary::{self, Measured, ModelFigures, RunInfo};
 use crate::run::{self, fmt_measure, ModelOutcome, Progress, Silent};
 use anyhow::{bail, Context};
@@ -115,19 +115,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         .scheme
         .parse()
         .map_err(|e: String| anyhow::anyhow!("--scheme: {e}"))?;
-    if args.revs < 2 {
-        bail!(
-            "--revs must be at least 2 (periodicity compares consecutive revolutions), got {}",
-            args.revs
-        );
-    }
-    if args.steps_per_rev < 8 || args.substeps == 0 {
-        bail!(
-            "--steps-per-rev must be >= 8 and --substeps >= 1 (got {} and {})",
-            args.steps_per_rev,
-            args.substeps
-        );
-    }
+    run::check_run_options(args.revs, args.steps_per_rev, args.substeps)?;
     let (sdof, rigid) = match args.model.as_str() {
         "uh60a" => (false, false),
         "rigid" => (false, true),
@@ -158,24 +146,21 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         hydraulics,
         ..RunOptions::default()
     };
-    let sdof_params = match (&rotor, sdof, rigid) {
-        (_, true, _) => Some(SdofParams::from_record(&record)?),
-        (Some(r), _, true) => Some(
-            SdofParams::from_rotor(&r.spec, &r.path, &record)
-                .with_context(|| format!("rigid-blade reduction of {}", r.path.display()))?,
-        ),
-        _ => None,
+    let sdof_params = if sdof {
+        Some(SdofParams::from_record(&record)?)
+    } else {
+        None
     };
     let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
         match (&rotor, &sdof_params) {
-            (_, Some(p)) => {
-                let mut sim =
-                    LagHingeSdof::new(p.clone(), &deck, m, hydraulics, args.steps_per_rev)?;
-                if rigid {
-                    sim.set_label(format!("{} (rigid)", m.name()));
-                }
-                Ok(Box::new(sim))
-            }
+            (_, Some(p)) => Ok(Box::new(LagHingeSdof::new(
+                p.clone(),
+                &deck,
+                m,
+                hydraulics,
+                args.steps_per_rev,
+            )?)),
+            (Some(r), None) if rigid => Ok(Box::new(rigid_reduction(r, &deck, m, &record, &opts)?)),
             (Some(r), None) => crate::rotor::build(r, &deck, m, &record, &opts),
             (None, None) => unreachable!("one rotor model is selected"),
         }
@@ -212,7 +197,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         rotor_model: if sdof {
             "lag-hinge sdof test double".into()
         } else if rigid {
-            "rigid-blade reduction of the rotor deck (lag hinge, control-pitch airloads)".into()
+            RIGID_LABEL.into()
         } else {
             "UH-60A multibody rotor".into()
         },

@@ -31,20 +31,7 @@ pub struct RotorRunOptions {
 
 impl RotorRunOptions {
     pub fn check(&self) -> anyhow::Result<()> {
-        if self.revs < 2 {
-            bail!(
-                "--revs must be at least 2 (periodicity compares consecutive revolutions), got {}",
-                self.revs
-            );
-        }
-        if self.steps_per_rev < 8 || self.substeps == 0 {
-            bail!(
-                "--steps-per-rev must be >= 8 and --substeps >= 1 (got {} and {})",
-                self.steps_per_rev,
-                self.substeps
-            );
-        }
-        Ok(())
+        crate::run::check_run_options(self.revs, self.steps_per_rev, self.substeps)
     }
     fn run_options(&self) -> RunOptions {
         RunOptions {
@@ -71,18 +58,13 @@ pub fn run_physical(
     damper.require(DamperModel::Physical)?;
     let t0 = Instant::now();
     let mut sim: Box<dyn crate::rotor::ForcedResponse> = if opts.rigid {
-        let p = crate::run::sdof::SdofParams::from_rotor(&rotor.spec, &rotor.path, record)
-            .context("rigid-blade reduction of the rotor deck")?;
-        let ro = opts.run_options();
-        let mut s = crate::run::sdof::LagHingeSdof::new(
-            p,
+        Box::new(crate::run::sdof::rigid_reduction(
+            rotor,
             damper,
             DamperModel::Physical,
-            ro.hydraulics,
-            ro.steps_per_rev,
-        )?;
-        s.set_label("physical (rigid)".into());
-        Box::new(s)
+            record,
+            &opts.run_options(),
+        )?)
     } else {
         crate::rotor::build(
             rotor,

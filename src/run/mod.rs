@@ -119,6 +119,22 @@ impl Progress for Silent {
 
 /// Drives `sim` for `revs` revolutions. Each revolution is sampled at the start of each of its
 /// steps (azimuths 0, 360/N, ...), so the last revolution is exactly one period of samples.
+/// The run options every rotor run needs: two revolutions at least (periodicity compares
+/// consecutive ones), 8 steps per revolution, one hydraulic sub-step.
+pub fn check_run_options(revs: usize, steps_per_rev: usize, substeps: usize) -> anyhow::Result<()> {
+    if revs < 2 {
+        anyhow::bail!(
+            "--revs must be at least 2 (periodicity compares consecutive revolutions), got {revs}"
+        );
+    }
+    if steps_per_rev < 8 || substeps == 0 {
+        anyhow::bail!(
+            "--steps-per-rev must be >= 8 and --substeps >= 1 (got {steps_per_rev} and {substeps})"
+        );
+    }
+    Ok(())
+}
+
 pub fn drive(
     sim: &mut dyn ForcedResponse,
     model: DamperModel,

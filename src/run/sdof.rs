@@ -217,6 +217,26 @@ impl SdofParams {
     }
 }
 
+/// `summary.json` `rotor_model` of the rigid-blade reduction.
+pub const RIGID_LABEL: &str =
+    "rigid-blade reduction of the rotor deck (lag hinge, control-pitch airloads)";
+
+/// The rigid-blade reduction of `rotor` (`rotorsim run --model rigid`) with damper model `model`
+/// of `damper`, labelled "<model> (rigid)".
+pub fn rigid_reduction(
+    rotor: &crate::rotor::RotorDeck,
+    damper: &DamperDeck,
+    model: DamperModel,
+    record: &FlightRecord,
+    opts: &crate::rotor::RunOptions,
+) -> anyhow::Result<LagHingeSdof> {
+    let p = SdofParams::from_rotor(&rotor.spec, &rotor.path, record)
+        .map_err(|e| anyhow::anyhow!("rigid-blade reduction of {}: {e:#}", rotor.path.display()))?;
+    let mut sim = LagHingeSdof::new(p, damper, model, opts.hydraulics, opts.steps_per_rev)?;
+    sim.label = format!("{} (rigid)", model.name());
+    Ok(sim)
+}
+
 /// The device, kept concrete for the physical damper without extensions so that the poppet
 /// velocities (states of the circuit) can be reported.
 #[derive(Debug)]
@@ -309,11 +329,6 @@ impl LagHingeSdof {
             timing: Timing::default(),
             p,
         })
-    }
-
-    /// Replace the label ("<model> (sdof)" by default).
-    pub fn set_label(&mut self, label: String) {
-        self.label = label;
     }
 
     /// Lag angle [rad] and rate [rad/s].
