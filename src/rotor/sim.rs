@@ -83,7 +83,16 @@ impl ControlPitch {
             Some(theta_ref) => {
                 theta_ref + self.spec.pitch_rad(&self.controls, p.t) - section_pitch(&p.r)
             }
-            None => 0.0,
+            // every load point of the blade was tabulated at construction (same model, same
+            // quadrature); anything else is a bug, not input
+            None => {
+                debug_assert!(
+                    false,
+                    "no reference pitch at element {} s {}",
+                    p.element, p.s_m
+                );
+                0.0
+            }
         }
     }
 }
