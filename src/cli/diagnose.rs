@@ -371,6 +371,7 @@ fn rotor_check(
             steps_per_rev: opts.steps_per_rev,
             substeps: opts.substeps,
             scheme: "rk4".into(),
+            newton: crate::solver::NewtonMethod::Modified.name().into(),
             synthetic: rec.meta.synthetic,
             counter: rec.meta.counter.clone(),
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),

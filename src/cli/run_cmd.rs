@@ -8,6 +8,7 @@ use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use crate::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams, RIGID_LABEL};
 use crate::run::summary::{self, Measured, ModelFigures, RunInfo};
 use crate::run::{self, fmt_measure, ModelOutcome, Progress, Silent};
+use crate::solver::NewtonMethod;
 use anyhow::{bail, Context};
 use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -47,6 +48,12 @@ pub struct RunArgs {
     /// pipeline, not a rotor model).
     #[arg(long, default_value = "uh60a")]
     pub model: String,
+    /// Newton method of the structural step: modified (the iteration matrix is factored once
+    /// and reused across iterations and steps in the frame turning with the shaft, refreshed
+    /// when it stops contracting) or full (factored at every iteration). Both converge to the
+    /// same residual test.
+    #[arg(long, default_value = "modified")]
+    pub newton: String,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
@@ -115,6 +122,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         .scheme
         .parse()
         .map_err(|e: String| anyhow::anyhow!("--scheme: {e}"))?;
+    let newton: NewtonMethod = args
+        .newton
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("--newton: {e}"))?;
     run::check_run_options(args.revs, args.steps_per_rev, args.substeps)?;
     let (sdof, rigid) = match args.model.as_str() {
         "uh60a" => (false, false),
@@ -144,6 +155,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     let opts = RunOptions {
         steps_per_rev: args.steps_per_rev,
         hydraulics,
+        newton,
         ..RunOptions::default()
     };
     let sdof_params = if sdof {
@@ -212,6 +224,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         steps_per_rev: args.steps_per_rev,
         substeps: args.substeps,
         scheme: args.scheme.clone(),
+        newton: newton.name().into(),
         synthetic: record.meta.synthetic,
         counter: record.meta.counter.clone(),
         wall_s: t0.elapsed().as_secs_f64(),

@@ -17,6 +17,8 @@ pub struct Timing {
     /// Structural steps taken and Newton iterations in total.
     pub steps: usize,
     pub iterations: usize,
+    /// Factorizations of the structural iteration matrix.
+    pub factorizations: usize,
 }
 
 /// Names of the channels every [`ForcedResponse`] reports first, in this order. Sign
@@ -117,6 +119,9 @@ pub struct RunOptions {
     pub hydraulics: IntegratorOptions,
     /// Generalized-alpha spectral radius at infinity.
     pub rho_inf: f64,
+    /// Newton method of the structural step (modified: factorization reused while it
+    /// contracts, in the frame turning with the shaft).
+    pub newton: crate::solver::NewtonMethod,
 }
 
 impl Default for RunOptions {
@@ -125,6 +130,7 @@ impl Default for RunOptions {
             steps_per_rev: 256,
             hydraulics: IntegratorOptions::default(),
             rho_inf: 0.9,
+            newton: crate::solver::NewtonMethod::Modified,
         }
     }
 }

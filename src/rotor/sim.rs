@@ -333,6 +333,7 @@ pub fn build_sim(
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
     // finite-difference tangent stalls Newton near 1e-8 ||r_0|| at some valve events (measured).
     solver.newton.rtol = RTOL;
+    solver.newton.method = opts.newton;
     solver.init_accelerations()?;
     let physical = model_kind == DamperModel::Physical;
     Ok(RotorSim {
@@ -497,6 +498,7 @@ impl ForcedResponse for RotorSim {
             hydraulics_s: self.probe.hydraulics_seconds(),
             steps: self.solver.steps,
             iterations: self.solver.total_iterations,
+            factorizations: self.solver.factorizations,
         }
     }
 }

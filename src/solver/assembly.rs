@@ -326,6 +326,7 @@ impl Assembler {
                 let xi = [x_i[nd[0]], x_i[nd[1]]];
                 let xf = [kin[nd[0]].x, kin[nd[1]].x];
                 self.step_out = ElementOutput::default();
+                s.want_jacobian(matrix);
                 s.evaluate(t_i, dt, xi, xf, &mut self.step_out)?;
                 for k in 0..2 {
                     for i in 0..3 {

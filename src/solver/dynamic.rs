@@ -9,11 +9,12 @@
 //! are `dq` and scaled multipliers; the iteration matrix is the exact derivative including the
 //! tangent operator of the exponential map.
 use super::assembly::Assembler;
-use super::newton::{model_size, norm, NewtonError, NewtonOptions};
+use super::newton::{model_size, norm, NewtonError, NewtonMethod, NewtonOptions};
 use super::state::{lambda_offsets, sensor_header, sensor_values, State};
 use super::statics::{commit, diag_scale};
+use crate::structure::joint::AngleLaw;
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
-use crate::structure::model::Model;
+use crate::structure::model::{Element, Model};
 use crate::structure::rotation::*;
 
 /// Generalized-alpha parameters (Chung & Hulbert 1993).
@@ -51,6 +52,63 @@ pub struct StepInfo {
     pub residual: f64,
 }
 
+/// The frame that turns with a driven shaft: the axis (global) and angle law of the model's one
+/// grounded joint with a prescribed rotation. A rotor's iteration matrix, seen from this frame,
+/// changes slowly, so a stored factorization turned by the angle travelled since it was made
+/// stays a good approximation (`J(t) ~ Q J_f Q^T`, `Q` the turn, on every node's force and
+/// moment rows and displacement and rotation columns; multipliers live in joint frames).
+/// The translational multipliers of grounded joints are reactions in the fixed joint frame,
+/// so they turn too (in joint-frame components, by `Q_A^T Q Q_A`).
+#[derive(Clone, Debug)]
+struct CoRotation {
+    axis: [f64; 3],
+    law: AngleLaw,
+    /// First multiplier dof and joint frame of every grounded joint.
+    grounded: Vec<(usize, [[f64; 3]; 3])>,
+}
+
+impl CoRotation {
+    /// The driven joint of `model`, if it has exactly one.
+    fn of(model: &Model, asm: &Assembler) -> Option<Self> {
+        let mut found = None;
+        let mut grounded = vec![];
+        for (ei, e) in model.elements.iter().enumerate() {
+            if let Element::Joint(j) = e {
+                if j.node_a.is_none() {
+                    grounded.push((asm.lam_start[ei], j.qa));
+                }
+                if let (None, Some(law)) = (j.node_a, &j.prescribed_angle) {
+                    if found.is_some() {
+                        return None;
+                    }
+                    found = Some((j.qa, law.clone()));
+                }
+            }
+        }
+        found.map(|(qa, law)| CoRotation {
+            axis: [qa[0][2], qa[1][2], qa[2][2]],
+            law,
+            grounded,
+        })
+    }
+
+    /// Turns the blocks of 3 that turn with the shaft (node forces and moments or displacements
+    /// and rotations in `v[..nn]`, grounded joints' reactions) by `q`, or by `q^T` if `back`.
+    fn turn(&self, v: &mut [f64], nn: usize, q: &[[f64; 3]; 3], back: bool) {
+        let apply = |m: &[[f64; 3]; 3], b: &mut [f64]| {
+            let x = [b[0], b[1], b[2]];
+            let y = if back { mtv(m, x) } else { mv(m, x) };
+            b.copy_from_slice(&y);
+        };
+        for b in v[..nn].chunks_exact_mut(3) {
+            apply(q, b);
+        }
+        for (l0, qa) in &self.grounded {
+            apply(&mtm(qa, &mm(q, qa)), &mut v[*l0..*l0 + 3]);
+        }
+    }
+}
+
 /// Dynamic solver owning the model and the state; step it with [`DynamicSolver::step`].
 pub struct DynamicSolver {
     pub model: Model,
@@ -77,11 +135,25 @@ pub struct DynamicSolver {
     ws_q: Vec<nalgebra::UnitQuaternion<f64>>,
     ws_q2: Vec<nalgebra::UnitQuaternion<f64>>,
     ws_lam: Vec<f64>,
+    /// True accelerations and multipliers of the step before the last (predictor).
+    prev_vd: Vec<[f64; 6]>,
+    prev_lam: Vec<f64>,
+    /// Residual of the last zero-acceleration predictor evaluated (convergence scale), and
+    /// whether the last step refactored.
+    r_ref: f64,
+    refreshed: bool,
     /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
     pub last_residuals: Vec<f64>,
     /// Total Newton iterations so far.
     pub total_iterations: usize,
+    /// Factorizations of the iteration matrix so far (one per iteration with full Newton).
+    pub factorizations: usize,
     pub steps: usize,
+    corot: Option<CoRotation>,
+    /// Whether the assembler holds a factorization usable by modified Newton, and the shaft
+    /// angle at which it was made.
+    have_factor: bool,
+    factor_angle: f64,
 }
 
 impl DynamicSolver {
@@ -110,6 +182,7 @@ impl DynamicSolver {
             .collect();
         let size = model_size(&state.x);
         let lam_offsets = lambda_offsets(&model);
+        let corot = CoRotation::of(&model, &asm);
         let mut s = DynamicSolver {
             model,
             h,
@@ -127,7 +200,11 @@ impl DynamicSolver {
             x_prev: state.x.clone(),
             lam_offsets,
             total_iterations: 0,
+            factorizations: 0,
             steps: 0,
+            corot,
+            have_factor: false,
+            factor_angle: 0.0,
             ws_a: vec![],
             ws_vd: vec![],
             ws_v: vec![],
@@ -135,6 +212,10 @@ impl DynamicSolver {
             ws_q: vec![],
             ws_q2: vec![],
             ws_lam: vec![],
+            prev_vd: vec![],
+            prev_lam: vec![],
+            r_ref: 0.0,
+            refreshed: false,
             last_residuals: Vec::with_capacity(64),
             state,
         };
@@ -180,6 +261,78 @@ impl DynamicSolver {
         Ok(())
     }
 
+    /// Residual (and with `matrix` the iteration matrix) at the current iterate `self.kin`.
+    fn assemble_at(
+        &mut self,
+        t: f64,
+        t_n: f64,
+        lam_hat: &[f64],
+        ctx: &EvalCtx,
+        matrix: bool,
+    ) -> Result<(), NewtonError> {
+        let (cv, ca) = self.coeffs();
+        let h = self.h;
+        let tl = &self.tl;
+        let seed = |node: usize, comp: usize| dyn_seed(comp, h, cv, ca, &tl[node]);
+        self.asm
+            .assemble(
+                &mut self.model,
+                &self.kin,
+                lam_hat,
+                ctx,
+                &seed,
+                Some((t_n, h, &self.x_prev)),
+                matrix,
+                &mut self.res,
+            )
+            .map_err(|source| NewtonError::Element { t, source })
+    }
+
+    /// Solve `J dq = res` in place with the stored factorization, turned from the shaft angle
+    /// at which it was made to `angle` (`dq = Q J_f^-1 Q^T res`); no turn without a driven
+    /// shaft.
+    fn solve_corotated(&mut self, angle: Option<f64>) {
+        let turn = match (&self.corot, angle) {
+            (Some(c), Some(a)) if a != self.factor_angle => {
+                Some((c, exp_map(fmul(a - self.factor_angle, c.axis))))
+            }
+            _ => None,
+        };
+        let nn = 6 * self.model.nodes.len();
+        if let Some((c, q)) = &turn {
+            c.turn(&mut self.res, nn, q, true);
+        }
+        self.asm.solve(&mut self.res);
+        if let Some((c, q)) = &turn {
+            c.turn(&mut self.res, nn, q, false);
+        }
+    }
+
+    /// Moves the zero-acceleration predictor to the one extrapolated from the last two steps:
+    /// `vd = 2 vd_n - vd_n-1`, `lambda = 2 lambda_n - lambda_n-1`, through the same linear
+    /// relations as a Newton correction (`dq += d`, `v += cv d`, `vd += ca d`).
+    fn shift_predictor(
+        &mut self,
+        lam_hat: &mut [f64],
+        v_new: &mut [[f64; 6]],
+        vd_new: &mut [[f64; 6]],
+        cv: f64,
+        ca: f64,
+    ) {
+        for (k, l) in lam_hat.iter_mut().enumerate() {
+            *l += self.lam_hat[k] - self.prev_lam[k];
+        }
+        for i in 0..v_new.len() {
+            let vdn = cat(self.state.a[i], self.state.al[i]);
+            for k in 0..6 {
+                let d = (2.0 * vdn[k] - self.prev_vd[i][k] - vd_new[i][k]) / ca;
+                self.dq[i][k] += d;
+                v_new[i][k] += cv * d;
+                vd_new[i][k] += ca * d;
+            }
+        }
+    }
+
     /// Advance one step of size `h`. On error the state is left at the last converged step.
     pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
         let p = self.params;
@@ -213,21 +366,35 @@ impl DynamicSolver {
         q_prev.clone_from(&self.state.q);
         let mut lam_hat = std::mem::take(&mut self.ws_lam);
         lam_hat.clone_from(&self.lam_hat);
-        let mut ctx = EvalCtx {
+        let ctx = EvalCtx {
             t,
             load_factor: 1.0,
             gravity: self.model.gravity,
             cscale: self.cscale,
             inertia: true,
         };
-        ctx.cscale = self.cscale;
         let mut r0 = 0.0;
+        let mut r_prev = 0.0;
         let mut it = 0;
         self.last_residuals.clear();
         let mut x_new = std::mem::take(&mut self.ws_x);
         x_new.clone_from(&self.x_prev);
         let mut q_new = std::mem::take(&mut self.ws_q2);
         q_new.clone_from(&q_prev);
+        let modified = self.newton.method == NewtonMethod::Modified;
+        let angle_t = self.corot.as_ref().map(|c| c.law.angle(t));
+        // Convergence: ||r|| <= rtol r_ref, r_ref the residual of the zero-acceleration
+        // predictor. Full Newton starts every step there. Modified Newton evaluates it at the
+        // first step and after each refactorization, and starts from a predictor extrapolated
+        // from the last two steps (accelerations and multipliers), whose residual is ~1000x
+        // smaller, so that the stored matrix has less to correct.
+        let extrapolate = modified && self.prev_vd.len() == n;
+        let mut scale_pending = !extrapolate || self.refreshed || self.r_ref == 0.0;
+        if !scale_pending {
+            r0 = self.r_ref;
+            self.shift_predictor(&mut lam_hat, &mut v_new, &mut vd_new, cv, ca);
+        }
+        self.refreshed = false;
         loop {
             // configuration from dq
             for i in 0..n {
@@ -250,21 +417,11 @@ impl DynamicSolver {
                 });
             }
             self.model.update_distributed_loads(t, &self.kin);
-            let tl = &self.tl;
-            let seed = |node: usize, comp: usize| dyn_seed(comp, h, cv, ca, &tl[node]);
-            let xp = &self.x_prev;
-            self.asm
-                .assemble(
-                    &mut self.model,
-                    &self.kin,
-                    &lam_hat,
-                    &ctx,
-                    &seed,
-                    Some((t_n, h, xp)),
-                    true,
-                    &mut self.res,
-                )
-                .map_err(|source| NewtonError::Element { t, source })?;
+            // A matrix is assembled only where it is factored: modified Newton without a
+            // stored factorization assembles it with the residual; otherwise the residual
+            // comes first and the matrix only if the iterate is not converged.
+            let mut assembled = modified && !self.have_factor && !(scale_pending && extrapolate);
+            self.assemble_at(t, t_n, &lam_hat, &ctx, assembled)?;
             let rn = norm(&self.res);
             if !rn.is_finite() {
                 return Err(NewtonError::NonFinite { t, iteration: it });
@@ -272,8 +429,14 @@ impl DynamicSolver {
             if self.last_residuals.len() < self.last_residuals.capacity() {
                 self.last_residuals.push(rn);
             }
-            if it == 0 {
+            if scale_pending {
+                scale_pending = false;
                 r0 = rn;
+                self.r_ref = rn;
+                if extrapolate && rn > self.newton.rtol * r0 && rn != 0.0 {
+                    self.shift_predictor(&mut lam_hat, &mut v_new, &mut vd_new, cv, ca);
+                    continue;
+                }
             }
             if rn <= self.newton.rtol * r0 || rn == 0.0 {
                 break;
@@ -286,15 +449,32 @@ impl DynamicSolver {
                     initial: r0,
                 });
             }
-            self.asm.factor().map_err(|source| NewtonError::Linear {
-                t,
-                iteration: it,
-                source,
-            })?;
+            // Contraction-rate rule: the stored matrix is kept while each iteration divides
+            // the residual by 1 / max_contraction at least.
+            let refresh = !modified
+                || !self.have_factor
+                || (it > 0 && rn > self.newton.max_contraction * r_prev);
+            if refresh {
+                if !assembled {
+                    self.assemble_at(t, t_n, &lam_hat, &ctx, true)?;
+                    assembled = true;
+                }
+                self.asm.factor().map_err(|source| NewtonError::Linear {
+                    t,
+                    iteration: it,
+                    source,
+                })?;
+                self.have_factor = true;
+                self.refreshed = true;
+                self.factor_angle = angle_t.unwrap_or(0.0);
+                self.factorizations += 1;
+            }
+            debug_assert!(!refresh || assembled);
+            r_prev = rn;
             for r in self.res.iter_mut() {
                 *r = -*r;
             }
-            self.asm.solve(&mut self.res);
+            self.solve_corotated(angle_t);
             let mut dmax: f64 = 0.0;
             for i in 0..n {
                 for k in 0..6 {
@@ -325,6 +505,11 @@ impl DynamicSolver {
             }
         }
         // accept
+        self.prev_vd.resize(n, [0.0; 6]);
+        for i in 0..n {
+            self.prev_vd[i] = cat(self.state.a[i], self.state.al[i]);
+        }
+        self.prev_lam.clone_from(&self.lam_hat);
         for i in 0..n {
             let vdn = cat(self.state.a[i], self.state.al[i]);
             for k in 0..6 {
@@ -485,6 +670,7 @@ impl DynamicSolver {
                 row += nl;
             }
         }
+        self.have_factor = false;
         self.asm.factor().map_err(|source| NewtonError::Linear {
             t,
             iteration: 0,

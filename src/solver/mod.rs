@@ -13,6 +13,6 @@ pub mod verification;
 pub use assembly::Assembler;
 
 pub use dynamic::{DynamicSolver, GenAlphaParams, StepInfo};
-pub use newton::{NewtonError, NewtonOptions};
+pub use newton::{NewtonError, NewtonMethod, NewtonOptions};
 pub use state::State;
 pub use statics::{static_solve, StaticOptions, StaticReport};

@@ -3,6 +3,37 @@ use super::assembly::LinearError;
 use crate::structure::model::ElementError;
 use thiserror::Error;
 
+/// How the iteration matrix is kept: refactored at every iterate (full Newton) or reused across
+/// iterations and steps while it contracts (modified Newton).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum NewtonMethod {
+    #[default]
+    Full,
+    Modified,
+}
+
+impl NewtonMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            NewtonMethod::Full => "full",
+            NewtonMethod::Modified => "modified",
+        }
+    }
+}
+
+impl std::str::FromStr for NewtonMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "full" => Ok(NewtonMethod::Full),
+            "modified" => Ok(NewtonMethod::Modified),
+            _ => Err(format!(
+                "unknown Newton method '{s}' (expected full or modified)"
+            )),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct NewtonOptions {
     pub max_iterations: usize,
@@ -10,6 +41,11 @@ pub struct NewtonOptions {
     pub rtol: f64,
     /// ... or when the largest configuration correction <= xtol * model size.
     pub xtol: f64,
+    /// Dynamic solver only: full or modified Newton.
+    pub method: NewtonMethod,
+    /// Modified Newton: the stored matrix is refreshed at the current iterate as soon as an
+    /// iteration reduces the residual by less than this factor (contraction-rate rule).
+    pub max_contraction: f64,
 }
 
 impl Default for NewtonOptions {
@@ -18,6 +54,8 @@ impl Default for NewtonOptions {
             max_iterations: 25,
             rtol: 1e-9,
             xtol: 1e-11,
+            method: NewtonMethod::Full,
+            max_contraction: 0.2,
         }
     }
 }

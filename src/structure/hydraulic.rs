@@ -155,6 +155,8 @@ pub struct HydraulicForceElement {
     /// Step force applied at the last evaluation [N].
     last_applied: f64,
     channel_buf: Vec<f64>,
+    /// Whether evaluations need `dF/dd_f` (the finite-difference trial of `F_end`).
+    want_jacobian: bool,
 }
 
 impl HydraulicForceElement {
@@ -173,6 +175,7 @@ impl HydraulicForceElement {
             nodes: [node_a, node_b],
             device,
             reference_length_m: None,
+            want_jacobian: true,
             probe,
             applied: AppliedForce::default(),
             trial: None,
@@ -241,6 +244,13 @@ impl HydraulicForceElement {
                 let sf = self.device.trial_step(t_i, dt, d_i, d_f)?;
                 self.last_step = Some(sf);
                 Ok((sf.force_mean, sf.dforce_dstroke))
+            }
+            AppliedForce::End if !self.want_jacobian => {
+                // residual only (modified Newton): the nominal step alone
+                self.probe.trials.fetch_add(1, Ordering::Relaxed);
+                let sf = self.device.trial_step(t_i, dt, d_i, d_f)?;
+                self.last_step = Some(sf);
+                Ok((sf.force_end, 0.0))
             }
             AppliedForce::End => {
                 // d F_end / d d_f by a forward difference of the whole step (flows included);
@@ -356,6 +366,10 @@ impl StepElement for HydraulicForceElement {
             }
         }
         Ok(())
+    }
+
+    fn want_jacobian(&mut self, yes: bool) {
+        self.want_jacobian = yes;
     }
 
     fn commit(&mut self) {

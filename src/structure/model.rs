@@ -53,6 +53,9 @@ pub trait StepElement: Send {
         out: &mut ElementOutput,
     ) -> Result<(), ElementError>;
     fn commit(&mut self);
+    /// Whether the following `evaluate` calls need `jac` (false: only `force` is read, so an
+    /// element may skip the work of its derivative). Default: ignored.
+    fn want_jacobian(&mut self, _yes: bool) {}
     /// Named scalar outputs (units in the name), written by sensors.
     fn sensors(&self) -> Vec<(String, f64)> {
         vec![]
