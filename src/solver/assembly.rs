@@ -1,5 +1,6 @@
 //! Global assembly: dof numbering, sparse pattern (built once), residual and tangent by seeded
 //! dual numbers, sparse LU (faer) with the symbolic factorisation done once.
+use crate::structure::joint::Joint;
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
 use crate::structure::model::{Element, ElementError, ElementOutput, Model};
 use crate::structure::real::{c, Dual, DualN, Real};
@@ -40,6 +41,8 @@ pub struct Assembler {
     /// Beam tangents from one 24-lane dual evaluation (true) or 24 single-lane ones (false);
     /// both give the same exact derivatives.
     pub multilane: bool,
+    /// Joint residuals and tangents by nested duals (true) instead of the closed form (false).
+    pub joint_tangent_dual: bool,
 }
 
 /// Node kinematics with the 6 seeds of local node `l` in lanes 6l..6l+6.
@@ -112,6 +115,42 @@ pub fn element_residual<T: Real>(
             } else {
                 j.residual(&NodeKin::ground(), &k[0], lam, ctx, out)
             }
+        }
+    }
+}
+
+/// Closed-form joint residual and (if `mat`) tangent block, scattered into `res` and `values`
+/// at `pos`.
+#[allow(clippy::too_many_arguments)]
+fn assemble_joint(
+    j: &Joint,
+    k: &[NodeKin<f64>],
+    lam: &[f64],
+    ctx: &EvalCtx,
+    seed: &dyn Fn(usize, usize) -> Seed,
+    dofs: &[usize],
+    res: &mut [f64],
+    mat: Option<(&mut [f64], &[usize])>,
+) {
+    let (a, b) = match j.node_a {
+        Some(_) => (k[0], k[1]),
+        None => (NodeKin::ground(), k[0]),
+    };
+    let n = dofs.len();
+    let mut r = [0.0; 18];
+    j.residual_f64(&a, &b, lam, ctx, &mut r[..n]);
+    for (&d, &v) in dofs.iter().zip(&r[..n]) {
+        res[d] += v;
+    }
+    if let Some((values, pos)) = mat {
+        let mut seeds = [[Seed::default(); 6]; 2];
+        for (l, sl) in seeds.iter_mut().enumerate().take(k.len()) {
+            *sl = std::array::from_fn(|c| seed(dofs[6 * l] / 6, c));
+        }
+        let mut t = [0.0; 18 * 18];
+        j.tangent(&a, &b, lam, ctx, &seeds[..k.len()], &mut t[..n * n]);
+        for (&p, &v) in pos.iter().zip(&t[..n * n]) {
+            values[p] += v;
         }
     }
 }
@@ -195,6 +234,7 @@ impl Assembler {
             factored: false,
             step_out: ElementOutput::default(),
             multilane: true,
+            joint_tangent_dual: false,
         })
     }
 
@@ -269,6 +309,11 @@ impl Assembler {
             let nlam = n - 6 * nnodes;
             for l in 0..nlam {
                 lam_f[l] = lam_hat[dofs[6 * nnodes + l] - nl6];
+            }
+            if let (Element::Joint(j), false) = (e, self.joint_tangent_dual) {
+                let out = matrix.then_some((&mut self.values[..], &self.elem_pos[ei][..]));
+                assemble_joint(j, &kf[..nnodes], &lam_f[..nlam], ctx, seed, dofs, res, out);
+                continue;
             }
             out_f[..n].iter_mut().for_each(|x| *x = 0.0);
             element_residual(e, &kf[..nnodes], &lam_f[..nlam], ctx, &mut out_f[..n]);

@@ -6,8 +6,10 @@
 //! `psi_p(t)` about z, `Rr <- Rz(psi_p)^T Rr`. Locked rotations use
 //! `Phi = 1/2 axial(Rr - Rr^T)` components (clamp), `Rr_31, Rr_32` (revolute: z axes stay
 //! aligned), `Rr_12` (universal). Translations: `Q_A^T R_A^T (x_B + R_B d_B - x_A - R_A d_A) - u(t)`.
-//! Constraint forces `B^T lambda` with `B = dPhi/dq` obtained by nested dual numbers.
-use super::kin::{EvalCtx, NodeKin, TimeTable};
+//! Constraint forces `B^T lambda` with `B = dPhi/dq`: in closed form (`residual_f64`, `tangent`,
+//! used by the assembler) and, as the reference, by nested dual numbers (`residual`,
+//! `tangent_dual`).
+use super::kin::{EvalCtx, NodeKin, Seed, TimeTable};
 use super::real::{c, Dual, Real};
 use super::rotation::*;
 
@@ -222,6 +224,347 @@ impl Joint {
                 }
             }
         }
+    }
+}
+
+/// Rotation constraints as sums `sum coef Rr'_ij` (i, j 0-based), indexed by `nrot`:
+/// clamp/prescribed `1/2 axial(Rr' - Rr'^T)`, revolute `Rr_31, Rr_32`, universal `Rr_12`.
+type RotTerms = &'static [&'static [(f64, usize, usize)]];
+const ROT_TERMS: [RotTerms; 4] = [
+    &[],
+    &[&[(1.0, 0, 1)]],
+    &[&[(1.0, 2, 0)], &[(1.0, 2, 1)]],
+    &[
+        &[(0.5, 2, 1), (-0.5, 1, 2)],
+        &[(0.5, 0, 2), (-0.5, 2, 0)],
+        &[(0.5, 1, 0), (-0.5, 0, 1)],
+    ],
+];
+
+/// Joint geometry at one configuration (f64), shared by `residual_f64` and `tangent`.
+struct Geo {
+    /// Joint axes of A, `f_k = R_A Q_A e_k` (translations are measured along them).
+    f: [V3<f64>; 3],
+    /// Axes of A turned by the prescribed angle, `a_i = R_A Q_A Rz e_i`, and of B,
+    /// `b_j = R_B Q_B e_j`: `Rr'_ij = a_i . b_j`.
+    ax: [V3<f64>; 3],
+    bx: [V3<f64>; 3],
+    /// Offsets `rho_A = R_A d_A`, `rho_B = R_B d_B`.
+    rho_a: V3<f64>,
+    rho_b: V3<f64>,
+    /// `p_B - x_A` and `r = p_B - p_A` (joint points `p = x + rho`).
+    pb_xa: V3<f64>,
+    r: V3<f64>,
+}
+
+fn col(m: &M3<f64>, k: usize) -> V3<f64> {
+    [m[0][k], m[1][k], m[2][k]]
+}
+
+impl Joint {
+    fn geo(&self, a: &NodeKin<f64>, b: &NodeKin<f64>, t: f64) -> Geo {
+        let fa = mm(&a.r, &self.qa);
+        let fb = mm(&b.r, &self.qb);
+        let f = [col(&fa, 0), col(&fa, 1), col(&fa, 2)];
+        let mut ax = f;
+        if let Some(law) = &self.prescribed_angle {
+            let (sn, cs) = law.angle(t).sin_cos();
+            ax[0] = add(fmul(cs, f[0]), fmul(sn, f[1]));
+            ax[1] = sub(fmul(cs, f[1]), fmul(sn, f[0]));
+        }
+        let rho_a = mv(&a.r, self.da);
+        let rho_b = mv(&b.r, self.db);
+        let pb = add(b.x, rho_b);
+        let pb_xa = sub(pb, a.x);
+        Geo {
+            f,
+            ax,
+            bx: [col(&fb, 0), col(&fb, 1), col(&fb, 2)],
+            rho_a,
+            rho_b,
+            pb_xa,
+            r: sub(pb_xa, rho_a),
+        }
+    }
+
+    fn rot_terms(&self) -> RotTerms {
+        ROT_TERMS[self.locks().1]
+    }
+
+    /// Whether the spring/damper about the joint axis acts.
+    fn has_spring(&self) -> bool {
+        (self.spring_nm_per_rad != 0.0 || self.damper_nms_per_rad != 0.0)
+            && self.prescribed_angle.is_none()
+    }
+
+    /// Constraint gradients w.r.t. the rotation of A of the rotation constraints,
+    /// `w_m = sum coef a_i x b_j` (that w.r.t. B is `-w_m`), from `d(a_i . b_j) =
+    /// th_A . (a_i x b_j) - th_B . (a_i x b_j)`.
+    fn rot_grads(&self, g: &Geo) -> [V3<f64>; 3] {
+        let mut w = [[0.0; 3]; 3];
+        for (m, terms) in self.rot_terms().iter().enumerate() {
+            for &(cf, i, j) in terms.iter() {
+                w[m] = add(w[m], fmul(cf, cross(g.ax[i], g.bx[j])));
+            }
+        }
+        w
+    }
+
+    /// Resultants of the scaled multipliers: force `F = s sum lam_k f_k` on B and moment `M =
+    /// s sum lam_m w_m` on A (`-M` on B).
+    fn resultants(&self, g: &Geo, lam: &[f64], s: f64, w: &[V3<f64>; 3]) -> (V3<f64>, V3<f64>) {
+        let mut fo = [0.0; 3];
+        for k in 0..3 {
+            fo = add(fo, fmul(s * lam[k], g.f[k]));
+        }
+        let mut mo = [0.0; 3];
+        for m in 0..self.locks().1 {
+            mo = add(mo, fmul(s * lam[3 + m], w[m]));
+        }
+        (fo, mo)
+    }
+
+    /// Residual in closed form, same value and layout as `residual::<f64>` (accumulated).
+    /// Constraint gradients (left rotation increments `th`, `d f = th x f`):
+    /// translation `k`: `B = [-f_k, f_k x (p_B - x_A), f_k, rho_B x f_k]` (the term
+    /// `f_k . rho_A = Q_A e_k . d_A` is constant); rotation `m`: `B = [0, w_m, 0, -w_m]`.
+    /// So `B^T s lam = [-F, F x (p_B - x_A) + M, F, rho_B x F - M]`.
+    pub fn residual_f64(
+        &self,
+        a: &NodeKin<f64>,
+        b: &NodeKin<f64>,
+        lam: &[f64],
+        ctx: &EvalCtx,
+        out: &mut [f64],
+    ) {
+        let has_a = self.node_a.is_some();
+        let off_b = if has_a { 6 } else { 0 };
+        let nn = off_b + 6;
+        let g = self.geo(a, b, ctx.t);
+        let s = ctx.cscale;
+        let u = self.prescribed_disp(ctx.t);
+        for k in 0..3 {
+            out[nn + k] += s * (dot(g.f[k], g.r) - u[k]);
+        }
+        for (m, terms) in self.rot_terms().iter().enumerate() {
+            let p: f64 = terms
+                .iter()
+                .map(|&(cf, i, j)| cf * dot(g.ax[i], g.bx[j]))
+                .sum();
+            out[nn + 3 + m] += s * p;
+        }
+        let w = self.rot_grads(&g);
+        let (fo, mo) = self.resultants(&g, lam, s, &w);
+        let mut add_to = |o: usize, v: V3<f64>| {
+            for i in 0..3 {
+                out[o + i] += v[i];
+            }
+        };
+        if has_a {
+            add_to(0, fmul(-1.0, fo));
+            add_to(3, add(cross(fo, g.pb_xa), mo));
+        }
+        add_to(off_b, fo);
+        add_to(off_b + 3, sub(cross(g.rho_b, fo), mo));
+        if self.has_spring() {
+            let z = g.f[2];
+            let mz = fmul(self.spring_moment(a, b, z), z);
+            add_to(off_b + 3, mz);
+            if has_a {
+                add_to(3, fmul(-1.0, mz));
+            }
+        }
+    }
+
+    fn prescribed_disp(&self, t: f64) -> V3<f64> {
+        match &self.displacement_m {
+            Some((u, tb)) => fmul(tb.eval(t), *u),
+            None => [0.0; 3],
+        }
+    }
+
+    /// Spring/damper moment `k psi + c z . (w_B - w_A)` about the joint axis `z`.
+    fn spring_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>, z: V3<f64>) -> f64 {
+        self.angle(a, b) * self.spring_nm_per_rad + dot(z, sub(b.w, a.w)) * self.damper_nms_per_rad
+    }
+
+    /// Tangent in closed form, same as `tangent_dual`: the directional derivative of
+    /// `residual_f64` along each seed (columns of node dofs) and `d/d lam` (multiplier
+    /// columns), local n x n, row-major, overwritten. Node columns differentiate the
+    /// residual above with `d f = th_A x f`, `d b = th_B x b`, `d rho = th x rho` (geometric
+    /// stiffness of the constraints) and, for the spring, `d psi = (th_A - th_B) . g_psi`
+    /// (derivative of `atan2(Rr_21 - Rr_12, Rr_11 + Rr_22)`), `d z = th_A x z`.
+    pub fn tangent(
+        &self,
+        a: &NodeKin<f64>,
+        b: &NodeKin<f64>,
+        lam: &[f64],
+        ctx: &EvalCtx,
+        seeds: &[[Seed; 6]],
+        out: &mut [f64],
+    ) {
+        let has_a = self.node_a.is_some();
+        let off_b = if has_a { 6 } else { 0 };
+        let nn = off_b + 6;
+        let nrot = self.locks().1;
+        let n = nn + 3 + nrot;
+        out[..n * n].iter_mut().for_each(|x| *x = 0.0);
+        let g = self.geo(a, b, ctx.t);
+        let s = ctx.cscale;
+        let w = self.rot_grads(&g);
+        let (fo, _) = self.resultants(&g, lam, s, &w);
+        let terms = self.rot_terms();
+        let mut set = |row: usize, col: usize, v: V3<f64>| {
+            for i in 0..3 {
+                out[(row + i) * n + col] = v[i];
+            }
+        };
+        // multiplier columns: s B^T
+        for k in 0..3 {
+            let fk = fmul(s, g.f[k]);
+            if has_a {
+                set(0, nn + k, fmul(-1.0, fk));
+                set(3, nn + k, cross(fk, g.pb_xa));
+            }
+            set(off_b, nn + k, fk);
+            set(off_b + 3, nn + k, cross(g.rho_b, fk));
+        }
+        for m in 0..nrot {
+            let wm = fmul(s, w[m]);
+            if has_a {
+                set(3, nn + 3 + m, wm);
+            }
+            set(off_b + 3, nn + 3 + m, fmul(-1.0, wm));
+        }
+        // spring/damper: moment m z, d m = k d psi + c (d z . (w_B - w_A) + z . (dw_B - dw_A))
+        let spring = self.has_spring().then(|| {
+            let z = g.f[2];
+            let (f0, f1, b0, b1) = (g.f[0], g.f[1], g.bx[0], g.bx[1]);
+            let sn = dot(f1, b0) - dot(f0, b1);
+            let cs = dot(f0, b0) + dot(f1, b1);
+            let gs = sub(cross(f1, b0), cross(f0, b1));
+            let gc = add(cross(f0, b0), cross(f1, b1));
+            let gpsi = fmul(1.0 / (sn * sn + cs * cs), sub(fmul(cs, gs), fmul(sn, gc)));
+            (z, self.spring_moment(a, b, z), gpsi, sub(b.w, a.w))
+        });
+        let zero = [0.0; 3];
+        for col in 0..nn {
+            let (l, comp) = (col / 6, col % 6);
+            let sd = &seeds[l][comp];
+            let (dxa, ta, dwa, dxb, tb, dwb) = if has_a && l == 0 {
+                (sd.dx, sd.dth, sd.dw, zero, zero, zero)
+            } else {
+                (zero, zero, zero, sd.dx, sd.dth, sd.dw)
+            };
+            let mut c = [0.0; 18];
+            // constraint rows: s dPhi
+            let drho_a = cross(ta, g.rho_a);
+            let drho_b = cross(tb, g.rho_b);
+            let dpb_xa = sub(add(dxb, drho_b), dxa);
+            let dr = sub(dpb_xa, drho_a);
+            for k in 0..3 {
+                c[nn + k] = s * (dot(cross(ta, g.f[k]), g.r) + dot(g.f[k], dr));
+            }
+            let da: [V3<f64>; 3] = std::array::from_fn(|i| cross(ta, g.ax[i]));
+            let db: [V3<f64>; 3] = std::array::from_fn(|j| cross(tb, g.bx[j]));
+            let mut dmo = [0.0; 3];
+            for (m, tm) in terms.iter().enumerate() {
+                let mut dp = 0.0;
+                let mut dw = [0.0; 3];
+                for &(cf, i, j) in tm.iter() {
+                    dp += cf * (dot(da[i], g.bx[j]) + dot(g.ax[i], db[j]));
+                    let t = add(cross(da[i], g.bx[j]), cross(g.ax[i], db[j]));
+                    dw = add(dw, fmul(cf, t));
+                }
+                c[nn + 3 + m] = s * dp;
+                dmo = add(dmo, fmul(s * lam[3 + m], dw));
+            }
+            // node rows: d(B^T s lam), with d F = th_A x F
+            let dfo = cross(ta, fo);
+            let mut mom_a = add(add(cross(dfo, g.pb_xa), cross(fo, dpb_xa)), dmo);
+            let mut mom_b = sub(add(cross(drho_b, fo), cross(g.rho_b, dfo)), dmo);
+            if let Some((z, mz, gpsi, wr)) = spring {
+                let dz = cross(ta, z);
+                let dm = self.spring_nm_per_rad * dot(sub(ta, tb), gpsi)
+                    + self.damper_nms_per_rad * (dot(dz, wr) + dot(z, sub(dwb, dwa)));
+                let dmz = add(fmul(dm, z), fmul(mz, dz));
+                mom_a = sub(mom_a, dmz);
+                mom_b = add(mom_b, dmz);
+            }
+            if has_a {
+                c[..3].copy_from_slice(&fmul(-1.0, dfo));
+                c[3..6].copy_from_slice(&mom_a);
+            }
+            c[off_b..off_b + 3].copy_from_slice(&dfo);
+            c[off_b + 3..off_b + 6].copy_from_slice(&mom_b);
+            for row in 0..n {
+                out[row * n + col] = c[row];
+            }
+        }
+    }
+
+    /// Reference tangent by dual numbers: one `residual::<Dual<f64>>` per column, node `l`
+    /// seeded along `seeds[l][comp]` (rotations by the first-order `R + eps dth~ R`). Same
+    /// signature and layout as `tangent`.
+    pub fn tangent_dual(
+        &self,
+        a: &NodeKin<f64>,
+        b: &NodeKin<f64>,
+        lam: &[f64],
+        ctx: &EvalCtx,
+        seeds: &[[Seed; 6]],
+        out: &mut [f64],
+    ) {
+        let has_a = self.node_a.is_some();
+        let nn = if has_a { 12 } else { 6 };
+        let nl = self.n_lambda();
+        let n = nn + nl;
+        let (ad0, bd0) = (seeded(a, None), seeded(b, None));
+        let mut ld = [Dual::<f64>::cst(0.0); 6];
+        for k in 0..nl {
+            ld[k] = Dual::new(lam[k], 0.0);
+        }
+        let mut o = [Dual::<f64>::cst(0.0); 18];
+        for col in 0..n {
+            let (mut ad, mut bd) = (ad0, bd0);
+            if col < nn {
+                let (l, comp) = (col / 6, col % 6);
+                let s = &seeds[l][comp];
+                if has_a && l == 0 {
+                    ad = seeded(a, Some(s));
+                } else {
+                    bd = seeded(b, Some(s));
+                }
+            } else {
+                ld[col - nn].d = 1.0;
+            }
+            o[..n].iter_mut().for_each(|x| *x = Dual::cst(0.0));
+            self.residual(&ad, &bd, &ld[..nl], ctx, &mut o[..n]);
+            if col >= nn {
+                ld[col - nn].d = 0.0;
+            }
+            for row in 0..n {
+                out[row * n + col] = o[row].d;
+            }
+        }
+    }
+}
+
+/// Node kinematics as duals with derivative parts along `s` (none: constants).
+fn seeded(k: &NodeKin<f64>, s: Option<&Seed>) -> NodeKin<Dual<f64>> {
+    let z = Seed::default();
+    let s = s.unwrap_or(&z);
+    let d = |v: &[f64; 3], e: &[f64; 3]| -> [Dual<f64>; 3] {
+        std::array::from_fn(|i| Dual::new(v[i], e[i]))
+    };
+    let dr = mm(&skew(s.dth), &k.r);
+    NodeKin {
+        x: d(&k.x, &s.dx),
+        r: std::array::from_fn(|i| d(&k.r[i], &dr[i])),
+        v: d(&k.v, &s.dv),
+        w: d(&k.w, &s.dw),
+        a: d(&k.a, &s.da),
+        al: d(&k.al, &s.dal),
     }
 }
 
