@@ -1,10 +1,11 @@
-//! Benchmark (issue #6): cost of the `rotorsim run` forced response per structural step, for
-//! each damper model on the UH-60A rotor (rotors/uh60a.toml, flightdata/c8534like, 256 steps per
-//! revolution, RK4 with 25 sub-steps), with the structure/hydraulics split from `timing()`.
-//! Runs a few revolutions per model (ROTORSIM_BENCH_REVS, default 3), one model at a time on
-//! one thread, and extrapolates to the default 75-revolution run. Wall and CPU time of the
-//! thread (CPU time is insensitive to other processes sharing the cores). The rigid-blade
-//! reduction (`--model rigid`) and the lag-hinge test double are timed too, for scale.
+//! Benchmark: cost of the `rotorsim run` forced response per structural step, for each damper
+//! model on the UH-60A rotor with its joints and damper (rotors/uh60a.toml,
+//! flightdata/c8534like, 256 steps per revolution, RK4 with 25 sub-steps), full and modified
+//! Newton in the same run, with the structure/hydraulics split from `timing()`. Runs a few
+//! revolutions per model (ROTORSIM_BENCH_REVS, default 3), one model at a time on one thread,
+//! and extrapolates to the default 75-revolution run. Wall and CPU time of the thread (CPU time
+//! is insensitive to other processes sharing the cores). The rigid-blade reduction
+//! (`--model rigid`) and the lag-hinge test double are timed too, for scale.
 //!
 //! `cargo bench --bench rotor_run`
 use rotorsim::flight::FlightRecord;
@@ -12,6 +13,7 @@ use rotorsim::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use rotorsim::run::drive;
 use rotorsim::run::sdof::{LagHingeSdof, SdofParams};
+use rotorsim::solver::NewtonMethod;
 use std::path::Path;
 use std::time::Instant;
 
@@ -68,11 +70,12 @@ fn time_model(
     let per_step = t.total_s / steps;
     let hyd = t.hydraulics_s / t.total_s.max(1e-300);
     println!(
-        "{name:<30} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.4} ms/step wall, {:9.4} ms/step CPU ({:.2} Newton it/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
+        "{name:<30} build {build_s:6.2} s | {revs} revs: {:8.2} s, {:9.4} ms/step wall, {:9.4} ms/step CPU ({:.2} Newton it/step, {:.3} factorizations/step), structure {:5.1}%, hydraulics {:5.1}% | 75 revs x {STEPS} steps: {:8.1} s (extrapolated) | periodicity after {revs} revs {}",
         t.total_s,
         1e3 * per_step,
         1e3 * cpu / steps,
         t.iterations as f64 / steps,
+        t.factorizations as f64 / steps,
         100.0 * (1.0 - hyd),
         100.0 * hyd,
         per_step * (DEFAULT_REVS * STEPS) as f64 + build_s,
@@ -103,11 +106,15 @@ fn main() {
         DamperModel::Physical,
     ];
     for m in models {
-        time_model(&format!("uh60a {}", m.name()), m, revs, || {
-            let rotor = RotorDeck::from_file(&rotor_path)?;
-            let deck = rotor.damper()?;
-            rotorsim::rotor::build(&rotor, &deck, m, &record, &opts)
-        });
+        for newton in [NewtonMethod::Full, NewtonMethod::Modified] {
+            let name = format!("uh60a {} {} Newton", m.name(), newton.name());
+            time_model(&name, m, revs, || {
+                let rotor = RotorDeck::from_file(&rotor_path)?;
+                let deck = rotor.damper()?;
+                let opts = RunOptions { newton, ..opts };
+                rotorsim::rotor::build(&rotor, &deck, m, &record, &opts)
+            });
+        }
     }
     let deck = DamperDeck::from_file(&rotor_path).expect("damper table");
     let rotor = RotorDeck::from_file(&rotor_path).expect("rotor deck");

@@ -3,8 +3,8 @@
 //! measured damper force of a flight record.
 //!
 //! The pipeline knows nothing of the rotor model: it asks a builder for one simulation per
-//! damper model, runs them in parallel (rayon; the structural solver factorizes with
-//! `faer::Par::Seq`, so each run stays on one thread), monitors periodicity once per revolution
+//! damper model, runs them in parallel (one thread each; the structural solver factorizes
+//! with `faer::Par::Seq`, so each run stays on its thread), monitors periodicity once per revolution
 //! with [`PeriodicityMonitor`], keeps the last revolution, and hands the results to
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
@@ -16,7 +16,6 @@ pub mod summary;
 use crate::analysis::periodicity::PeriodicityMonitor;
 use crate::hydraulics::DamperModel;
 use crate::rotor::{ForcedResponse, Timing};
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// Periodicity tolerance of issue #6: the measure must fall below it by the last revolution.
@@ -229,37 +228,64 @@ pub fn run_models<B>(
 where
     B: Fn(DamperModel) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
 {
-    models
-        .par_iter()
-        .enumerate()
-        .map(|(i, &model)| {
-            let t0 = Instant::now();
-            let result = build(model)
-                .map_err(|e| e.context(format!("building the {} model", model.name())))
-                .and_then(|mut sim| {
-                    let build_s = t0.elapsed().as_secs_f64();
-                    let cb = |rev: usize, m: Option<f64>| progress.revolution(i, rev, revs, m);
-                    let mut run = drive(sim.as_mut(), model, revs, &cb)?;
-                    run.build_s = build_s;
-                    run.wall_s = t0.elapsed().as_secs_f64();
-                    Ok(run)
+    // One thread per model, not a pool of one per core: three models on two cores then share
+    // both cores to the end instead of two running first and the third alone while a core
+    // idles. Each model runs on its own thread only, so its results do not depend on how
+    // many there are.
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = models
+            .iter()
+            .enumerate()
+            .map(|(i, &model)| scope.spawn(move || run_one(i, model, revs, build, progress)))
+            .collect();
+        handles
+            .into_iter()
+            .zip(models)
+            .map(|(h, &model)| {
+                h.join().unwrap_or_else(|_| ModelOutcome {
+                    model,
+                    result: Err("the model's thread panicked".into()),
                 })
-                .map_err(|e| format!("{e:#}"));
-            match &result {
-                Ok(r) => progress.finished(
-                    i,
-                    true,
-                    &format!(
-                        "periodicity {} after {} revs",
-                        fmt_measure(r.last_measure()),
-                        r.revolutions
-                    ),
-                ),
-                Err(e) => progress.finished(i, false, e),
-            }
-            ModelOutcome { model, result }
+            })
+            .collect()
+    })
+}
+
+fn run_one<B>(
+    i: usize,
+    model: DamperModel,
+    revs: usize,
+    build: &B,
+    progress: &dyn Progress,
+) -> ModelOutcome
+where
+    B: Fn(DamperModel) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
+{
+    let t0 = Instant::now();
+    let result = build(model)
+        .map_err(|e| e.context(format!("building the {} model", model.name())))
+        .and_then(|mut sim| {
+            let build_s = t0.elapsed().as_secs_f64();
+            let cb = |rev: usize, m: Option<f64>| progress.revolution(i, rev, revs, m);
+            let mut run = drive(sim.as_mut(), model, revs, &cb)?;
+            run.build_s = build_s;
+            run.wall_s = t0.elapsed().as_secs_f64();
+            Ok(run)
         })
-        .collect()
+        .map_err(|e| format!("{e:#}"));
+    match &result {
+        Ok(r) => progress.finished(
+            i,
+            true,
+            &format!(
+                "periodicity {} after {} revs",
+                fmt_measure(r.last_measure()),
+                r.revolutions
+            ),
+        ),
+        Err(e) => progress.finished(i, false, e),
+    }
+    ModelOutcome { model, result }
 }
 
 /// A periodicity measure for humans.
