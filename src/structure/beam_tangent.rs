@@ -490,16 +490,21 @@ mod tests {
         }
     }
 
-    /// Curved (arc of radius 3 m, 0.4 rad, with a rise), pre-twisted (0.6 rad) element with
-    /// coupled, spanwise-varying sections, cm offset, damping, follower and fixed loads.
-    fn test_beam(rng: &mut Rng, mu: f64) -> (Beam, [V; 4], [M; 4]) {
+    /// Curved (arc of radius 3 m, 0.4 rad, with a rise), pre-twisted (0.6 rad) element, or a
+    /// straight untwisted one, with coupled, spanwise-varying sections, cm offset, damping,
+    /// follower and fixed loads.
+    fn test_beam(rng: &mut Rng, mu: f64, curved: bool) -> (Beam, [V; 4], [M; 4]) {
         let mut x0 = [[0.0; 3]; 4];
         let mut r0 = [IM; 4];
         for i in 0..4 {
             let u = i as f64 / 3.0;
             let ang = 0.4 * u;
-            x0[i] = [3.0 * ang.sin(), 3.0 * (1.0 - ang.cos()), 0.1 * u];
-            r0[i] = mm(&exp_map([0.0, 0.0, ang]), &exp_map([0.6 * u, 0.0, 0.0]));
+            if curved {
+                x0[i] = [3.0 * ang.sin(), 3.0 * (1.0 - ang.cos()), 0.1 * u];
+                r0[i] = mm(&exp_map([0.0, 0.0, ang]), &exp_map([0.6 * u, 0.0, 0.0]));
+            } else {
+                x0[i] = [1.2 * u, 0.0, 0.0];
+            }
         }
         let table = SectionTable::new(vec![section(0.0, 1.0), section(2.0, 1.3)], "test").unwrap();
         let mut b = Beam::new("t", [0, 1, 2, 3], &x0, &r0, &table, 0.2, mu);
@@ -527,14 +532,14 @@ mod tests {
         (b, x0, r0)
     }
 
-    /// Rigid rotation up to 0.9 pi of the reference, node rotations up to 0.25 rad on top
-    /// (relative rotations between nodes up to 0.5 rad beyond the reference ones), random rates.
-    fn config(rng: &mut Rng, x0: &[V; 4], r0: &[M; 4]) -> [NodeKin<f64>; 4] {
+    /// Rigid rotation up to 0.9 pi of the reference, node rotations up to `dev` rad on top
+    /// (relative rotations between nodes up to `2 dev` beyond the reference ones), random rates.
+    fn config(rng: &mut Rng, x0: &[V; 4], r0: &[M; 4], dev: f64) -> [NodeKin<f64>; 4] {
         let rb = exp_map(rng.rotvec(0.9 * std::f64::consts::PI));
         let off = rng.vec(2.0);
         std::array::from_fn(|i| NodeKin {
-            x: add(add(mv(&rb, x0[i]), off), rng.vec(0.05)),
-            r: mm(&exp_map(rng.rotvec(0.25)), &mm(&rb, &r0[i])),
+            x: add(add(mv(&rb, x0[i]), off), rng.vec(0.2 * dev)),
+            r: mm(&exp_map(rng.rotvec(dev)), &mm(&rb, &r0[i])),
             v: rng.vec(3.0),
             w: rng.vec(4.0),
             a: rng.vec(20.0),
@@ -675,8 +680,10 @@ mod tests {
         let mut worst = [0.0f64; 7];
         for case in 0..24 {
             let mu = if case % 4 == 3 { 0.0 } else { 0.01 };
-            let (b, x0, r0) = test_beam(&mut rng, mu);
-            let k = config(&mut rng, &x0, &r0);
+            // cases 0 and 1: straight beam, undeformed or nearly (small-angle branches)
+            let (b, x0, r0) = test_beam(&mut rng, mu, case > 1);
+            let dev = [0.0, 1e-4, 0.25][case.min(2)];
+            let k = config(&mut rng, &x0, &r0, dev);
             let cx = ctx(case % 3 != 2);
             for (mi, mask) in MASKS.iter().enumerate() {
                 let s = seeds(&mut rng, 2e-3, 1e3, 7e5, *mask);
@@ -710,8 +717,8 @@ mod tests {
         let mut rng = Rng(0x2545_f491_4f6c_dd1d);
         let mut worst = [0.0f64; 7];
         for case in 0..8 {
-            let (b, x0, r0) = test_beam(&mut rng, 0.01);
-            let k = config(&mut rng, &x0, &r0);
+            let (b, x0, r0) = test_beam(&mut rng, 0.01, true);
+            let k = config(&mut rng, &x0, &r0, 0.25);
             let cx = ctx(case % 3 != 2);
             for (mi, mask) in MASKS.iter().enumerate() {
                 let s = seeds(&mut rng, 1.0, 1.0, 1.0, *mask);
@@ -739,8 +746,8 @@ mod tests {
     #[ignore]
     fn timing() {
         let mut rng = Rng(7);
-        let (b, x0, r0) = test_beam(&mut rng, 0.01);
-        let k = config(&mut rng, &x0, &r0);
+        let (b, x0, r0) = test_beam(&mut rng, 0.01, true);
+        let k = config(&mut rng, &x0, &r0, 0.25);
         let cx = ctx(true);
         let s = seeds(&mut rng, 2e-3, 1e3, 7e5, [true; 6]);
         let best = |f: &mut dyn FnMut()| {
