@@ -266,7 +266,20 @@ fn multilane_and_single_lane_beam_tangents_agree() {
         .iter()
         .zip(&a2.values)
         .fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
-    println!("multi-lane vs single-lane: max difference {diff:.2e} (scale {scale:.2e})");
+    println!("closed-form vs single-lane: max difference {diff:.2e} (scale {scale:.2e})");
     assert!(diff <= 1e-12 * scale);
     assert_eq!(r1, r2);
+    // the 24-lane dual path, still selectable
+    let mut a3 = Assembler::new(&m).unwrap();
+    a3.beam_tangent_dual = true;
+    let mut r3 = vec![0.0; a1.ndof];
+    a3.assemble(&mut m, &kin, &lam, &ctx, &seed, None, true, &mut r3)
+        .unwrap();
+    let diff = a3
+        .values
+        .iter()
+        .zip(&a2.values)
+        .fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
+    println!("multi-lane vs single-lane: max difference {diff:.2e}");
+    assert!(diff <= 1e-12 * scale);
 }

@@ -44,6 +44,9 @@ pub struct Assembler {
     pub multilane: bool,
     /// Joint residuals and tangents by nested duals (true) instead of the closed form (false).
     pub joint_tangent_dual: bool,
+    /// With `multilane`: beam tangents from the 24-lane dual evaluation (true) or from the
+    /// closed form [`Beam::tangent`](crate::structure::Beam::tangent) (false, default).
+    pub beam_tangent_dual: bool,
 }
 
 /// Node kinematics with the 6 seeds of local node `l` in lanes 6l..6l+6.
@@ -243,6 +246,7 @@ impl Assembler {
             step_out: ElementOutput::default(),
             multilane: true,
             joint_tangent_dual: false,
+            beam_tangent_dual: false,
         })
     }
 
@@ -332,6 +336,18 @@ impl Assembler {
                 continue;
             }
             let pos = &self.elem_pos[ei];
+            if let (Element::Beam(bm), true, false) = (e, self.multilane, self.beam_tangent_dual) {
+                // all 24 columns in closed form
+                let kk = [kf[0], kf[1], kf[2], kf[3]];
+                let seeds: [[Seed; 6]; 4] =
+                    std::array::from_fn(|l| std::array::from_fn(|c| seed(dofs[6 * l] / 6, c)));
+                let mut t = [0.0; 576];
+                bm.tangent(&kk, ctx, &seeds, &mut t);
+                for (p, v) in pos.iter().zip(t.iter()) {
+                    self.values[*p] += v;
+                }
+                continue;
+            }
             if let (Element::Beam(bm), true) = (e, self.multilane) {
                 // all 24 columns from one multi-lane evaluation
                 let mut k24 = [NodeKin::<DualN<24>>::ground(); 4];

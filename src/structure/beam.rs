@@ -8,7 +8,8 @@
 //! `r_x,i = int N_i' F`, `r_th,i = int (N_i' M - N_i x' x F)` with `F = R C_N eps`,
 //! `M = R C_M eps`. Stiffness terms use reduced 3-point Gauss integration (shear locking),
 //! inertia and loads 4 points. Elastic, dissipative, inertial and external parts are separate
-//! functions; the tangent is their exact derivative by dual numbers.
+//! functions; the tangent is their exact derivative, in closed form in `beam_tangent.rs` and by
+//! dual numbers (the reference) when the residual is evaluated with `DualN`.
 use super::kin::{EvalCtx, NodeKin, TimeTable};
 use super::real::{c, Real};
 use super::rotation::*;

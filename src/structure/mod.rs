@@ -2,6 +2,7 @@
 // Index loops mirror the component formulas of the formulation.
 #![allow(clippy::needless_range_loop)]
 pub mod beam;
+mod beam_tangent;
 pub mod deck;
 pub mod hydraulic;
 pub mod joint;
