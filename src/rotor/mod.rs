@@ -122,6 +122,9 @@ pub struct RunOptions {
     /// Newton method of the structural step (modified: factorization reused while it
     /// contracts, in the frame turning with the shaft).
     pub newton: crate::solver::NewtonMethod,
+    /// Newton tolerance of a structural step: `||r|| <= rtol ||r_pred||`, `r_pred` the residual
+    /// of the zero-acceleration predictor (default [`sim::RTOL`]).
+    pub newton_rtol: f64,
 }
 
 impl Default for RunOptions {
@@ -131,6 +134,7 @@ impl Default for RunOptions {
             hydraulics: IntegratorOptions::default(),
             rho_inf: 0.9,
             newton: crate::solver::NewtonMethod::Modified,
+            newton_rtol: sim::RTOL,
         }
     }
 }

@@ -191,6 +191,8 @@ pub struct RotorSim {
     twist_ref: f64,
     total_s: f64,
     relaxed_steps: usize,
+    /// Newton tolerance of a step (relative to the zero-acceleration predictor residual).
+    rtol: f64,
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -332,7 +334,7 @@ pub fn build_sim(
     // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
     // finite-difference tangent stalls Newton near 1e-8 ||r_0|| at some valve events (measured).
-    solver.newton.rtol = RTOL;
+    solver.newton.rtol = opts.newton_rtol;
     solver.newton.method = opts.newton;
     solver.init_accelerations()?;
     let physical = model_kind == DamperModel::Physical;
@@ -368,6 +370,7 @@ pub fn build_sim(
         twist_ref,
         total_s: 0.0,
         relaxed_steps: 0,
+        rtol: opts.newton_rtol,
     })
 }
 
@@ -446,7 +449,7 @@ impl ForcedResponse for RotorSim {
             if *residual <= RTOL_STALL * initial {
                 self.solver.newton.rtol = RTOL_STALL;
                 r = self.solver.step();
-                self.solver.newton.rtol = RTOL;
+                self.solver.newton.rtol = self.rtol;
                 self.relaxed_steps += 1;
             }
         }
