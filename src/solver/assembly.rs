@@ -328,7 +328,13 @@ impl Assembler {
                 continue;
             }
             out_f[..n].iter_mut().for_each(|x| *x = 0.0);
-            element_residual(e, &kf[..nnodes], &lam_f[..nlam], ctx, &mut out_f[..n]);
+            match e {
+                Element::Beam(b) => {
+                    let kk = [kf[0], kf[1], kf[2], kf[3]];
+                    b.residual_f64(&kk, ctx, &mut out_f[..n])
+                }
+                _ => element_residual(e, &kf[..nnodes], &lam_f[..nlam], ctx, &mut out_f[..n]),
+            }
             for a in 0..n {
                 res[dofs[a]] += out_f[a];
             }

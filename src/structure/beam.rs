@@ -73,6 +73,28 @@ pub struct Beam {
     pub ext: [SectionLoad; NPTS_M],
     /// Reference arc length at the element ends.
     pub s_range: [f64; 2],
+    /// Interpolation of the last [`Beam::load_points_cached`] configuration, reused by
+    /// [`Beam::residual_f64`] at the same configuration (the distributed loads and the residual
+    /// of one Newton iterate see the same nodes).
+    pub cache: InterpCache,
+}
+
+/// Reference rotation, local rotation vectors and inertia-point rotations of one nodal
+/// configuration (positions and rotations of the 4 nodes, compared bit for bit).
+#[derive(Clone, Debug, Default)]
+pub struct InterpCache {
+    valid: bool,
+    x: [[f64; 3]; 4],
+    r: [M3<f64>; 4],
+    rr: M3<f64>,
+    psi: [V3<f64>; 4],
+    rg: [M3<f64>; NPTS_M],
+}
+
+impl InterpCache {
+    fn holds(&self, k: &[NodeKin<f64>; 4]) -> bool {
+        self.valid && (0..4).all(|i| self.x[i] == k[i].x && self.r[i] == k[i].r)
+    }
 }
 
 /// Gauss-Legendre points and weights on [-1, 1].
@@ -209,6 +231,7 @@ impl Beam {
             loads: vec![],
             ext: [SectionLoad::default(); NPTS_M],
             s_range: [s_start, s_start + len],
+            cache: InterpCache::default(),
         };
         // initial strains so that the reference configuration is stress free
         let kin: [NodeKin<f64>; 4] = std::array::from_fn(|i| NodeKin {
@@ -330,10 +353,22 @@ impl Beam {
         ctx: &EvalCtx,
         out: &mut [T],
     ) {
+        let rg = std::array::from_fn(|q| Self::rot_at(&self.gm[q], rr, psi));
+        self.inertial_and_external_at(k, &rg, ctx, out);
+    }
+
+    /// [`Beam::inertial_and_external`] with the section rotations `rg` at the inertia points.
+    fn inertial_and_external_at<T: Real>(
+        &self,
+        k: &[NodeKin<T>; 4],
+        rg: &[M3<T>; NPTS_M],
+        ctx: &EvalCtx,
+        out: &mut [T],
+    ) {
         let grav = ctx.gravity;
         let has_g = grav != [0.0; 3];
         for (q, g) in self.gm.iter().enumerate() {
-            let r = Self::rot_at(g, rr, psi);
+            let r = rg[q];
             let mut f = zero3();
             let mut mo = zero3();
             if ctx.inertia || has_g {
@@ -397,6 +432,37 @@ impl Beam {
         self.inertial_and_external(k, &rr, &psi, ctx, out);
     }
 
+    /// [`Beam::residual`] in f64, reusing the interpolation of [`Beam::load_points_cached`]
+    /// when `k` is the configuration it was made for (same bits as computing it afresh).
+    pub fn residual_f64(&self, k: &[NodeKin<f64>; 4], ctx: &EvalCtx, out: &mut [f64]) {
+        if self.cache.holds(k) {
+            let c = &self.cache;
+            self.internal(k, &c.rr, &c.psi, out);
+            self.inertial_and_external_at(k, &c.rg, ctx, out);
+        } else {
+            self.residual(k, ctx, out);
+        }
+    }
+
+    /// [`Beam::load_points`], keeping the interpolation for [`Beam::residual_f64`].
+    #[allow(clippy::type_complexity)]
+    pub fn load_points_cached(
+        &mut self,
+        k: &[NodeKin<f64>; 4],
+    ) -> [([f64; 3], M3<f64>, [f64; 3], [f64; 3]); NPTS_M] {
+        let (rr, psi) = Self::local_rotations(k);
+        let pts = self.points_with(k, &rr, &psi);
+        self.cache = InterpCache {
+            valid: true,
+            x: k.map(|n| n.x),
+            r: k.map(|n| n.r),
+            rr,
+            psi,
+            rg: pts.map(|p| p.1),
+        };
+        pts
+    }
+
     /// Section forces and moments in the section frame at each stiffness point:
     /// (s_m, [N1, N2, N3, M1, M2, M3]).
     pub fn section_forces(&self, k: &[NodeKin<f64>; 4]) -> Vec<(f64, [f64; 6])> {
@@ -419,9 +485,19 @@ impl Beam {
         k: &[NodeKin<f64>; 4],
     ) -> [([f64; 3], M3<f64>, [f64; 3], [f64; 3]); NPTS_M] {
         let (rr, psi) = Self::local_rotations(k);
+        self.points_with(k, &rr, &psi)
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn points_with(
+        &self,
+        k: &[NodeKin<f64>; 4],
+        rr: &M3<f64>,
+        psi: &[V3<f64>; 4],
+    ) -> [([f64; 3], M3<f64>, [f64; 3], [f64; 3]); NPTS_M] {
         std::array::from_fn(|q| {
             let g = &self.gm[q];
-            let r = Self::rot_at(g, &rr, &psi);
+            let r = Self::rot_at(g, rr, psi);
             let mut x = [0.0; 3];
             let mut v = [0.0; 3];
             let mut w = [0.0; 3];

@@ -435,7 +435,7 @@ impl Model {
             for &ei in ids.iter() {
                 if let Element::Beam(b) = &mut elements[ei] {
                     let k = b.nodes.map(|i| kin[i]);
-                    let pts = b.load_points(&k);
+                    let pts = b.load_points_cached(&k);
                     let mut ext = [SectionLoad::default(); NPTS_M];
                     for q in 0..NPTS_M {
                         let (x, r, v, w) = pts[q];
