@@ -70,34 +70,6 @@ fn seeded_lanes(k: &NodeKin<f64>, l: usize, seed: &dyn Fn(usize) -> Seed) -> Nod
     out
 }
 
-fn seeded_node(k: &NodeKin<f64>, s: Option<&Seed>) -> NodeKin<Dual<f64>> {
-    let d = |v: &[f64; 3], e: &[f64; 3]| -> [Dual<f64>; 3] {
-        std::array::from_fn(|i| Dual::new(v[i], e[i]))
-    };
-    let z = [0.0; 3];
-    match s {
-        None => NodeKin {
-            x: d(&k.x, &z),
-            r: std::array::from_fn(|i| d(&k.r[i], &z)),
-            v: d(&k.v, &z),
-            w: d(&k.w, &z),
-            a: d(&k.a, &z),
-            al: d(&k.al, &z),
-        },
-        Some(s) => {
-            let dr = mm(&skew(s.dth), &k.r);
-            NodeKin {
-                x: d(&k.x, &s.dx),
-                r: std::array::from_fn(|i| d(&k.r[i], &dr[i])),
-                v: d(&k.v, &s.dv),
-                w: d(&k.w, &s.dw),
-                a: d(&k.a, &s.da),
-                al: d(&k.al, &s.dal),
-            }
-        }
-    }
-}
-
 /// Residual of one built-in element in scalar `T`; `k` holds the element's nodes in order.
 pub fn element_residual<T: Real>(
     e: &Element,
@@ -370,7 +342,7 @@ impl Assembler {
                 continue;
             }
             for l in 0..nnodes {
-                kd[l] = seeded_node(&kf[l], None);
+                kd[l] = kf[l].seeded(None);
             }
             for l in 0..nlam {
                 lam_d[l] = Dual::new(lam_f[l], 0.0);
@@ -379,10 +351,10 @@ impl Assembler {
                 if b < 6 * nnodes {
                     let (l, comp) = (b / 6, b % 6);
                     let s = seed(dofs[6 * l] / 6, comp);
-                    kd[l] = seeded_node(&kf[l], Some(&s));
+                    kd[l] = kf[l].seeded(Some(&s));
                     out_d[..n].iter_mut().for_each(|x| *x = Dual::cst(0.0));
                     element_residual(e, &kd[..nnodes], &lam_d[..nlam], ctx, &mut out_d[..n]);
-                    kd[l] = seeded_node(&kf[l], None);
+                    kd[l] = kf[l].seeded(None);
                 } else {
                     let l = b - 6 * nnodes;
                     lam_d[l].d = 1.0;

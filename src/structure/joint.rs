@@ -519,7 +519,7 @@ impl Joint {
         let nn = if has_a { 12 } else { 6 };
         let nl = self.n_lambda();
         let n = nn + nl;
-        let (ad0, bd0) = (seeded(a, None), seeded(b, None));
+        let (ad0, bd0) = (a.seeded(None), b.seeded(None));
         let mut ld = [Dual::<f64>::cst(0.0); 6];
         for k in 0..nl {
             ld[k] = Dual::new(lam[k], 0.0);
@@ -531,9 +531,9 @@ impl Joint {
                 let (l, comp) = (col / 6, col % 6);
                 let s = &seeds[l][comp];
                 if has_a && l == 0 {
-                    ad = seeded(a, Some(s));
+                    ad = a.seeded(Some(s));
                 } else {
-                    bd = seeded(b, Some(s));
+                    bd = b.seeded(Some(s));
                 }
             } else {
                 ld[col - nn].d = 1.0;
@@ -547,24 +547,6 @@ impl Joint {
                 out[row * n + col] = o[row].d;
             }
         }
-    }
-}
-
-/// Node kinematics as duals with derivative parts along `s` (none: constants).
-fn seeded(k: &NodeKin<f64>, s: Option<&Seed>) -> NodeKin<Dual<f64>> {
-    let z = Seed::default();
-    let s = s.unwrap_or(&z);
-    let d = |v: &[f64; 3], e: &[f64; 3]| -> [Dual<f64>; 3] {
-        std::array::from_fn(|i| Dual::new(v[i], e[i]))
-    };
-    let dr = mm(&skew(s.dth), &k.r);
-    NodeKin {
-        x: d(&k.x, &s.dx),
-        r: std::array::from_fn(|i| d(&k.r[i], &dr[i])),
-        v: d(&k.v, &s.dv),
-        w: d(&k.w, &s.dw),
-        a: d(&k.a, &s.da),
-        al: d(&k.al, &s.dal),
     }
 }
 

@@ -29,6 +29,27 @@ impl<T: Real> NodeKin<T> {
 }
 
 impl NodeKin<f64> {
+    /// As single-lane duals whose derivative parts are the seed `s` (rotation by the
+    /// first-order `R + eps dth~ R`); none: constants.
+    pub fn seeded(&self, s: Option<&Seed>) -> NodeKin<super::real::Dual<f64>> {
+        use super::real::Dual;
+        use super::rotation::{mm, skew};
+        let z = Seed::default();
+        let s = s.unwrap_or(&z);
+        let d = |v: &[f64; 3], e: &[f64; 3]| -> [Dual<f64>; 3] {
+            std::array::from_fn(|i| Dual::new(v[i], e[i]))
+        };
+        let dr = mm(&skew(s.dth), &self.r);
+        NodeKin {
+            x: d(&self.x, &s.dx),
+            r: std::array::from_fn(|i| d(&self.r[i], &dr[i])),
+            v: d(&self.v, &s.dv),
+            w: d(&self.w, &s.dw),
+            a: d(&self.a, &s.da),
+            al: d(&self.al, &s.dal),
+        }
+    }
+
     /// Lift to a dual-capable scalar with zero derivative parts.
     pub fn lift<T: Real>(&self) -> NodeKin<T> {
         use super::rotation::{m3c, v3c};
