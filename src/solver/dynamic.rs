@@ -7,7 +7,10 @@
 //! `(1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) vd_{n+1} + alpha_f vd_n`, with the
 //! equations of motion and constraints `Phi(q_{n+1}) = 0` enforced at t_{n+1}. Newton unknowns
 //! are `dq` and scaled multipliers; the iteration matrix is the exact derivative including the
-//! tangent operator of the exponential map.
+//! tangent operator of the exponential map. Full Newton refactors it at every iterate;
+//! modified Newton keeps the factorization across iterations and steps, turned with the
+//! driven shaft, until an iteration stops contracting (docs/structure.md, "Full and modified
+//! Newton").
 use super::assembly::Assembler;
 use super::newton::{model_size, norm, NewtonError, NewtonMethod, NewtonOptions};
 use super::state::{lambda_offsets, sensor_header, sensor_values, State};
