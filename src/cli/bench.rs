@@ -1,4 +1,4 @@
-//! `rotorsim bench` (issue #2): harmonic sweeps of a damper deck (paper Figs. 13-14) and replay
+//! `rotorsim bench`: harmonic sweeps of a damper deck (paper Figs. 13-14) and replay
 //! of measured bench tests.
 use crate::hydraulics::bench::{self, HarmonicRun, History, SweepOptions, IN_TO_M, LB_TO_N};
 use crate::hydraulics::{DamperDeck, DamperModel, Device, IntegratorOptions, Scheme};

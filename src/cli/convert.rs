@@ -1,4 +1,4 @@
-//! `rotorsim convert IN OUT`: flight record CSV triple <-> MCAP, without loss (issue #5).
+//! `rotorsim convert IN OUT`: flight record CSV triple <-> MCAP, without loss.
 use crate::flight::FlightRecord;
 use clap::Args;
 use std::path::PathBuf;

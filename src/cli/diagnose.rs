@@ -1,4 +1,4 @@
-//! `rotorsim diagnose` (issue #7): find what the damper model gets wrong in measured data, name
+//! `rotorsim diagnose`: find what the damper model gets wrong in measured data, name
 //! the cause, extend the model and measure the gain on held-out data.
 use crate::diagnose::rotor::{
     flight_measurement, mean_and_amplitude, periodic_stroke, rotor_check_runs, run_physical,

@@ -1,4 +1,4 @@
-//! `rotorsim dynamic` (issue #3): generalized-alpha time integration of a model deck.
+//! `rotorsim dynamic`: generalized-alpha time integration of a model deck.
 use crate::io::{csv_string, OutDir};
 use crate::solver::statics::check_constraints;
 use crate::solver::{static_solve, DynamicSolver, State, StaticOptions};

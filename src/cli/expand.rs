@@ -1,4 +1,4 @@
-//! `rotorsim expand --rotor DECK` (issue #6): print the multibody model deck generated from a
+//! `rotorsim expand --rotor DECK`: print the multibody model deck generated from a
 //! rotor deck (docs/rotor_deck.md -> docs/model_deck.md).
 use crate::hydraulics::DamperModel;
 use crate::rotor::expand::{Controls, ExpandOptions, HydraulicRef};

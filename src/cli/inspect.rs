@@ -1,4 +1,4 @@
-//! `rotorsim inspect RECORD`: what a flight record holds (issue #5).
+//! `rotorsim inspect RECORD`: what a flight record holds.
 use crate::flight::FlightRecord;
 use clap::Args;
 use std::fmt::Write as _;

@@ -1,6 +1,6 @@
-//! `rotorsim modes` (issue #3): natural frequencies and mode shapes of a model deck, about the
+//! `rotorsim modes`: natural frequencies and mode shapes of a model deck, about the
 //! static equilibrium, optionally in a frame rotating at each of `[modes] speeds_rad_s` (fan).
-//! `rotorsim modes --rotor DECK --speeds 0:1.2:0.1` (issue #6): fan plot of a rotor deck with
+//! `rotorsim modes --rotor DECK --speeds 0:1.2:0.1`: fan plot of a rotor deck with
 //! the digitized UH-60A reference over it (src/rotor/fan.rs).
 use crate::io::{csv_string, OutDir};
 use crate::solver::modal::{modes, ModalOptions, Mode};

@@ -1,4 +1,4 @@
-//! `rotorsim run` (issue #6): forced response of a rotor to a flight record with one or all
+//! `rotorsim run`: forced response of a rotor to a flight record with one or all
 //! damper models, to a periodic solution; writes summary.json, <model>/last_rev.csv,
 //! report.html and result.mcap (docs/run.md).
 use crate::flight::FlightRecord;

@@ -1,4 +1,4 @@
-//! `rotorsim static` (issue #3): nonlinear static analysis of a model deck.
+//! `rotorsim static`: nonlinear static analysis of a model deck.
 use crate::io::{csv_string, OutDir};
 use crate::solver::fdcheck::check_model;
 use crate::solver::state::{lambda_offsets, sensor_header, sensor_values};

@@ -1,4 +1,4 @@
-//! `rotorsim verify` (issue #3): runs the structural verification suite, writes DIR/verify.json
+//! `rotorsim verify`: runs the structural verification suite, writes DIR/verify.json
 //! (`{case, quantity, computed, reference, rel_error, source, tolerance, pass}`) and a table.
 use crate::io::OutDir;
 use crate::solver::verification::*;

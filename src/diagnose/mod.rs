@@ -1,4 +1,4 @@
-//! Model diagnosis (issue #7): residual analysis of the baseline damper model against measured
+//! Model diagnosis: residual analysis of the baseline damper model against measured
 //! stroke-driven data, a library of physical extensions fitted by nonlinear least squares
 //! (Levenberg-Marquardt), ranking by BIC, validation on held-out data and the choice of a cause
 //! (or `none`). See docs/diagnosis.md.

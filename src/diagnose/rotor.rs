@@ -1,5 +1,5 @@
-//! Rotor-level parts of the diagnosis (issue #7): the damper stroke of a flight record that
-//! has none, simulated by the full rotor run (issue #6), and the rotor-level before/after check
+//! Rotor-level parts of the diagnosis: the damper stroke of a flight record that
+//! has none, simulated by the full rotor run, and the rotor-level before/after check
 //! of an extended damper deck (baseline deck vs extended deck, physical damper, in parallel).
 //!
 //! Conventions are those of docs/run.md: model time t = 0 is psi = 0 of the reference blade,

@@ -105,7 +105,7 @@ pub struct CircuitParams {
     pub p_s: f64,
     /// Initial chamber pressures [Pa].
     pub p_init: [f64; 2],
-    /// Entrained air and piston leakage (issue #7; default: none, the paper's model).
+    /// Entrained air and piston leakage (default: none, the paper's model).
     pub ext: HydraulicExtensions,
 }
 

@@ -97,7 +97,7 @@ pub struct DamperDeck {
     pub extensions: DeviceExtensions,
 }
 
-/// Seal friction and free play of the physical damper (issue #7; default: none).
+/// Seal friction and free play of the physical damper (default: none).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DeviceExtensions {
     pub friction: Option<SealFriction>,

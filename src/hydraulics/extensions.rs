@@ -1,4 +1,4 @@
-//! Model extensions beyond the paper (issue #7; the paper's conclusions list what its model
+//! Model extensions beyond the paper (the paper's conclusions list what its model
 //! misses: friction, force dwell near zero, asymmetric peaks). Each is a physical element:
 //! - [`SealFriction`]: Coulomb/Stribeck friction of the piston and rod seals (force element in
 //!   parallel with the hydraulic force);

@@ -1,5 +1,5 @@
 //! Rotor deck -> multibody model, and the forced-response simulation interface used by
-//! `rotorsim run` (issue #6).
+//! `rotorsim run`.
 //!
 //! Split of responsibilities: this module builds a rotor (deck, expansion to a model deck,
 //! the UH-60A multibody model, airload replay, swashplate controls, damper coupling) and

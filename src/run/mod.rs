@@ -1,4 +1,4 @@
-//! `rotorsim run` (issue #6): drive forced-response simulations ([`ForcedResponse`]) to a
+//! `rotorsim run`: drive forced-response simulations ([`ForcedResponse`]) to a
 //! periodic solution, revolution by revolution, and compare their last revolution with the
 //! measured damper force of a flight record.
 //!
@@ -18,7 +18,7 @@ use crate::hydraulics::DamperModel;
 use crate::rotor::{ForcedResponse, Timing};
 use std::time::Instant;
 
-/// Periodicity tolerance of issue #6: the measure must fall below it by the last revolution.
+/// Periodicity tolerance: the measure must fall below it by the last revolution.
 pub const PERIODICITY_TOL: f64 = 1e-3;
 
 /// Channels monitored for periodicity, with the floor of their scale (a channel that barely

@@ -1,4 +1,4 @@
-//! Verification cases shared by tests/ and `rotorsim verify` (issue #3).
+//! Verification cases shared by tests/ and `rotorsim verify`.
 use crate::solver::{static_solve, State, StaticOptions};
 use crate::structure::*;
 
