@@ -19,6 +19,8 @@ pub struct Timing {
     pub iterations: usize,
     /// Factorizations of the structural iteration matrix.
     pub factorizations: usize,
+    /// Steps accepted at the relaxed tolerance after Newton stalled at a valve event.
+    pub relaxed_steps: usize,
 }
 
 /// Names of the channels every [`ForcedResponse`] reports first, in this order. Sign

@@ -502,6 +502,7 @@ impl ForcedResponse for RotorSim {
             steps: self.solver.steps,
             iterations: self.solver.total_iterations,
             factorizations: self.solver.factorizations,
+            relaxed_steps: self.relaxed_steps,
         }
     }
 }

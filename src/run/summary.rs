@@ -616,6 +616,7 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
             "iterations_per_step": t.iterations as f64 / steps,
             "factorizations": t.factorizations,
             "factorizations_per_step": t.factorizations as f64 / steps,
+            "relaxed_steps": t.relaxed_steps,
         },
         "cost_per_step_s": t.total_s / steps,
         "metrics": metrics,
