@@ -3,27 +3,9 @@
 mod flight_support;
 use flight_support::*;
 use rotorsim::flight::{AirloadReplay, FlightRecord, ReplayMode, ReplayOptions};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
-struct Counting;
-thread_local! {
-    // Per thread, so the harness's own threads cannot disturb the count.
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod alloc_support;
+use alloc_support::{allocations, assert_counting};
 
 #[test]
 fn queries_do_not_allocate() {
@@ -41,13 +23,9 @@ fn queries_do_not_allocate() {
         )
         .unwrap(),
     ];
-    // The counter sees allocations of this thread.
-    let b = ALLOCS.with(Cell::get);
-    let v: Vec<u8> = Vec::with_capacity(8);
-    std::hint::black_box(&v);
-    assert!(ALLOCS.with(Cell::get) > b, "counting allocator inactive");
+    assert_counting();
     for rp in &providers {
-        let before = ALLOCS.with(Cell::get);
+        let before = allocations();
         let mut acc = 0.0;
         for k in 0..2000 {
             let t = k as f64 * 7.7e-4 - 0.1;
@@ -57,6 +35,6 @@ fn queries_do_not_allocate() {
             acc += rp.at_azimuth(k as f64 * 0.37, 0.9).normal_N_per_m;
         }
         assert!(acc.is_finite());
-        assert_eq!(ALLOCS.with(Cell::get), before, "a query allocated");
+        assert_eq!(allocations(), before, "a query allocated");
     }
 }

@@ -8,28 +8,10 @@ use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::sim::build_sim;
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use rotorsim::solver::NewtonMethod;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::path::PathBuf;
 
-struct Counting;
-thread_local! {
-    // Per thread, so the harness's own threads cannot disturb the count.
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod alloc_support;
+use alloc_support::{allocations, assert_counting};
 
 fn repo(p: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
@@ -42,9 +24,7 @@ fn rotor_steps_do_not_allocate() {
     let deck = RotorDeck::from_file(&repo("rotors/uh60a.toml")).unwrap();
     let damper = deck.damper().unwrap();
     let rec = FlightRecord::read(&repo("flightdata/c8534like")).unwrap();
-    let b = ALLOCS.with(Cell::get);
-    std::hint::black_box(Vec::<u8>::with_capacity(8));
-    assert!(ALLOCS.with(Cell::get) > b, "counting allocator inactive");
+    assert_counting();
     for newton in [NewtonMethod::Modified, NewtonMethod::Full] {
         let opts = RunOptions {
             newton,
@@ -66,11 +46,11 @@ fn rotor_steps_do_not_allocate() {
         }
         let (mut plain, mut refactored) = (0, 0);
         for _ in 0..256 {
-            let a0 = ALLOCS.with(Cell::get);
+            let a0 = allocations();
             let f0 = sim.timing().factorizations;
             sim.step().unwrap();
             sim.channels(&mut ch);
-            let allocs = ALLOCS.with(Cell::get) - a0;
+            let allocs = allocations() - a0;
             let f = sim.timing().factorizations - f0;
             if f == 0 {
                 plain += 1;

@@ -138,25 +138,7 @@ fn case(rng: &mut Rng, kind: JointKind, grounded: bool, extra: Extra, dyn_seeds:
                 let tl = tangent_left(fmul(h, rng.v3(50.0)));
                 let cv = rng.uni(0.5, 2.0) / h;
                 let ca = cv / (0.3 * h);
-                std::array::from_fn(|comp| {
-                    let mut e = [0.0; 3];
-                    e[comp % 3] = 1.0;
-                    if comp < 3 {
-                        Seed {
-                            dx: fmul(h, e),
-                            dv: fmul(cv, e),
-                            da: fmul(ca, e),
-                            ..Default::default()
-                        }
-                    } else {
-                        Seed {
-                            dth: fmul(h, mv(&tl, e)),
-                            dw: fmul(cv, e),
-                            dal: fmul(ca, e),
-                            ..Default::default()
-                        }
-                    }
-                })
+                std::array::from_fn(|comp| Seed::generalized_alpha(comp, h, cv, ca, &tl))
             } else {
                 // every part of every seed non-zero
                 std::array::from_fn(|_| Seed {

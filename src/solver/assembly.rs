@@ -4,7 +4,6 @@ use crate::structure::joint::Joint;
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
 use crate::structure::model::{Element, ElementError, ElementOutput, Model};
 use crate::structure::real::{c, Dual, DualN, Real};
-use crate::structure::rotation::*;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
@@ -47,27 +46,6 @@ pub struct Assembler {
     /// With `multilane`: beam tangents from the 24-lane dual evaluation (true) or from the
     /// closed form [`Beam::tangent`](crate::structure::Beam::tangent) (false, default).
     pub beam_tangent_dual: bool,
-}
-
-/// Node kinematics with the 6 seeds of local node `l` in lanes 6l..6l+6.
-fn seeded_lanes(k: &NodeKin<f64>, l: usize, seed: &dyn Fn(usize) -> Seed) -> NodeKin<DualN<24>> {
-    let mut out: NodeKin<DualN<24>> = k.lift();
-    for c in 0..6 {
-        let s = seed(c);
-        let lane = 6 * l + c;
-        let dr = mm(&skew(s.dth), &k.r);
-        for i in 0..3 {
-            out.x[i].d[lane] = s.dx[i];
-            out.v[i].d[lane] = s.dv[i];
-            out.w[i].d[lane] = s.dw[i];
-            out.a[i].d[lane] = s.da[i];
-            out.al[i].d[lane] = s.dal[i];
-            for j in 0..3 {
-                out.r[i][j].d[lane] = dr[i][j];
-            }
-        }
-    }
-    out
 }
 
 /// Residual of one built-in element in scalar `T`; `k` holds the element's nodes in order.
@@ -330,7 +308,8 @@ impl Assembler {
                 // all 24 columns from one multi-lane evaluation
                 let mut k24 = [NodeKin::<DualN<24>>::ground(); 4];
                 for l in 0..4 {
-                    k24[l] = seeded_lanes(&kf[l], l, &|c| seed(dofs[6 * l] / 6, c));
+                    k24[l] =
+                        kf[l].seeded_lanes(l, &std::array::from_fn(|c| seed(dofs[6 * l] / 6, c)));
                 }
                 let mut o24 = [DualN::<24>::default(); 24];
                 bm.residual(&k24, ctx, &mut o24);

@@ -237,7 +237,7 @@ impl DynamicSolver {
         self.state.kin(&mut self.kin);
         let (cv, ca) = self.coeffs();
         let h = self.h;
-        let seed = move |_: usize, comp: usize| dyn_seed(comp, h, cv, ca, &IDENT);
+        let seed = move |_: usize, comp: usize| Seed::generalized_alpha(comp, h, cv, ca, &IDENT);
         let ctx = EvalCtx {
             t,
             load_factor: 1.0,
@@ -276,7 +276,7 @@ impl DynamicSolver {
         let (cv, ca) = self.coeffs();
         let h = self.h;
         let tl = &self.tl;
-        let seed = |node: usize, comp: usize| dyn_seed(comp, h, cv, ca, &tl[node]);
+        let seed = |node: usize, comp: usize| Seed::generalized_alpha(comp, h, cv, ca, &tl[node]);
         self.asm
             .assemble(
                 &mut self.model,
@@ -714,26 +714,6 @@ fn cat(a: [f64; 3], b: [f64; 3]) -> [f64; 6] {
 }
 
 const IDENT: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-fn dyn_seed(comp: usize, h: f64, cv: f64, ca: f64, tl: &[[f64; 3]; 3]) -> Seed {
-    let mut e = [0.0; 3];
-    e[comp % 3] = 1.0;
-    if comp < 3 {
-        Seed {
-            dx: fmul(h, e),
-            dv: fmul(cv, e),
-            da: fmul(ca, e),
-            ..Default::default()
-        }
-    } else {
-        Seed {
-            dth: fmul(h, mv(tl, e)),
-            dw: fmul(cv, e),
-            dal: fmul(ca, e),
-            ..Default::default()
-        }
-    }
-}
 
 /// (kinetic, strain) energy of the model at a state.
 pub fn energy(model: &Model, st: &State) -> (f64, f64) {

@@ -582,25 +582,7 @@ mod tests {
         ctx: &EvalCtx,
         s: &[[Seed; 6]; 4],
     ) -> Vec<f64> {
-        let k24: [NodeKin<DualN<24>>; 4] = std::array::from_fn(|l| {
-            let mut o: NodeKin<DualN<24>> = k[l].lift();
-            for c in 0..6 {
-                let sd = &s[l][c];
-                let lane = 6 * l + c;
-                let dr = mm(&skew(sd.dth), &k[l].r);
-                for i in 0..3 {
-                    o.x[i].d[lane] = sd.dx[i];
-                    o.v[i].d[lane] = sd.dv[i];
-                    o.w[i].d[lane] = sd.dw[i];
-                    o.a[i].d[lane] = sd.da[i];
-                    o.al[i].d[lane] = sd.dal[i];
-                    for j in 0..3 {
-                        o.r[i][j].d[lane] = dr[i][j];
-                    }
-                }
-            }
-            o
-        });
+        let k24: [NodeKin<DualN<24>>; 4] = std::array::from_fn(|l| k[l].seeded_lanes(l, &s[l]));
         let mut o24 = [DualN::<24>::default(); 24];
         b.residual(&k24, ctx, &mut o24);
         (0..576).map(|i| o24[i / 24].d[i % 24]).collect()

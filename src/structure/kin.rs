@@ -29,6 +29,28 @@ impl<T: Real> NodeKin<T> {
 }
 
 impl NodeKin<f64> {
+    /// As 24-lane duals with the 6 seeds `s` of local node `l` in lanes `6l..6l+6` (one
+    /// evaluation of a 4-node element then gives all 24 tangent columns).
+    pub fn seeded_lanes(&self, l: usize, s: &[Seed; 6]) -> NodeKin<super::real::DualN<24>> {
+        use super::rotation::{mm, skew};
+        let mut out: NodeKin<super::real::DualN<24>> = self.lift();
+        for (c, sd) in s.iter().enumerate() {
+            let lane = 6 * l + c;
+            let dr = mm(&skew(sd.dth), &self.r);
+            for i in 0..3 {
+                out.x[i].d[lane] = sd.dx[i];
+                out.v[i].d[lane] = sd.dv[i];
+                out.w[i].d[lane] = sd.dw[i];
+                out.a[i].d[lane] = sd.da[i];
+                out.al[i].d[lane] = sd.dal[i];
+                for j in 0..3 {
+                    out.r[i][j].d[lane] = dr[i][j];
+                }
+            }
+        }
+        out
+    }
+
     /// As single-lane duals whose derivative parts are the seed `s` (rotation by the
     /// first-order `R + eps dth~ R`); none: constants.
     pub fn seeded(&self, s: Option<&Seed>) -> NodeKin<super::real::Dual<f64>> {
@@ -74,6 +96,32 @@ pub struct Seed {
     pub dw: [f64; 3],
     pub da: [f64; 3],
     pub dal: [f64; 3],
+}
+
+impl Seed {
+    /// Generalized-alpha seed of dof `comp` (0-2 translation, 3-5 rotation) of a node:
+    /// `dx = h e`, `dth = h T_L e` (`tl` the tangent of the iterate's rotation increment),
+    /// `dv = dw = cv e`, `da = dal = ca e`.
+    pub fn generalized_alpha(comp: usize, h: f64, cv: f64, ca: f64, tl: &[[f64; 3]; 3]) -> Self {
+        use super::rotation::{fmul, mv};
+        let mut e = [0.0; 3];
+        e[comp % 3] = 1.0;
+        if comp < 3 {
+            Seed {
+                dx: fmul(h, e),
+                dv: fmul(cv, e),
+                da: fmul(ca, e),
+                ..Default::default()
+            }
+        } else {
+            Seed {
+                dth: fmul(h, mv(tl, e)),
+                dw: fmul(cv, e),
+                dal: fmul(ca, e),
+                ..Default::default()
+            }
+        }
+    }
 }
 
 /// Evaluation context common to all elements.
