@@ -102,6 +102,7 @@ impl Seed {
     /// Generalized-alpha seed of dof `comp` (0-2 translation, 3-5 rotation) of a node:
     /// `dx = h e`, `dth = h T_L e` (`tl` the tangent of the iterate's rotation increment),
     /// `dv = dw = cv e`, `da = dal = ca e`.
+    #[inline]
     pub fn generalized_alpha(comp: usize, h: f64, cv: f64, ca: f64, tl: &[[f64; 3]; 3]) -> Self {
         use super::rotation::{fmul, mv};
         let mut e = [0.0; 3];
