@@ -371,6 +371,12 @@ impl Device for CentralDiff {
     fn reset(&mut self) {
         self.0.reset()
     }
+    fn state_values(&self) -> Vec<f64> {
+        self.0.state_values()
+    }
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), rotorsim::hydraulics::HydraulicError> {
+        self.0.set_state_values(v)
+    }
 }
 
 fn rand_unit(seed: &mut u64) -> f64 {

@@ -28,7 +28,8 @@ fn runs(models: &[DamperModel], newton: NewtonMethod, rtol: f64, revs: usize) ->
     let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
         rotorsim::rotor::build(&rotor, &deck, m, &rec, &opts)
     };
-    run_models(models, revs, &build, &Silent)
+    let opts = vec![rotorsim::run::PeriodicOptions::march(revs); models.len()];
+    run_models(models, &opts, &build, &Silent)
         .into_iter()
         .map(|o| o.result.unwrap())
         .collect()

@@ -30,9 +30,26 @@ pub struct RunArgs {
     /// Damper deck overriding the rotor deck's [damper] table (e.g. from `diagnose --write-deck`).
     #[arg(long)]
     pub damper_deck: Option<PathBuf>,
-    /// Rotor revolutions to run; the last one is reported.
+    /// Most rotor revolutions integrated per model (shooting: perturbed and trial revolutions
+    /// included); the run stops earlier once periodic. The reported revolution is the last
+    /// accepted one.
     #[arg(long, default_value_t = 75)]
     pub revs: usize,
+    /// Periodic solver: shooting (Newton-Picard on the revolution map, falling back to
+    /// marching when it cannot converge) or march (revolution after revolution).
+    #[arg(long, default_value = "shooting")]
+    pub periodic: String,
+    /// Periodicity residual at which a model stops: per monitored channel (damper force, tip
+    /// flap, lag, twist) the change over one revolution relative to its peak-to-peak.
+    #[arg(long, default_value_t = crate::run::periodic::DEFAULT_TOL)]
+    pub periodic_tol: f64,
+    /// Start from a saved periodic state: a periodic_state.json, or the directory of an
+    /// earlier run (then each model starts from its own <model>/periodic_state.json).
+    #[arg(long)]
+    pub initial_state: Option<PathBuf>,
+    /// Exit non-zero when a model does not reach the periodicity tolerance.
+    #[arg(long)]
+    pub require_periodic: bool,
     /// Structural steps per revolution.
     #[arg(long, default_value_t = 256)]
     pub steps_per_rev: usize,
@@ -127,6 +144,28 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         .parse()
         .map_err(|e: String| anyhow::anyhow!("--newton: {e}"))?;
     run::check_run_options(args.revs, args.steps_per_rev, args.substeps)?;
+    let method = match args.periodic.as_str() {
+        "shooting" => run::PeriodicMethod::Shooting,
+        "march" => run::PeriodicMethod::March,
+        m => bail!("--periodic: unknown method '{m}' (expected shooting or march)"),
+    };
+    if !(args.periodic_tol > 0.0 && args.periodic_tol.is_finite()) {
+        bail!(
+            "--periodic-tol must be positive and finite (got {})",
+            args.periodic_tol
+        );
+    }
+    let initial = match &args.initial_state {
+        None => vec![None; models.len()],
+        Some(p) if p.is_dir() => models
+            .iter()
+            .map(|m| {
+                run::PeriodicStateFile::read(&p.join(m.name()).join("periodic_state.json"))
+                    .map(Some)
+            })
+            .collect::<anyhow::Result<_>>()?,
+        Some(p) => vec![Some(run::PeriodicStateFile::read(p)?); models.len()],
+    };
     let (sdof, rigid) = match args.model.as_str() {
         "uh60a" => (false, false),
         "rigid" => (false, true),
@@ -156,6 +195,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         steps_per_rev: args.steps_per_rev,
         hydraulics,
         newton,
+        // the delayed perturbation damping vanishes on the periodic solution: it only speeds
+        // up marching, and its history would be part of the revolution map's state
+        perturbation_damping: method == run::PeriodicMethod::March,
         ..RunOptions::default()
     };
     let sdof_params = if sdof {
@@ -181,13 +223,15 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     let out = OutDir::create(&args.out)?;
     let tty = std::io::stderr().is_terminal();
     eprintln!(
-        "rotorsim run: {} model(s) {}, {} revolutions x {} steps{}",
+        "rotorsim run: {} model(s) {}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
         models.len(),
         models
             .iter()
             .map(|m| m.name())
             .collect::<Vec<_>>()
             .join(", "),
+        method.name(),
+        args.periodic_tol,
         args.revs,
         args.steps_per_rev,
         if sdof {
@@ -198,11 +242,22 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             ""
         }
     );
+    let popts: Vec<run::PeriodicOptions> = initial
+        .into_iter()
+        .map(|init| run::PeriodicOptions {
+            method,
+            tol: args.periodic_tol,
+            max_revs: args.revs,
+            stop_early: true,
+            initial_state: init,
+            min_floquet_dirs: 0,
+        })
+        .collect();
     let outcomes = if tty {
         let bars = Bars::new(&models, args.revs);
-        run::run_models(&models, args.revs, &build, &bars)
+        run::run_models(&models, &popts, &build, &bars)
     } else {
-        run::run_models(&models, args.revs, &build, &Silent)
+        run::run_models(&models, &popts, &build, &Silent)
     };
     let info = RunInfo {
         rotor: args.rotor.display().to_string(),
@@ -225,12 +280,30 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         substeps: args.substeps,
         scheme: args.scheme.clone(),
         newton: newton.name().into(),
+        periodic: method.name().into(),
+        periodic_tol: args.periodic_tol,
+        initial_state: args.initial_state.as_ref().map(|p| p.display().to_string()),
         synthetic: record.meta.synthetic,
         counter: record.meta.counter.clone(),
         wall_s: t0.elapsed().as_secs_f64(),
     };
     let failed = write_outputs(&out, &info, &outcomes, &measured)?;
     print_summary(&out, &outcomes, &measured);
+    let not_periodic: Vec<String> = outcomes
+        .iter()
+        .filter_map(|o| o.result.as_ref().ok())
+        .filter(|r| !r.converged())
+        .map(|r| format!("{} (residual {})", r.label, fmt_measure(r.last_measure())))
+        .collect();
+    if failed.is_empty() && args.require_periodic && !not_periodic.is_empty() {
+        let summary_path = out.file("summary.json");
+        out.finish()?;
+        bail!(
+            "not periodic (--require-periodic): {}; results in {} (each model's best revolution)",
+            not_periodic.join(", "),
+            summary_path.display()
+        );
+    }
     if failed.is_empty() {
         out.finish()?;
         Ok(())
@@ -265,7 +338,10 @@ pub fn write_outputs(
     for (o, f) in outcomes.iter().zip(&figs) {
         match (&o.result, f) {
             (Err(e), _) | (Ok(_), Some(Err(e))) => failed.push(format!("{}: {e}", o.model.name())),
-            (Ok(r), _) => summary::write_last_rev(out, r)?,
+            (Ok(r), _) => {
+                summary::write_last_rev(out, r)?;
+                summary::write_periodic_state(out, r)?;
+            }
         }
     }
     let metrics: Vec<(String, &crate::analysis::compare::Metrics)> = outcomes
@@ -314,10 +390,12 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                 });
                 let t = r.timing;
                 println!(
-                    "{:<22} periodicity {} ({}){}  wall {:.1} s (structure {:.1} s, hydraulics {:.1} s)",
+                    "{:<22} residual {} ({}, {} revs, {}){}  wall {:.1} s (structure {:.1} s, hydraulics {:.1} s)",
                     r.label,
                     fmt_measure(r.last_measure()),
-                    if r.converged() { "periodic" } else { "NOT below 1e-3" },
+                    if r.converged() { "periodic" } else { "NOT periodic" },
+                    r.periodic.revolutions_integrated,
+                    r.periodic.method_used.name(),
                     cmp.map(|m| format!(
                         "  RMS error {:.0} N, correlation {:.3}",
                         m.rms_error, m.correlation

@@ -648,4 +648,20 @@ impl Device for CircuitDevice {
         self.committed_d = 0.0;
         self.trial = None;
     }
+
+    fn state_values(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self.committed.iter().copied().collect();
+        v.push(self.committed_t);
+        v.push(self.committed_d);
+        v
+    }
+
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        super::check_state_len("hydraulic circuit", v, NS + 2)?;
+        self.committed = State::from_column_slice(&v[..NS]);
+        self.committed_t = v[NS];
+        self.committed_d = v[NS + 1];
+        self.trial = None;
+        Ok(())
+    }
 }

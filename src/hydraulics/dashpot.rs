@@ -58,6 +58,15 @@ impl Device for LinearDashpot {
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }
+    fn state_values(&self) -> Vec<f64> {
+        vec![self.committed_v]
+    }
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        super::check_state_len("dashpot", v, 1)?;
+        self.committed_v = v[0];
+        self.trial_v = None;
+        Ok(())
+    }
     fn reset(&mut self) {
         self.committed_v = 0.0;
         self.trial_v = None;
@@ -218,6 +227,15 @@ impl Device for NonlinearDashpot {
     }
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
+    }
+    fn state_values(&self) -> Vec<f64> {
+        vec![self.committed_v]
+    }
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        super::check_state_len("dashpot", v, 1)?;
+        self.committed_v = v[0];
+        self.trial_v = None;
+        Ok(())
     }
     fn reset(&mut self) {
         self.committed_v = 0.0;

@@ -265,6 +265,31 @@ impl Device for ExtendedDamper {
         self.fresh = true;
         self.trial = None;
     }
+
+    fn state_values(&self) -> Vec<f64> {
+        let mut v = vec![
+            self.d_h,
+            f64::from(u8::from(self.contact)),
+            self.v_h,
+            f64::from(u8::from(self.fresh)),
+        ];
+        v.extend(self.inner.state_values());
+        v
+    }
+
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        if v.len() < 4 {
+            return super::check_state_len("extended damper", v, 4);
+        }
+        self.inner.set_state_values(&v[4..])?;
+        super::check_state_len("extended damper", &v[..4], 4)?;
+        self.d_h = v[0];
+        self.contact = v[1] != 0.0;
+        self.v_h = v[2];
+        self.fresh = v[3] != 0.0;
+        self.trial = None;
+        Ok(())
+    }
 }
 
 /// Elastic mounts (rod-end bearings, bushings, airframe attachment) in series with a damper:
@@ -464,6 +489,23 @@ impl Device for SeriesMount {
         self.d_h = 0.0;
         self.fresh = true;
         self.trial = None;
+    }
+
+    fn state_values(&self) -> Vec<f64> {
+        let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
+        v.extend(self.inner.state_values());
+        v
+    }
+
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        if v.len() < 2 {
+            return super::check_state_len("series mount", v, 2);
+        }
+        self.inner.set_state_values(&v[2..])?;
+        self.d_h = v[0];
+        self.fresh = v[1] != 0.0;
+        self.trial = None;
+        Ok(())
     }
 }
 

@@ -62,6 +62,8 @@ pub enum HydraulicError {
     SingularJacobian { t: f64, stage: usize },
     #[error("invalid step at t = {t} s: {reason}")]
     BadStep { t: f64, reason: String },
+    #[error("invalid device state: {reason}")]
+    BadState { reason: String },
 }
 
 /// A hydraulic (or dashpot) device connecting two structural points, as seen by the structure.
@@ -91,6 +93,26 @@ pub trait Device: Send + Sync + std::fmt::Debug {
     fn clone_device(&self) -> Box<dyn Device>;
     /// Back to the initial state (start of a new test).
     fn reset(&mut self);
+    /// The committed state as numbers (saved periodic states, warm starts); any trial state
+    /// is not part of it.
+    fn state_values(&self) -> Vec<f64>;
+    /// Restores a state of [`Device::state_values`] (same device kind and layout) and drops
+    /// any trial state.
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError>;
+}
+
+/// `v` has `n` values, else a [`HydraulicError::BadState`] naming `what`.
+pub(crate) fn check_state_len(what: &str, v: &[f64], n: usize) -> Result<(), HydraulicError> {
+    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+        return Err(HydraulicError::BadState {
+            reason: format!(
+                "{what} state needs {n} finite values, got {} ({:?})",
+                v.len(),
+                &v[..v.len().min(8)]
+            ),
+        });
+    }
+    Ok(())
 }
 
 impl Clone for Box<dyn Device> {

@@ -100,6 +100,41 @@ pub trait ForcedResponse: Send {
         None
     }
     fn timing(&self) -> Timing;
+    /// The current state, for periodic solutions and warm starts; None when this simulation
+    /// cannot save it (it can then only be marched).
+    fn save_state(&self) -> Option<SimState> {
+        None
+    }
+    /// Continue from `s` (saved by this simulation or by one of the same model).
+    fn restore_state(&mut self, _s: &SimState) -> anyhow::Result<()> {
+        anyhow::bail!("{}: cannot restore a saved state", self.label())
+    }
+    /// Time from which the forcing repeats every period [s] (end of the ramps).
+    fn periodic_from_s(&self) -> f64 {
+        0.0
+    }
+    /// Which motion dominates a (complex) mode given in the coordinates of
+    /// [`SimState::coords`]: "lag", "flap", "torsion", ... ("" when unknown).
+    fn mode_label(&self, _re: &[f64], _im: &[f64]) -> String {
+        String::new()
+    }
+}
+
+/// A saved state of a [`ForcedResponse`]: the perturbable coordinates (periodic solvers work
+/// on them; scaled to comparable units, e.g. velocities times 1/Omega) and the rest, restored
+/// as is.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SimState {
+    /// Time [s].
+    pub t_s: f64,
+    /// Perturbable coordinates (their meaning is the simulation's).
+    pub coords: Vec<f64>,
+    /// The structural solver's state (multibody simulations).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<crate::solver::SolverSnapshot>,
+    /// Other state values (e.g. a device's), in the simulation's layout.
+    #[serde(default)]
+    pub aux: Vec<f64>,
 }
 
 pub mod deck;
@@ -127,6 +162,10 @@ pub struct RunOptions {
     /// Newton tolerance of a structural step: `||r|| <= rtol ||r_pred||`, `r_pred` the residual
     /// of the zero-acceleration predictor (default [`sim::RTOL`]).
     pub newton_rtol: f64,
+    /// Whether the deck's perturbation damping (`blade.perturbation_damping_*`) is applied.
+    /// It vanishes on the periodic solution and only speeds up marching; shooting turns it off
+    /// (its delayed history would be part of the revolution map's state).
+    pub perturbation_damping: bool,
 }
 
 impl Default for RunOptions {
@@ -137,6 +176,7 @@ impl Default for RunOptions {
             rho_inf: 0.9,
             newton: crate::solver::NewtonMethod::Modified,
             newton_rtol: sim::RTOL,
+            perturbation_damping: true,
         }
     }
 }

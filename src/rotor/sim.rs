@@ -193,6 +193,10 @@ pub struct RotorSim {
     relaxed_steps: usize,
     /// Newton tolerance of a step (relative to the zero-acceleration predictor residual).
     rtol: f64,
+    /// Reference orientation of every node (the chart of the saved coordinates).
+    r0: Vec<[[f64; 3]; 3]>,
+    /// End of the cyclic ramp [s].
+    t_ramp: f64,
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -298,6 +302,7 @@ pub fn build_sim(
         spec,
         record,
         opts.steps_per_rev,
+        opts.perturbation_damping,
     )?;
     model.add_distributed_load(names::BLADE, load)?;
     // initial state: rotating static equilibrium under the mean loads and the collective
@@ -330,6 +335,7 @@ pub fn build_sim(
     let root = model.node_id(&format!("{}.n0", names::BLADE))?;
     let tip_ref = model.nodes[tip].x0;
     let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
+    let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
     let mut solver = DynamicSolver::new(model, st, h, opts.rho_inf)?;
     // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
@@ -371,6 +377,8 @@ pub fn build_sim(
         total_s: 0.0,
         relaxed_steps: 0,
         rtol: opts.newton_rtol,
+        r0,
+        t_ramp,
     })
 }
 
@@ -494,6 +502,59 @@ impl ForcedResponse for RotorSim {
     }
     fn relief_regulation(&self) -> Option<[super::ReliefRegulation; 2]> {
         self.regulation
+    }
+    fn save_state(&self) -> Option<super::SimState> {
+        let snap = self.solver.snapshot();
+        Some(super::SimState {
+            t_s: snap.t_s,
+            coords: snap.coords(&self.r0, 1.0 / self.spec.rotor.omega_rad_s),
+            solver: Some(snap),
+            aux: vec![],
+        })
+    }
+    fn restore_state(&mut self, s: &super::SimState) -> anyhow::Result<()> {
+        let Some(snap) = &s.solver else {
+            anyhow::bail!(
+                "the saved state has no structural state (not a state of the elastic rotor model)"
+            );
+        };
+        let mut snap = snap.clone();
+        let n = crate::solver::snapshot::COORDS_PER_NODE * snap.nodes();
+        if s.coords.len() != n {
+            anyhow::bail!(
+                "the saved state has {} coordinates, its structural state {n}",
+                s.coords.len()
+            );
+        }
+        snap.set_coords(&self.r0, 1.0 / self.spec.rotor.omega_rad_s, &s.coords);
+        snap.t_s = s.t_s;
+        self.solver
+            .restore(&snap)
+            .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))
+    }
+    fn periodic_from_s(&self) -> f64 {
+        self.t_ramp
+    }
+    /// Largest of the tip lag (-y), tip flap (z) and tip twist about x times R/10 (a coarse
+    /// label: the blade lies along x at the azimuth of a saved state).
+    fn mode_label(&self, re: &[f64], im: &[f64]) -> String {
+        use crate::solver::snapshot::COORDS_PER_NODE as K;
+        let (t, r) = (K * self.tip, K * self.root);
+        if re.len() < t + K || im.len() != re.len() {
+            return String::new();
+        }
+        let mag = |i: usize| re[i].hypot(im[i]);
+        let twist = (re[t + 3] - re[r + 3]).hypot(im[t + 3] - im[r + 3]);
+        let parts = [
+            ("lag", mag(t + 1)),
+            ("flap", mag(t + 2)),
+            ("torsion", twist * self.spec.rotor.radius_m / 10.0),
+        ];
+        parts
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|p| p.0.to_string())
+            .unwrap_or_default()
     }
     fn timing(&self) -> Timing {
         Timing {

@@ -190,7 +190,7 @@ impl<L: DistributedLoad> DistributedLoad for Damped<L> {
 }
 
 /// The blade load of the forced response: `airloads` alone when the deck's
-/// `blade.perturbation_damping_gain` is 0, else wrapped in [`Damped`] with
+/// `blade.perturbation_damping_gain` is 0 or `enabled` is false, else wrapped in [`Damped`] with
 /// `c_n(r) = 1/2 rho a c Omega r` (rho, c from the record meta `density_kg_m3`, `chord_m`).
 pub fn blade_load<L: DistributedLoad + 'static>(
     airloads: L,
@@ -199,9 +199,10 @@ pub fn blade_load<L: DistributedLoad + 'static>(
     spec: &RotorSpec,
     record: &FlightRecord,
     steps_per_rev: usize,
+    enabled: bool,
 ) -> anyhow::Result<Box<dyn DistributedLoad>> {
     let gain = spec.blade.perturbation_damping_gain;
-    if gain == 0.0 {
+    if gain == 0.0 || !enabled {
         return Ok(Box::new(airloads));
     }
     let need = |v: Option<f64>, key: &str| {

@@ -9,17 +9,16 @@
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
 pub mod mcap_out;
+pub mod periodic;
 pub mod report;
 pub mod sdof;
 pub mod summary;
 
-use crate::analysis::periodicity::PeriodicityMonitor;
 use crate::hydraulics::DamperModel;
-use crate::rotor::{ForcedResponse, Timing};
+use crate::rotor::{ForcedResponse, SimState, Timing};
+use periodic::{integrate, max_nan, Revolution, SimMap, FLOQUET_REPORTED};
+pub use periodic::{PeriodicInfo, PeriodicMethod, PeriodicOptions, PeriodicStateFile};
 use std::time::Instant;
-
-/// Periodicity tolerance: the measure must fall below it by the last revolution.
-pub const PERIODICITY_TOL: f64 = 1e-3;
 
 /// Channels monitored for periodicity, with the floor of their scale (a channel that barely
 /// moves, e.g. the tip twist of a rigid-blade model, is then judged on that floor).
@@ -40,12 +39,14 @@ pub struct ModelRun {
     pub model: String,
     /// The simulation's own label (e.g. "physical (sdof)" for the test double).
     pub label: String,
-    /// Revolutions completed.
+    /// Revolutions integrated (shooting: perturbed and trial revolutions included).
     pub revolutions: usize,
     pub steps_per_rev: usize,
     pub period_s: f64,
-    /// Per revolution (from the second): measure of each monitored channel.
-    pub periodicity: PeriodicityMonitor,
+    /// How periodic the reported revolution is, and how it was found.
+    pub periodic: PeriodicInfo,
+    /// State at the start of the reported revolution (None: the simulation cannot save it).
+    pub periodic_state: Option<SimState>,
     /// Channel names (with units), [`crate::rotor::BASE_CHANNELS`] first.
     pub channel_names: Vec<String>,
     /// Azimuth of each sample of the last revolution [deg], in [0, 360).
@@ -70,26 +71,16 @@ impl ModelRun {
             .position(|n| n == name)
             .map(|i| self.last_rev[i].as_slice())
     }
-    /// Max-over-channels periodicity measure after each revolution (from revolution 1).
+    /// Periodicity residual history (see [`PeriodicInfo::residual_history`]).
     pub fn measure_history(&self) -> Vec<f64> {
-        self.periodicity
-            .history
-            .iter()
-            .map(|v| {
-                if v.iter().any(|x| x.is_nan()) {
-                    f64::NAN
-                } else {
-                    v.iter().fold(0.0f64, |m, x| m.max(*x))
-                }
-            })
-            .collect()
+        self.periodic.residual_history.clone()
     }
-    /// The periodicity measure of the last revolution.
+    /// The periodicity residual of the reported revolution.
     pub fn last_measure(&self) -> Option<f64> {
-        self.periodicity.latest()
+        Some(self.periodic.residual)
     }
     pub fn converged(&self) -> bool {
-        self.periodicity.converged(PERIODICITY_TOL)
+        self.periodic.converged
     }
 }
 
@@ -140,9 +131,28 @@ pub fn drive(
     revs: usize,
     progress: &dyn Fn(usize, Option<f64>),
 ) -> anyhow::Result<ModelRun> {
-    let t_start = Instant::now();
     if revs < 2 {
         anyhow::bail!("--revs must be at least 2 so that periodicity can be measured (got {revs})");
+    }
+    drive_periodic(sim, model, &PeriodicOptions::march(revs), progress)
+}
+
+/// Periodic-forcing revolutions marched before shooting starts: the first one after the
+/// ramps lets the fast modes it excited decay, the second is the first shooting iterate.
+pub const MARCH_BEFORE_SHOOTING: usize = 2;
+
+/// Drives `sim` to its periodic solution (`o.method`), at most `o.max_revs` revolutions, and
+/// keeps the reported revolution: sampled at the start of each of its steps (azimuths 0,
+/// 360/N, ...), exactly one period of samples.
+pub fn drive_periodic(
+    sim: &mut dyn ForcedResponse,
+    model: DamperModel,
+    o: &PeriodicOptions,
+    progress: &dyn Fn(usize, Option<f64>),
+) -> anyhow::Result<ModelRun> {
+    let t_start = Instant::now();
+    if o.max_revs < 1 {
+        anyhow::bail!("at least one revolution is needed (got {})", o.max_revs);
     }
     let period = sim.period_s();
     let dt = sim.time_step_s();
@@ -165,50 +175,176 @@ pub fn drive(
             )
         })
     };
-    let monitored: Vec<usize> = MONITORED
+    let mon: Vec<usize> = MONITORED
         .iter()
         .map(|(n, _)| idx(n))
         .collect::<anyhow::Result<_>>()?;
-    let mut monitor = PeriodicityMonitor::new(&MONITORED);
-    // Current revolution: samples[c][j]; allocated once, swapped out per revolution.
-    let mut samples = vec![vec![0.0; n]; nc];
-    let mut azimuth = vec![0.0; n];
-    let mut buf = vec![0.0; nc];
-    for r in 0..revs {
-        for j in 0..n {
-            sim.channels(&mut buf);
-            for (c, v) in buf.iter().enumerate() {
-                samples[c][j] = *v;
+    let mut warm_note = None;
+    if let Some(f) = &o.initial_state {
+        let (s, note) = f.start_state(sim, model.name())?;
+        sim.restore_state(&s)
+            .map_err(|e| e.context("starting from the saved state (--initial-state)"))?;
+        warm_note = note;
+    }
+    let can_save = sim.save_state().is_some();
+    let shooting = o.method == PeriodicMethod::Shooting && can_save;
+    let mut info = PeriodicInfo {
+        method: o.method,
+        method_used: PeriodicMethod::March,
+        converged: false,
+        tolerance: o.tol,
+        residual: f64::NAN,
+        residual_by_channel: vec![f64::NAN; mon.len()],
+        residual_history: vec![],
+        revolutions_integrated: 0,
+        marched_revolutions: 0,
+        iterations: 0,
+        directions: 0,
+        rejected_trials: 0,
+        floquet_multipliers: vec![],
+        error_estimate: None,
+        message: String::new(),
+        start_t_s: 0.0,
+    };
+    if o.method == PeriodicMethod::Shooting && !can_save {
+        info.message = format!("{} cannot save its state: marched", sim.label());
+    }
+    if let Some(n) = warm_note {
+        info.message = n;
+    }
+    let periodic_from = sim.periodic_from_s() - 0.5 * dt;
+    let mut rev = Revolution::new(nc, n);
+    let mut start_state: Option<SimState> = None;
+    let mut periods = 0;
+    let mut in_periodic = 0;
+    let march_label = |p: usize| {
+        format!(
+            "{} model, revolution {p} of at most {}",
+            model.name(),
+            o.max_revs
+        )
+    };
+    // March: all of it, or until shooting starts.
+    let mut shoot_from: Option<SimState> = None;
+    while periods < o.max_revs {
+        let periodic = sim.time_s() >= periodic_from;
+        let st0 = if can_save { sim.save_state() } else { None };
+        integrate(sim, &mut rev, &march_label(periods + 1))?;
+        periods += 1;
+        in_periodic += usize::from(periodic);
+        info.residual_by_channel = rev.residual(&mon);
+        let r = max_nan(&info.residual_by_channel);
+        info.residual_history.push(r);
+        progress(periods, Some(r));
+        start_state = st0;
+        if periodic && r <= o.tol {
+            info.converged = true;
+            if o.stop_early {
+                break;
             }
-            azimuth[j] = (sim.azimuth_deg() - 360.0 * r as f64).rem_euclid(360.0);
-            // Keep floating-point drift from wrapping 359.99999 to 0 at the first sample.
-            if j == 0 && azimuth[j] > 359.0 {
-                azimuth[j] = 0.0;
-            }
-            sim.step().map_err(|e| {
-                e.context(format!(
-                    "{} model, revolution {} of {revs}, step {j} of {n} (t = {:.6} s)",
-                    model.name(),
-                    r + 1,
-                    sim.time_s()
-                ))
-            })?;
+        } else {
+            info.converged = false;
         }
-        let mon: Vec<Vec<f64>> = monitored.iter().map(|&c| samples[c].clone()).collect();
-        let m = monitor.push_revolution(mon);
-        progress(r + 1, m);
+        if shooting && in_periodic >= MARCH_BEFORE_SHOOTING {
+            shoot_from = start_state.clone();
+            break;
+        }
+    }
+    info.marched_revolutions = periods;
+    if let (Some(st0), false) = (shoot_from, info.converged) {
+        let end = sim
+            .save_state()
+            .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
+        let label = format!("{} model", model.name());
+        let mut map = SimMap::new(sim, mon.clone(), st0, end, rev, periods, progress, label);
+        info.residual_history = vec![max_nan(&map.residual_by_channel)];
+        let out = periodic::run_shooting(&mut map, o);
+        periods = map.periods;
+        info.iterations = out.iterations;
+        info.directions = out.directions;
+        info.rejected_trials = out.rejected_trials;
+        info.residual_history = out.residual_history.clone();
+        info.residual_by_channel = map.residual_by_channel.clone();
+        info.converged = out.converged();
+        info.method_used = PeriodicMethod::Shooting;
+        let (start, end) = (map.start.clone(), map.end.clone());
+        rev = std::mem::replace(&mut map.rev, Revolution::new(0, 0));
+        drop(map);
+        start_state = Some(start);
+        let mut mult: Vec<_> = out
+            .ritz
+            .iter()
+            .map(|p| {
+                let mut m = p.multiplier.clone();
+                m.mode = sim.mode_label(&p.vector_re, &p.vector_im);
+                m
+            })
+            .collect();
+        // lag mode first, then least damped first
+        if let Some(i) = mult.iter().position(|m| m.mode == "lag") {
+            let lag = mult.remove(i);
+            mult.insert(0, lag);
+        }
+        mult.truncate(FLOQUET_REPORTED);
+        info.error_estimate = out
+            .ritz
+            .first()
+            .map(|p| p.multiplier.magnitude)
+            .filter(|m| *m < 1.0)
+            .map(|m| max_nan(&info.residual_by_channel) / (1.0 - m));
+        info.floquet_multipliers = mult;
+        if !info.converged {
+            use crate::periodic::shooting::Stop;
+            let why = match &out.stop {
+                Stop::Budget => format!("the budget of {} revolutions ran out", o.max_revs),
+                Stop::LineSearch => "no step along the Newton-Picard direction decreased the residual (non-smooth valves?)".into(),
+                Stop::Failed(e) => format!("a revolution failed: {e}"),
+                Stop::Converged => String::new(),
+            };
+            info.message = format!(
+                "shooting did not converge ({why}; residual {:.2e}); marching on from its best state",
+                max_nan(&info.residual_by_channel)
+            );
+            // march on from the end of the best revolution
+            sim.restore_state(&end)?;
+            while periods < o.max_revs {
+                let st0 = sim.save_state();
+                integrate(sim, &mut rev, &march_label(periods + 1))?;
+                periods += 1;
+                info.residual_by_channel = rev.residual(&mon);
+                let r = max_nan(&info.residual_by_channel);
+                info.residual_history.push(r);
+                progress(periods, Some(r));
+                start_state = st0;
+                info.method_used = PeriodicMethod::March;
+                if r <= o.tol {
+                    info.converged = true;
+                    break;
+                }
+            }
+        }
+    }
+    info.residual = max_nan(&info.residual_by_channel);
+    info.revolutions_integrated = periods;
+    info.start_t_s = rev.start_t_s;
+    if !info.converged && info.message.is_empty() {
+        info.message = format!(
+            "not periodic: residual {:.2e} after {periods} revolutions, above the tolerance {:.0e}",
+            info.residual, o.tol
+        );
     }
     let timing = sim.timing();
     Ok(ModelRun {
         model: model.name().to_string(),
         label: sim.label().to_string(),
-        revolutions: revs,
+        revolutions: periods,
         steps_per_rev: n,
         period_s: period,
-        periodicity: monitor,
+        periodic: info,
+        periodic_state: start_state,
         channel_names: names,
-        azimuth_deg: azimuth,
-        last_rev: samples,
+        azimuth_deg: rev.azimuth,
+        last_rev: rev.samples,
         force_limits_n: sim.force_limits_n(),
         relief_regulation: sim.relief_regulation(),
         timing,
@@ -219,9 +355,10 @@ pub fn drive(
 
 /// Builds and drives one simulation per model in parallel. A failed model (build or run) is
 /// returned as an error message; the others are unaffected.
+/// `opts[i]` for `models[i]`.
 pub fn run_models<B>(
     models: &[DamperModel],
-    revs: usize,
+    opts: &[PeriodicOptions],
     build: &B,
     progress: &dyn Progress,
 ) -> Vec<ModelOutcome>
@@ -236,7 +373,8 @@ where
         let handles: Vec<_> = models
             .iter()
             .enumerate()
-            .map(|(i, &model)| scope.spawn(move || run_one(i, model, revs, build, progress)))
+            .zip(opts)
+            .map(|((i, &model), o)| scope.spawn(move || run_one(i, model, o, build, progress)))
             .collect();
         handles
             .into_iter()
@@ -254,7 +392,7 @@ where
 fn run_one<B>(
     i: usize,
     model: DamperModel,
-    revs: usize,
+    opts: &PeriodicOptions,
     build: &B,
     progress: &dyn Progress,
 ) -> ModelOutcome
@@ -266,8 +404,8 @@ where
         .map_err(|e| e.context(format!("building the {} model", model.name())))
         .and_then(|mut sim| {
             let build_s = t0.elapsed().as_secs_f64();
-            let cb = |rev: usize, m: Option<f64>| progress.revolution(i, rev, revs, m);
-            let mut run = drive(sim.as_mut(), model, revs, &cb)?;
+            let cb = |rev: usize, m: Option<f64>| progress.revolution(i, rev, opts.max_revs, m);
+            let mut run = drive_periodic(sim.as_mut(), model, opts, &cb)?;
             run.build_s = build_s;
             run.wall_s = t0.elapsed().as_secs_f64();
             Ok(run)
@@ -278,9 +416,10 @@ where
             i,
             true,
             &format!(
-                "periodicity {} after {} revs",
+                "residual {} after {} revs ({})",
                 fmt_measure(r.last_measure()),
-                r.revolutions
+                r.revolutions,
+                r.periodic.method_used.name()
             ),
         ),
         Err(e) => progress.finished(i, false, e),

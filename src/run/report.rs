@@ -2,7 +2,7 @@
 //! convergence, the metrics table and plain statements of which damper model comes closest and
 //! what none of them reproduces. Self-contained (inline SVG).
 use super::summary::{periodicity_statement, Measured, ModelFigures, Ranking, RunInfo};
-use super::{ModelOutcome, ModelRun, PERIODICITY_TOL};
+use super::{ModelOutcome, ModelRun};
 use crate::analysis::compare::PeriodicInterp;
 use crate::report::html::HtmlReport;
 use crate::report::plot::{stacked_svg, Plot};
@@ -260,7 +260,7 @@ pub fn report_html(
         .iter()
         .map(|r| format!("{}: {}", r.label, periodicity_statement(r)))
         .collect();
-    rep.paragraph("Periodicity (largest change of the damper force and the blade tip motion from one revolution to the next, relative to the peak-to-peak):");
+    rep.paragraph("Periodicity (residual of the reported revolution: the largest change of the damper force and the blade tip flap, lag and twist over the revolution, end against start, relative to their peak-to-peak):");
     rep.list(&per);
     let lim: Vec<String> = ok
         .iter()
@@ -314,7 +314,7 @@ pub fn report_html(
             "RMS error [N]",
             "p-p error [N]",
             "correlation",
-            "periodicity (last rev)",
+            "periodicity residual",
             "wall [s]",
             "structure [s]",
             "hydraulics [s]",
@@ -491,27 +491,98 @@ pub fn report_html(
         );
     }
 
-    rep.heading(2, "Periodicity convergence");
+    rep.heading(2, "Periodic solution");
     let mut pc = Plot::new(
-        "Periodicity measure per revolution",
-        "revolution",
-        "log10(measure)",
+        "Periodicity residual",
+        "iterate (shooting) or revolution (march)",
+        "log10(residual)",
     );
+    let mut longest = 1usize;
     for r in &runs {
         let h = r.measure_history();
-        let x: Vec<f64> = (2..=r.revolutions).map(|k| k as f64).collect();
+        longest = longest.max(h.len());
+        let x: Vec<f64> = (1..=h.len()).map(|k| k as f64).collect();
         let y: Vec<f64> = h.iter().map(|m| m.max(1e-16).log10()).collect();
         pc = pc.line(&r.label, &x, &y);
     }
     if let Some(r) = runs.first() {
-        let t = PERIODICITY_TOL.log10();
-        pc = pc.dashed("tolerance 1e-3", &[1.0, r.revolutions as f64], &[t, t]);
+        let t = r.periodic.tolerance.log10();
+        pc = pc.dashed(
+            &format!("tolerance {:.0e}", r.periodic.tolerance),
+            &[1.0, longest as f64],
+            &[t, t],
+        );
     }
     svg(
         &mut rep,
-        "log10 of the largest relative change from one revolution to the next (damper force, tip flap, lag and twist); the dashed line is the 1e-3 tolerance.",
+        "log10 of the periodicity residual after each shooting iterate (or marched revolution); the dashed line is the tolerance.",
         &[pc],
     );
+    let per: Vec<Vec<String>> = runs
+        .iter()
+        .map(|r| {
+            let p = &r.periodic;
+            vec![
+                r.label.clone(),
+                p.method_used.name().to_string(),
+                if p.converged {
+                    "yes".into()
+                } else {
+                    "NO".into()
+                },
+                super::fmt_measure(Some(p.residual)),
+                p.error_estimate
+                    .map_or("-".into(), |e| super::fmt_measure(Some(e))),
+                p.revolutions_integrated.to_string(),
+                p.iterations.to_string(),
+                p.directions.to_string(),
+            ]
+        })
+        .collect();
+    rep.table(
+        &[
+            "model",
+            "method",
+            "converged",
+            "residual",
+            "error estimate",
+            "revolutions integrated",
+            "iterations",
+            "subspace directions",
+        ],
+        &per,
+    );
+    let mut frows = Vec::new();
+    for r in &runs {
+        for m in &r.periodic.floquet_multipliers {
+            frows.push(vec![
+                r.label.clone(),
+                if m.mode.is_empty() {
+                    "-".into()
+                } else {
+                    m.mode.clone()
+                },
+                format!("{:.6} {:+.6}i", m.re, m.im),
+                format!("{:.4}", m.magnitude),
+                format!("{:.4}", m.frequency_per_rev),
+                format!("{:.4}", m.damping_ratio),
+            ]);
+        }
+    }
+    if !frows.is_empty() {
+        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency; the mode label is the largest of tip lag, flap and twist in the mode.");
+        rep.table(
+            &[
+                "model",
+                "mode",
+                "multiplier",
+                "|mu|",
+                "frequency [/rev, mod 1]",
+                "damping ratio",
+            ],
+            &frows,
+        );
+    }
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: FORMATS.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()

@@ -458,4 +458,45 @@ impl ForcedResponse for LagHingeSdof {
     fn timing(&self) -> Timing {
         self.timing
     }
+
+    /// Coordinates `[zeta, zeta_dot / Omega]` [rad]; aux: the device state.
+    fn save_state(&self) -> Option<crate::rotor::SimState> {
+        Some(crate::rotor::SimState {
+            t_s: self.time_s(),
+            coords: vec![self.zeta, self.zeta_dot / self.p.omega_rad_s],
+            solver: None,
+            aux: self.dev.dev_ref().state_values(),
+        })
+    }
+
+    fn restore_state(&mut self, s: &crate::rotor::SimState) -> anyhow::Result<()> {
+        if s.coords.len() != 2 || s.coords.iter().any(|c| !c.is_finite()) {
+            bail!(
+                "{}: a saved state of the lag-hinge model has 2 finite coordinates, got {:?}",
+                self.label,
+                s.coords
+            );
+        }
+        let step = (s.t_s / self.dt).round();
+        if !(step >= 0.0 && (step * self.dt - s.t_s).abs() <= 1e-6 * self.dt.max(s.t_s.abs())) {
+            bail!(
+                "{}: saved time {} s is not a whole number of steps of {} s",
+                self.label,
+                s.t_s,
+                self.dt
+            );
+        }
+        self.dev
+            .dev()
+            .set_state_values(&s.aux)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", self.label))?;
+        self.step = step as usize;
+        self.zeta = s.coords[0];
+        self.zeta_dot = s.coords[1] * self.p.omega_rad_s;
+        Ok(())
+    }
+
+    fn mode_label(&self, _re: &[f64], _im: &[f64]) -> String {
+        "lag".into()
+    }
 }

@@ -1,7 +1,7 @@
 //! Per-model figures of a run: damper force statistics, relief-valve limit check, comparison
 //! with the measured damper force (metrics of `crate::analysis::compare` on the measurement's
 //! own azimuths) and a residual analysis; written as DIR/summary.json and DIR/<model>/last_rev.csv.
-use super::{ModelOutcome, ModelRun, N_HARMONICS, PERIODICITY_TOL};
+use super::{ModelOutcome, ModelRun, MONITORED, N_HARMONICS};
 use crate::analysis::compare::{compare, Metrics, Periodic, PeriodicInterp};
 use crate::analysis::harmonics::{harmonics, Harmonic};
 use crate::flight::FlightRecord;
@@ -513,6 +513,11 @@ pub struct RunInfo {
     pub scheme: String,
     /// Newton method of the structural step ("full" or "modified").
     pub newton: String,
+    /// Periodic solver ("shooting" or "march") and its tolerance; `revs` is its budget.
+    pub periodic: String,
+    pub periodic_tol: f64,
+    /// Saved state the models started from (`--initial-state`).
+    pub initial_state: Option<String>,
     pub synthetic: bool,
     pub counter: Option<String>,
     pub wall_s: f64,
@@ -560,7 +565,11 @@ pub fn summary_json(
             "substeps": info.substeps,
             "scheme": info.scheme,
             "newton": info.newton,
-            "periodicity_tolerance": PERIODICITY_TOL,
+            "periodic": info.periodic,
+            "periodic_tol": info.periodic_tol,
+            "max_revs": info.revs,
+            "initial_state": info.initial_state,
+            "periodicity_tolerance": info.periodic_tol,
             "harmonics_max_per_rev": N_HARMONICS,
         },
         "wall_time_s": info.wall_s,
@@ -591,15 +600,16 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "steps_per_rev": r.steps_per_rev,
         "period_s": r.period_s,
         "periodicity": {
-            "channels": r.periodicity.channels,
-            "floors": r.periodicity.floors,
-            "history_by_channel": r.periodicity.history,
+            "channels": MONITORED.iter().map(|c| c.0).collect::<Vec<_>>(),
+            "floors": MONITORED.iter().map(|c| c.1).collect::<Vec<_>>(),
+            "last_by_channel": r.periodic.residual_by_channel,
             "history": r.measure_history(),
             "last": last,
-            "tolerance": PERIODICITY_TOL,
+            "tolerance": r.periodic.tolerance,
             "converged": converged,
             "statement": periodicity_statement(r),
         },
+        "periodic": periodic_json(r),
         "damper_force_N": f.force,
         "relief_valve_limits": limits,
         "wall_time_s": {
@@ -626,44 +636,91 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
     })
 }
 
-/// Plain statement of the periodicity at the last revolution.
+/// summary.json `periodic` of one model.
+pub fn periodic_json(r: &ModelRun) -> Value {
+    let p = &r.periodic;
+    json!({
+        "method": p.method_used.name(),
+        "method_requested": p.method.name(),
+        "converged": p.converged,
+        "residual": p.residual,
+        "residual_by_channel": MONITORED
+            .iter()
+            .map(|c| c.0)
+            .zip(&p.residual_by_channel)
+            .map(|(c, v)| (c.to_string(), json!(v)))
+            .collect::<serde_json::Map<_, _>>(),
+        "tolerance": p.tolerance,
+        "residual_history": p.residual_history,
+        "revolutions_integrated": p.revolutions_integrated,
+        "marched_revolutions": p.marched_revolutions,
+        "iterations": p.iterations,
+        "directions": p.directions,
+        "rejected_trials": p.rejected_trials,
+        "floquet_multipliers": p.floquet_multipliers,
+        "error_estimate": p.error_estimate,
+        "message": p.message,
+    })
+}
+
+/// Plain statement of the periodicity of the reported revolution.
 pub fn periodicity_statement(r: &ModelRun) -> String {
-    match r.last_measure() {
-        Some(m) if m < PERIODICITY_TOL => format!(
-            "periodic: the measure fell to {m:.2e} (< {PERIODICITY_TOL:.0e}) at revolution {}",
-            r.revolutions
-        ),
-        Some(m) => {
-            // Name the channel that holds the measure up, and how far the damper force got.
-            let hist = &r.periodicity.history;
-            let last = hist.last().cloned().unwrap_or_default();
-            let iw = last
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.total_cmp(b.1))
-                .map_or(0, |(i, _)| i);
-            let worst = format!(
-                "{} {}",
-                r.periodicity.channels.get(iw).map_or("", |s| s.as_str()),
-                super::fmt_measure(last.get(iw).copied())
-            );
-            // Is that channel still decaying? Compare with 10 revolutions earlier.
-            let advice = match hist.len().checked_sub(11).map(|k| hist[k][iw]) {
-                Some(before) if last[iw] > 0.5 * before => format!(
-                    "it has not halved over the last ten revolutions ({} ten revolutions earlier): run more revolutions (with delayed perturbation damping the decay starts only after its delay, docs/rotor_model.md) or check the transient damping of the rotor deck",
-                    super::fmt_measure(Some(before))
-                ),
-                _ => "run more revolutions".into(),
-            };
-            format!(
-                "NOT periodic: the measure is {} at the last revolution ({}), above the {PERIODICITY_TOL:.0e} tolerance (largest: {worst}; damper force {}); {advice}",
-                super::fmt_measure(Some(m)),
-                r.revolutions,
-                super::fmt_measure(last.first().copied())
-            )
-        }
-        None => "periodicity not measured".into(),
+    let p = &r.periodic;
+    if p.residual.is_nan() {
+        return "periodicity not measured (NaN residual)".into();
     }
+    let how = match p.method_used {
+        super::PeriodicMethod::Shooting => format!(
+            "shooting, {} Newton-Picard iterations, {} revolutions integrated",
+            p.iterations, p.revolutions_integrated
+        ),
+        super::PeriodicMethod::March => {
+            format!("marching, {} revolutions", p.revolutions_integrated)
+        }
+    };
+    if p.converged {
+        format!(
+            "periodic: residual {:.2e} (< {:.0e}) by {how}",
+            p.residual, p.tolerance
+        )
+    } else {
+        let iw = p
+            .residual_by_channel
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map_or(0, |(i, _)| i);
+        format!(
+            "NOT periodic: residual {:.2e} above the {:.0e} tolerance (largest: {} {:.2e}) after {how}{}; run more revolutions (--revs) or check the transient damping of the rotor deck",
+            p.residual,
+            p.tolerance,
+            MONITORED.get(iw).map_or("", |c| c.0),
+            p.residual_by_channel.get(iw).copied().unwrap_or(f64::NAN),
+            if p.message.is_empty() { String::new() } else { format!(" ({})", p.message) }
+        )
+    }
+}
+
+/// DIR/<model>/periodic_state.json (when the simulation can save its state).
+pub fn write_periodic_state(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
+    let Some(state) = &r.periodic_state else {
+        return Ok(());
+    };
+    let f = super::PeriodicStateFile {
+        format: super::periodic::STATE_FORMAT.into(),
+        model: r.model.clone(),
+        label: r.label.clone(),
+        steps_per_rev: r.steps_per_rev,
+        period_s: r.period_s,
+        converged: r.periodic.converged,
+        residual: r.periodic.residual,
+        state: state.clone(),
+    };
+    out.write(
+        &format!("{}/periodic_state.json", r.model),
+        serde_json::to_string(&f)?.as_bytes(),
+    )?;
+    Ok(())
 }
 
 /// DIR/<model>/last_rev.csv: azimuth_deg then every channel (units in the names).

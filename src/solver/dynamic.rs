@@ -121,12 +121,12 @@ pub struct DynamicSolver {
     pub newton: NewtonOptions,
     asm: Assembler,
     /// Algorithmic accelerations per node (translation, rotation).
-    acc: Vec<[f64; 6]>,
-    lam_hat: Vec<f64>,
+    pub(super) acc: Vec<[f64; 6]>,
+    pub(super) lam_hat: Vec<f64>,
     cscale: f64,
     size: f64,
     res: Vec<f64>,
-    kin: Vec<NodeKin<f64>>,
+    pub(super) kin: Vec<NodeKin<f64>>,
     dq: Vec<[f64; 6]>,
     tl: Vec<[[f64; 3]; 3]>,
     x_prev: Vec<[f64; 3]>,
@@ -139,11 +139,11 @@ pub struct DynamicSolver {
     ws_q2: Vec<nalgebra::UnitQuaternion<f64>>,
     ws_lam: Vec<f64>,
     /// True accelerations and multipliers of the step before the last (predictor).
-    prev_vd: Vec<[f64; 6]>,
-    prev_lam: Vec<f64>,
+    pub(super) prev_vd: Vec<[f64; 6]>,
+    pub(super) prev_lam: Vec<f64>,
     /// Residual of the last zero-acceleration predictor evaluated (convergence scale), and
     /// whether the last step refactored.
-    r_ref: f64,
+    pub(super) r_ref: f64,
     refreshed: bool,
     /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
     pub last_residuals: Vec<f64>,

@@ -6,6 +6,7 @@ pub mod dynamic;
 pub mod fdcheck;
 pub mod modal;
 pub mod newton;
+pub mod snapshot;
 pub mod state;
 pub mod statics;
 pub mod verification;
@@ -14,5 +15,6 @@ pub use assembly::Assembler;
 
 pub use dynamic::{DynamicSolver, GenAlphaParams, StepInfo};
 pub use newton::{NewtonError, NewtonMethod, NewtonOptions};
+pub use snapshot::SolverSnapshot;
 pub use state::State;
 pub use statics::{static_solve, StaticOptions, StaticReport};

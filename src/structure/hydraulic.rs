@@ -389,6 +389,44 @@ impl StepElement for HydraulicForceElement {
         let v = self.probe.values();
         self.probe.channel_names().iter().cloned().zip(v).collect()
     }
+
+    /// `[L_ref (-1: not yet taken), force_applied, stroke, rate, last applied, device...]`.
+    fn state_values(&self) -> Vec<f64> {
+        let mut v = vec![
+            self.reference_length_m.unwrap_or(-1.0),
+            self.committed.force_applied,
+            self.committed.stroke_m,
+            self.committed.rate_m_s,
+            self.last_applied,
+        ];
+        v.extend(self.device.state_values());
+        v
+    }
+
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), String> {
+        if v.len() < 5 || v[..5].iter().any(|x| !x.is_finite()) {
+            return Err(format!(
+                "hydraulic element {}: state needs 5 finite values and the device's, got {}",
+                self.name,
+                v.len()
+            ));
+        }
+        self.device
+            .set_state_values(&v[5..])
+            .map_err(|e| format!("hydraulic element {}: {e}", self.name))?;
+        self.reference_length_m = (v[0] > 0.0).then_some(v[0]);
+        self.committed = Trial {
+            force_applied: v[1],
+            stroke_m: v[2],
+            rate_m_s: v[3],
+        };
+        self.last_applied = v[4];
+        self.trial = None;
+        self.last_step = None;
+        // the probe shows the committed state, as after a commit
+        self.commit();
+        Ok(())
+    }
 }
 
 impl HydraulicForceElement {

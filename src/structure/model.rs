@@ -60,6 +60,23 @@ pub trait StepElement: Send {
     fn sensors(&self) -> Vec<(String, f64)> {
         vec![]
     }
+    /// The committed state as numbers (saved states of a simulation: periodic solutions,
+    /// warm starts). Default: stateless.
+    fn state_values(&self) -> Vec<f64> {
+        vec![]
+    }
+    /// Restores a state of [`StepElement::state_values`]; drops any trial state.
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), String> {
+        if v.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "element {} has no state, got {} values",
+                self.name(),
+                v.len()
+            ))
+        }
+    }
 }
 
 /// Where an externally supplied distributed load is evaluated.

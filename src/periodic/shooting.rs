@@ -1,0 +1,376 @@
+//! Newton-Picard shooting with a recycled Krylov subspace.
+//!
+//! The fixed point `x = Phi(x)` solves `(I - M) dx = r`, `r = Phi(x) - x`, `M = dPhi/dx` the
+//! monodromy matrix. A periodically forced structure has a few slow modes (multipliers near
+//! the unit circle: they make marching slow) and many fast ones (multipliers near 0). Per
+//! iteration:
+//!
+//! 1. Newton on a subspace: directions `S` (orthonormal) with images `Y = M S` from
+//!    finite-difference periods `(Phi(x + eps s) - Phi(x)) / eps`; `c` minimises
+//!    `||r - (S - Y) c||`. While that least-squares residual `rho` is above `eta ||r||`, `rho`
+//!    itself (orthogonalised) becomes the next direction: for a linear map this builds the
+//!    Krylov space of GMRES on `(I - M) dx = r`, one period per direction.
+//! 2. Picard on the rest: `dx = S c + rho` (the part of `r` the subspace does not explain is
+//!    taken as one marched period would take it).
+//! 3. Globalisation: the step is halved (up to `max_halvings` times) until the residual
+//!    norm decreases; the relief valves make the map only piecewise smooth.
+//!
+//! The subspace is kept across iterations (the map changes little between iterates), so
+//! later iterations cost one period each unless the residual leaves the subspace. Its Ritz
+//! values are the least-damped Floquet multipliers ([`super::floquet`]).
+use super::floquet::{dot, ritz_pairs, RitzPair};
+use super::PeriodMap;
+use faer::linalg::solvers::SolveLstsq;
+use faer::Mat;
+
+/// Options of [`shoot`].
+#[derive(Clone, Copy, Debug)]
+pub struct ShootingOptions {
+    /// Stop when [`PeriodMap::residual`] is at or below it.
+    pub tol: f64,
+    /// Most periods integrated in all (the map's count, marched periods included).
+    pub max_periods: usize,
+    /// Subspace accuracy: new directions while the least-squares residual exceeds
+    /// `eta ||r||`.
+    pub eta: f64,
+    /// Most subspace directions.
+    pub max_dirs: usize,
+    /// Finite-difference step along a unit direction, in the map's coordinates.
+    pub fd_step: f64,
+    /// Step halvings before giving up.
+    pub max_halvings: usize,
+    /// No new direction once the newest one contracts at least this much in one period
+    /// (`||M d|| <= picard_rate`): what is left of the residual is then taken by Picard.
+    pub picard_rate: f64,
+    /// Directions the subspace has at least when the solver stops converged (more Floquet
+    /// multipliers, one period each).
+    pub min_dirs: usize,
+}
+
+impl Default for ShootingOptions {
+    fn default() -> Self {
+        ShootingOptions {
+            tol: 1e-4,
+            max_periods: 75,
+            eta: 0.1,
+            max_dirs: 40,
+            fd_step: 1e-4,
+            max_halvings: 3,
+            picard_rate: 0.2,
+            min_dirs: 0,
+        }
+    }
+}
+
+/// Why [`shoot`] stopped.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    Converged,
+    /// `max_periods` reached first.
+    Budget,
+    /// No step decreased the residual.
+    LineSearch,
+    /// The map failed (the error's message).
+    Failed(String),
+}
+
+/// What [`shoot`] found.
+pub struct ShootingOutcome {
+    pub stop: Stop,
+    /// Residual of the accepted point after each iteration (the first: the starting point).
+    pub residual_history: Vec<f64>,
+    /// Newton-Picard iterations (accepted steps).
+    pub iterations: usize,
+    /// Periods spent on subspace directions and on rejected trials.
+    pub directions: usize,
+    pub rejected_trials: usize,
+    /// Ritz pairs of the subspace, least damped first.
+    pub ritz: Vec<RitzPair>,
+}
+
+impl ShootingOutcome {
+    pub fn converged(&self) -> bool {
+        self.stop == Stop::Converged
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    dot(v, v).sqrt()
+}
+
+/// `(c, rho)`: least squares `min ||r - (S - Y) c||` and its residual.
+fn project(s: &[Vec<f64>], y: &[Vec<f64>], r: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let k = s.len();
+    if k == 0 {
+        return (vec![], r.to_vec());
+    }
+    let n = r.len();
+    let a = Mat::<f64>::from_fn(n, k, |i, j| s[j][i] - y[j][i]);
+    let rhs = Mat::<f64>::from_fn(n, 1, |i, _| r[i]);
+    let sol = a.col_piv_qr().solve_lstsq(&rhs);
+    let c: Vec<f64> = (0..k).map(|j| sol[(j, 0)]).collect();
+    let mut rho = r.to_vec();
+    for j in 0..k {
+        for i in 0..n {
+            rho[i] -= c[j] * (s[j][i] - y[j][i]);
+        }
+    }
+    (c, rho)
+}
+
+/// `d` orthogonalised against the orthonormal `s` (twice: classical Gram-Schmidt loses
+/// orthogonality otherwise) and normalised; None when nothing new is left.
+fn new_direction(s: &[Vec<f64>], d: &[f64]) -> Option<Vec<f64>> {
+    let mut d = d.to_vec();
+    let n0 = norm(&d);
+    for _ in 0..2 {
+        for si in s {
+            let c = dot(si, &d);
+            for (x, v) in d.iter_mut().zip(si) {
+                *x -= c * v;
+            }
+        }
+    }
+    let n = norm(&d);
+    if n.is_nan() || n <= 1e-10 * n0 {
+        return None;
+    }
+    d.iter_mut().for_each(|x| *x /= n);
+    Some(d)
+}
+
+/// Adds one direction `d` (unit) and its image `M d` about the accepted point.
+fn add_direction(
+    map: &mut dyn PeriodMap,
+    o: &ShootingOptions,
+    s: &mut Vec<Vec<f64>>,
+    y: &mut Vec<Vec<f64>>,
+    d: Vec<f64>,
+) -> anyhow::Result<()> {
+    let (x, f) = map.accepted();
+    let (x, f) = (x.to_vec(), f.to_vec());
+    let xp: Vec<f64> = x.iter().zip(&d).map(|(a, b)| a + o.fd_step * b).collect();
+    let fp = map.perturbed(&xp)?;
+    y.push(
+        fp.iter()
+            .zip(&f)
+            .map(|(a, b)| (a - b) / o.fd_step)
+            .collect(),
+    );
+    s.push(d);
+    Ok(())
+}
+
+/// Drive `map` to a periodic solution (see the module documentation). `on_iteration` is
+/// called after every accepted step with the periods integrated and the new residual.
+pub fn shoot(
+    map: &mut dyn PeriodMap,
+    o: &ShootingOptions,
+    on_iteration: &mut dyn FnMut(usize, f64),
+) -> ShootingOutcome {
+    let mut s: Vec<Vec<f64>> = Vec::new();
+    let mut y: Vec<Vec<f64>> = Vec::new();
+    let mut out = ShootingOutcome {
+        stop: Stop::Budget,
+        residual_history: vec![map.residual()],
+        iterations: 0,
+        directions: 0,
+        rejected_trials: 0,
+        ritz: vec![],
+    };
+    let result = (|| -> anyhow::Result<Stop> {
+        loop {
+            if map.residual() <= o.tol {
+                // more multipliers if asked, about the periodic solution
+                while s.len() < o.min_dirs && map.periods() < o.max_periods {
+                    let seed = match y.last() {
+                        Some(v) => v.clone(),
+                        None => {
+                            let (x, f) = map.accepted();
+                            f.iter().zip(x).map(|(a, b)| a - b).collect()
+                        }
+                    };
+                    let Some(d) = new_direction(&s, &seed) else {
+                        break;
+                    };
+                    add_direction(map, o, &mut s, &mut y, d)?;
+                    out.directions += 1;
+                }
+                return Ok(Stop::Converged);
+            }
+            if map.periods() >= o.max_periods {
+                return Ok(Stop::Budget);
+            }
+            let (x, f) = map.accepted();
+            let (x, f) = (x.to_vec(), f.to_vec());
+            let r: Vec<f64> = f.iter().zip(&x).map(|(a, b)| a - b).collect();
+            let rn = norm(&r);
+            let (mut c, mut rho) = project(&s, &y, &r);
+            // keep one period for the trial
+            let mut fast = false;
+            while norm(&rho) > o.eta * rn
+                && !fast
+                && s.len() < o.max_dirs
+                && map.periods() + 1 < o.max_periods
+            {
+                let Some(d) = new_direction(&s, &rho) else {
+                    break;
+                };
+                add_direction(map, o, &mut s, &mut y, d)?;
+                out.directions += 1;
+                fast = y.last().is_some_and(|v| norm(v) <= o.picard_rate);
+                (c, rho) = project(&s, &y, &r);
+            }
+            if std::env::var_os("ROTORSIM_DEBUG").is_some() {
+                eprintln!(
+                    "shooting: |r| {rn:.3e}, residual {:.3e}, {} directions, |rho|/|r| {:.3e}",
+                    map.residual(),
+                    s.len(),
+                    norm(&rho) / rn
+                );
+            }
+            let mut dx = rho;
+            for (cj, sj) in c.iter().zip(&s) {
+                for (d, v) in dx.iter_mut().zip(sj) {
+                    *d += cj * v;
+                }
+            }
+            let mut lam = 1.0;
+            let mut halvings = 0;
+            loop {
+                if map.periods() >= o.max_periods {
+                    return Ok(Stop::Budget);
+                }
+                let xt: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + lam * b).collect();
+                let ft = map.trial(&xt)?;
+                let rt: f64 = norm(&ft.iter().zip(&xt).map(|(a, b)| a - b).collect::<Vec<_>>());
+                if std::env::var_os("ROTORSIM_DEBUG").is_some() {
+                    eprintln!("shooting: trial lambda {lam}: |r| {rt:.3e}");
+                }
+                if rt.is_finite() && rt < rn {
+                    map.accept();
+                    break;
+                }
+                out.rejected_trials += 1;
+                halvings += 1;
+                if halvings > o.max_halvings {
+                    return Ok(Stop::LineSearch);
+                }
+                lam *= 0.5;
+            }
+            out.iterations += 1;
+            out.residual_history.push(map.residual());
+            on_iteration(map.periods(), map.residual());
+        }
+    })();
+    out.stop = result.unwrap_or_else(|e| Stop::Failed(format!("{e:#}")));
+    out.ritz = ritz_pairs(&s, &y);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `Phi(x) = M x + b` with a known spectrum; the map counts periods like a simulation.
+    struct Affine {
+        m: Vec<Vec<f64>>,
+        b: Vec<f64>,
+        x: Vec<f64>,
+        f: Vec<f64>,
+        trial: Option<(Vec<f64>, Vec<f64>)>,
+        periods: usize,
+    }
+
+    impl Affine {
+        fn phi(&mut self, x: &[f64]) -> Vec<f64> {
+            self.periods += 1;
+            self.m
+                .iter()
+                .zip(&self.b)
+                .map(|(row, b)| dot(row, x) + b)
+                .collect()
+        }
+    }
+
+    impl PeriodMap for Affine {
+        fn accepted(&self) -> (&[f64], &[f64]) {
+            (&self.x, &self.f)
+        }
+        fn perturbed(&mut self, x: &[f64]) -> anyhow::Result<Vec<f64>> {
+            Ok(self.phi(x))
+        }
+        fn trial(&mut self, x: &[f64]) -> anyhow::Result<Vec<f64>> {
+            let f = self.phi(x);
+            self.trial = Some((x.to_vec(), f.clone()));
+            Ok(f)
+        }
+        fn accept(&mut self) {
+            if let Some((x, f)) = self.trial.take() {
+                self.x = x;
+                self.f = f;
+            }
+        }
+        fn residual(&self) -> f64 {
+            norm(
+                &self
+                    .f
+                    .iter()
+                    .zip(&self.x)
+                    .map(|(a, b)| a - b)
+                    .collect::<Vec<_>>(),
+            )
+        }
+        fn periods(&self) -> usize {
+            self.periods
+        }
+    }
+
+    #[test]
+    fn slow_modes_by_newton_fast_ones_by_picard() {
+        // block diagonal: a slow rotation (0.99, 0.3 rad), a slow real 0.97 and fast 0.05 ones
+        let n = 12;
+        let mut m = vec![vec![0.0; n]; n];
+        let (c, s) = (0.99 * 0.3f64.cos(), 0.99 * 0.3f64.sin());
+        m[0][0] = c;
+        m[0][1] = -s;
+        m[1][0] = s;
+        m[1][1] = c;
+        m[2][2] = 0.97;
+        for i in 3..n {
+            m[i][i] = 0.05 * (i as f64 / n as f64);
+            if i + 1 < n {
+                m[i][i + 1] = 0.01;
+            }
+        }
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
+        let x0 = vec![0.0; n];
+        let mut map = Affine {
+            m,
+            b,
+            x: x0.clone(),
+            f: vec![],
+            trial: None,
+            periods: 0,
+        };
+        // three marched periods first, as a simulation would start (the fast modes decay)
+        map.f = map.phi(&x0);
+        for _ in 0..3 {
+            map.x = map.f.clone();
+            map.f = map.phi(&map.x.clone());
+        }
+        let o = ShootingOptions {
+            tol: 1e-10,
+            ..Default::default()
+        };
+        let out = shoot(&mut map, &o, &mut |_, _| {});
+        assert!(out.converged(), "{:?} {:?}", out.stop, out.residual_history);
+        // marching would need ~2300 periods for the 0.99 mode; here 4 marched, 6 directions
+        // (3 slow, the rest until the newest contracts by 5x) and a trial per iteration
+        assert!(map.periods <= 4 + 6 + 4, "{} periods", map.periods);
+        let mu = &out.ritz[0].multiplier;
+        assert!((mu.magnitude - 0.99).abs() < 1e-9, "{mu:?}");
+        assert!((mu.frequency_per_rev * 2.0 * std::f64::consts::PI - 0.3).abs() < 1e-9);
+        assert!((out.ritz[1].multiplier.re - 0.97).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,385 @@
+//! Driving a [`ForcedResponse`] to its periodic solution: by shooting (Newton-Picard on the
+//! revolution map, [`crate::periodic`]) or by marching, both stopped by the same periodicity
+//! residual (docs/periodic.md).
+//!
+//! Residual of a revolution started from state `x`: per monitored channel,
+//! `|c(Phi(x)) - c(x)| / max(peak-to-peak of c over the revolution, floor)`, the largest over
+//! channels: the channels seen at the end of the revolution against the start.
+use super::MONITORED;
+use crate::periodic::{shoot, Multiplier, PeriodMap, ShootingOptions};
+use crate::rotor::{ForcedResponse, SimState};
+
+/// How the periodic solution is found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PeriodicMethod {
+    /// Newton-Picard shooting on the revolution map (falls back to marching).
+    Shooting,
+    /// Revolution after revolution.
+    March,
+}
+
+impl PeriodicMethod {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PeriodicMethod::Shooting => "shooting",
+            PeriodicMethod::March => "march",
+        }
+    }
+}
+
+/// Options of [`super::drive_periodic`].
+#[derive(Clone, Debug)]
+pub struct PeriodicOptions {
+    pub method: PeriodicMethod,
+    /// Periodicity residual at which a run stops.
+    pub tol: f64,
+    /// Most revolutions integrated (shooting: perturbed and trial revolutions included).
+    pub max_revs: usize,
+    /// Stop as soon as the residual is below `tol` (false: march all `max_revs`).
+    pub stop_early: bool,
+    /// Start from this saved state instead of the simulation's own initial state.
+    pub initial_state: Option<PeriodicStateFile>,
+    /// Directions of the shooting subspace at least (more Floquet multipliers).
+    pub min_floquet_dirs: usize,
+}
+
+impl PeriodicOptions {
+    /// March exactly `revs` revolutions (the residual is still measured).
+    pub fn march(revs: usize) -> Self {
+        PeriodicOptions {
+            method: PeriodicMethod::March,
+            tol: DEFAULT_TOL,
+            max_revs: revs,
+            stop_early: false,
+            initial_state: None,
+            min_floquet_dirs: 0,
+        }
+    }
+    /// Shooting to `tol`, at most `max_revs` revolutions.
+    pub fn shooting(tol: f64, max_revs: usize) -> Self {
+        PeriodicOptions {
+            method: PeriodicMethod::Shooting,
+            tol,
+            max_revs,
+            stop_early: true,
+            initial_state: None,
+            min_floquet_dirs: 0,
+        }
+    }
+}
+
+/// Default periodicity tolerance (`--periodic-tol`).
+pub const DEFAULT_TOL: f64 = 1e-4;
+
+/// Multipliers reported (least damped first, the lag mode at the top).
+pub const FLOQUET_REPORTED: usize = 8;
+
+/// What the periodic solver did for one model.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PeriodicInfo {
+    /// The method asked for, and the one that produced the reported revolution.
+    pub method: PeriodicMethod,
+    pub method_used: PeriodicMethod,
+    pub converged: bool,
+    pub tolerance: f64,
+    /// Residual of the reported revolution.
+    pub residual: f64,
+    /// Per monitored channel.
+    pub residual_by_channel: Vec<f64>,
+    /// Shooting: residual of each accepted iterate; marching: of each revolution.
+    pub residual_history: Vec<f64>,
+    /// Every revolution integrated (marched, perturbed and trial).
+    pub revolutions_integrated: usize,
+    /// Shooting: marched revolutions before it, Newton-Picard iterations, subspace
+    /// directions (one revolution each) and rejected trials.
+    pub marched_revolutions: usize,
+    pub iterations: usize,
+    pub directions: usize,
+    pub rejected_trials: usize,
+    /// Least-damped Floquet multipliers (shooting), lag mode first.
+    pub floquet_multipliers: Vec<Multiplier>,
+    /// `residual / (1 - |mu_1|)`: distance to the periodic solution implied by the
+    /// least-damped multiplier (None without multipliers).
+    pub error_estimate: Option<f64>,
+    /// What happened, in words (fallbacks, budget).
+    pub message: String,
+    /// Time at the start of the reported revolution [s].
+    #[serde(skip)]
+    pub start_t_s: f64,
+}
+
+/// Samples of one revolution: channel values at the start of every step, and at its end.
+pub(super) struct Revolution {
+    pub samples: Vec<Vec<f64>>,
+    pub azimuth: Vec<f64>,
+    pub end: Vec<f64>,
+    pub start_t_s: f64,
+}
+
+impl Revolution {
+    pub fn new(nc: usize, n: usize) -> Self {
+        Revolution {
+            samples: vec![vec![0.0; n]; nc],
+            azimuth: vec![0.0; n],
+            end: vec![0.0; nc],
+            start_t_s: 0.0,
+        }
+    }
+
+    /// Per monitored channel (indices `mon`, floors of [`MONITORED`]): the residual.
+    pub fn residual(&self, mon: &[usize]) -> Vec<f64> {
+        mon.iter()
+            .zip(MONITORED.iter())
+            .map(|(&c, (_, floor))| {
+                let s = &self.samples[c];
+                let (lo, hi) = s
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                        (l.min(*v), h.max(*v))
+                    });
+                let d = (self.end[c] - s[0]).abs();
+                if d.is_nan() || lo.is_nan() || hi.is_nan() {
+                    f64::NAN
+                } else {
+                    d / (hi - lo).max(*floor)
+                }
+            })
+            .collect()
+    }
+}
+
+/// Largest value, NaN if any is NaN.
+pub(super) fn max_nan(v: &[f64]) -> f64 {
+    if v.iter().any(|x| x.is_nan()) {
+        f64::NAN
+    } else {
+        v.iter().fold(0.0f64, |m, x| m.max(*x))
+    }
+}
+
+/// One revolution of `sim` into `rev`.
+pub(super) fn integrate(
+    sim: &mut dyn ForcedResponse,
+    rev: &mut Revolution,
+    what: &str,
+) -> anyhow::Result<()> {
+    let n = rev.azimuth.len();
+    let mut buf = vec![0.0; rev.end.len()];
+    rev.start_t_s = sim.time_s();
+    let turns = (sim.azimuth_deg() / 360.0).round();
+    for j in 0..n {
+        sim.channels(&mut buf);
+        for (c, v) in buf.iter().enumerate() {
+            rev.samples[c][j] = *v;
+        }
+        let mut psi = (sim.azimuth_deg() - 360.0 * turns).rem_euclid(360.0);
+        // keep floating-point drift from wrapping 359.99999 to 0 at the first sample
+        if j == 0 && psi > 359.0 {
+            psi = 0.0;
+        }
+        rev.azimuth[j] = psi;
+        sim.step().map_err(|e| {
+            e.context(format!(
+                "{what}, step {j} of {n} (t = {:.6} s)",
+                sim.time_s()
+            ))
+        })?;
+    }
+    sim.channels(&mut rev.end);
+    Ok(())
+}
+
+/// The revolution map of a simulation, for [`shoot`].
+pub(super) struct SimMap<'a> {
+    pub sim: &'a mut dyn ForcedResponse,
+    pub mon: Vec<usize>,
+    pub start: SimState,
+    pub end: SimState,
+    pub rev: Revolution,
+    trial: Option<(SimState, SimState, Revolution)>,
+    scratch: Revolution,
+    pub periods: usize,
+    pub residual_by_channel: Vec<f64>,
+    pub progress: &'a dyn Fn(usize, Option<f64>),
+    pub label: String,
+}
+
+impl<'a> SimMap<'a> {
+    /// The map with `rev` (integrated from `start` to `end`) as the accepted point.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        sim: &'a mut dyn ForcedResponse,
+        mon: Vec<usize>,
+        start: SimState,
+        end: SimState,
+        rev: Revolution,
+        periods: usize,
+        progress: &'a dyn Fn(usize, Option<f64>),
+        label: String,
+    ) -> Self {
+        let residual_by_channel = rev.residual(&mon);
+        let scratch = Revolution::new(rev.end.len(), rev.azimuth.len());
+        SimMap {
+            sim,
+            mon,
+            start,
+            end,
+            rev,
+            trial: None,
+            scratch,
+            periods,
+            residual_by_channel,
+            progress,
+            label,
+        }
+    }
+
+    fn run_from(&mut self, from: SimState, into_trial: bool) -> anyhow::Result<SimState> {
+        self.sim.restore_state(&from)?;
+        self.periods += 1;
+        let what = format!("{}, revolution {} (shooting)", self.label, self.periods);
+        let mut rev = std::mem::replace(&mut self.scratch, Revolution::new(0, 0));
+        let r = integrate(self.sim, &mut rev, &what);
+        let end = self
+            .sim
+            .save_state()
+            .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", self.label));
+        let res = max_nan(&rev.residual(&self.mon));
+        if into_trial {
+            let n = (rev.end.len(), rev.azimuth.len());
+            let end = r.and(end)?;
+            self.trial = Some((from, end.clone(), rev));
+            self.scratch = Revolution::new(n.0, n.1);
+            (self.progress)(self.periods, Some(res));
+            Ok(end)
+        } else {
+            self.scratch = rev;
+            (self.progress)(self.periods, None);
+            r.and(end)
+        }
+    }
+}
+
+impl PeriodMap for SimMap<'_> {
+    fn accepted(&self) -> (&[f64], &[f64]) {
+        (&self.start.coords, &self.end.coords)
+    }
+    fn perturbed(&mut self, x: &[f64]) -> anyhow::Result<Vec<f64>> {
+        let mut from = self.start.clone();
+        from.coords.copy_from_slice(x);
+        Ok(self.run_from(from, false)?.coords)
+    }
+    fn trial(&mut self, x: &[f64]) -> anyhow::Result<Vec<f64>> {
+        let mut from = self.end.clone();
+        from.coords.copy_from_slice(x);
+        Ok(self.run_from(from, true)?.coords)
+    }
+    fn accept(&mut self) {
+        if let Some((s, e, rev)) = self.trial.take() {
+            self.start = s;
+            self.end = e;
+            self.scratch = std::mem::replace(&mut self.rev, rev);
+            self.residual_by_channel = self.rev.residual(&self.mon);
+        }
+    }
+    fn residual(&self) -> f64 {
+        max_nan(&self.residual_by_channel)
+    }
+    fn periods(&self) -> usize {
+        self.periods
+    }
+}
+
+/// Shooting options of a run (the tolerance and budget from `o`).
+pub(super) fn shooting_options(o: &PeriodicOptions) -> ShootingOptions {
+    ShootingOptions {
+        tol: o.tol,
+        max_periods: o.max_revs,
+        min_dirs: o.min_floquet_dirs,
+        ..Default::default()
+    }
+}
+
+/// Runs [`shoot`] on `map`; returns the outcome's summary pieces.
+pub(super) fn run_shooting(
+    map: &mut SimMap<'_>,
+    o: &PeriodicOptions,
+) -> crate::periodic::ShootingOutcome {
+    shoot(map, &shooting_options(o), &mut |_, _| {})
+}
+
+/// DIR/<model>/periodic_state.json: the state at the start of the reported revolution, for
+/// `--initial-state` (docs/periodic.md).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct PeriodicStateFile {
+    /// "rotorsim periodic state 1".
+    pub format: String,
+    /// Damper model and simulation label it was saved from.
+    pub model: String,
+    pub label: String,
+    pub steps_per_rev: usize,
+    pub period_s: f64,
+    /// Whether the run converged, and its residual.
+    pub converged: bool,
+    pub residual: f64,
+    pub state: SimState,
+}
+
+pub const STATE_FORMAT: &str = "rotorsim periodic state 1";
+
+impl PeriodicStateFile {
+    pub fn read(path: &std::path::Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("reading saved state {}: {e}", path.display()))?;
+        let f: Self = serde_json::from_str(&text).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: not a saved periodic state (line {}, column {}: {e}); expected the periodic_state.json of a run",
+                path.display(),
+                e.line(),
+                e.column()
+            )
+        })?;
+        if f.format != STATE_FORMAT {
+            anyhow::bail!(
+                "{}: format `{}`, expected `{STATE_FORMAT}`",
+                path.display(),
+                f.format
+            );
+        }
+        Ok(f)
+    }
+
+    /// The state to start `sim` (damper model `model`) from: the saved one, with the device
+    /// state replaced by the simulation's own when it was saved from another damper model,
+    /// and the time moved to a whole number of periods after the simulation's ramps.
+    pub fn start_state(
+        &self,
+        sim: &dyn ForcedResponse,
+        model: &str,
+    ) -> anyhow::Result<(SimState, Option<String>)> {
+        let own = sim
+            .save_state()
+            .ok_or_else(|| anyhow::anyhow!("{} cannot start from a saved state", sim.label()))?;
+        let mut s = self.state.clone();
+        let mut note = None;
+        if self.model != model {
+            if let (Some(a), Some(b)) = (s.solver.as_mut(), own.solver.as_ref()) {
+                a.step_elements.clone_from(&b.step_elements);
+            }
+            s.aux.clone_from(&own.aux);
+            note = Some(format!(
+                "structural state from the {} model's saved state, damper state its own initial one",
+                self.model
+            ));
+        }
+        let period = sim.period_s();
+        let k_min = (sim.periodic_from_s() / period - 1e-9).ceil().max(0.0);
+        let k = (s.t_s / period).round().max(k_min);
+        s.t_s = k * period;
+        if let Some(sn) = s.solver.as_mut() {
+            sn.t_s = s.t_s;
+        }
+        Ok((s, note))
+    }
+}
