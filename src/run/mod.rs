@@ -281,7 +281,11 @@ pub fn drive_periodic(
             })
             .collect();
         // lag mode first, then least damped first
-        if let Some(i) = mult.iter().position(|m| m.mode == "lag") {
+        // (an oscillating one: a real multiplier is a decaying or half-per-rev motion)
+        if let Some(i) = mult
+            .iter()
+            .position(|m| m.mode == "lag" && m.im.abs() > 0.0 && m.frequency_per_rev < 0.5)
+        {
             let lag = mult.remove(i);
             mult.insert(0, lag);
         }
