@@ -17,6 +17,19 @@ const MODELS: [DamperModel; 3] = [
     DamperModel::Physical,
 ];
 
+/// Elastic-model options at 128 steps per revolution (hydraulic sub-step as at 256 x 25).
+fn elastic_opts(perturbation_damping: bool) -> RunOptions {
+    RunOptions {
+        steps_per_rev: 128,
+        hydraulics: IntegratorOptions {
+            substeps: 50,
+            ..Default::default()
+        },
+        perturbation_damping,
+        ..Default::default()
+    }
+}
+
 fn setup() -> (RotorDeck, FlightRecord) {
     let deck = RotorDeck::from_file(&root().join("rotors/uh60a.toml")).unwrap();
     let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
@@ -180,16 +193,7 @@ fn shooting_matches_a_200_revolution_march_elastic_model() {
     let (deck, rec) = setup();
     let damper = deck.damper().unwrap();
     check_against_march("elastic", &|m, damping| {
-        let opts = RunOptions {
-            steps_per_rev: 128,
-            hydraulics: IntegratorOptions {
-                substeps: 50,
-                ..Default::default()
-            },
-            perturbation_damping: damping,
-            ..Default::default()
-        };
-        rotorsim::rotor::build(&deck, &damper, m, &rec, &opts).unwrap()
+        rotorsim::rotor::build(&deck, &damper, m, &rec, &elastic_opts(damping)).unwrap()
     });
 }
 
@@ -198,15 +202,7 @@ fn shooting_matches_a_200_revolution_march_elastic_model() {
 fn warm_start_from_a_saved_state_is_periodic_at_once() {
     let (deck, rec) = setup();
     let damper = deck.damper().unwrap();
-    let opts = RunOptions {
-        steps_per_rev: 128,
-        hydraulics: IntegratorOptions {
-            substeps: 50,
-            ..Default::default()
-        },
-        perturbation_damping: false,
-        ..Default::default()
-    };
+    let opts = elastic_opts(false);
     let m = DamperModel::Physical;
     let mut sim = rotorsim::rotor::build(&deck, &damper, m, &rec, &opts).unwrap();
     let first = drive_periodic(

@@ -9,22 +9,42 @@
 /// the same azimuths. `floor` is the smallest scale used (in the channel's unit).
 pub fn relative_change(prev: &[f64], cur: &[f64], floor: f64) -> f64 {
     assert_eq!(prev.len(), cur.len(), "revolutions sampled alike");
-    let (mut lo, mut hi, mut dmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for (a, b) in prev.iter().zip(cur) {
-        lo = lo.min(*b);
-        hi = hi.max(*b);
-        let d = (b - a).abs();
-        // NaN compares false: make it poison the measure instead of vanishing.
-        if d.is_nan() || b.is_nan() {
-            return f64::NAN;
-        }
-        dmax = dmax.max(d);
+    let d = max_nan_poisoned(
+        &prev
+            .iter()
+            .zip(cur)
+            .map(|(a, b)| (b - a).abs())
+            .collect::<Vec<_>>(),
+    );
+    d / scale(cur, floor)
+}
+
+/// Change of a channel over one revolution, end against start, relative to its peak-to-peak
+/// over the revolution (`samples[0]` is the start, `end` the value after the last step): the
+/// periodicity residual `|c(Phi(x)) - c(x)| / ptp` of a revolution map (docs/periodic.md).
+pub fn boundary_change(samples: &[f64], end: f64, floor: f64) -> f64 {
+    let d = (end - samples[0]).abs();
+    if d.is_nan() {
+        return f64::NAN;
     }
-    dmax / (hi - lo).max(floor)
+    d / scale(samples, floor)
+}
+
+/// Peak-to-peak of `v`, at least `floor`; NaN if any value is NaN.
+fn scale(v: &[f64], floor: f64) -> f64 {
+    if v.iter().any(|x| x.is_nan()) {
+        return f64::NAN;
+    }
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+            (l.min(*x), h.max(*x))
+        });
+    (hi - lo).max(floor)
 }
 
 /// Largest value, NaN if any value is NaN (`f64::max` would silently drop it).
-fn max_nan_poisoned(v: &[f64]) -> f64 {
+pub fn max_nan_poisoned(v: &[f64]) -> f64 {
     if v.iter().any(|x| x.is_nan()) {
         f64::NAN
     } else {
@@ -118,6 +138,28 @@ mod tests {
         }
         // 0.5^r / 2 < 1e-3  <=>  r >= 9.
         assert_eq!(first_converged, Some(9));
+    }
+
+    #[test]
+    fn boundary_change_of_a_decaying_revolution() {
+        // y(psi) = sin(psi) + 0.5 e^{-psi / 2 pi} over one revolution: start 0.5, end 0.5/e
+        let n = 256;
+        let y: Vec<f64> = (0..n)
+            .map(|i| {
+                let p = i as f64 * 2.0 * std::f64::consts::PI / n as f64;
+                p.sin() + 0.5 * (-p / (2.0 * std::f64::consts::PI)).exp()
+            })
+            .collect();
+        let end = 0.5 * (-1.0f64).exp();
+        let (lo, hi) = y
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        let want = (0.5 - end) / (hi - lo);
+        assert!((boundary_change(&y, end, 1e-3) - want).abs() < 1e-15);
+        // a flat channel is judged on its floor
+        assert_eq!(boundary_change(&[1.0, 1.0], 1.5, 2.0), 0.25);
+        assert!(boundary_change(&[1.0, f64::NAN], 1.0, 1.0).is_nan());
+        assert!(boundary_change(&[1.0, 2.0], f64::NAN, 1.0).is_nan());
     }
 
     #[test]

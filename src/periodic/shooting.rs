@@ -161,13 +161,9 @@ fn add_direction(
     Ok(())
 }
 
-/// Drive `map` to a periodic solution (see the module documentation). `on_iteration` is
-/// called after every accepted step with the periods integrated and the new residual.
-pub fn shoot(
-    map: &mut dyn PeriodMap,
-    o: &ShootingOptions,
-    on_iteration: &mut dyn FnMut(usize, f64),
-) -> ShootingOutcome {
+/// Drive `map` to a periodic solution (see the module documentation); the map reports its
+/// own progress.
+pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
     let mut s: Vec<Vec<f64>> = Vec::new();
     let mut y: Vec<Vec<f64>> = Vec::new();
     let mut out = ShootingOutcome {
@@ -221,14 +217,6 @@ pub fn shoot(
                 fast = y.last().is_some_and(|v| norm(v) <= o.picard_rate);
                 (c, rho) = project(&s, &y, &r);
             }
-            if std::env::var_os("ROTORSIM_DEBUG").is_some() {
-                eprintln!(
-                    "shooting: |r| {rn:.3e}, residual {:.3e}, {} directions, |rho|/|r| {:.3e}",
-                    map.residual(),
-                    s.len(),
-                    norm(&rho) / rn
-                );
-            }
             let mut dx = rho;
             for (cj, sj) in c.iter().zip(&s) {
                 for (d, v) in dx.iter_mut().zip(sj) {
@@ -244,9 +232,6 @@ pub fn shoot(
                 let xt: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + lam * b).collect();
                 let ft = map.trial(&xt)?;
                 let rt: f64 = norm(&ft.iter().zip(&xt).map(|(a, b)| a - b).collect::<Vec<_>>());
-                if std::env::var_os("ROTORSIM_DEBUG").is_some() {
-                    eprintln!("shooting: trial lambda {lam}: |r| {rt:.3e}");
-                }
                 if rt.is_finite() && rt < rn {
                     map.accept();
                     break;
@@ -260,7 +245,6 @@ pub fn shoot(
             }
             out.iterations += 1;
             out.residual_history.push(map.residual());
-            on_iteration(map.periods(), map.residual());
         }
     })();
     out.stop = result.unwrap_or_else(|e| Stop::Failed(format!("{e:#}")));
@@ -363,7 +347,7 @@ mod tests {
             tol: 1e-10,
             ..Default::default()
         };
-        let out = shoot(&mut map, &o, &mut |_, _| {});
+        let out = shoot(&mut map, &o);
         assert!(out.converged(), "{:?} {:?}", out.stop, out.residual_history);
         // marching would need ~2300 periods for the 0.99 mode; here 4 marched, 6 directions
         // (3 slow, the rest until the newest contracts by 5x) and a trial per iteration

@@ -4,8 +4,8 @@
 //!
 //! The pipeline knows nothing of the rotor model: it asks a builder for one simulation per
 //! damper model, runs them in parallel (one thread each; the structural solver factorizes
-//! with `faer::Par::Seq`, so each run stays on its thread), monitors periodicity once per revolution
-//! with [`PeriodicityMonitor`], keeps the last revolution, and hands the results to
+//! with `faer::Par::Seq`, so each run stays on its thread), drives each to its periodic solution
+//! ([`drive_periodic`]: shooting or marching), keeps the reported revolution, and hands the results to
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
 pub mod mcap_out;
@@ -258,7 +258,7 @@ pub fn drive_periodic(
         let label = format!("{} model", model.name());
         let mut map = SimMap::new(sim, mon.clone(), st0, end, rev, periods, progress, label);
         info.residual_history = vec![max_nan(&map.residual_by_channel)];
-        let out = periodic::run_shooting(&mut map, o);
+        let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
         periods = map.periods;
         info.iterations = out.iterations;
         info.directions = out.directions;

@@ -6,7 +6,9 @@
 //! `|c(Phi(x)) - c(x)| / max(peak-to-peak of c over the revolution, floor)`, the largest over
 //! channels: the channels seen at the end of the revolution against the start.
 use super::MONITORED;
-use crate::periodic::{shoot, Multiplier, PeriodMap, ShootingOptions};
+use crate::analysis::periodicity::boundary_change;
+pub(super) use crate::analysis::periodicity::max_nan_poisoned as max_nan;
+use crate::periodic::{Multiplier, PeriodMap, ShootingOptions};
 use crate::rotor::{ForcedResponse, SimState};
 
 /// How the periodic solution is found.
@@ -131,30 +133,8 @@ impl Revolution {
     pub fn residual(&self, mon: &[usize]) -> Vec<f64> {
         mon.iter()
             .zip(MONITORED.iter())
-            .map(|(&c, (_, floor))| {
-                let s = &self.samples[c];
-                let (lo, hi) = s
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                        (l.min(*v), h.max(*v))
-                    });
-                let d = (self.end[c] - s[0]).abs();
-                if d.is_nan() || lo.is_nan() || hi.is_nan() {
-                    f64::NAN
-                } else {
-                    d / (hi - lo).max(*floor)
-                }
-            })
+            .map(|(&c, (_, floor))| boundary_change(&self.samples[c], self.end[c], *floor))
             .collect()
-    }
-}
-
-/// Largest value, NaN if any is NaN.
-pub(super) fn max_nan(v: &[f64]) -> f64 {
-    if v.iter().any(|x| x.is_nan()) {
-        f64::NAN
-    } else {
-        v.iter().fold(0.0f64, |m, x| m.max(*x))
     }
 }
 
@@ -190,7 +170,7 @@ pub(super) fn integrate(
     Ok(())
 }
 
-/// The revolution map of a simulation, for [`shoot`].
+/// The revolution map of a simulation, for [`crate::periodic::shoot`].
 pub(super) struct SimMap<'a> {
     pub sim: &'a mut dyn ForcedResponse,
     pub mon: Vec<usize>,
@@ -198,7 +178,6 @@ pub(super) struct SimMap<'a> {
     pub end: SimState,
     pub rev: Revolution,
     trial: Option<(SimState, SimState, Revolution)>,
-    scratch: Revolution,
     pub periods: usize,
     pub residual_by_channel: Vec<f64>,
     pub progress: &'a dyn Fn(usize, Option<f64>),
@@ -219,7 +198,6 @@ impl<'a> SimMap<'a> {
         label: String,
     ) -> Self {
         let residual_by_channel = rev.residual(&mon);
-        let scratch = Revolution::new(rev.end.len(), rev.azimuth.len());
         SimMap {
             sim,
             mon,
@@ -227,7 +205,6 @@ impl<'a> SimMap<'a> {
             end,
             rev,
             trial: None,
-            scratch,
             periods,
             residual_by_channel,
             progress,
@@ -235,29 +212,23 @@ impl<'a> SimMap<'a> {
         }
     }
 
+    /// One revolution from `from`; a trial keeps its start, end and samples for `accept`.
     fn run_from(&mut self, from: SimState, into_trial: bool) -> anyhow::Result<SimState> {
         self.sim.restore_state(&from)?;
         self.periods += 1;
         let what = format!("{}, revolution {} (shooting)", self.label, self.periods);
-        let mut rev = std::mem::replace(&mut self.scratch, Revolution::new(0, 0));
-        let r = integrate(self.sim, &mut rev, &what);
+        let mut rev = Revolution::new(self.rev.end.len(), self.rev.azimuth.len());
+        integrate(self.sim, &mut rev, &what)?;
         let end = self
             .sim
             .save_state()
-            .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", self.label));
-        let res = max_nan(&rev.residual(&self.mon));
+            .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", self.label))?;
+        let residual = into_trial.then(|| max_nan(&rev.residual(&self.mon)));
+        (self.progress)(self.periods, residual);
         if into_trial {
-            let n = (rev.end.len(), rev.azimuth.len());
-            let end = r.and(end)?;
             self.trial = Some((from, end.clone(), rev));
-            self.scratch = Revolution::new(n.0, n.1);
-            (self.progress)(self.periods, Some(res));
-            Ok(end)
-        } else {
-            self.scratch = rev;
-            (self.progress)(self.periods, None);
-            r.and(end)
         }
+        Ok(end)
     }
 }
 
@@ -279,7 +250,7 @@ impl PeriodMap for SimMap<'_> {
         if let Some((s, e, rev)) = self.trial.take() {
             self.start = s;
             self.end = e;
-            self.scratch = std::mem::replace(&mut self.rev, rev);
+            self.rev = rev;
             self.residual_by_channel = self.rev.residual(&self.mon);
         }
     }
@@ -299,14 +270,6 @@ pub(super) fn shooting_options(o: &PeriodicOptions) -> ShootingOptions {
         min_dirs: o.min_floquet_dirs,
         ..Default::default()
     }
-}
-
-/// Runs [`shoot`] on `map`; returns the outcome's summary pieces.
-pub(super) fn run_shooting(
-    map: &mut SimMap<'_>,
-    o: &PeriodicOptions,
-) -> crate::periodic::ShootingOutcome {
-    shoot(map, &shooting_options(o), &mut |_, _| {})
 }
 
 /// DIR/<model>/periodic_state.json: the state at the start of the reported revolution, for

@@ -232,16 +232,4 @@ impl DynamicSolver {
         self.state.kin(&mut self.kin);
         Ok(())
     }
-
-    /// Start afresh from the current configuration and velocities: consistent accelerations
-    /// and multipliers ([`DynamicSolver::init_accelerations`]) and no predictor history, so
-    /// that what follows depends on positions and velocities only (a periodic solver's
-    /// revolution map).
-    pub fn restart(&mut self) -> Result<(), super::NewtonError> {
-        self.init_accelerations()?;
-        self.prev_vd.clear();
-        self.prev_lam.clear();
-        self.r_ref = 0.0;
-        Ok(())
-    }
 }
