@@ -7,7 +7,7 @@ use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::{DamperModel, IntegratorOptions};
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use rotorsim::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams};
-use rotorsim::run::{drive_periodic, ModelRun, PeriodicOptions, MONITORED};
+use rotorsim::run::{drive_periodic, PeriodicOptions};
 mod support;
 use support::root;
 
@@ -107,29 +107,6 @@ fn floquet_multipliers_of_a_rigid_lag_hinge_match_the_analytic_roots() {
     assert_eq!(mu.mode, "lag");
 }
 
-/// Largest difference of the monitored channels between two reported revolutions, relative
-/// to each channel's peak-to-peak (floors of [`MONITORED`]).
-fn difference(a: &ModelRun, b: &ModelRun) -> (f64, &'static str) {
-    let mut worst = (0.0, "");
-    for (name, floor) in MONITORED {
-        let (x, y) = (a.channel(name).unwrap(), b.channel(name).unwrap());
-        let (lo, hi) = y
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                (l.min(*v), h.max(*v))
-            });
-        let d = x
-            .iter()
-            .zip(y)
-            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
-            / (hi - lo).max(floor);
-        if d > worst.0 {
-            worst = (d, name);
-        }
-    }
-    worst
-}
-
 fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn ForcedResponse>) {
     for model in MODELS {
         let mut sim = build(model, true);
@@ -148,7 +125,7 @@ fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn 
             &|_, _| {},
         )
         .unwrap();
-        let (d, worst) = difference(&shot, &march);
+        let (d, worst) = shot.difference_from(&march).unwrap();
         eprintln!(
             "{name} {}: shooting {} revolutions, residual {:.2e}; march residual {:.2e}; difference {d:.2e} ({worst})",
             model.name(),
@@ -237,6 +214,6 @@ fn warm_start_from_a_saved_state_is_periodic_at_once() {
         "{:?}",
         warm.periodic
     );
-    let (d, worst) = difference(&warm, &first);
+    let (d, worst) = warm.difference_from(&first).unwrap();
     assert!(d < 1e-4, "warm start differs by {d:.2e} ({worst})");
 }

@@ -565,3 +565,63 @@ fn short_run_of_the_uh60a_rotor_with_the_three_dampers() {
         .contains("TEST DOUBLE"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn a_run_that_is_not_periodic_says_so_and_fails_only_when_asked() {
+    // Three revolutions are too few for the 1e-4 tolerance by either method.
+    for method in ["march", "shooting"] {
+        let out = tmp(&format!("notperiodic_{method}"));
+        let o = run_sdof(
+            &example(),
+            &out,
+            &["--revs", "3", "--damper", "linear", "--periodic", method],
+        );
+        ok(&o);
+        let s = summary(&out);
+        let p = &s["models"]["linear"]["periodic"];
+        assert_eq!(p["converged"], false, "{method}: {p}");
+        assert!(p["residual"].as_f64().unwrap() > 1e-4, "{method}: {p}");
+        assert!(
+            p["message"].as_str().unwrap().contains("not"),
+            "{method}: {p}"
+        );
+        // the best revolution is kept: its state can start the next run
+        assert!(out.join("linear/periodic_state.json").exists());
+        let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+        assert!(html.contains("NOT periodic"), "{method}");
+
+        let o = run_sdof(
+            &example(),
+            &out,
+            &[
+                "--revs",
+                "3",
+                "--damper",
+                "linear",
+                "--periodic",
+                method,
+                "--require-periodic",
+            ],
+        );
+        assert!(!o.status.success(), "{method}: --require-periodic");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(e.contains("not periodic (--require-periodic)"), "{e}");
+        // the results are still written, complete
+        assert_eq!(summary(&out)["models"]["linear"]["status"], "ok");
+        assert!(!out.join("INCOMPLETE").exists());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    // a run that reaches the periodic solution passes with the flag
+    let out = tmp("periodic_required");
+    let o = run_sdof(
+        &example(),
+        &out,
+        &["--damper", "linear", "--require-periodic"],
+    );
+    ok(&o);
+    assert_eq!(
+        summary(&out)["models"]["linear"]["periodic"]["converged"],
+        true
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

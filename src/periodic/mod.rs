@@ -32,4 +32,9 @@ pub trait PeriodMap {
     fn residual(&self) -> f64;
     /// Periods integrated so far (every one: marched, perturbed and trial).
     fn periods(&self) -> usize;
+    /// How much the last accepted step changed the accepted period, in the measure of
+    /// [`PeriodMap::residual`] but over the whole period (e.g. every sample of an output
+    /// channel, relative to its range); None before the first step. The solver turns it
+    /// into the distance to the periodic solution.
+    fn step_change(&self) -> Option<f64>;
 }

@@ -26,7 +26,8 @@ use faer::Mat;
 /// Options of [`shoot`].
 #[derive(Clone, Copy, Debug)]
 pub struct ShootingOptions {
-    /// Stop when [`PeriodMap::residual`] is at or below it.
+    /// Stop when [`PeriodMap::residual`] and the estimated distance to the periodic
+    /// solution ([`ShootingOutcome::error_estimate`]) are at or below it.
     pub tol: f64,
     /// Most periods integrated in all (the map's count, marched periods included).
     pub max_periods: usize,
@@ -52,7 +53,7 @@ impl Default for ShootingOptions {
         ShootingOptions {
             tol: 1e-4,
             max_periods: 75,
-            eta: 0.1,
+            eta: 0.2,
             max_dirs: 40,
             fd_step: 1e-4,
             max_halvings: 3,
@@ -86,6 +87,11 @@ pub struct ShootingOutcome {
     pub rejected_trials: usize,
     /// Ritz pairs of the subspace, least damped first.
     pub ritz: Vec<RitzPair>,
+    /// Estimated distance of the accepted point to the periodic solution, over the whole
+    /// period: the last step's change `d_k` times `q / (1 - q)`, `q = r_k / r_(k-1)` the
+    /// observed contraction of the residual (`e_k = q e_(k-1)`, `d_k = e_(k-1) - e_k`). None
+    /// before the first step.
+    pub error_estimate: Option<f64>,
 }
 
 impl ShootingOutcome {
@@ -93,6 +99,9 @@ impl ShootingOutcome {
         self.stop == Stop::Converged
     }
 }
+
+/// Contraction per step assumed at most when estimating the distance to the solution.
+const MAX_CONTRACTION: f64 = 0.9;
 
 fn norm(v: &[f64]) -> f64 {
     dot(v, v).sqrt()
@@ -173,10 +182,11 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
         directions: 0,
         rejected_trials: 0,
         ritz: vec![],
+        error_estimate: None,
     };
     let result = (|| -> anyhow::Result<Stop> {
         loop {
-            if map.residual() <= o.tol {
+            if map.residual() <= o.tol && out.error_estimate.is_none_or(|e| e <= o.tol) {
                 // more multipliers if asked, about the periodic solution
                 while s.len() < o.min_dirs && map.periods() < o.max_periods {
                     let seed = match y.last() {
@@ -202,8 +212,9 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
             let r: Vec<f64> = f.iter().zip(&x).map(|(a, b)| a - b).collect();
             let rn = norm(&r);
             let (mut c, mut rho) = project(&s, &y, &r);
+            // residual met, distance not: one step on the subspace as it is
+            let mut fast = map.residual() <= o.tol;
             // keep one period for the trial
-            let mut fast = false;
             while norm(&rho) > o.eta * rn
                 && !fast
                 && s.len() < o.max_dirs
@@ -245,6 +256,12 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
             }
             out.iterations += 1;
             out.residual_history.push(map.residual());
+            out.error_estimate = map.step_change().map(|d| {
+                let h = &out.residual_history;
+                // a contraction slower than 0.9 per step is taken as 0.9
+                let q = (h[h.len() - 1] / h[h.len() - 2]).min(MAX_CONTRACTION);
+                d * q / (1.0 - q)
+            });
         }
     })();
     out.stop = result.unwrap_or_else(|e| Stop::Failed(format!("{e:#}")));
@@ -264,16 +281,58 @@ mod tests {
         f: Vec<f64>,
         trial: Option<(Vec<f64>, Vec<f64>)>,
         periods: usize,
+        step: Option<f64>,
+        /// `quad * x_0^2` added to component 2: a smooth nonlinearity.
+        quad: f64,
     }
 
     impl Affine {
         fn phi(&mut self, x: &[f64]) -> Vec<f64> {
             self.periods += 1;
-            self.m
+            let mut f: Vec<f64> = self
+                .m
                 .iter()
                 .zip(&self.b)
                 .map(|(row, b)| dot(row, x) + b)
-                .collect()
+                .collect();
+            f[2] += self.quad * x[0] * x[0];
+            f
+        }
+        /// Block diagonal: a slow rotation (0.99, 0.3 rad), a slow real 0.97 and fast ones
+        /// below 0.05; started after three marched periods, as a simulation would start.
+        fn slow_and_fast(quad: f64) -> Self {
+            let n = 12;
+            let mut m = vec![vec![0.0; n]; n];
+            let (c, s) = (0.99 * 0.3f64.cos(), 0.99 * 0.3f64.sin());
+            m[0][0] = c;
+            m[0][1] = -s;
+            m[1][0] = s;
+            m[1][1] = c;
+            m[2][2] = 0.97;
+            for i in 3..n {
+                m[i][i] = 0.05 * (i as f64 / n as f64);
+                if i + 1 < n {
+                    m[i][i + 1] = 0.01;
+                }
+            }
+            let b: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
+            let x0 = vec![0.0; n];
+            let mut map = Affine {
+                m,
+                b,
+                x: x0.clone(),
+                f: vec![],
+                trial: None,
+                periods: 0,
+                step: None,
+                quad,
+            };
+            map.f = map.phi(&x0);
+            for _ in 0..3 {
+                map.x = map.f.clone();
+                map.f = map.phi(&map.x.clone());
+            }
+            map
         }
     }
 
@@ -291,6 +350,8 @@ mod tests {
         }
         fn accept(&mut self) {
             if let Some((x, f)) = self.trial.take() {
+                let d: Vec<f64> = x.iter().zip(&self.x).map(|(a, b)| a - b).collect();
+                self.step = Some(norm(&d));
                 self.x = x;
                 self.f = f;
             }
@@ -308,41 +369,14 @@ mod tests {
         fn periods(&self) -> usize {
             self.periods
         }
+        fn step_change(&self) -> Option<f64> {
+            self.step
+        }
     }
 
     #[test]
     fn slow_modes_by_newton_fast_ones_by_picard() {
-        // block diagonal: a slow rotation (0.99, 0.3 rad), a slow real 0.97 and fast 0.05 ones
-        let n = 12;
-        let mut m = vec![vec![0.0; n]; n];
-        let (c, s) = (0.99 * 0.3f64.cos(), 0.99 * 0.3f64.sin());
-        m[0][0] = c;
-        m[0][1] = -s;
-        m[1][0] = s;
-        m[1][1] = c;
-        m[2][2] = 0.97;
-        for i in 3..n {
-            m[i][i] = 0.05 * (i as f64 / n as f64);
-            if i + 1 < n {
-                m[i][i + 1] = 0.01;
-            }
-        }
-        let b: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
-        let x0 = vec![0.0; n];
-        let mut map = Affine {
-            m,
-            b,
-            x: x0.clone(),
-            f: vec![],
-            trial: None,
-            periods: 0,
-        };
-        // three marched periods first, as a simulation would start (the fast modes decay)
-        map.f = map.phi(&x0);
-        for _ in 0..3 {
-            map.x = map.f.clone();
-            map.f = map.phi(&map.x.clone());
-        }
+        let mut map = Affine::slow_and_fast(0.0);
         let o = ShootingOptions {
             tol: 1e-10,
             ..Default::default()
@@ -356,5 +390,42 @@ mod tests {
         assert!((mu.magnitude - 0.99).abs() < 1e-9, "{mu:?}");
         assert!((mu.frequency_per_rev * 2.0 * std::f64::consts::PI - 0.3).abs() < 1e-9);
         assert!((out.ritz[1].multiplier.re - 0.97).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_error_estimate_is_the_distance_to_the_fixed_point() {
+        // nonlinear, so Newton takes several steps; the fixed point by Picard iterations
+        // (the slowest mode contracts by 0.99: 10^4 periods leave 1e-44 of the start)
+        let mut map = Affine::slow_and_fast(2e-3);
+        let mut exact = map.x.clone();
+        for _ in 0..10_000 {
+            exact = map.phi(&exact);
+        }
+        map.periods = 0;
+        for tol in [1e-4, 1e-7] {
+            let mut map = Affine::slow_and_fast(2e-3);
+            let o = ShootingOptions {
+                tol,
+                ..Default::default()
+            };
+            let out = shoot(&mut map, &o);
+            assert!(out.converged(), "{:?} {:?}", out.stop, out.residual_history);
+            let err = norm(
+                &map.x
+                    .iter()
+                    .zip(&exact)
+                    .map(|(a, b)| a - b)
+                    .collect::<Vec<_>>(),
+            );
+            let est = out.error_estimate.unwrap();
+            assert!(est <= tol, "{est}");
+            // on the safe side: Newton converges superlinearly, so the contraction of the
+            // last step overstates the remaining error (by 10x here at 1e-4), never understates
+            assert!(
+                err <= est,
+                "tol {tol:.0e}: true {err:.2e}, estimate {est:.2e}, residuals {:?}",
+                out.residual_history
+            );
+        }
     }
 }

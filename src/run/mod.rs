@@ -82,6 +82,24 @@ impl ModelRun {
     pub fn converged(&self) -> bool {
         self.periodic.converged
     }
+    /// Largest difference of the monitored channels between this reported revolution and
+    /// `reference`'s (sampled alike), relative to the reference's peak-to-peak (floors of
+    /// [`MONITORED`]), with the channel it occurs on. None if a channel is missing or the
+    /// revolutions are sampled differently.
+    pub fn difference_from(&self, reference: &ModelRun) -> Option<(f64, &'static str)> {
+        let mut worst = (0.0, MONITORED[0].0);
+        for (name, floor) in MONITORED {
+            let (a, b) = (self.channel(name)?, reference.channel(name)?);
+            if a.len() != b.len() {
+                return None;
+            }
+            let d = crate::analysis::periodicity::relative_change(a, b, floor);
+            if d.is_nan() || d > worst.0 {
+                worst = (d, name);
+            }
+        }
+        Some(worst)
+    }
 }
 
 /// Outcome of one model: its run, or the error that stopped it.
@@ -188,6 +206,7 @@ pub fn drive_periodic(
     }
     let can_save = sim.save_state().is_some();
     let shooting = o.method == PeriodicMethod::Shooting && can_save;
+    let (mut slowest, mut step_estimate) = (None, None);
     let mut info = PeriodicInfo {
         method: o.method,
         method_used: PeriodicMethod::March,
@@ -290,12 +309,12 @@ pub fn drive_periodic(
             mult.insert(0, lag);
         }
         mult.truncate(FLOQUET_REPORTED);
-        info.error_estimate = out
+        slowest = out
             .ritz
             .first()
             .map(|p| p.multiplier.magnitude)
-            .filter(|m| *m < 1.0)
-            .map(|m| max_nan(&info.residual_by_channel) / (1.0 - m));
+            .filter(|m| *m < 1.0);
+        step_estimate = out.error_estimate;
         info.floquet_multipliers = mult;
         if !info.converged {
             use crate::periodic::shooting::Stop;
@@ -329,6 +348,12 @@ pub fn drive_periodic(
         }
     }
     info.residual = max_nan(&info.residual_by_channel);
+    // shooting: from the last step and the contraction it achieved; marching: a slow mode
+    // decaying by |mu_1| per revolution is residual / (1 - |mu_1|) from its end
+    info.error_estimate = match info.method_used {
+        PeriodicMethod::Shooting => step_estimate,
+        PeriodicMethod::March => slowest.map(|m| info.residual / (1.0 - m)),
+    };
     info.revolutions_integrated = periods;
     info.start_t_s = rev.start_t_s;
     if !info.converged && info.message.is_empty() {

@@ -6,8 +6,8 @@
 //! `|c(Phi(x)) - c(x)| / max(peak-to-peak of c over the revolution, floor)`, the largest over
 //! channels: the channels seen at the end of the revolution against the start.
 use super::MONITORED;
-use crate::analysis::periodicity::boundary_change;
 pub(super) use crate::analysis::periodicity::max_nan_poisoned as max_nan;
+use crate::analysis::periodicity::{boundary_change, relative_change};
 use crate::periodic::{Multiplier, PeriodMap, ShootingOptions};
 use crate::rotor::{ForcedResponse, SimState};
 
@@ -136,6 +136,15 @@ impl Revolution {
             .map(|(&c, (_, floor))| boundary_change(&self.samples[c], self.end[c], *floor))
             .collect()
     }
+
+    /// Per monitored channel: the largest change of any sample from `prev`, relative to this
+    /// revolution's peak-to-peak.
+    pub fn change_from(&self, prev: &Revolution, mon: &[usize]) -> Vec<f64> {
+        mon.iter()
+            .zip(MONITORED.iter())
+            .map(|(&c, (_, floor))| relative_change(&prev.samples[c], &self.samples[c], *floor))
+            .collect()
+    }
 }
 
 /// One revolution of `sim` into `rev`.
@@ -178,6 +187,8 @@ pub(super) struct SimMap<'a> {
     pub end: SimState,
     pub rev: Revolution,
     trial: Option<(SimState, SimState, Revolution)>,
+    /// Change of the accepted revolution made by the last accepted step.
+    step_change: Option<f64>,
     pub periods: usize,
     pub residual_by_channel: Vec<f64>,
     pub progress: &'a dyn Fn(usize, Option<f64>),
@@ -205,6 +216,7 @@ impl<'a> SimMap<'a> {
             end,
             rev,
             trial: None,
+            step_change: None,
             periods,
             residual_by_channel,
             progress,
@@ -250,6 +262,7 @@ impl PeriodMap for SimMap<'_> {
         if let Some((s, e, rev)) = self.trial.take() {
             self.start = s;
             self.end = e;
+            self.step_change = Some(max_nan(&rev.change_from(&self.rev, &self.mon)));
             self.rev = rev;
             self.residual_by_channel = self.rev.residual(&self.mon);
         }
@@ -259,6 +272,9 @@ impl PeriodMap for SimMap<'_> {
     }
     fn periods(&self) -> usize {
         self.periods
+    }
+    fn step_change(&self) -> Option<f64> {
+        self.step_change
     }
 }
 
