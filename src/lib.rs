@@ -8,6 +8,7 @@ pub mod diagnose;
 pub mod flight;
 pub mod hydraulics;
 pub mod io;
+pub mod loads;
 pub mod periodic;
 pub mod report;
 pub mod rotor;

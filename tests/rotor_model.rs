@@ -172,6 +172,43 @@ fn rotor_deck_unknown_key_names_file_line_key() {
 }
 
 #[test]
+fn outputs_table_is_checked_and_names_the_key() {
+    let base = std::fs::read_to_string(repo("rotors/uh60a.toml")).unwrap();
+    let parse = |extra: &str| {
+        rotorsim::rotor::deck::RotorSpec::parse(&format!("{base}\n{extra}"), "x/uh60a.toml")
+    };
+    // the default stations: r/R 0.1 .. 0.9, the bearing and the horn
+    let spec = parse("").unwrap();
+    let st: Vec<f64> = spec.load_stations().iter().map(|s| s.1).collect();
+    assert_eq!(st.len(), 11);
+    assert!((st[0] - 0.381 / 8.1786).abs() < 1e-12 && (st[10] - 0.9).abs() < 1e-12);
+    for (extra, key, what) in [
+        (
+            "[outputs]\nstations_r_over_R = [0.5, 1.2]",
+            "outputs.stations_r_over_R",
+            "1.2",
+        ),
+        (
+            "[outputs]\nstations_r_over_R = [0.5, 0.501]",
+            "outputs.stations_r_over_R",
+            "same r/R",
+        ),
+        (
+            "[outputs]\nsection_channels = [\"flap_momnet\"]",
+            "outputs.section_channels",
+            "flap_momnet",
+        ),
+        ("[outputs]\nstation = [0.5]", "station", "unknown"),
+    ] {
+        let e = parse(extra).unwrap_err().to_string();
+        assert!(
+            e.contains("x/uh60a.toml") && e.contains(key) && e.contains(what),
+            "{extra}: {e}"
+        );
+    }
+}
+
+#[test]
 fn expand_prints_a_model_deck_that_loads_back() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
         .args(["expand", "--rotor"])

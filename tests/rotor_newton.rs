@@ -8,6 +8,7 @@ use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::sim::RTOL;
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions};
+use rotorsim::run::loads::is_load_channel;
 use rotorsim::run::{run_models, ModelRun, Silent};
 use rotorsim::solver::NewtonMethod;
 use std::path::PathBuf;
@@ -109,7 +110,15 @@ fn modified_newton_reproduces_full_newton_on_every_channel() {
             // valve's chatter the residual test fixes them only to ~1e-5 (full Newton at a 3x
             // tighter tolerance moves x_valve0 by 1.1e-5 of its peak-to-peak: `floor`), and an
             // event one sub-step earlier or later moves a flow by a few times that.
-            let bound = if is_valve(&name) { 1e-4 } else { 1e-5 };
+            // Blade loads: 1e-4. A section load is an element's force balance, which the
+            // residual test fixes to ||r|| <= 1e-7 ||r_0|| (r_0, the predictor residual, ~1e6 N)
+            // only: full Newton at a 3x tighter tolerance moves shear_chord_r0.05_N by 2.3e-5
+            // of its peak-to-peak (`floor`), the small shears and hub loads most.
+            let bound = if is_valve(&name) || is_load_channel(&name) {
+                1e-4
+            } else {
+                1e-5
+            };
             assert!(
                 d <= bound,
                 "{}: {name} differs by {d:.2e} of its peak-to-peak (bound {bound:.1e})",
@@ -123,7 +132,7 @@ fn modified_newton_reproduces_full_newton_on_every_channel() {
             "full Newton, rtol {RTOL:e} vs {:e}: {name} moves by {d:.2e} of its peak-to-peak",
             RTOL / 3.0
         );
-        if !is_valve(name) {
+        if !is_valve(name) && !is_load_channel(name) {
             assert!(
                 *d < 1e-5,
                 "full Newton moves {name} by {d:e} between tolerances"

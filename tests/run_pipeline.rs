@@ -544,6 +544,62 @@ fn short_run_of_the_uh60a_rotor_with_the_three_dampers() {
         let (f, v) = (&cols[1], &cols[3]);
         let fv: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
         assert!(fv < 0.0, "{m}: damper force does positive work");
+        // Blade loads (docs/loads.md): the channels in last_rev.csv and summary.json, the
+        // equilibrium check met, and the 4-blade hub loads free of non-multiples of 4/rev.
+        for want in [
+            "flap_moment_r0.50_Nm",
+            "chord_moment_r0.50_Nm",
+            "torsion_moment_r0.50_Nm",
+            "shear_flap_r0.50_N",
+            "shear_chord_r0.50_N",
+            "axial_force_r0.50_N",
+            "flap_moment_r0.05_Nm",
+            "torsion_moment_r0.07_Nm",
+            "pitch_link_force_N",
+            "root_fx_N",
+            "root_mz_Nm",
+            "hub_fz_fixed_N",
+            "hub_mz_fixed_Nm",
+        ] {
+            assert!(
+                h.iter().any(|c| c == want),
+                "{m}: no {want} in last_rev.csv"
+            );
+            assert!(
+                j["loads"]["channels"][want]["harmonics"]
+                    .as_array()
+                    .unwrap()
+                    .len()
+                    == 11,
+                "{m}: {want} in summary.json"
+            );
+        }
+        assert!(!h.iter().any(|c| c.starts_with("check_")), "{m}");
+        let eq = &j["loads"]["equilibrium_check"];
+        assert_eq!(eq["passed"], true, "{m}: {eq}");
+        assert!(eq["max_rel_error"].as_f64().unwrap() < 5e-3, "{m}: {eq}");
+        for ch in [
+            "hub_fx_fixed_N",
+            "hub_fy_fixed_N",
+            "hub_fz_fixed_N",
+            "hub_mx_fixed_Nm",
+            "hub_my_fixed_Nm",
+            "hub_mz_fixed_Nm",
+        ] {
+            let hs = j["loads"]["channels"][ch]["harmonics"].as_array().unwrap();
+            let amp = |x: &Value| x["amplitude"].as_f64().unwrap();
+            let big = hs.iter().map(amp).fold(0.0, f64::max);
+            for x in hs {
+                let n = x["n_per_rev"].as_u64().unwrap();
+                if n % 4 != 0 {
+                    assert!(
+                        amp(x) < 1e-9 * big,
+                        "{m} {ch}: {n}/rev amplitude {} of {big}",
+                        amp(x)
+                    );
+                }
+            }
+        }
         // The blade moves: tip flap and lag are not zero.
         for ch in ["tip_flap_m", "tip_lag_m"] {
             let i = h.iter().position(|x| x == ch).unwrap();

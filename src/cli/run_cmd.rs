@@ -405,6 +405,12 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                     t.total_s - t.hydraulics_s,
                     t.hydraulics_s
                 );
+                if let Some(c) = r.loads_check.as_ref().filter(|c| !c.passed) {
+                    println!(
+                        "warning: {}: blade root loads differ from the resultant of the applied, inertial, damper and pitch-link loads by {:.2e} of {}'s peak-to-peak (above {:.1e}): the structural solution is not in equilibrium to the accuracy the loads need",
+                        r.label, c.max_rel_error, c.channel, c.tolerance
+                    );
+                }
                 if !r.converged() {
                     println!(
                         "warning: {}: {}",

@@ -14,6 +14,9 @@ pub struct RotorSpec {
     pub bearing: BearingTable,
     pub pitch_control: PitchControlTable,
     pub damper_attachment: DamperAttachment,
+    /// Load output channels (docs/loads.md); defaults when absent.
+    #[serde(default)]
+    pub outputs: OutputsTable,
     /// Read by `DamperDeck` (kept opaque here).
     #[serde(default)]
     pub damper: Option<toml::Value>,
@@ -147,7 +150,76 @@ pub struct DamperAttachment {
     pub horn_mass_kg: f64,
 }
 
+/// Section kinds of the `[outputs]` table, in channel order, with their units.
+pub const SECTION_KINDS: [(&str, &str); 6] = [
+    ("flap_moment", "Nm"),
+    ("chord_moment", "Nm"),
+    ("torsion_moment", "Nm"),
+    ("shear_flap", "N"),
+    ("shear_chord", "N"),
+    ("axial_force", "N"),
+];
+
+/// `[outputs]`: where section loads are recovered and which (docs/loads.md).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputsTable {
+    /// Blade stations r/R (default 0.1 to 0.9 by 0.1).
+    #[serde(rename = "stations_r_over_R", default = "default_stations")]
+    pub stations_r_over_r: Vec<f64>,
+    /// Also the section just outboard of the bearing (r = hinge_r_m) and of the pitch horn
+    /// (r = horn_r_m).
+    #[serde(default = "yes")]
+    pub bearing_station: bool,
+    #[serde(default = "yes")]
+    pub horn_station: bool,
+    /// Section channels at every station (default all of [`SECTION_KINDS`]).
+    #[serde(default = "default_kinds")]
+    pub section_channels: Vec<String>,
+}
+
+impl Default for OutputsTable {
+    fn default() -> Self {
+        OutputsTable {
+            stations_r_over_r: default_stations(),
+            bearing_station: true,
+            horn_station: true,
+            section_channels: default_kinds(),
+        }
+    }
+}
+
+fn default_stations() -> Vec<f64> {
+    (1..=9).map(|k| k as f64 / 10.0).collect()
+}
+fn default_kinds() -> Vec<String> {
+    SECTION_KINDS.iter().map(|k| k.0.to_string()).collect()
+}
+fn yes() -> bool {
+    true
+}
+
 impl RotorSpec {
+    /// Stations of section loads: (r [m], r/R) in increasing r, the bearing and horn stations
+    /// included when asked.
+    pub fn load_stations(&self) -> Vec<(f64, f64)> {
+        let big_r = self.rotor.radius_m;
+        let mut v: Vec<(f64, f64)> = self
+            .outputs
+            .stations_r_over_r
+            .iter()
+            .map(|x| (x * big_r, *x))
+            .collect();
+        if self.outputs.bearing_station {
+            v.push((self.retention.hinge_r_m, self.retention.hinge_r_m / big_r));
+        }
+        if self.outputs.horn_station {
+            v.push((self.retention.horn_r_m, self.retention.horn_r_m / big_r));
+        }
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
+    }
+
     /// Parse deck text; `file` names it in errors (toml reports line and column).
     pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
         let spec: RotorSpec = toml::from_str(text)
@@ -266,6 +338,44 @@ impl RotorSpec {
         let tw = &self.blade.twist_deg;
         if tw.windows(2).any(|w| w[1][0] <= w[0][0]) {
             return Err(bad("blade.twist_deg", "r_m must be strictly increasing"));
+        }
+        let o = &self.outputs;
+        let lo = self.retention.hinge_r_m / self.rotor.radius_m;
+        for x in &o.stations_r_over_r {
+            if !(x.is_finite() && *x >= lo && *x <= 1.0) {
+                return Err(bad(
+                    "outputs.stations_r_over_R",
+                    &format!(
+                        "{x} is outside the blade: expected hinge_r_m / radius_m = {lo:.4} to 1"
+                    ),
+                ));
+            }
+        }
+        for k in &o.section_channels {
+            if !SECTION_KINDS.iter().any(|c| c.0 == k) {
+                let known: Vec<&str> = SECTION_KINDS.iter().map(|c| c.0).collect();
+                return Err(bad(
+                    "outputs.section_channels",
+                    &format!(
+                        "unknown channel `{k}`, expected some of {}",
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+        // channel names carry r/R to two decimals: two stations must not share one
+        let mut names: Vec<String> = self
+            .load_stations()
+            .iter()
+            .map(|(_, x)| format!("{x:.2}"))
+            .collect();
+        let n = names.len();
+        names.dedup();
+        if names.len() != n {
+            return Err(bad(
+                "outputs.stations_r_over_R",
+                "two stations (the bearing and horn stations included) round to the same r/R at two decimals",
+            ));
         }
         Ok(())
     }

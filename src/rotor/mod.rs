@@ -96,6 +96,17 @@ pub trait ForcedResponse: Send {
     }
     /// Relief-valve regulation (physical damper): per valve, what turns the poppet's spring and
     /// damping forces into damper force beyond the cracking force (Eq. 5); else None.
+    /// Whether the channels derived from the state for output only (blade loads) are
+    /// computed (default); off, they read NaN. Revolutions whose samples are never reported
+    /// (the perturbed revolutions of shooting) turn them off.
+    fn set_output_channels(&mut self, _on: bool) {}
+    fn output_channels(&self) -> bool {
+        true
+    }
+    /// Number of identical blades of the rotor (None: not a rotor with blade loads).
+    fn blades(&self) -> Option<usize> {
+        None
+    }
     fn relief_regulation(&self) -> Option<[ReliefRegulation; 2]> {
         None
     }
@@ -140,6 +151,7 @@ pub struct SimState {
 pub mod deck;
 pub mod expand;
 pub mod fan;
+pub mod loads;
 pub mod sim;
 pub mod transient;
 

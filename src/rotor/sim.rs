@@ -197,6 +197,13 @@ pub struct RotorSim {
     r0: Vec<[[f64; 3]; 3]>,
     /// End of the cyclic ramp [s].
     t_ramp: f64,
+    /// Blade load channels (after the base and device channels).
+    loads: super::loads::LoadChannels,
+    /// Damper end nodes and their positions at the start of the last step.
+    damper_nodes: [usize; 2],
+    damper_x_start: [[f64; 3]; 2],
+    /// Load channels computed (see [`ForcedResponse::set_output_channels`]).
+    output_channels: bool,
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -336,6 +343,7 @@ pub fn build_sim(
     let tip_ref = model.nodes[tip].x0;
     let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
     let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
+    let loads = super::loads::LoadChannels::new(spec, &model)?;
     let mut solver = DynamicSolver::new(model, st, h, opts.rho_inf)?;
     // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
@@ -379,6 +387,10 @@ pub fn build_sim(
         rtol: opts.newton_rtol,
         r0,
         t_ramp,
+        loads,
+        damper_nodes: [n_hub_end, n_blade_end],
+        damper_x_start: [[0.0; 3]; 2],
+        output_channels: true,
     })
 }
 
@@ -440,6 +452,7 @@ impl ForcedResponse for RotorSim {
     }
     fn step(&mut self) -> anyhow::Result<()> {
         let t0 = Instant::now();
+        self.damper_x_start = self.damper_nodes.map(|i| self.solver.state.x[i]);
         let tn = self.solver.state.t;
         let t1 = tn + self.h;
         let z0 = self.spec.swash_z(self.spec.pitch_rad(&self.controls, tn));
@@ -476,6 +489,7 @@ impl ForcedResponse for RotorSim {
         if self.physical {
             v.extend(self.dev_names.iter().cloned());
         }
+        v.extend(self.loads.names().iter().cloned());
         v
     }
     fn channels(&self, out: &mut [f64]) {
@@ -496,9 +510,37 @@ impl ForcedResponse for RotorSim {
         let rr = quat_to_arr(&st.q[self.root]);
         let rt = quat_to_arr(&st.q[self.tip]);
         out[5] = rel_twist(&rr, &rt) - self.twist_ref;
+        let nl = self.loads.names().len();
+        let at = out.len() - nl;
+        if !self.output_channels {
+            out[at..].fill(f64::NAN);
+            return;
+        }
+        let damper = super::loads::DamperStep {
+            nodes: self.damper_nodes,
+            x_start: self.damper_x_start,
+            force_n: out[0],
+        };
+        if self
+            .loads
+            .values(&self.solver.model, st, &damper, &mut out[at..])
+            .is_err()
+        {
+            // a wiring error of the load channels, checked when they were resolved
+            out[at..].fill(f64::NAN);
+        }
     }
     fn force_limits_n(&self) -> Option<(f64, f64)> {
         self.limits
+    }
+    fn blades(&self) -> Option<usize> {
+        Some(self.spec.rotor.blades)
+    }
+    fn set_output_channels(&mut self, on: bool) {
+        self.output_channels = on;
+    }
+    fn output_channels(&self) -> bool {
+        self.output_channels
     }
     fn relief_regulation(&self) -> Option<[super::ReliefRegulation; 2]> {
         self.regulation
@@ -530,7 +572,12 @@ impl ForcedResponse for RotorSim {
         snap.t_s = s.t_s;
         self.solver
             .restore(&snap)
-            .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))
+            .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))?;
+        // the step that ended here is not saved: its start taken as the damper ends turned
+        // back with the shaft (the lag motion over a step is two orders smaller)
+        let back = exp_map([0.0, 0.0, -self.spec.rotor.omega_rad_s * self.h]);
+        self.damper_x_start = self.damper_nodes.map(|i| mv(&back, self.solver.state.x[i]));
+        Ok(())
     }
     fn periodic_from_s(&self) -> f64 {
         self.t_ramp

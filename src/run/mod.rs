@@ -8,6 +8,7 @@
 //! ([`drive_periodic`]: shooting or marching), keeps the reported revolution, and hands the results to
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
+pub mod loads;
 pub mod mcap_out;
 pub mod periodic;
 pub mod report;
@@ -61,6 +62,10 @@ pub struct ModelRun {
     pub wall_s: f64,
     /// Wall time of building the simulation [s].
     pub build_s: f64,
+    /// Equilibrium check of the blade loads (models with load channels).
+    pub loads_check: Option<loads::EquilibriumCheck>,
+    /// Identical blades of the rotor (for the hub loads).
+    pub blades: Option<usize>,
 }
 
 impl ModelRun {
@@ -363,7 +368,8 @@ pub fn drive_periodic(
         );
     }
     let timing = sim.timing();
-    Ok(ModelRun {
+    let blades = sim.blades();
+    let mut run = ModelRun {
         model: model.name().to_string(),
         label: sim.label().to_string(),
         revolutions: periods,
@@ -379,7 +385,11 @@ pub fn drive_periodic(
         timing,
         wall_s: t_start.elapsed().as_secs_f64(),
         build_s: 0.0,
-    })
+        loads_check: None,
+        blades,
+    };
+    loads::finish(&mut run, blades);
+    Ok(run)
 }
 
 /// Builds and drives one simulation per model in parallel. A failed model (build or run) is

@@ -230,7 +230,12 @@ impl<'a> SimMap<'a> {
         self.periods += 1;
         let what = format!("{}, revolution {} (shooting)", self.label, self.periods);
         let mut rev = Revolution::new(self.rev.end.len(), self.rev.azimuth.len());
-        integrate(self.sim, &mut rev, &what)?;
+        // a perturbed revolution is never reported: no output-only channels
+        let was = self.sim.output_channels();
+        self.sim.set_output_channels(was && into_trial);
+        let r = integrate(self.sim, &mut rev, &what);
+        self.sim.set_output_channels(was);
+        r?;
         let end = self
             .sim
             .save_state()

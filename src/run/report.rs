@@ -583,7 +583,137 @@ pub fn report_html(
             &frows,
         );
     }
+    blade_loads(&mut rep, &runs);
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: FORMATS.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()
+}
+
+/// Radial distributions of the section loads, pitch-link and root loads vs azimuth, and the
+/// N/rev hub loads (docs/loads.md).
+fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+    use crate::rotor::deck::SECTION_KINDS;
+    let with: Vec<&ModelRun> = runs
+        .iter()
+        .copied()
+        .filter(|r| r.channel("root_fx_N").is_some())
+        .collect();
+    if with.is_empty() {
+        return;
+    }
+    rep.heading(2, "Blade loads");
+    rep.paragraph("Section loads are what the outboard part of the blade exerts on the inboard part, in the deformed section frame: flap moment positive for tip-up bending, chord moment positive for bending toward the leading edge, torsion nose up, axial force in tension (docs/loads.md, sign conventions). Stations r/R below the blade root are the section just outboard of the bearing and of the pitch horn.");
+    let multi = with.len() > 1;
+    let mut plots = vec![];
+    for (kind, unit) in SECTION_KINDS.iter().take(3) {
+        let mut p = Plot::new(
+            &format!(
+                "{} along the blade: mean (solid), half peak-to-peak (dashed)",
+                kind.replace('_', " ")
+            ),
+            "r/R",
+            &format!("[{unit}]"),
+        );
+        for r in &with {
+            let mut pts: Vec<(f64, f64, f64)> = vec![];
+            for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
+                let Some(rest) = name.strip_prefix(&format!("{kind}_r")) else {
+                    continue;
+                };
+                let Some(x) = rest.split('_').next().and_then(|x| x.parse::<f64>().ok()) else {
+                    continue;
+                };
+                let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+                let (lo, hi) = v
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+                        (l.min(*y), h.max(*y))
+                    });
+                pts.push((x, mean, 0.5 * (hi - lo)));
+            }
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            let m: Vec<f64> = pts.iter().map(|p| p.1).collect();
+            let h: Vec<f64> = pts.iter().map(|p| p.2).collect();
+            let lab = if multi {
+                r.label.clone()
+            } else {
+                String::new()
+            };
+            p = p
+                .line(&format!("{lab} mean"), &x, &m)
+                .dashed(&format!("{lab} half p-p"), &x, &h);
+        }
+        plots.push(p);
+    }
+    svg(
+        rep,
+        "Section loads along the blade over the last revolution.",
+        &plots,
+    );
+    svg(
+        rep,
+        "Pitch-link axial load (tension positive), last revolution.",
+        &[channel_plot(
+            runs,
+            "Pitch-link load",
+            "force [N]",
+            &[("pitch_link_force_N", "")],
+        )],
+    );
+    svg(
+        rep,
+        "Blade root loads at the hub centre, rotating hub frame (x outward, y toward the leading edge, z up): forces (top), moments (bottom).",
+        &[
+            channel_plot(
+                &with,
+                "Root forces",
+                "force [N]",
+                &[("root_fx_N", "fx"), ("root_fy_N", "fy"), ("root_fz_N", "fz")],
+            ),
+            channel_plot(
+                &with,
+                "Root moments",
+                "moment [N m]",
+                &[("root_mx_Nm", "mx"), ("root_my_Nm", "my"), ("root_mz_Nm", "mz")],
+            ),
+        ],
+    );
+    let mut rows = vec![];
+    for r in &with {
+        for ch in super::loads::HUB_CHANNELS {
+            let Some(v) = r.channel(ch) else { continue };
+            let Ok(h) =
+                crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, super::N_HARMONICS)
+            else {
+                continue;
+            };
+            let amp = |n: usize| h.get(n).map_or(f64::NAN, |x| x.amplitude);
+            let nb = r.blades.unwrap_or(4);
+            rows.push(vec![
+                r.label.clone(),
+                ch.to_string(),
+                format!("{:.1}", amp(0)),
+                format!("{:.1} ({nb}/rev)", amp(nb)),
+                format!("{:.1} ({}/rev)", amp(2 * nb), 2 * nb),
+            ]);
+        }
+        if let Some(c) = &r.loads_check {
+            rep.paragraph(&format!(
+                "{}: equilibrium check, root loads against the resultant of the applied, inertial, damper and pitch-link loads: largest difference {:.1e} of {}'s peak-to-peak ({}, tolerance {:.1e}).",
+                r.label,
+                c.max_rel_error,
+                c.channel,
+                if c.passed { "passed" } else { "FAILED" },
+                c.tolerance
+            ));
+        }
+    }
+    if !rows.is_empty() {
+        rep.paragraph("Hub loads in the non-rotating frame (x along the reference blade at azimuth 0, z up): the rotor's identical blades' root loads summed, so only multiples of N/rev remain. Amplitudes [N, N m]:");
+        rep.table(
+            &["model", "channel", "mean (0/rev)", "N/rev", "2N/rev"],
+            &rows,
+        );
+    }
 }

@@ -610,6 +610,7 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
             "statement": periodicity_statement(r),
         },
         "periodic": periodic_json(r),
+        "loads": super::loads::loads_json(r),
         "damper_force_N": f.force,
         "relief_valve_limits": limits,
         "wall_time_s": {

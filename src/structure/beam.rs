@@ -60,6 +60,26 @@ pub struct SectionLoad {
     pub follower: bool,
 }
 
+/// Interpolation of one nodal configuration: reference rotation, local rotation vectors and
+/// the section rotations at the inertia points.
+#[derive(Clone, Copy, Debug)]
+pub struct Interp {
+    pub rr: M3<f64>,
+    pub psi: [V3<f64>; 4],
+    pub rg: [M3<f64>; NPTS_M],
+}
+
+/// Inertial minus applied load per unit length at an inertia point ([`Beam::point_densities`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointDensity {
+    pub s_m: f64,
+    pub weight_m: f64,
+    pub x: [f64; 3],
+    pub force_n_per_m: [f64; 3],
+    /// About `x`.
+    pub moment_nm_per_m: [f64; 3],
+}
+
 #[derive(Clone, Debug)]
 pub struct Beam {
     pub name: String,
@@ -365,56 +385,8 @@ impl Beam {
         ctx: &EvalCtx,
         out: &mut [T],
     ) {
-        let grav = ctx.gravity;
-        let has_g = grav != [0.0; 3];
         for (q, g) in self.gm.iter().enumerate() {
-            let r = rg[q];
-            let mut f = zero3();
-            let mut mo = zero3();
-            if ctx.inertia || has_g {
-                let mut a = zero3();
-                let mut w = zero3();
-                let mut al = zero3();
-                if ctx.inertia {
-                    for i in 0..4 {
-                        a = add(a, fmul(g.n[i], k[i].a));
-                        w = add(w, fmul(g.n[i], k[i].w));
-                        al = add(al, fmul(g.n[i], k[i].al));
-                    }
-                }
-                let a = sub(a, v3c(&grav));
-                let eta = mv(&r, v3c(&g.xi));
-                let jr = mm(&mm(&r, &m3c(&g.jref)), &transpose(&r));
-                let m = g.m;
-                f = fmul(m, add(a, add(cross(al, eta), cross(w, cross(w, eta)))));
-                mo = add(
-                    fmul(m, cross(eta, a)),
-                    add(mv(&jr, al), cross(w, mv(&jr, w))),
-                );
-            }
-            for l in &self.loads {
-                let fac = l.time.eval(ctx.t) * ctx.load_factor;
-                let (fe, me) = if l.follower {
-                    (
-                        mv(&r, v3c(&l.force_n_per_m)),
-                        mv(&r, v3c(&l.moment_nm_per_m)),
-                    )
-                } else {
-                    (v3c(&l.force_n_per_m), v3c(&l.moment_nm_per_m))
-                };
-                f = sub(f, fmul(fac, fe));
-                mo = sub(mo, fmul(fac, me));
-            }
-            let e = &self.ext[q];
-            if e.force != [0.0; 3] || e.moment != [0.0; 3] {
-                let (fe, me) = if e.follower {
-                    (mv(&r, v3c(&e.force)), mv(&r, v3c(&e.moment)))
-                } else {
-                    (v3c(&e.force), v3c(&e.moment))
-                };
-                f = sub(f, fe);
-                mo = sub(mo, me);
-            }
+            let (f, mo) = self.density_at(q, k, &rg[q], ctx);
             for i in 0..4 {
                 let b = g.n[i] * g.wj;
                 for j in 0..3 {
@@ -423,6 +395,152 @@ impl Beam {
                 }
             }
         }
+    }
+
+    /// Inertial force and moment minus gravity and applied loads per unit reference length at
+    /// inertia point `q` (section rotation `r`): the integrand of the element's
+    /// inertial-and-external residual, the moment about the reference-line point.
+    #[inline]
+    fn density_at<T: Real>(
+        &self,
+        q: usize,
+        k: &[NodeKin<T>; 4],
+        r: &M3<T>,
+        ctx: &EvalCtx,
+    ) -> (V3<T>, V3<T>) {
+        let g = &self.gm[q];
+        let grav = ctx.gravity;
+        let has_g = grav != [0.0; 3];
+        let r = *r;
+        let mut f = zero3();
+        let mut mo = zero3();
+        if ctx.inertia || has_g {
+            let mut a = zero3();
+            let mut w = zero3();
+            let mut al = zero3();
+            if ctx.inertia {
+                for i in 0..4 {
+                    a = add(a, fmul(g.n[i], k[i].a));
+                    w = add(w, fmul(g.n[i], k[i].w));
+                    al = add(al, fmul(g.n[i], k[i].al));
+                }
+            }
+            let a = sub(a, v3c(&grav));
+            let eta = mv(&r, v3c(&g.xi));
+            let jr = mm(&mm(&r, &m3c(&g.jref)), &transpose(&r));
+            let m = g.m;
+            f = fmul(m, add(a, add(cross(al, eta), cross(w, cross(w, eta)))));
+            mo = add(
+                fmul(m, cross(eta, a)),
+                add(mv(&jr, al), cross(w, mv(&jr, w))),
+            );
+        }
+        for l in &self.loads {
+            let fac = l.time.eval(ctx.t) * ctx.load_factor;
+            let (fe, me) = if l.follower {
+                (
+                    mv(&r, v3c(&l.force_n_per_m)),
+                    mv(&r, v3c(&l.moment_nm_per_m)),
+                )
+            } else {
+                (v3c(&l.force_n_per_m), v3c(&l.moment_nm_per_m))
+            };
+            f = sub(f, fmul(fac, fe));
+            mo = sub(mo, fmul(fac, me));
+        }
+        let e = &self.ext[q];
+        if e.force != [0.0; 3] || e.moment != [0.0; 3] {
+            let (fe, me) = if e.follower {
+                (mv(&r, v3c(&e.force)), mv(&r, v3c(&e.moment)))
+            } else {
+                (v3c(&e.force), v3c(&e.moment))
+            };
+            f = sub(f, fe);
+            mo = sub(mo, me);
+        }
+        (f, mo)
+    }
+
+    /// The interpolation of configuration `k`: from the cache when `k` is the configuration
+    /// it was made for (the converged iterate), else computed.
+    pub fn interp(&self, k: &[NodeKin<f64>; 4]) -> Interp {
+        if self.cache.holds(k) {
+            let c = &self.cache;
+            Interp {
+                rr: c.rr,
+                psi: c.psi,
+                rg: c.rg,
+            }
+        } else {
+            let (rr, psi) = Self::local_rotations(k);
+            let rg = std::array::from_fn(|q| Self::rot_at(&self.gm[q], &rr, &psi));
+            Interp { rr, psi, rg }
+        }
+    }
+
+    /// Per inertia point: the reference-line position, the quadrature weight (reference
+    /// length), and the inertial minus applied force and moment per unit length (the moment
+    /// about that point), as the residual integrates them. For load recovery
+    /// ([`crate::loads`]).
+    pub fn point_densities(&self, k: &[NodeKin<f64>; 4], ctx: &EvalCtx) -> [PointDensity; NPTS_M] {
+        self.densities_with(k, &self.interp(k).rg, ctx)
+    }
+
+    /// [`Beam::point_densities`] with the section rotations `rg` at the inertia points.
+    pub fn densities_with(
+        &self,
+        k: &[NodeKin<f64>; 4],
+        rg: &[M3<f64>; NPTS_M],
+        ctx: &EvalCtx,
+    ) -> [PointDensity; NPTS_M] {
+        std::array::from_fn(|q| {
+            let g = &self.gm[q];
+            let (f, m) = self.density_at(q, k, &rg[q], ctx);
+            let mut x = [0.0; 3];
+            for i in 0..4 {
+                x = add(x, fmul(g.n[i], k[i].x));
+            }
+            PointDensity {
+                s_m: g.s_m,
+                weight_m: g.wj,
+                x,
+                force_n_per_m: f,
+                moment_nm_per_m: m,
+            }
+        })
+    }
+
+    /// What load recovery needs of one element at configuration `k` beyond its densities `d`
+    /// ([`Beam::densities_with`] of the same interpolation): the full residual (24 entries),
+    /// and the position and section rotation at reference arc length `s_m`.
+    pub fn recovery(
+        &self,
+        k: &[NodeKin<f64>; 4],
+        ip: &Interp,
+        d: &[PointDensity; NPTS_M],
+        s_m: f64,
+    ) -> ([f64; 24], [f64; 3], M3<f64>) {
+        let mut r = [0.0; 24];
+        self.internal(k, &ip.rr, &ip.psi, &mut r);
+        // the inertial-and-external residual from the same densities
+        for (g, p) in self.gm.iter().zip(d) {
+            for i in 0..4 {
+                let b = g.n[i] * g.wj;
+                for j in 0..3 {
+                    r[6 * i + j] += p.force_n_per_m[j] * b;
+                    r[6 * i + 3 + j] += p.moment_nm_per_m[j] * b;
+                }
+            }
+        }
+        let xi = -1.0 + 2.0 * (s_m - self.s_range[0]) / (self.s_range[1] - self.s_range[0]);
+        let (n, _) = shape(xi);
+        let mut x = [0.0; 3];
+        let mut ps = zero3();
+        for i in 0..4 {
+            x = add(x, fmul(n[i], k[i].x));
+            ps = add(ps, fmul(n[i], ip.psi[i]));
+        }
+        (r, x, mm(&ip.rr, &exp_map(ps)))
     }
 
     /// Full element residual (24 entries, accumulated into `out`).

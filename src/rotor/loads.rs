@@ -1,0 +1,297 @@
+//! Blade load channels of the rotor model (docs/loads.md): section loads at the `[outputs]`
+//! stations, the pitch-link load, the blade root loads at the hub centre (rotating hub frame)
+//! and, for the run-time equilibrium check, the same root loads from the applied and inertial
+//! loads of the blade system and the pitch-link reaction.
+use super::deck::{RotorSpec, SECTION_KINDS};
+use super::expand::names;
+use crate::loads::{self, Resultant};
+use crate::solver::State;
+use crate::structure::beam::{Interp, PointDensity, NPTS_M};
+use crate::structure::kin::{EvalCtx, NodeKin};
+use crate::structure::model::{Element, Model};
+use crate::structure::rotation::*;
+use std::sync::Mutex;
+
+fn norm(v: [f64; 3]) -> f64 {
+    dot(v, v).sqrt()
+}
+
+/// Prefix of the channels that only feed the equilibrium check (not written as outputs).
+pub const CHECK_PREFIX: &str = "check_";
+
+/// Root channel names, force then moment (x, y, z of the rotating hub frame).
+pub const ROOT_CHANNELS: [&str; 6] = [
+    "root_fx_N",
+    "root_fy_N",
+    "root_fz_N",
+    "root_mx_Nm",
+    "root_my_Nm",
+    "root_mz_Nm",
+];
+
+pub const PITCH_LINK_CHANNEL: &str = "pitch_link_force_N";
+
+/// The damper's end nodes (hub end, blade end), their positions at the start of the last
+/// step and the force it applied over the step (positive along the blade end's line).
+#[derive(Clone, Copy, Debug)]
+pub struct DamperStep {
+    pub nodes: [usize; 2],
+    pub x_start: [[f64; 3]; 2],
+    pub force_n: f64,
+}
+
+struct Station {
+    elem: usize,
+    s_m: f64,
+}
+
+/// One beam element of the blade system at the current state (computed once per sample).
+#[derive(Clone, Copy)]
+struct ElemData {
+    elem: usize,
+    k: [NodeKin<f64>; 4],
+    ip: Interp,
+    d: [PointDensity; NPTS_M],
+}
+
+/// Which elements carry which load, resolved once from the expanded model.
+pub struct LoadChannels {
+    stations: Vec<Station>,
+    /// Indices into [`SECTION_KINDS`] written at every station.
+    kinds: Vec<usize>,
+    names: Vec<String>,
+    link: Station,
+    hub: usize,
+    /// Elements joining the blade system to the hub node: the retention's first beam element
+    /// and the damper's hub mount.
+    hub_cut: Vec<usize>,
+    /// Beam elements of the blade system (retention segments and blade), and its rigid bodies
+    /// (horn, damper lever and bracket).
+    beams: Vec<usize>,
+    rigid: Vec<usize>,
+    /// Per station: its element's index in `beams`.
+    station_beam: Vec<usize>,
+    /// Per-sample element data (preallocated: the channels are read every step).
+    scratch: Mutex<Vec<ElemData>>,
+    /// The pitch link's joint on the horn, and the horn node.
+    link_joint: usize,
+    horn_node: usize,
+    lam_off: Vec<usize>,
+}
+
+fn beam_ids<'a>(m: &'a Model, name: &str) -> anyhow::Result<&'a [usize]> {
+    m.beams
+        .get(name)
+        .map(|v| v.as_slice())
+        .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no beam `{name}`"))
+}
+
+fn element(m: &Model, name: &str) -> anyhow::Result<usize> {
+    m.element_id(name)
+        .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no element `{name}`"))
+}
+
+impl LoadChannels {
+    pub fn new(spec: &RotorSpec, m: &Model) -> anyhow::Result<Self> {
+        let r = &spec.retention;
+        let mut stations = vec![];
+        for (radius, _) in spec.load_stations() {
+            let (beam, s) = if radius >= spec.blade.root_r_m {
+                (names::BLADE, radius - spec.blade.root_r_m)
+            } else if radius >= r.horn_r_m {
+                ("seg3", radius - r.horn_r_m)
+            } else if radius >= r.hinge_r_m {
+                ("seg2", radius - r.hinge_r_m)
+            } else {
+                ("seg1", radius)
+            };
+            let elem = loads::element_at(m, beam_ids(m, beam)?, s).ok_or_else(|| {
+                anyhow::anyhow!("no element of `{beam}` at r = {radius} m (outputs station)")
+            })?;
+            stations.push(Station { elem, s_m: s });
+        }
+        let kinds: Vec<usize> = spec
+            .outputs
+            .section_channels
+            .iter()
+            .filter_map(|k| SECTION_KINDS.iter().position(|c| c.0 == k))
+            .collect();
+        let mut names_v = vec![];
+        for (_, x) in spec.load_stations() {
+            for &k in &kinds {
+                let (kind, unit) = SECTION_KINDS[k];
+                names_v.push(format!("{kind}_r{x:.2}_{unit}"));
+            }
+        }
+        names_v.push(PITCH_LINK_CHANNEL.to_string());
+        names_v.extend(ROOT_CHANNELS.iter().map(|s| s.to_string()));
+        names_v.extend(ROOT_CHANNELS.iter().map(|s| format!("{CHECK_PREFIX}{s}")));
+        let link_ids = beam_ids(m, "pitch_link")?;
+        let half = 0.5 * spec.pitch_control.link_length_m;
+        let link = Station {
+            elem: loads::element_at(m, link_ids, half)
+                .ok_or_else(|| anyhow::anyhow!("no pitch-link element at mid-length"))?,
+            s_m: half,
+        };
+        let hub = m.node_id(names::HUB)?;
+        let hub_cut = vec![beam_ids(m, "seg1")?[0], element(m, "damper_hub_mount")?];
+        let mut beams = vec![];
+        for b in ["seg1", "seg2", "seg3", names::BLADE] {
+            beams.extend_from_slice(beam_ids(m, b)?);
+        }
+        let mut rigid = vec![];
+        for b in ["pitch_horn", "damper_arm", "damper_horn"] {
+            rigid.push(element(m, b)?);
+        }
+        let station_beam = stations
+            .iter()
+            .map(|s| {
+                beams.iter().position(|&e| e == s.elem).ok_or_else(|| {
+                    anyhow::anyhow!("station element {} is not a blade-system beam", s.elem)
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let scratch = Mutex::new(Vec::with_capacity(beams.len()));
+        let link_joint = element(m, "pitch_link_upper")?;
+        let horn_node = match &m.elements[link_joint] {
+            Element::Joint(j) => j
+                .node_a
+                .ok_or_else(|| anyhow::anyhow!("pitch_link_upper has no horn node"))?,
+            _ => anyhow::bail!("pitch_link_upper is not a joint"),
+        };
+        Ok(LoadChannels {
+            stations,
+            kinds,
+            names: names_v,
+            link,
+            hub,
+            hub_cut,
+            beams,
+            rigid,
+            station_beam,
+            scratch,
+            link_joint,
+            horn_node,
+            lam_off: loads::lambda_offsets(m),
+        })
+    }
+
+    /// Channel names, in the order of [`LoadChannels::values`].
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Every channel at the current state (`out.len()` = `names().len()`). `damper`: the
+    /// damper's last step, for its forces in the equilibrium check.
+    pub fn values(
+        &self,
+        m: &Model,
+        st: &State,
+        damper: &DamperStep,
+        out: &mut [f64],
+    ) -> anyhow::Result<()> {
+        let ctx = EvalCtx {
+            t: st.t,
+            load_factor: 1.0,
+            gravity: m.gravity,
+            cscale: 1.0,
+            inertia: true,
+        };
+        let mut data = self
+            .scratch
+            .lock()
+            .map_err(|_| anyhow::anyhow!("load channel scratch poisoned"))?;
+        data.clear();
+        for &e in &self.beams {
+            let Element::Beam(b) = &m.elements[e] else {
+                anyhow::bail!("element {e} is not a beam");
+            };
+            let k = b.nodes.map(|n| st.node_kin(n));
+            let ip = b.interp(&k);
+            let d = b.densities_with(&k, &ip.rg, &ctx);
+            data.push(ElemData { elem: e, k, ip, d });
+        }
+        let mut i = 0;
+        for (s, &j) in self.stations.iter().zip(&self.station_beam) {
+            let e = &data[j];
+            let Element::Beam(b) = &m.elements[e.elem] else {
+                anyhow::bail!("element {} is not a beam", e.elem);
+            };
+            let c = loads::section_from(b, &e.k, &e.ip, &e.d, s.s_m).components();
+            let all = [
+                c.flap_nm,
+                c.chord_nm,
+                c.torsion_nm,
+                c.shear_flap_n,
+                c.shear_chord_n,
+                c.axial_n,
+            ];
+            for &k in &self.kinds {
+                out[i] = all[k];
+                i += 1;
+            }
+        }
+        out[i] = loads::section(m, st, &ctx, self.link.elem, self.link.s_m)?
+            .components()
+            .axial_n;
+        i += 1;
+        let xh = st.x[self.hub];
+        let rh = quat_to_arr(&st.q[self.hub]);
+        // what the blade system exerts on the hub, about the hub centre
+        // the retention's first element from this sample's data (its node 0 is the hub)
+        let r0 = &data[0];
+        let Element::Beam(b0) = &m.elements[r0.elem] else {
+            anyhow::bail!("element {} is not a beam", r0.elem);
+        };
+        let (res, _, _) = b0.recovery(&r0.k, &r0.ip, &r0.d, b0.s_range[0]);
+        let mut root = Resultant {
+            force: [-res[0], -res[1], -res[2]],
+            moment: [-res[3], -res[4], -res[5]],
+        };
+        for &e in &self.hub_cut[1..] {
+            root = root.add(&loads::element_on_node(
+                m,
+                st,
+                &ctx,
+                &self.lam_off,
+                e,
+                self.hub,
+            )?);
+        }
+        // the same from the other side: applied and inertial loads of the blade system plus
+        // the pitch link's pull on the horn
+        let mut body = loads::applied_and_inertial(m, st, &ctx, &self.rigid, xh)?;
+        for e in data.iter() {
+            for p in &e.d {
+                let f = fmul(-p.weight_m, p.force_n_per_m);
+                let mo = fmul(-p.weight_m, p.moment_nm_per_m);
+                body.force = add(body.force, f);
+                body.moment = add(body.moment, add(mo, cross(sub(p.x, xh), f)));
+            }
+        }
+        let link =
+            loads::element_on_node(m, st, &ctx, &self.lam_off, self.link_joint, self.horn_node)?
+                .moved(st.x[self.horn_node], xh);
+        // The damper's end forces act along the mean direction of the step (paper Eqs. 12-13),
+        // not along the final line: a couple u_f x F e_m, with the line turning by Omega h in
+        // a step about half a step behind (docs/loads.md)
+        let [a, b] = damper.nodes;
+        let u_i = sub(damper.x_start[1], damper.x_start[0]);
+        let u_f = sub(st.x[b], st.x[a]);
+        let l_m = 0.5 * (norm(u_i) + norm(u_f));
+        let e_m = fmul(0.5 / l_m, add(u_i, u_f));
+        let f_b = fmul(damper.force_n, e_m);
+        let couple = Resultant {
+            force: [0.0; 3],
+            moment: cross(u_f, f_b),
+        };
+        let check = body.add(&link).add(&couple);
+        for r in [root, check] {
+            let l = r.in_frame(&rh);
+            out[i..i + 3].copy_from_slice(&l.force);
+            out[i + 3..i + 6].copy_from_slice(&l.moment);
+            i += 6;
+        }
+        Ok(())
+    }
+}

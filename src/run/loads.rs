@@ -1,0 +1,146 @@
+//! Blade loads of a run (docs/loads.md): the run-time equilibrium check, the fixed-frame hub
+//! loads of the rotor's identical blades, and per-channel statistics for summary.json.
+use super::ModelRun;
+use crate::loads::hub;
+use crate::rotor::loads::{CHECK_PREFIX, ROOT_CHANNELS};
+
+/// Largest relative difference accepted between the root loads and the resultant of the
+/// applied, inertial, damper and pitch-link loads (of each root channel's peak-to-peak).
+pub const EQUILIBRIUM_TOL: f64 = 5e-3;
+
+/// Fixed-frame hub load channels, in the order of [`ROOT_CHANNELS`].
+pub const HUB_CHANNELS: [&str; 6] = [
+    "hub_fx_fixed_N",
+    "hub_fy_fixed_N",
+    "hub_fz_fixed_N",
+    "hub_mx_fixed_Nm",
+    "hub_my_fixed_Nm",
+    "hub_mz_fixed_Nm",
+];
+
+/// Root loads against the resultant of everything applied to the blade system, over the
+/// reported revolution.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EquilibriumCheck {
+    /// Largest `|root - resultant| / peak-to-peak(root)` over samples and channels.
+    pub max_rel_error: f64,
+    pub channel: String,
+    pub tolerance: f64,
+    pub passed: bool,
+}
+
+fn ptp(v: &[f64]) -> f64 {
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+            (l.min(*x), h.max(*x))
+        });
+    hi - lo
+}
+
+/// Consumes the check channels (computing the equilibrium check) and adds the fixed-frame
+/// hub loads when the run has root loads and `blades` is known.
+pub fn finish(run: &mut ModelRun, blades: Option<usize>) {
+    let idx = |r: &ModelRun, n: &str| r.channel_names.iter().position(|c| c == n);
+    let root: Option<Vec<usize>> = ROOT_CHANNELS.iter().map(|c| idx(run, c)).collect();
+    let check: Option<Vec<usize>> = ROOT_CHANNELS
+        .iter()
+        .map(|c| idx(run, &format!("{CHECK_PREFIX}{c}")))
+        .collect();
+    if let (Some(root), Some(check)) = (&root, &check) {
+        let mut worst = (0.0f64, String::new());
+        for (k, (&i, &j)) in root.iter().zip(check).enumerate() {
+            let scale = ptp(&run.last_rev[i]).max(f64::MIN_POSITIVE);
+            let e = run.last_rev[i]
+                .iter()
+                .zip(&run.last_rev[j])
+                .map(|(a, b)| (a - b).abs() / scale)
+                .fold(0.0f64, |m, x| if x.is_nan() { f64::NAN } else { m.max(x) });
+            if e.is_nan() || e > worst.0 || k == 0 {
+                worst = (e, ROOT_CHANNELS[k].to_string());
+            }
+        }
+        run.loads_check = Some(EquilibriumCheck {
+            max_rel_error: worst.0,
+            channel: worst.1,
+            tolerance: EQUILIBRIUM_TOL,
+            passed: worst.0 <= EQUILIBRIUM_TOL,
+        });
+    }
+    // the check channels are not outputs
+    let keep: Vec<bool> = run
+        .channel_names
+        .iter()
+        .map(|c| !c.starts_with(CHECK_PREFIX))
+        .collect();
+    let mut k = keep.iter();
+    run.channel_names.retain(|_| *k.next().unwrap_or(&true));
+    let mut k = keep.iter();
+    run.last_rev.retain(|_| *k.next().unwrap_or(&true));
+    let (Some(n), Some(_)) = (blades, root) else {
+        return;
+    };
+    let root: Vec<usize> = ROOT_CHANNELS.iter().filter_map(|c| idx(run, c)).collect();
+    if root.len() != 6 || n == 0 {
+        return;
+    }
+    // blade 0's root loads in the non-rotating frame, then the sum over the blades
+    let m = run.azimuth_deg.len();
+    let mut fixed = vec![vec![0.0; m]; 6];
+    for (i, az) in run.azimuth_deg.iter().enumerate() {
+        let psi = az.to_radians();
+        for part in 0..2 {
+            let v = std::array::from_fn(|c| run.last_rev[root[3 * part + c]][i]);
+            let f = hub::to_fixed(psi, v);
+            for (c, fc) in f.iter().enumerate() {
+                fixed[3 * part + c][i] = *fc;
+            }
+        }
+    }
+    for (c, y) in fixed.iter().enumerate() {
+        run.channel_names.push(HUB_CHANNELS[c].to_string());
+        run.last_rev.push(hub::sum_of_blades(y, n));
+    }
+}
+
+/// Whether `name` is a blade load channel (section, pitch link, root or hub).
+pub fn is_load_channel(name: &str) -> bool {
+    use crate::rotor::deck::SECTION_KINDS;
+    SECTION_KINDS
+        .iter()
+        .any(|(k, _)| name.starts_with(&format!("{k}_r")))
+        || name == crate::rotor::loads::PITCH_LINK_CHANNEL
+        || ROOT_CHANNELS.contains(&name)
+        || HUB_CHANNELS.contains(&name)
+}
+
+/// summary.json `loads`: per load channel mean, half peak-to-peak and harmonics 0-10/rev
+/// (amplitude, phase), and the equilibrium check. Null for a run without load channels.
+pub fn loads_json(r: &ModelRun) -> serde_json::Value {
+    use serde_json::json;
+    let mut channels = serde_json::Map::new();
+    for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
+        if !is_load_channel(name) {
+            continue;
+        }
+        let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        let h = crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, super::N_HARMONICS)
+            .map(|h| {
+                h.iter()
+                    .map(|x| json!({"n_per_rev": x.n, "amplitude": x.amplitude, "phase_deg": x.phase_deg}))
+                    .collect::<Vec<_>>()
+            })
+            .unwrap_or_default();
+        channels.insert(
+            name.clone(),
+            json!({"mean": mean, "half_peak_to_peak": 0.5 * ptp(v), "harmonics": h}),
+        );
+    }
+    if channels.is_empty() {
+        return serde_json::Value::Null;
+    }
+    json!({
+        "channels": channels,
+        "equilibrium_check": r.loads_check,
+    })
+}
