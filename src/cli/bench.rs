@@ -166,16 +166,26 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     );
     out.write("peak_force_vs_velocity.svg", p.to_svg(800, 480)?.as_bytes())?;
     out.finish()?;
-    println!("wrote {}", args.out.display());
+    outln!("wrote {}", args.out.display());
     Ok(())
 }
 
 fn history_csv(h: &History) -> String {
     let mut header = vec!["time_s", "stroke_m", "velocity_m_s", "force_N"];
-    header.extend(h.channel_names.iter().copied());
     let mut cols: Vec<&[f64]> = vec![&h.time_s, &h.stroke_m, &h.velocity_m_s, &h.force_n];
-    cols.extend(h.channels.iter().map(|c| c.as_slice()));
+    push_device_channels(h, &mut header, &mut cols);
     csv_from_columns(&header, &cols)
+}
+
+/// The device's channels after the bench's own, except those the bench already wrote (a
+/// dashpot's only channel is the stroke rate, `velocity_m_s`): no column twice.
+fn push_device_channels<'a>(h: &'a History, header: &mut Vec<&'a str>, cols: &mut Vec<&'a [f64]>) {
+    for (n, c) in h.channel_names.iter().zip(&h.channels) {
+        if !header.contains(n) {
+            header.push(n);
+            cols.push(c);
+        }
+    }
 }
 
 fn channel<'a>(h: &'a History, name: &str) -> Option<&'a [f64]> {
@@ -265,7 +275,7 @@ fn print_table(
     factor: f64,
     opts: IntegratorOptions,
 ) {
-    println!(
+    outln!(
         "{} model, omega {} rad/s, {} cycles x {} steps, {:?} x {} substeps; peaks over the last cycle",
         model.name(),
         args.omega,
@@ -274,7 +284,7 @@ fn print_table(
         opts.scheme,
         opts.substeps
     );
-    println!(
+    outln!(
         "{:>12} {:>12} {:>14} {:>14} {:>12} {:>12}",
         format!("v [{}]", args.velocity_unit),
         "v [m/s]",
@@ -284,7 +294,7 @@ fn print_table(
         "F- [lb]"
     );
     for r in runs {
-        println!(
+        outln!(
             "{:>12.3} {:>12.5} {:>14.1} {:>14.1} {:>12.1} {:>12.1}",
             r.peak_velocity_m_s / factor,
             r.peak_velocity_m_s,
@@ -323,8 +333,7 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
                 header.push("force_measured_N");
                 cols.push(m);
             }
-            header.extend(h.channel_names.iter().copied());
-            cols.extend(h.channels.iter().map(|c| c.as_slice()));
+            push_device_channels(h, &mut header, &mut cols);
             out.write(
                 &format!("replay_{stem}.csv"),
                 csv_from_columns(&header, &cols).as_bytes(),
@@ -352,14 +361,14 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
                 rms
             ));
             match r.rms_error_n {
-                Some(v) => println!(
+                Some(v) => outln!(
                     "{} ({} model): RMS error {:.1} N over {} samples",
                     test.name,
                     model.name(),
                     v,
                     test.time_s.len()
                 ),
-                None => println!(
+                None => outln!(
                     "{} ({} model): no measured force, model force written",
                     test.name,
                     model.name()
@@ -369,6 +378,6 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
     }
     out.write("replay_summary.csv", summary.as_bytes())?;
     out.finish()?;
-    println!("wrote {}", args.out.display());
+    outln!("wrote {}", args.out.display());
     Ok(())
 }

@@ -23,7 +23,7 @@ pub fn run(args: ConvertArgs) -> anyhow::Result<()> {
     };
     if out.ends_with(".mcap") {
         rec.write_mcap(&args.output)?;
-        println!("wrote {out}{label}");
+        outln!("wrote {out}{label}");
     } else {
         let stem = crate::flight::record::CSV_SUFFIXES
             .iter()
@@ -31,7 +31,7 @@ pub fn run(args: ConvertArgs) -> anyhow::Result<()> {
             .unwrap_or(&out)
             .to_string();
         rec.write_csv(std::path::Path::new(&stem))?;
-        println!("wrote {stem}.meta.json, {stem}.airloads.csv, {stem}.damper.csv{label}");
+        outln!("wrote {stem}.meta.json, {stem}.airloads.csv, {stem}.damper.csv{label}");
     }
     Ok(())
 }

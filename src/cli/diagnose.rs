@@ -110,7 +110,7 @@ impl DiagnoseArgs {
 /// Stderr progress of a rotor run, every 5 revolutions.
 fn progress_line(what: &str, rev: usize, revs: usize, m: Option<f64>) {
     if rev.is_multiple_of(5) || rev == revs {
-        eprintln!(
+        errln!(
             "rotorsim diagnose: {what}: revolution {rev}/{revs}, periodicity {}",
             fmt_measure(m)
         );
@@ -147,7 +147,7 @@ fn simulated_measurement(
             rotor_path.display()
         )
     })?;
-    eprintln!(
+    errln!(
         "rotorsim diagnose: {} has no damper stroke: running the rotor {} (physical damper, baseline deck) for {} revolutions x {} steps to simulate it",
         fl.display(),
         rotor_path.display(),
@@ -317,7 +317,7 @@ fn rotor_check(
     let meas = measured
         .as_ref()
         .map_err(|e| anyhow::anyhow!("--rotor-check: {e}"))?;
-    eprintln!(
+    errln!(
         "rotorsim diagnose: rotor check: {} revolutions x {} steps, physical damper, baseline deck and extended deck in parallel",
         opts.revs, opts.steps_per_rev
     );
@@ -752,11 +752,11 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     })?;
     out.write("diagnosis.html", html.as_bytes())?;
     out.finish()?;
-    println!("cause: {}", d.cause);
+    outln!("cause: {}", d.cause);
     for (k, v) in &d.parameters {
-        println!("  {k} = {v:.6e}");
+        outln!("  {k} = {v:.6e}");
     }
-    println!(
+    outln!(
         "RMS error: baseline {:.1} N, extended {:.1} N; held-out ({}): baseline {:.1} N, extended {:.1} N, gain {:.3}",
         d.baseline_rms_N,
         d.extended_rms_N,
@@ -765,43 +765,53 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         d.validation.extended_rms_N,
         d.gain
     );
-    println!(
+    outln!(
         "{:<18} {:>3} {:>14} {:>12} {:>14}",
-        "candidate", "k", "BIC", "RMS [N]", "held-out [N]"
+        "candidate",
+        "k",
+        "BIC",
+        "RMS [N]",
+        "held-out [N]"
     );
     for c in &d.candidates {
-        println!(
+        outln!(
             "{:<18} {:>3} {:>14.1} {:>12.1} {:>14.1}",
-            c.cause, c.k, c.bic, c.rms_N, c.held_out_rms_N
+            c.cause,
+            c.k,
+            c.bic,
+            c.rms_N,
+            c.held_out_rms_N
         );
     }
     for l in &d.limitations {
-        println!("limitation: {l}");
+        outln!("limitation: {l}");
     }
     if let Some(s) = &stroke_info {
         if s["kind"] == "simulated" {
-            println!("stroke: {}", s["statement"].as_str().unwrap_or_default());
+            outln!("stroke: {}", s["statement"].as_str().unwrap_or_default());
             if let Some(w) = s.get("warning") {
-                println!("warning: {}", w.as_str().unwrap_or_default());
+                outln!("warning: {}", w.as_str().unwrap_or_default());
             }
         }
     }
     if let Some(c) = &check {
-        println!("{}", c.statement);
-        println!(
+        outln!("{}", c.statement);
+        outln!(
             "{:<52} {:>14} {:>14}  change",
-            "rotor check", "baseline", "extended"
+            "rotor check",
+            "baseline",
+            "extended"
         );
         for row in &c.rows {
-            println!("{:<52} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
+            outln!("{:<52} {:>14} {:>14}  {}", row[0], row[1], row[2], row[3]);
         }
     }
-    println!(
+    outln!(
         "wrote {}/diagnosis.json and diagnosis.html",
         args.out.display()
     );
     if let Some(p) = &args.write_deck {
-        println!("wrote extended deck {}", p.display());
+        outln!("wrote extended deck {}", p.display());
     }
     Ok(())
 }

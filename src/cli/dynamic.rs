@@ -73,7 +73,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
             rows.push(solver.sensor_values());
         }
         if k % (nsteps / 20).max(1) == 0 {
-            eprintln!(
+            errln!(
                 "t = {:.6} s ({:3.0} %), {} Newton iterations so far",
                 solver.state.t,
                 100.0 * k as f64 / nsteps as f64,
@@ -119,7 +119,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
             args.out.display()
         );
     }
-    println!(
+    outln!(
         "dynamic: {} steps of {h} s, {} Newton iterations ({:.2} per step), {elapsed:.2} s wall",
         solver.steps,
         solver.total_iterations,

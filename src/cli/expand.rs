@@ -55,6 +55,6 @@ pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
         }),
         ..Default::default()
     });
-    print!("{text}");
+    out!("{text}");
     Ok(())
 }

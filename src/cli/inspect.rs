@@ -13,7 +13,7 @@ pub struct InspectArgs {
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
     // The error names the file, line or channel already.
     let rec = FlightRecord::read(&args.record)?;
-    print!("{}", summary(&rec, &args.record.display().to_string()));
+    out!("{}", summary(&rec, &args.record.display().to_string()));
     Ok(())
 }
 

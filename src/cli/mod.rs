@@ -1,6 +1,62 @@
 //! Command line interface: one file per subcommand, each with its own clap `Args` and `run`.
+//!
+//! Everything printed goes through [`outln!`] / [`errln!`]: a closed or full standard output or
+//! error never panics. A reader that went away (broken pipe, `rotorsim ... | head`) is not an
+//! error; any other failure to write standard output (a full disk) fails the command at the end
+//! with the reason, since what it printed is lost.
 use clap::{Parser, Subcommand};
+use std::io::Write as _;
 use std::process::ExitCode;
+use std::sync::Mutex;
+
+/// The first failure to write standard output other than a broken pipe.
+static STDOUT_ERROR: Mutex<Option<std::io::Error>> = Mutex::new(None);
+
+#[doc(hidden)]
+pub fn write_stdout(args: std::fmt::Arguments<'_>, newline: bool) {
+    let mut o = std::io::stdout().lock();
+    let r = o
+        .write_fmt(args)
+        .and_then(|_| if newline { o.write_all(b"\n") } else { Ok(()) })
+        .and_then(|_| o.flush());
+    if let Err(e) = r {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            if let Ok(mut slot) = STDOUT_ERROR.lock() {
+                slot.get_or_insert(e);
+            }
+        }
+    }
+}
+
+#[doc(hidden)]
+pub fn write_stderr(args: std::fmt::Arguments<'_>, newline: bool) {
+    // nowhere left to report a failure to write the error stream
+    let mut e = std::io::stderr().lock();
+    let _ = e
+        .write_fmt(args)
+        .and_then(|_| if newline { e.write_all(b"\n") } else { Ok(()) });
+}
+
+/// `println!` that never panics (see the module documentation).
+macro_rules! outln {
+    () => { $crate::cli::write_stdout(format_args!(""), true) };
+    ($($t:tt)*) => { $crate::cli::write_stdout(format_args!($($t)*), true) };
+}
+/// `print!` that never panics.
+#[allow(unused_macros)]
+macro_rules! out {
+    ($($t:tt)*) => { $crate::cli::write_stdout(format_args!($($t)*), false) };
+}
+/// `eprintln!` that never panics.
+macro_rules! errln {
+    () => { $crate::cli::write_stderr(format_args!(""), true) };
+    ($($t:tt)*) => { $crate::cli::write_stderr(format_args!($($t)*), true) };
+}
+/// `eprint!` that never panics.
+#[allow(unused_macros)]
+macro_rules! errout {
+    ($($t:tt)*) => { $crate::cli::write_stderr(format_args!($($t)*), false) };
+}
 
 pub mod bench;
 pub mod convert;
@@ -50,10 +106,16 @@ pub enum Command {
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
+    let r = run(cli);
+    let lost = STDOUT_ERROR.lock().ok().and_then(|mut s| s.take());
+    match (r, lost) {
+        (Ok(()), None) => ExitCode::SUCCESS,
+        (Ok(()), Some(e)) => {
+            errln!("error: cannot write standard output: {e} (what it printed is lost)");
+            ExitCode::FAILURE
+        }
+        (Err(e), _) => {
+            errln!("error: {e:#}");
             ExitCode::FAILURE
         }
     }

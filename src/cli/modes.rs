@@ -108,9 +108,9 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
                 return Err(e.into());
             }
         };
-        println!("Omega = {sp} rad/s");
+        outln!("Omega = {sp} rad/s");
         for (i, m) in ms.iter().enumerate() {
-            println!(
+            outln!(
                 "  mode {:>2}: {:>12.6} Hz  {:<8} damping {:.2e}",
                 i + 1,
                 m.freq_hz,
@@ -303,13 +303,17 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     out.write("modes.csv", csv_string(&mh, &mrows).as_bytes())?;
     // comparison with the reference at the speeds it has
     let mut cmp = vec![];
-    println!(
+    outln!(
         "rotor {}: damper as lag-hinge spring/damper (stroke = arm x lag)",
         path.display()
     );
-    println!(
+    outln!(
         "{:>6} {:>9} {:>10} {:>10} {:>8}",
-        "x", "mode", "model_Hz", "ref_Hz", "err_%"
+        "x",
+        "mode",
+        "model_Hz",
+        "ref_Hz",
+        "err_%"
     );
     if let Some(rf) = &reference {
         for p in &pts {
@@ -334,9 +338,13 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
         text.push_str("# mode_index: 0 lag1, 1 flap1, 2 flap2, 3 flap3, 4 torsion1\n");
         out.write("fan_comparison.csv", text.as_bytes())?;
         for c in &cmp {
-            println!(
+            outln!(
                 "{:>6.2} {:>9} {:>10.4} {:>10.4} {:>8.2}",
-                c.0, TRACKED[c.1], c.2, c.3, c.4
+                c.0,
+                TRACKED[c.1],
+                c.2,
+                c.3,
+                c.4
             );
         }
     }
@@ -366,6 +374,6 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     }
     out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
     out.finish()?;
-    println!("wrote {}", args.out.display());
+    outln!("wrote {}", args.out.display());
     Ok(())
 }

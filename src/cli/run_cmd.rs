@@ -222,7 +222,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     let measured = Measured::from_record(&record);
     let out = OutDir::create(&args.out)?;
     let tty = std::io::stderr().is_terminal();
-    eprintln!(
+    errln!(
         "rotorsim run: {} model(s) {}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
         models.len(),
         models
@@ -389,7 +389,7 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                     .ok()
                 });
                 let t = r.timing;
-                println!(
+                outln!(
                     "{:<22} residual {} ({}, {} revs, {}){}  wall {:.1} s (structure {:.1} s, hydraulics {:.1} s)",
                     r.label,
                     fmt_measure(r.last_measure()),
@@ -406,26 +406,26 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
                     t.hydraulics_s
                 );
                 if let Some(c) = r.loads_check.as_ref().filter(|c| !c.passed) {
-                    println!(
+                    outln!(
                         "warning: {}: blade root loads differ from the resultant of the applied, inertial, damper and pitch-link loads by {:.2e} of {}'s peak-to-peak (above {:.1e}): the structural solution is not in equilibrium to the accuracy the loads need",
                         r.label, c.max_rel_error, c.channel, c.tolerance
                     );
                 }
                 if !r.converged() {
-                    println!(
+                    outln!(
                         "warning: {}: {}",
                         r.label,
                         summary::periodicity_statement(r)
                     );
                 }
             }
-            Err(e) => println!("{:<22} FAILED: {e}", o.model.name()),
+            Err(e) => outln!("{:<22} FAILED: {e}", o.model.name()),
         }
     }
     if let Err(note) = measured {
-        println!("note: {note}");
+        outln!("note: {note}");
     }
-    println!(
+    outln!(
         "summary: {}  report: {}",
         out.file("summary.json").display(),
         out.file("report.html").display()

@@ -66,9 +66,9 @@ pub fn run(args: StaticArgs) -> anyhow::Result<()> {
     };
     let result = static_solve(&mut model, &mut st, &opts, |s, n, it, r| {
         if it == 0 {
-            eprintln!("load step {s}/{n}");
+            errln!("load step {s}/{n}");
         }
-        eprintln!("  iteration {it}: residual {r:.3e}");
+        errln!("  iteration {it}: residual {r:.3e}");
     });
     let rep = match result {
         Ok(r) => r,
@@ -115,7 +115,7 @@ pub fn run(args: StaticArgs) -> anyhow::Result<()> {
         "node_names.csv",
         format!("node_index,name\n{names}").as_bytes(),
     )?;
-    println!(
+    outln!(
         "static: {} load steps, Newton iterations per step {:?}, final residual {:.3e}",
         rep.iterations.len(),
         rep.iterations,
@@ -125,13 +125,13 @@ pub fn run(args: StaticArgs) -> anyhow::Result<()> {
         .iter()
         .zip(sensor_values(&model, &st, &lambda_offsets(&model)))
     {
-        println!("  {h:<32} {v}");
+        outln!("  {h:<32} {v}");
     }
     if args.check_tangent {
         let (w, s) = tangent_report(&model, &st, "solved state");
         worst = worst.max(w);
         report.push_str(&s);
-        print!("{report}");
+        out!("{report}");
         out.write("tangent_check.txt", report.as_bytes())?;
         if worst > 1e-5 {
             out.mark_incomplete("tangent check failed")?;

@@ -159,13 +159,18 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<()> {
             }
         })
         .collect();
-    println!(
+    outln!(
         "{:<44} {:<34} {:>14} {:>14} {:>10} {:>8}  pass",
-        "case", "quantity", "computed", "reference", "rel_error", "tol"
+        "case",
+        "quantity",
+        "computed",
+        "reference",
+        "rel_error",
+        "tol"
     );
     for e in &entries {
         let c = &e.check;
-        println!(
+        outln!(
             "{:<44} {:<34} {:>14.6} {:>14.6} {:>10.2e} {:>8}  {}",
             c.case,
             c.quantity,
@@ -190,7 +195,7 @@ pub fn run(args: VerifyArgs) -> anyhow::Result<()> {
             args.out.join("verify.json").display()
         );
     }
-    println!("all {} checks pass", entries.len());
+    outln!("all {} checks pass", entries.len());
     out.finish()?;
     Ok(())
 }

@@ -97,12 +97,7 @@ pub fn bend45(n_elem: usize) -> Result<Vec<BendResult>, String> {
             ..Default::default()
         };
         prev = f / 600.0;
-        static_solve(&mut m, &mut st, &opts, |s, n, it, r| {
-            if std::env::var("DBG").is_ok() {
-                eprintln!("step {s}/{n} it {it} r {r:.3e}")
-            }
-        })
-        .map_err(|e| e.to_string())?;
+        static_solve(&mut m, &mut st, &opts, |_, _, _, _| {}).map_err(|e| e.to_string())?;
         out.push((f, st.x[tip], rf));
     }
     Ok(out)
