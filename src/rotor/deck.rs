@@ -255,6 +255,65 @@ impl RotorSpec {
             }
         };
         pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
+        if self.rotor.blades == 0 {
+            return Err(bad("rotor.blades", "expected at least 1 blade"));
+        }
+        for (key, sec) in [
+            (
+                "retention.segment1.section",
+                &self.retention.segment1.section,
+            ),
+            (
+                "retention.segment2.section",
+                &self.retention.segment2.section,
+            ),
+            (
+                "retention.segment3.section",
+                &self.retention.segment3.section,
+            ),
+            (
+                "pitch_control.link_section",
+                &self.pitch_control.link_section,
+            ),
+        ] {
+            sec.check().map_err(|(k, what)| {
+                let v = toml::Value::try_from(sec)
+                    .ok()
+                    .and_then(|t| t.get(k).cloned())
+                    .map_or("?".to_string(), |v| v.to_string());
+                bad(
+                    &format!("{key}.{k}"),
+                    &format!("expected {what}, found {v}"),
+                )
+            })?;
+        }
+        for (key, seg) in [
+            ("retention.segment1.damping_mu_s", &self.retention.segment1),
+            ("retention.segment2.damping_mu_s", &self.retention.segment2),
+            ("retention.segment3.damping_mu_s", &self.retention.segment3),
+        ] {
+            nonneg(key, seg.damping_mu_s)?;
+        }
+        if self.pitch_control.horn_tip_m.iter().any(|v| !v.is_finite()) {
+            return Err(bad(
+                "pitch_control.horn_tip_m",
+                &format!(
+                    "expected three finite coordinates, found {:?}",
+                    self.pitch_control.horn_tip_m
+                ),
+            ));
+        }
+        if let Some(p) = self
+            .blade
+            .twist_deg
+            .iter()
+            .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(bad(
+                "blade.twist_deg",
+                &format!("expected finite [r_m, deg] pairs, found {p:?}"),
+            ));
+        }
         pos("rotor.radius_m", self.rotor.radius_m)?;
         let r = &self.retention;
         pos("retention.hinge_r_m", r.hinge_r_m)?;

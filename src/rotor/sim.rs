@@ -324,11 +324,7 @@ pub fn build_sim(
     const STEPS: usize = 8;
     for k in 0..=STEPS {
         scale.store((k as f64 / STEPS as f64).to_bits(), Ordering::Relaxed);
-        static_solve(&mut model, &mut st, &sopts, |a, b, c, d| {
-            if std::env::var_os("ROTORSIM_DEBUG").is_some() {
-                eprintln!("static step {k}: {a} {b} {c} {d:e}")
-            }
-        })
+        static_solve(&mut model, &mut st, &sopts, |_, _, _, _| {})
         .map_err(|e| {
             anyhow::anyhow!(
                 "rotating equilibrium at t = 0 under {:.0}% of the mean airloads (initial state): {e}",

@@ -92,6 +92,46 @@ pub struct SectionProps {
 }
 
 impl SectionProps {
+    /// The first value that is not physical, as (key, what was expected): stiffnesses finite
+    /// and positive, mass and inertias finite and non-negative, offsets finite.
+    pub fn check(&self) -> Result<(), (&'static str, &'static str)> {
+        for (k, v) in [
+            ("EA_N", self.ea),
+            ("GA2_N", self.ga2),
+            ("GA3_N", self.ga3),
+            ("GJ_Nm2", self.gj),
+            ("EI2_Nm2", self.ei2),
+            ("EI3_Nm2", self.ei3),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err((k, "a finite positive stiffness"));
+            }
+        }
+        for (k, v) in [
+            ("m_kg_per_m", self.m),
+            ("I1_kgm", self.i1),
+            ("I2_kgm", self.i2),
+            ("I3_kgm", self.i3),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((k, "a finite non-negative mass or inertia"));
+            }
+        }
+        for (k, v) in [
+            ("cm2_m", self.cm2),
+            ("cm3_m", self.cm3),
+            ("sc2_m", self.sc2),
+            ("sc3_m", self.sc3),
+            ("ca2_m", self.ca2),
+            ("ca3_m", self.ca3),
+        ] {
+            if !v.is_finite() {
+                return Err((k, "a finite offset"));
+            }
+        }
+        Ok(())
+    }
+
     fn as_array(&self) -> [f64; 17] {
         [
             self.s_m, self.ea, self.ei2, self.ei3, self.gj, self.ga2, self.ga3, self.m, self.i1,

@@ -1,0 +1,142 @@
+//! Inputs that used to slip through: the rigid-blade reduction checks the record against the
+//! deck as the elastic model does, and its Newton loop does not call a tiny update with a large
+//! residual converged.
+use std::path::PathBuf;
+use std::process::Command;
+
+mod support;
+use support::tmp;
+
+fn repo(p: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+fn rotorsim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn rigid_reduction_refuses_a_record_of_another_rotor_speed() {
+    let dir = tmp("rigid_speed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let stem = dir.join("rec");
+    let meta = std::fs::read_to_string(repo("flightdata/c8534like.meta.json")).unwrap();
+    let mut j: serde_json::Value = serde_json::from_str(&meta).unwrap();
+    j["rotor_speed_rad_s"] = serde_json::json!(25.0);
+    std::fs::write(stem.with_extension("meta.json"), j.to_string()).unwrap();
+    for ext in ["airloads.csv", "damper.csv"] {
+        let src = repo(&format!("flightdata/c8534like.{ext}"));
+        if src.exists() {
+            std::fs::copy(src, dir.join(format!("rec.{ext}"))).unwrap();
+        }
+    }
+    let out = dir.join("out");
+    let o = rotorsim(&[
+        "run",
+        "--model",
+        "rigid",
+        "--flight",
+        stem.to_str().unwrap(),
+        "--revs",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("rotor speed 25 rad/s differs from the rotor deck's 27 rad/s"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_device_stiff_beyond_sense_fails_with_time_iteration_and_residual() {
+    // bulk_alpha = 1e-30 /Pa: an oil column 1e20 times stiffer than oil; every Newton update
+    // is tiny, the residual is not
+    let dir = tmp("rigid_stiff");
+    std::fs::create_dir_all(&dir).unwrap();
+    let deck = repo("rotors/uh60a.toml");
+    let text = std::fs::read_to_string(&deck)
+        .unwrap()
+        .replace("bulk_alpha_per_Pa = 6.667e-10", "bulk_alpha_per_Pa = 1e-30")
+        .replace(
+            "sections_csv = \"data/",
+            &format!("sections_csv = \"{}/", repo("rotors/data").display()),
+        );
+    assert!(text.contains("1e-30"));
+    let p = dir.join("stiff.toml");
+    std::fs::write(&p, text).unwrap();
+    let out = dir.join("out");
+    let o = rotorsim(&[
+        "run",
+        "--model",
+        "rigid",
+        "--rotor",
+        p.to_str().unwrap(),
+        "--flight",
+        repo("flightdata/c8534like").to_str().unwrap(),
+        "--damper",
+        "physical",
+        "--revs",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success(),
+        "a stiff device must not pass as periodic"
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("did not converge")
+            && e.contains("t = ")
+            && e.contains("iterations")
+            && e.contains("residual"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn rotor_deck_values_are_checked_with_the_key_named() {
+    let base = std::fs::read_to_string(repo("rotors/uh60a.toml")).unwrap();
+    for (from, to, key) in [
+        ("blades = 4 ", "blades = 0 ", "rotor.blades"),
+        (
+            "horn_tip_m = [0.381, 0.20, 0.0]",
+            "horn_tip_m = [nan, 0.20, 0.0]",
+            "pitch_control.horn_tip_m",
+        ),
+        ("[1.68344, 9.823]", "[1.68344, nan]", "blade.twist_deg"),
+        (
+            "segment1 = { elements = 3, section = { EA_N = 5.0e9",
+            "segment1 = { elements = 3, section = { EA_N = -5.0e9",
+            "retention.segment1.section.EA_N",
+        ),
+        (
+            "m_kg_per_m = 47.4, I1_kgm = 0.08",
+            "m_kg_per_m = 47.4, I1_kgm = -0.08",
+            "retention.segment2.section.I1_kgm",
+        ),
+        (
+            "link_section = { EA_N = 9.0e5",
+            "link_section = { EA_N = nan",
+            "pitch_control.link_section.EA_N",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let text = base.replacen(from, to, 1);
+        let e = rotorsim::rotor::deck::RotorSpec::parse(&text, "x/uh60a.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x/uh60a.toml") && e.contains(key) && e.contains("expected"),
+            "{to}: {e}"
+        );
+    }
+}
