@@ -140,3 +140,33 @@ fn rotor_deck_values_are_checked_with_the_key_named() {
         );
     }
 }
+
+#[test]
+fn metadata_that_describes_the_data_must_agree_with_it() {
+    let dir = tmp("meta_agrees");
+    std::fs::create_dir_all(&dir).unwrap();
+    let meta = std::fs::read_to_string(repo("flightdata/c8534like.meta.json")).unwrap();
+    assert!(meta.contains("\"azimuths_per_revolution\": 256"));
+    for ext in ["airloads.csv", "damper.csv"] {
+        let src = repo(&format!("flightdata/c8534like.{ext}"));
+        if src.exists() {
+            std::fs::copy(src, dir.join(format!("r.{ext}"))).unwrap();
+        }
+    }
+    std::fs::write(
+        dir.join("r.meta.json"),
+        meta.replace(
+            "\"azimuths_per_revolution\": 256",
+            "\"azimuths_per_revolution\": 251",
+        ),
+    )
+    .unwrap();
+    let o = rotorsim(&["inspect", dir.join("r").to_str().unwrap()]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("r.meta.json") && e.contains("azimuths_per_revolution") && e.contains("256"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

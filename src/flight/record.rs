@@ -468,6 +468,24 @@ impl AirloadAssembler {
     }
 }
 
+/// Metadata keys that describe the data must agree with it: `azimuths_per_revolution` and
+/// `revolutions` (extension keys of the shipped record), when present, are the airload grid's.
+fn meta_agrees(meta: &FlightMeta, n_az: usize, n_rev: usize) -> Result<(), String> {
+    for (key, n, what) in [
+        ("azimuths_per_revolution", n_az, "azimuths per revolution"),
+        ("revolutions", n_rev, "revolutions"),
+    ] {
+        if let Some(v) = meta.raw.get(key) {
+            if v.as_u64() != Some(n as u64) {
+                return Err(format!(
+                    "meta key `{key}` = {v}, but the airloads have {n} {what}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 impl FlightRecord {
     /// Builds a record from full-grid arrays (index `(i_rev * n_az + i_az) * n_st + i_st`),
     /// checking grids, values and damper samples.
@@ -516,6 +534,7 @@ impl FlightRecord {
         {
             return Err(inv("azimuths must increase strictly within [0, 360)".into()));
         }
+        meta_agrees(&meta, azimuths_deg.len(), revolutions.len()).map_err(inv)?;
         if !revolutions.windows(2).all(|w| w[0] < w[1]) {
             return Err(inv("revolutions must increase strictly".into()));
         }
@@ -765,10 +784,20 @@ impl FlightRecord {
     /// Reads a record: an MCAP file, a CSV stem (`flightdata/c8534like`), or any one of the
     /// three CSV files of the triple.
     pub fn read(path: &Path) -> Result<Self, FlightError> {
-        match resolve(path)? {
-            Form::Mcap(p) => super::mcap::read_mcap(&p),
-            Form::Csv(stem) => super::csv::read_csv(&stem),
-        }
+        let (rec, meta_file) = match resolve(path)? {
+            Form::Mcap(p) => (super::mcap::read_mcap(&p)?, p),
+            Form::Csv(stem) => {
+                let m = PathBuf::from(format!("{}.meta.json", stem.display()));
+                (super::csv::read_csv(&stem)?, m)
+            }
+        };
+        meta_agrees(&rec.meta, rec.azimuths.len(), rec.revolutions.len()).map_err(|msg| {
+            FlightError::Invalid {
+                path: meta_file,
+                msg,
+            }
+        })?;
+        Ok(rec)
     }
 
     /// Writes the CSV triple `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (SI).
