@@ -170,3 +170,31 @@ fn metadata_that_describes_the_data_must_agree_with_it() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_missing_metadata_file_or_record_is_named() {
+    let dir = tmp("missing_meta");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        repo("flightdata/c8534like.airloads.csv"),
+        dir.join("r.airloads.csv"),
+    )
+    .unwrap();
+    let o = rotorsim(&["inspect", dir.join("r").to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("r.meta.json is missing"),
+        "{e}"
+    );
+    let o = rotorsim(&["inspect", dir.join("nothing").to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("no such file or record"),
+        "{e}"
+    );
+    // a cause is not printed twice
+    let o = rotorsim(&["inspect", dir.join("r.airloads.csv").to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(e.matches("os error 2").count(), 1, "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

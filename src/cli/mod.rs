@@ -115,10 +115,27 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
         (Err(e), _) => {
-            errln!("error: {e:#}");
+            errln!("error: {}", error_chain(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes, `: `-separated, without repeating a cause that a message already
+/// quotes (many errors show their source in their own message).
+pub fn error_chain(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if out.contains(&c) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&c);
+    }
+    out
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {

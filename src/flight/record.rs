@@ -959,8 +959,27 @@ pub(crate) fn resolve(path: &Path) -> Result<Form, FlightError> {
             }
         }
     }
+    let present: Vec<String> = [".airloads.csv", ".damper.csv"]
+        .iter()
+        .map(|suf| with(suf))
+        .filter(|p| p.exists())
+        .map(|p| p.display().to_string())
+        .collect();
+    let msg = if !present.is_empty() {
+        format!(
+            "{} is missing: a CSV record is the triple STEM.meta.json, STEM.airloads.csv, STEM.damper.csv, and only {} is there",
+            with(".meta.json").display(),
+            present.join(" and ")
+        )
+    } else if !path.exists() {
+        format!(
+            "no such file or record: neither {s}, {s}.meta.json nor {s}.mcap exists (expected an MCAP file, a CSV stem or one of its three files)"
+        )
+    } else {
+        "expected an MCAP file (.mcap), a stem STEM with STEM.meta.json, STEM.airloads.csv, STEM.damper.csv, or one of those three files".into()
+    };
     Err(FlightError::NotARecord {
         path: path.to_path_buf(),
-        msg: "expected an MCAP file (.mcap), a stem STEM with STEM.meta.json, STEM.airloads.csv, STEM.damper.csv, or one of those three files".into(),
+        msg,
     })
 }
