@@ -171,6 +171,20 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
             c[side]["metrics"]["rms_error"]
         );
         assert!(!out.join(format!("rotor_check/{side}/INCOMPLETE")).exists());
+        // A nested result folder: its own manifest, listed in the parent's.
+        let m = read_json(&out.join(format!("rotor_check/{side}/manifest.json")));
+        assert_eq!(m["complete"], true);
+        assert!(m["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|o| o["path"] == "summary.json"));
+        let parent = read_json(&out.join("manifest.json"));
+        assert!(parent["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|o| o["path"] == format!("rotor_check/{side}/manifest.json")));
     }
     // The change is the difference of the two, and the gain its relative form.
     let b = c["baseline"]["metrics"]["rms_error"].as_f64().unwrap();

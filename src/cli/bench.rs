@@ -105,7 +105,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         cycles: args.cycles,
         steps_per_cycle: args.steps_per_cycle,
     };
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, std::slice::from_ref(&args.deck))?;
     let mut all = Vec::new();
     for (model, dev) in &devices {
         let mut runs = Vec::with_capacity(sweep.peak_velocities_m_s.len());
@@ -313,7 +313,10 @@ fn run_replay(args: &BenchArgs, devices: &[(DamperModel, Box<dyn Device>)]) -> a
         .iter()
         .map(|p| bench::read_bench_csv(p))
         .collect::<Result<Vec<_>, _>>()?;
-    let out = OutDir::create(&args.out)?;
+    let inputs: Vec<PathBuf> = std::iter::once(args.deck.clone())
+        .chain(args.measured.iter().cloned())
+        .collect();
+    let out = OutDir::create(&args.out, &inputs)?;
     let mut summary = String::from("test,model,samples,rms_error_N\n");
     for (model, dev) in devices {
         for test in &tests {

@@ -353,11 +353,11 @@ fn rotor_check(
         (
             "extended",
             &runs.extended,
-            extended_path.display().to_string(),
-            cmd(Some(extended_path)),
+            out.published_path(extended_path).display().to_string(),
+            cmd(Some(&out.published_path(extended_path))),
         ),
     ] {
-        let sub = OutDir::create(&out.file("rotor_check").join(which))?;
+        let sub = out.sub_dir(&format!("rotor_check/{which}"))?;
         let outcome = ModelOutcome {
             model: crate::hydraulics::DamperModel::Physical,
             result: res.clone(),
@@ -688,7 +688,18 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     };
     let outcome = diagnose::diagnose(&deck, &data, &opts)?;
     let d = &outcome.diagnosis;
-    let out = OutDir::create(&args.out)?;
+    let mut inputs: Vec<PathBuf> = args.deck.iter().cloned().collect();
+    if let Some(r) = &args.rotor {
+        match crate::rotor::RotorDeck::from_file(r) {
+            Ok(d) => inputs.extend(d.input_files()),
+            Err(_) => inputs.push(r.clone()), // read as a damper deck only
+        }
+    }
+    if let Some(fl) = &args.flight {
+        inputs.extend(FlightRecord::files(fl)?);
+    }
+    inputs.extend(args.measured.iter().cloned());
+    let out = OutDir::create(&args.out, &inputs)?;
     let deck_text = format!(
         "# Extended damper deck written by `rotorsim diagnose` (cause: {}), from {}\n{}",
         d.cause,

@@ -38,7 +38,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
     }
     let mut st = State::from_model(&model);
     check_constraints(&mut model, &st).map_err(|e| anyhow::anyhow!("deck {file}: {e}"))?;
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, std::slice::from_ref(&args.deck))?;
     if dy.start_from_static {
         let opts = StaticOptions {
             load_steps: deck.statics.load_steps,

@@ -64,7 +64,7 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
     let file = path.display().to_string();
     let st0 = State::from_model(&model);
     check_constraints(&mut model, &st0).map_err(|e| anyhow::anyhow!("deck {file}: {e}"))?;
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, std::slice::from_ref(&path))?;
     let md = &deck.modes;
     let axis = md.axis;
     let na = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
@@ -227,18 +227,24 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     use crate::rotor::fan::{fan, read_reference, TRACKED};
     let deck = crate::rotor::RotorDeck::from_file(path)?;
     let fractions = parse_speeds(&args.speeds)?;
+    let mut inputs = deck.input_files();
     let reference = match &args.reference {
-        Some(p) => Some(read_reference(p)?),
+        Some(p) => {
+            inputs.push(p.clone());
+            Some(read_reference(p)?)
+        }
         None => {
             let p = default_reference(path);
             if p.exists() {
-                Some(read_reference(&p)?)
+                let r = read_reference(&p)?;
+                inputs.push(p);
+                Some(r)
             } else {
                 None
             }
         }
     };
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, &inputs)?;
     let pts = match fan(&deck, &fractions, args.count.max(5)) {
         Ok(p) => p,
         Err(e) => {

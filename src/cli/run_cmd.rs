@@ -220,7 +220,23 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         }
     };
     let measured = Measured::from_record(&record);
-    let out = OutDir::create(&args.out)?;
+    let mut inputs = FlightRecord::files(&args.flight)?;
+    match (&rotor, &args.damper_deck) {
+        (Some(r), _) => inputs.extend(r.input_files()),
+        (None, None) => inputs.push(args.rotor.clone()),
+        (None, Some(_)) => {}
+    }
+    inputs.extend(args.damper_deck.clone());
+    match &args.initial_state {
+        Some(p) if p.is_dir() => inputs.extend(
+            models
+                .iter()
+                .map(|m| p.join(m.name()).join("periodic_state.json")),
+        ),
+        Some(p) => inputs.push(p.clone()),
+        None => {}
+    }
+    let out = OutDir::create(&args.out, &inputs)?;
     let tty = std::io::stderr().is_terminal();
     errln!(
         "rotorsim run: {} model(s) {}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",

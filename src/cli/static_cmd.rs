@@ -47,7 +47,7 @@ pub fn run(args: StaticArgs) -> anyhow::Result<()> {
     let mut st = State::from_model(&model);
     check_constraints(&mut model, &st)
         .map_err(|e| anyhow::anyhow!("deck {}: {e}", args.deck.display()))?;
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, std::slice::from_ref(&args.deck))?;
     let mut worst: f64 = 0.0;
     let mut report = String::new();
     if args.check_tangent {

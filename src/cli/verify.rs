@@ -136,7 +136,7 @@ fn suite() -> Result<Vec<(Check, f64)>, String> {
 }
 
 pub fn run(args: VerifyArgs) -> anyhow::Result<()> {
-    let out = OutDir::create(&args.out)?;
+    let out = OutDir::create(&args.out, &[])?;
     let checks = match suite() {
         Ok(c) => c,
         Err(e) => {

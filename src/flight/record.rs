@@ -800,6 +800,19 @@ impl FlightRecord {
         Ok(rec)
     }
 
+    /// The files [`FlightRecord::read`] reads for `path`: the MCAP file, or the CSV triple of
+    /// the stem (those that exist).
+    pub fn files(path: &Path) -> Result<Vec<PathBuf>, FlightError> {
+        Ok(match resolve(path)? {
+            Form::Mcap(p) => vec![p],
+            Form::Csv(stem) => CSV_SUFFIXES
+                .iter()
+                .map(|suf| PathBuf::from(format!("{}{suf}", stem.to_string_lossy())))
+                .filter(|p| p.is_file())
+                .collect(),
+        })
+    }
+
     /// Writes the CSV triple `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (SI).
     pub fn write_csv(&self, stem: &Path) -> Result<(), FlightError> {
         super::csv::write_csv(self, stem)

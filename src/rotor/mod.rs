@@ -211,6 +211,11 @@ impl RotorDeck {
             spec,
         })
     }
+    /// The files the deck was read from: the deck and its blade section table.
+    pub fn input_files(&self) -> Vec<std::path::PathBuf> {
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        vec![self.path.clone(), dir.join(&self.spec.blade.sections_csv)]
+    }
     /// The deck's `[damper]` table.
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
         Ok(DamperDeck::from_file(&self.path)?)
