@@ -13,25 +13,8 @@ use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::{RotorDeck, RunOptions};
 use std::path::Path;
 
-fn cpu_s() -> f64 {
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes one timespec to a valid pointer.
-    unsafe { clock_gettime(3, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-#[repr(C)]
-struct Timespec {
-    tv_sec: i64,
-    tv_nsec: i64,
-}
-
-extern "C" {
-    fn clock_gettime(clk: i32, tp: *mut Timespec) -> i32;
-}
+mod support;
+use support::cpu_s;
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

@@ -17,29 +17,11 @@ use rotorsim::solver::NewtonMethod;
 use std::path::Path;
 use std::time::Instant;
 
+mod support;
+use support::cpu_s;
+
 const DEFAULT_REVS: usize = 75;
 const STEPS: usize = 256;
-
-/// CPU time of the calling thread [s] (CLOCK_THREAD_CPUTIME_ID).
-fn cpu_s() -> f64 {
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes one timespec to a valid pointer.
-    unsafe { clock_gettime(3, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-#[repr(C)]
-struct Timespec {
-    tv_sec: i64,
-    tv_nsec: i64,
-}
-
-extern "C" {
-    fn clock_gettime(clk: i32, tp: *mut Timespec) -> i32;
-}
 
 fn time_model(
     name: &str,

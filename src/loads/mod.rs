@@ -323,6 +323,19 @@ pub fn element_on_node(
     })
 }
 
+/// Applied minus inertial load of one element's densities (its quadrature), the moment about
+/// `about`.
+pub fn densities_resultant(d: &[PointDensity; NPTS_M], about: [f64; 3]) -> Resultant {
+    let mut out = Resultant::default();
+    for p in d {
+        let f = fmul(-p.weight_m, p.force_n_per_m);
+        let m = fmul(-p.weight_m, p.moment_nm_per_m);
+        out.force = add(out.force, f);
+        out.moment = add(out.moment, add(m, cross(sub(p.x, about), f)));
+    }
+    out
+}
+
 /// Applied minus inertial loads of the beams and rigid bodies `elems` (gravity included),
 /// the moment about `about`: what those bodies receive besides the forces of the elements
 /// joined to them.
@@ -337,12 +350,10 @@ pub fn applied_and_inertial(
     for &ei in elems {
         match model.elements.get(ei).ok_or(LoadsError::NoElement(ei))? {
             Element::Beam(b) => {
-                for p in b.point_densities(&beam_kin(b, st), ctx) {
-                    let f = fmul(-p.weight_m, p.force_n_per_m);
-                    let m = fmul(-p.weight_m, p.moment_nm_per_m);
-                    out.force = add(out.force, f);
-                    out.moment = add(out.moment, add(m, cross(sub(p.x, about), f)));
-                }
+                out = out.add(&densities_resultant(
+                    &b.point_densities(&beam_kin(b, st), ctx),
+                    about,
+                ));
             }
             Element::Rigid(b) => {
                 let mut r = [0.0; 6];

@@ -262,12 +262,7 @@ impl LoadChannels {
         // the pitch link's pull on the horn
         let mut body = loads::applied_and_inertial(m, st, &ctx, &self.rigid, xh)?;
         for e in data.iter() {
-            for p in &e.d {
-                let f = fmul(-p.weight_m, p.force_n_per_m);
-                let mo = fmul(-p.weight_m, p.moment_nm_per_m);
-                body.force = add(body.force, f);
-                body.moment = add(body.moment, add(mo, cross(sub(p.x, xh), f)));
-            }
+            body = body.add(&loads::densities_resultant(&e.d, xh));
         }
         let link =
             loads::element_on_node(m, st, &ctx, &self.lam_off, self.link_joint, self.horn_node)?

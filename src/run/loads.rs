@@ -30,12 +30,7 @@ pub struct EquilibriumCheck {
 }
 
 fn ptp(v: &[f64]) -> f64 {
-    let (lo, hi) = v
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
-            (l.min(*x), h.max(*x))
-        });
-    hi - lo
+    super::summary::Stats::of(v).peak_to_peak
 }
 
 /// Consumes the check channels (computing the equilibrium check) and adds the fixed-frame
@@ -123,7 +118,7 @@ pub fn loads_json(r: &ModelRun) -> serde_json::Value {
         if !is_load_channel(name) {
             continue;
         }
-        let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        let st = super::summary::Stats::of(v);
         let h = crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, super::N_HARMONICS)
             .map(|h| {
                 h.iter()
@@ -133,7 +128,7 @@ pub fn loads_json(r: &ModelRun) -> serde_json::Value {
             .unwrap_or_default();
         channels.insert(
             name.clone(),
-            json!({"mean": mean, "half_peak_to_peak": 0.5 * ptp(v), "harmonics": h}),
+            json!({"mean": st.mean, "half_peak_to_peak": 0.5 * st.peak_to_peak, "harmonics": h}),
         );
     }
     if channels.is_empty() {

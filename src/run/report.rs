@@ -623,13 +623,8 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
                 let Some(x) = rest.split('_').next().and_then(|x| x.parse::<f64>().ok()) else {
                     continue;
                 };
-                let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
-                let (lo, hi) = v
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
-                        (l.min(*y), h.max(*y))
-                    });
-                pts.push((x, mean, 0.5 * (hi - lo)));
+                let st = super::summary::Stats::of(v);
+                pts.push((x, st.mean, 0.5 * st.peak_to_peak));
             }
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
