@@ -14,6 +14,8 @@ struct SpringDamper {
     evaluations: usize,
     limit_m: f64,
     force_last: f64,
+    /// Multiplies the tangent: anything but 1 makes it lie.
+    tangent_scale: f64,
 }
 
 impl StepElement for SpringDamper {
@@ -49,7 +51,7 @@ impl StepElement for SpringDamper {
             };
             f[i] = self.k * d + self.c * rate;
         }
-        let kk = self.k + if dt > 0.0 { self.c / dt } else { 0.0 };
+        let kk = (self.k + if dt > 0.0 { self.c / dt } else { 0.0 }) * self.tangent_scale;
         out.force = [f, [-f[0], -f[1], -f[2]]];
         out.jac = [[[[0.0; 3]; 3]; 2]; 2];
         for i in 0..3 {
@@ -73,6 +75,10 @@ impl StepElement for SpringDamper {
 }
 
 fn model_with_spring(k: f64, c: f64, limit: f64) -> (Model, usize) {
+    model_with_spring_tangent(k, c, limit, 1.0)
+}
+
+fn model_with_spring_tangent(k: f64, c: f64, limit: f64, tangent_scale: f64) -> (Model, usize) {
     let (ei, l) = (100.0, 10.0);
     let sec = uniform_section(1e6, 1e6, 100.0, ei, ei, 1.0, 1e-4, 5e-5, 5e-5);
     let (mut m, tip, load) = cantilever(8, l, &sec);
@@ -95,6 +101,7 @@ fn model_with_spring(k: f64, c: f64, limit: f64) -> (Model, usize) {
         evaluations: 0,
         limit_m: limit,
         force_last: 0.0,
+        tangent_scale,
     }))
     .unwrap();
     (m, tip)
@@ -147,9 +154,65 @@ fn step_element_damper_is_committed_once_per_converged_step_and_can_abort() {
     let mut st = State::from_model(&m);
     let r = static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {});
     match r {
-        Err(NewtonError::Element { source, .. }) => assert!(source.msg.contains("exceeds limit")),
+        Err(e @ NewtonError::Element { .. }) => {
+            // the message says where: time, Newton iteration and the last residual norm
+            let msg = e.to_string();
+            let NewtonError::Element {
+                iteration,
+                residual,
+                ref source,
+                ..
+            } = e
+            else {
+                unreachable!()
+            };
+            assert!(source.msg.contains("exceeds limit"), "{msg}");
+            assert!(iteration >= 1 && residual.is_finite(), "{msg}");
+            assert!(
+                msg.contains("at t = ")
+                    && msg.contains(&format!("Newton iteration {iteration}, residual norm")),
+                "{msg}"
+            );
+        }
         other => panic!("expected element error, got {other:?}"),
     }
+}
+
+#[test]
+fn a_tiny_correction_with_a_large_residual_is_not_convergence() {
+    // A tangent 1e16 times too stiff makes every correction ~1e-18 m, below the increment
+    // tolerance, while the residual stays at the 0.05 N of the tip load: the static and the
+    // dynamic Newton loops must both refuse to call that converged.
+    let (mut m, _) = model_with_spring_tangent(0.2, 0.0, 1.0, 1e16);
+    let mut st = State::from_model(&m);
+    match static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {}) {
+        Err(NewtonError::StaticDiverged { residual, .. }) => {
+            assert!(residual > 1e-3, "{residual}")
+        }
+        other => panic!("expected the static solve to fail, got {other:?}"),
+    }
+    let (m, _) = model_with_spring_tangent(0.2, 0.0, 1.0, 1e16);
+    let st = State::from_model(&m);
+    let mut s = DynamicSolver::new(m, st, 0.01, 0.9).unwrap();
+    match s.step() {
+        Err(e @ NewtonError::Diverged { .. }) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("at t = 0.01 s") && msg.contains("residual norm"),
+                "{msg}"
+            )
+        }
+        other => panic!("expected the dynamic step to fail, got {other:?}"),
+    }
+    // the true tangent converges in a few iterations
+    let (mut m, _) = model_with_spring_tangent(0.2, 0.0, 1.0, 1.0);
+    let mut st = State::from_model(&m);
+    let rep = static_solve(&mut m, &mut st, &StaticOptions::default(), |_, _, _, _| {}).unwrap();
+    assert!(
+        rep.iterations.iter().all(|&i| i <= 6),
+        "{:?}",
+        rep.iterations
+    );
 }
 
 /// Uniform distributed force per unit length, global or follower.

@@ -298,6 +298,7 @@ pub fn sdirk_step<const N: usize, const S: usize>(
             Ok(y - base - sys.rhs(ti, y)? * hg)
         };
         let mut g = residual(&yi)?;
+        let g0_norm = wrms(&g, &sys.weights(&yi));
         let mut converged = false;
         let mut last = f64::INFINITY;
         let mut prev: Option<f64> = None;
@@ -352,7 +353,9 @@ pub fn sdirk_step<const N: usize, const S: usize>(
                     theta < 1.0 && theta / (1.0 - theta) * last <= newton.tol
                 }
             };
-            if done {
+            // The correction bounds the error (Hairer & Wanner IV.8); the residual must not
+            // have grown, or a wrong Jacobian could pass off a tiny correction as convergence.
+            if done && wrms(&g, &sys.weights(&yi)) <= g0_norm.max(newton.tol) {
                 converged = true;
                 break;
             }

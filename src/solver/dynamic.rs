@@ -144,6 +144,8 @@ pub struct DynamicSolver {
     /// Residual of the last zero-acceleration predictor evaluated (convergence scale), and
     /// whether the last step refactored.
     pub(super) r_ref: f64,
+    /// Largest reference residual seen: the force scale round-off is measured against.
+    pub(super) r_scale: f64,
     refreshed: bool,
     /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
     pub last_residuals: Vec<f64>,
@@ -218,6 +220,7 @@ impl DynamicSolver {
             prev_vd: vec![],
             prev_lam: vec![],
             r_ref: 0.0,
+            r_scale: 0.0,
             refreshed: false,
             last_residuals: Vec::with_capacity(64),
             state,
@@ -256,7 +259,12 @@ impl DynamicSolver {
                 true,
                 &mut self.res,
             )
-            .map_err(|source| NewtonError::Element { t, source })?;
+            .map_err(|source| NewtonError::Element {
+                t,
+                iteration: 0,
+                residual: f64::NAN,
+                source,
+            })?;
         self.cscale = diag_scale(&self.asm) / h;
         for (l, lp) in self.lam_hat.iter_mut().zip(&self.state.lambda) {
             *l = lp / self.cscale;
@@ -272,6 +280,7 @@ impl DynamicSolver {
         lam_hat: &[f64],
         ctx: &EvalCtx,
         matrix: bool,
+        (iteration, residual): (usize, f64),
     ) -> Result<(), NewtonError> {
         let (cv, ca) = self.coeffs();
         let h = self.h;
@@ -288,7 +297,12 @@ impl DynamicSolver {
                 matrix,
                 &mut self.res,
             )
-            .map_err(|source| NewtonError::Element { t, source })
+            .map_err(|source| NewtonError::Element {
+                t,
+                iteration,
+                residual,
+                source,
+            })
     }
 
     /// Solve `J dq = res` in place with the stored factorization, turned from the shaft angle
@@ -398,6 +412,10 @@ impl DynamicSolver {
             self.shift_predictor(&mut lam_hat, &mut v_new, &mut vd_new, cv, ca);
         }
         self.refreshed = false;
+        // A correction below xtol ends the iterations only where the residual at the corrected
+        // iterate has reached the round-off floor: a tiny update alone is not convergence.
+        let mut tiny = false;
+        let mut r_last = f64::NAN;
         loop {
             // configuration from dq
             for i in 0..n {
@@ -424,11 +442,16 @@ impl DynamicSolver {
             // stored factorization assembles it with the residual; otherwise the residual
             // comes first and the matrix only if the iterate is not converged.
             let mut assembled = modified && !self.have_factor && !(scale_pending && extrapolate);
-            self.assemble_at(t, t_n, &lam_hat, &ctx, assembled)?;
+            self.assemble_at(t, t_n, &lam_hat, &ctx, assembled, (it, r_last))?;
             let rn = norm(&self.res);
             if !rn.is_finite() {
-                return Err(NewtonError::NonFinite { t, iteration: it });
+                return Err(NewtonError::NonFinite {
+                    t,
+                    iteration: it,
+                    residual: r_last,
+                });
             }
+            r_last = rn;
             if self.last_residuals.len() < self.last_residuals.capacity() {
                 self.last_residuals.push(rn);
             }
@@ -436,12 +459,16 @@ impl DynamicSolver {
                 scale_pending = false;
                 r0 = rn;
                 self.r_ref = rn;
+                self.r_scale = self.r_scale.max(rn);
                 if extrapolate && rn > self.newton.rtol * r0 && rn != 0.0 {
                     self.shift_predictor(&mut lam_hat, &mut v_new, &mut vd_new, cv, ca);
                     continue;
                 }
             }
-            if rn <= self.newton.rtol * r0 || rn == 0.0 {
+            if rn <= self.newton.rtol * r0
+                || rn == 0.0
+                || (tiny && rn <= self.newton.floor(self.r_scale.max(r0)))
+            {
                 break;
             }
             if it >= self.newton.max_iterations {
@@ -459,7 +486,7 @@ impl DynamicSolver {
                 || (it > 0 && rn > self.newton.max_contraction * r_prev);
             if refresh {
                 if !assembled {
-                    self.assemble_at(t, t_n, &lam_hat, &ctx, true)?;
+                    self.assemble_at(t, t_n, &lam_hat, &ctx, true, (it, rn))?;
                     assembled = true;
                 }
                 self.asm.factor().map_err(|source| NewtonError::Linear {
@@ -493,19 +520,13 @@ impl DynamicSolver {
             }
             it += 1;
             if !dmax.is_finite() {
-                return Err(NewtonError::NonFinite { t, iteration: it });
+                return Err(NewtonError::NonFinite {
+                    t,
+                    iteration: it,
+                    residual: r_last,
+                });
             }
-            if dmax <= self.newton.xtol * self.size {
-                // final configuration update happens at the top of the loop
-                for i in 0..n {
-                    let th = [h * self.dq[i][3], h * self.dq[i][4], h * self.dq[i][5]];
-                    for k in 0..3 {
-                        x_new[i][k] = self.x_prev[i][k] + h * self.dq[i][k];
-                    }
-                    q_new[i] = update_left(&q_prev[i], th);
-                }
-                break;
-            }
+            tiny = dmax <= self.newton.xtol * self.size;
         }
         // accept
         self.prev_vd.resize(n, [0.0; 6]);
@@ -602,7 +623,12 @@ impl DynamicSolver {
                     true,
                     &mut tmp,
                 )
-                .map_err(|source| NewtonError::Element { t, source })?;
+                .map_err(|source| NewtonError::Element {
+                    t,
+                    iteration: 0,
+                    residual: f64::NAN,
+                    source,
+                })?;
         }
         let b_values = self.asm.values.clone();
         self.asm
@@ -616,7 +642,12 @@ impl DynamicSolver {
                 true,
                 &mut self.res,
             )
-            .map_err(|source| NewtonError::Element { t, source })?;
+            .map_err(|source| NewtonError::Element {
+                t,
+                iteration: 0,
+                residual: f64::NAN,
+                source,
+            })?;
         self.asm.overwrite_rows_from(&b_values, nn);
         for r in self.res.iter_mut().take(nn) {
             *r = -*r;

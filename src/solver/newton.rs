@@ -39,13 +39,24 @@ pub struct NewtonOptions {
     pub max_iterations: usize,
     /// Convergence when ||r|| <= rtol * ||r_0|| (r_0: residual of the predictor / load step).
     pub rtol: f64,
-    /// ... or when the largest configuration correction <= xtol * model size.
+    /// ... or when the largest configuration correction <= xtol * model size and the residual
+    /// is below `floor(r_0)`.
     pub xtol: f64,
     /// Dynamic solver only: full or modified Newton.
     pub method: NewtonMethod,
     /// Modified Newton: the stored matrix is refreshed at the current iterate as soon as an
     /// iteration reduces the residual by less than this factor (contraction-rate rule).
     pub max_contraction: f64,
+}
+
+impl NewtonOptions {
+    /// The residual a correction below `xtol` must reach to end the iterations: sqrt(rtol) of
+    /// the force scale (the largest initial residual of the analysis so far: a later load or
+    /// time step may start at round-off). Below it the update is round-off; above it a tiny
+    /// update means a stiffness beyond sense (or a wrong tangent), not convergence.
+    pub fn floor(&self, scale: f64) -> f64 {
+        self.rtol.sqrt() * scale
+    }
 }
 
 impl Default for NewtonOptions {
@@ -76,16 +87,36 @@ pub enum NewtonError {
         residual: f64,
         initial: f64,
     },
-    #[error("non-finite residual at t = {t} s, iteration {iteration}")]
-    NonFinite { t: f64, iteration: usize },
+    #[error("non-finite residual or correction at t = {t} s, {}", at_iterate(*.iteration, *.residual))]
+    NonFinite {
+        t: f64,
+        iteration: usize,
+        /// Residual norm of the last finite iterate (NaN if none).
+        residual: f64,
+    },
     #[error("at t = {t} s, iteration {iteration}: {source}")]
     Linear {
         t: f64,
         iteration: usize,
         source: LinearError,
     },
-    #[error("at t = {t} s: {source}")]
-    Element { t: f64, source: ElementError },
+    #[error("at t = {t} s, {}: {source}", at_iterate(*.iteration, *.residual))]
+    Element {
+        t: f64,
+        iteration: usize,
+        /// Residual norm of the last iterate (NaN before the first).
+        residual: f64,
+        source: ElementError,
+    },
+}
+
+/// Where a Newton loop stopped: the iteration and, once there is one, the last residual norm.
+fn at_iterate(iteration: usize, residual: f64) -> String {
+    if residual.is_finite() {
+        format!("Newton iteration {iteration}, residual norm {residual:.3e} at the last iterate")
+    } else {
+        format!("Newton iteration {iteration}")
+    }
 }
 
 pub fn norm(v: &[f64]) -> f64 {

@@ -38,6 +38,10 @@ pub struct SolverSnapshot {
     pub prev_acc: Vec<[f64; 6]>,
     pub prev_lambda_scaled: Vec<f64>,
     pub residual_scale: f64,
+    /// Largest reference residual seen (the force scale of the round-off floor); absent in
+    /// older files (then the current step's scale is used).
+    #[serde(default)]
+    pub force_scale: f64,
     /// Tracked (unwrapped) angle of every joint, None for other elements.
     pub joint_angles_rad: Vec<Option<f64>>,
     /// Committed state of every step element (e.g. a hydraulic device).
@@ -128,6 +132,7 @@ impl DynamicSolver {
             },
             prev_lambda_scaled: self.prev_lam.clone(),
             residual_scale: self.r_ref,
+            force_scale: self.r_scale,
             joint_angles_rad: self
                 .model
                 .elements
@@ -229,6 +234,7 @@ impl DynamicSolver {
             self.prev_lam.clear();
         }
         self.r_ref = s.residual_scale;
+        self.r_scale = s.force_scale;
         self.state.kin(&mut self.kin);
         Ok(())
     }
