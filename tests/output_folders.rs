@@ -275,3 +275,84 @@ fn git_commit_is_recorded() {
     assert!(!c.is_empty() && !c.contains(char::is_whitespace), "{c}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn a_killed_dynamic_run_leaves_the_earlier_result_whole_and_its_own_visibly_unfinished() {
+    // A finished dynamic analysis into D, then a long one into D killed mid-run: D is still
+    // the first run's folder, complete and matching its manifest; the killed run's files are
+    // only in its staging sibling, marked INCOMPLETE, never beside `"complete": true`.
+    let root = tmp("outfolders-killed-dynamic");
+    std::fs::create_dir_all(&root).unwrap();
+    // the cantilever's section is inline: the deck can be copied anywhere
+    let text =
+        std::fs::read_to_string(support::root().join("docs/examples/cantilever.toml")).unwrap();
+    let short = root.join("short.toml");
+    std::fs::write(&short, &text).unwrap();
+    let long = root.join("long.toml");
+    let long_text = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("end_time_s") {
+                "end_time_s = 1.0e5".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(long_text.contains("end_time_s = 1.0e5"));
+    std::fs::write(&long, long_text).unwrap();
+    let out = root.join("D");
+    let bin = env!("CARGO_BIN_EXE_rotorsim");
+    ok(&Command::new(bin)
+        .args([
+            "dynamic",
+            short.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap());
+    let before = checked_manifest(&out);
+    assert_eq!(before["complete"], true);
+    let mut child = Command::new(bin)
+        .args([
+            "dynamic",
+            long.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // wait until the run has started writing (its staging sibling exists), then kill it
+    let t0 = std::time::Instant::now();
+    while !names(&root).iter().any(|n| n.starts_with(".D.staging-")) {
+        assert!(t0.elapsed().as_secs() < 60, "no staging folder appeared");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the long run ended early"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(
+        checked_manifest(&out),
+        before,
+        "D is the first run's, unchanged"
+    );
+    let staging: Vec<String> = names(&root)
+        .into_iter()
+        .filter(|n| n.starts_with(".D.staging-"))
+        .collect();
+    assert_eq!(staging.len(), 1, "{staging:?}");
+    let s = root.join(&staging[0]);
+    assert!(s.join("INCOMPLETE").exists());
+    if let Ok(summary) = std::fs::read_to_string(s.join("summary.json")) {
+        assert!(!summary.contains("\"complete\": true"), "{summary}");
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -60,6 +60,17 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     if args.substeps == 0 || args.steps_per_cycle < 4 || args.cycles == 0 {
         bail!("--substeps and --cycles must be >= 1 and --steps-per-cycle >= 4");
     }
+    // per amplitude and model: cycles x steps x sub-steps, every step kept (5 columns)
+    let steps = args.cycles as f64 * args.steps_per_cycle as f64;
+    crate::solver::budget::substeps(steps * args.substeps as f64)
+        .plus(crate::solver::budget::samples(steps, 5.0))
+        .check(
+            &format!(
+                "{} cycles x {} steps x {} sub-steps per amplitude",
+                args.cycles, args.steps_per_cycle, args.substeps
+            ),
+            "check --cycles, --steps-per-cycle and --substeps",
+        )?;
     let opts = IntegratorOptions {
         scheme,
         substeps: args.substeps,

@@ -1,8 +1,9 @@
 //! `rotorsim dynamic`: generalized-alpha time integration of a model deck.
 use crate::io::{csv_string, OutDir};
+use crate::solver::budget;
 use crate::solver::statics::check_constraints;
 use crate::solver::{static_solve, DynamicSolver, State, StaticOptions};
-use crate::structure::deck::load_deck;
+use crate::structure::deck::load_deck_within;
 use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
@@ -18,7 +19,24 @@ pub struct DynamicArgs {
 }
 
 pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
-    let (deck, mut model) = load_deck(&args.deck)?;
+    // Refused before the model is built when beyond sense: 3 Newton iterations a step is
+    // typical (docs/performance.md); kept samples: the time and a channel a node at least.
+    let (deck, mut model) = load_deck_within(&args.deck, |d| {
+        let dy = &d.dynamic;
+        let (Some(h), Some(t_end)) = (dy.time_step_s, dy.end_time_s) else {
+            return Ok(());
+        };
+        let (ndof, nnz) = d.size_estimate();
+        let steps = t_end / h;
+        let rows = steps / dy.output_every.max(1) as f64;
+        budget::time_integration_of(ndof, nnz, steps, 3.0)
+            .plus(budget::samples(rows, 1.0 + ndof / 6.0))
+            .check(
+                &format!("dynamic analysis of {steps:.3e} steps of {ndof:.0} unknowns"),
+                "check dynamic.end_time_s and dynamic.time_step_s (seconds), raise dynamic.output_every or use fewer elements",
+            )
+            .map_err(|e| e.to_string())
+    })?;
     let file = args.deck.display().to_string();
     let dy = &deck.dynamic;
     let h = dy.time_step_s.ok_or_else(|| {
@@ -38,7 +56,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
     }
     let mut st = State::from_model(&model);
     check_constraints(&mut model, &st).map_err(|e| anyhow::anyhow!("deck {file}: {e}"))?;
-    let out = OutDir::create(&args.out, std::slice::from_ref(&args.deck))?;
+    let out = OutDir::create(&args.out, &deck.input_files(&args.deck))?;
     if dy.start_from_static {
         let opts = StaticOptions {
             load_steps: deck.statics.load_steps,

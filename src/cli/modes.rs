@@ -6,7 +6,7 @@ use crate::io::{csv_string, OutDir};
 use crate::solver::modal::{modes, ModalOptions, Mode};
 use crate::solver::statics::check_constraints;
 use crate::solver::{static_solve, State, StaticOptions};
-use crate::structure::deck::load_deck;
+use crate::structure::deck::load_deck_within;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -60,11 +60,19 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
         .deck
         .clone()
         .ok_or_else(|| anyhow::anyhow!("give a model deck or --rotor"))?;
-    let (deck, mut model) = load_deck(&path)?;
+    let (deck, mut model) = load_deck_within(&path, |d| {
+        let (ndof, _) = d.size_estimate();
+        crate::solver::budget::dense_modal_of(ndof)
+            .check(
+                &format!("modal analysis of {ndof:.0} unknowns (dense)"),
+                "use fewer or longer elements",
+            )
+            .map_err(|e| e.to_string())
+    })?;
     let file = path.display().to_string();
     let st0 = State::from_model(&model);
     check_constraints(&mut model, &st0).map_err(|e| anyhow::anyhow!("deck {file}: {e}"))?;
-    let out = OutDir::create(&args.out, std::slice::from_ref(&path))?;
+    let out = OutDir::create(&args.out, &deck.input_files(&path))?;
     let md = &deck.modes;
     let axis = md.axis;
     let na = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();

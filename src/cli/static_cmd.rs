@@ -1,10 +1,11 @@
 //! `rotorsim static`: nonlinear static analysis of a model deck.
 use crate::io::{csv_string, OutDir};
+use crate::solver::budget;
 use crate::solver::fdcheck::check_model;
 use crate::solver::state::{lambda_offsets, sensor_header, sensor_values};
 use crate::solver::statics::check_constraints;
 use crate::solver::{static_solve, State, StaticOptions};
-use crate::structure::deck::load_deck;
+use crate::structure::deck::load_deck_within;
 use crate::structure::EvalCtx;
 use anyhow::Context;
 use clap::Args;
@@ -43,11 +44,20 @@ pub fn tangent_report(model: &crate::structure::Model, st: &State, label: &str) 
 }
 
 pub fn run(args: StaticArgs) -> anyhow::Result<()> {
-    let (deck, mut model) = load_deck(&args.deck)?;
+    let (deck, mut model) = load_deck_within(&args.deck, |d| {
+        let (ndof, nnz) = d.size_estimate();
+        let iterations = (d.statics.load_steps.max(1) * d.statics.max_iterations) as f64;
+        budget::time_integration_of(ndof, nnz, 1.0, iterations)
+            .check(
+                &format!("static analysis of {ndof:.0} unknowns"),
+                "use fewer or longer elements, or fewer statics.load_steps",
+            )
+            .map_err(|e| e.to_string())
+    })?;
     let mut st = State::from_model(&model);
     check_constraints(&mut model, &st)
         .map_err(|e| anyhow::anyhow!("deck {}: {e}", args.deck.display()))?;
-    let out = OutDir::create(&args.out, std::slice::from_ref(&args.deck))?;
+    let out = OutDir::create(&args.out, &deck.input_files(&args.deck))?;
     let mut worst: f64 = 0.0;
     let mut report = String::new();
     if args.check_tangent {

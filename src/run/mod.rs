@@ -17,6 +17,7 @@ pub mod summary;
 
 use crate::hydraulics::DamperModel;
 use crate::rotor::{ForcedResponse, SimState, Timing};
+use crate::solver::budget;
 use periodic::{integrate, max_nan, Revolution, SimMap, FLOQUET_REPORTED};
 pub use periodic::{PeriodicInfo, PeriodicMethod, PeriodicOptions, PeriodicStateFile};
 use std::time::Instant;
@@ -145,6 +146,21 @@ pub fn check_run_options(revs: usize, steps_per_rev: usize, substeps: usize) -> 
             "--steps-per-rev must be >= 8 and --substeps >= 1 (got {steps_per_rev} and {substeps})"
         );
     }
+    // Beyond sense is refused before anything runs. Per model and step: the elastic blade's
+    // ~300 unknowns at 3 Newton iterations (a lower bound: the rigid reduction is cheaper but
+    // then sub-steps dominate) and the device's sub-steps; kept: up to 32 revolutions of ~100
+    // channels (shooting's subspace and the last revolutions).
+    let steps = revs as f64 * steps_per_rev as f64;
+    let e = budget::time_integration_of(100.0, 0.0, steps, 3.0)
+        .plus(budget::substeps(steps * substeps as f64))
+        .plus(budget::samples(
+            (revs.min(32) * steps_per_rev) as f64,
+            100.0,
+        ));
+    e.check(
+        &format!("{revs} revolutions x {steps_per_rev} steps x {substeps} sub-steps per model"),
+        "check --revs, --steps-per-rev and --substeps",
+    )?;
     Ok(())
 }
 

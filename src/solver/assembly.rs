@@ -6,8 +6,8 @@ use crate::structure::model::{Element, ElementError, ElementOutput, Model};
 use crate::structure::real::{c, Dual, DualN, Real};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::linalg::{LuError, SupernodalThreshold};
+use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 use thiserror::Error;
 
@@ -18,6 +18,24 @@ pub const MAXL: usize = 24;
 pub enum LinearError {
     #[error("sparse LU factorisation failed (singular iteration matrix: check for redundant or conflicting constraints, unconstrained rigid-body motion, or zero mass with free dofs): {0}")]
     Singular(String),
+    #[error("sparse LU of {ndof} unknowns: out of memory (the model is too large for this machine: use fewer or longer elements)")]
+    OutOfMemory { ndof: usize },
+}
+
+impl LinearError {
+    fn of_faer(e: FaerError, ndof: usize) -> Self {
+        match e {
+            FaerError::OutOfMemory | FaerError::IndexOverflow => LinearError::OutOfMemory { ndof },
+            other => LinearError::Singular(format!("{other:?}")),
+        }
+    }
+
+    fn of_lu(e: LuError, ndof: usize) -> Self {
+        match e {
+            LuError::Generic(g) => Self::of_faer(g, ndof),
+            other => LinearError::Singular(format!("{other:?}")),
+        }
+    }
 }
 
 /// Dof layout: node n has dofs 6n..6n+6 (translation, rotation); multipliers follow.
@@ -173,12 +191,13 @@ impl Assembler {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_lu(sym, params)
-            .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
+        let symbolic =
+            factorize_symbolic_lu(sym, params).map_err(|e| LinearError::of_faer(e, ndof))?;
         let req = symbolic
             .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let nnz = row_idx.len();
+        let buf = MemBuffer::try_new(req).map_err(|_| LinearError::OutOfMemory { ndof })?;
         Ok(Assembler {
             n_nodes,
             ndof,
@@ -191,7 +210,7 @@ impl Assembler {
             values: vec![0.0; nnz],
             symbolic,
             numeric: NumericLu::new(),
-            buf: MemBuffer::new(req),
+            buf,
             factored: false,
             step_out: ElementOutput::default(),
             multilane: true,
@@ -217,6 +236,21 @@ impl Assembler {
                 self.values[p] = other[p];
             }
         }
+    }
+
+    /// Rows `rows` of the assembled matrix, dense over columns `0..ncols` (the constraint
+    /// gradient without forming the whole matrix).
+    pub fn dense_rows(&self, rows: std::ops::Range<usize>, ncols: usize) -> Vec<Vec<f64>> {
+        let mut m = vec![vec![0.0; ncols]; rows.len()];
+        for j in 0..ncols.min(self.ndof) {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let r = self.row_idx[p];
+                if rows.contains(&r) {
+                    m[r - rows.start][j] += self.values[p];
+                }
+            }
+        }
+        m
     }
 
     /// Dense copy of the assembled matrix (tests, modal analysis).
@@ -393,7 +427,7 @@ impl Assembler {
         let stack = MemStack::new(&mut self.buf);
         self.symbolic
             .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
-            .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
+            .map_err(|e| LinearError::of_lu(e, self.ndof))?;
         self.factored = true;
         Ok(())
     }

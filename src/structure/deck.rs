@@ -32,6 +32,8 @@ pub enum DeckError {
         key: String,
         msg: String,
     },
+    #[error("deck {file}: {msg}")]
+    TooLarge { file: String, msg: String },
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -356,22 +358,89 @@ fn twist_table(t: &[[f64; 2]]) -> Result<TimeTable, String> {
 }
 
 /// Parse a deck and build the model.
+impl Deck {
+    /// Unknowns (node dofs and joint multipliers) and stored matrix entries of the model this
+    /// deck builds, counted from the deck alone: a beam of E cubic elements has 3E + 1 nodes
+    /// and E dense 24 x 24 blocks; a joint at most 6 multipliers on two nodes.
+    pub fn size_estimate(&self) -> (f64, f64) {
+        let mut nodes = (self.nodes.len() + self.rigid_bodies.len()) as f64;
+        let mut entries = 0.0;
+        for b in &self.beams {
+            let e = b.elements as f64;
+            nodes += 3.0 * e + 1.0;
+            entries += 576.0 * e;
+        }
+        let lambdas = 6.0 * self.joints.len() as f64;
+        entries += 18.0 * 18.0 * self.joints.len() as f64;
+        let ndof = 6.0 * nodes + lambdas;
+        (ndof, entries + ndof)
+    }
+
+    /// The deck at `path` and every file it references (section tables, device decks),
+    /// relative paths resolved as the reader resolves them: a result's inputs.
+    pub fn input_files(&self, path: &Path) -> Vec<PathBuf> {
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let resolve = |p: &str| {
+            let pb = PathBuf::from(p);
+            if pb.is_absolute() {
+                pb
+            } else {
+                base.join(pb)
+            }
+        };
+        let mut files = vec![path.to_path_buf()];
+        for f in self
+            .beams
+            .iter()
+            .filter_map(|b| b.sections_csv.as_deref())
+            .chain(self.hydraulics.iter().map(|h| h.deck.as_str()))
+        {
+            let f = resolve(f);
+            if !files.contains(&f) {
+                files.push(f);
+            }
+        }
+        files
+    }
+}
+
 pub fn load_deck(path: &Path) -> Result<(Deck, Model), DeckError> {
+    load_deck_within(path, |_| Ok(()))
+}
+
+/// As [`load_deck`], with `budget` run on the parsed deck before its model is built: a deck
+/// whose model would not fit (too many elements for memory, a run of years) is refused before
+/// anything is allocated for it.
+pub fn load_deck_within(
+    path: &Path,
+    budget: impl FnOnce(&Deck) -> Result<(), String>,
+) -> Result<(Deck, Model), DeckError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| DeckError::Io {
         file: file.clone(),
         source,
     })?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse_deck(&text, &file, &base)
+    let mut deck = deserialize(&text, &file)?;
+    budget(&deck).map_err(|msg| DeckError::TooLarge {
+        file: file.clone(),
+        msg,
+    })?;
+    let (model, probes) = build(&deck, &file, &base)?;
+    deck.hydraulic_probes = probes;
+    Ok((deck, model))
+}
+
+fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
+    toml::from_str(text).map_err(|e| DeckError::Parse {
+        file: file.into(),
+        msg: e.to_string().trim_end().to_string(),
+    })
 }
 
 /// Parse deck text (`file` names it in errors; relative CSV paths resolve against `base`).
 pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), DeckError> {
-    let mut deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
-        file: file.into(),
-        msg: e.to_string().trim_end().to_string(),
-    })?;
+    let mut deck = deserialize(text, file)?;
     let (model, probes) = build(&deck, file, base)?;
     deck.hydraulic_probes = probes;
     Ok((deck, model))
