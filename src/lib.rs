@@ -9,6 +9,7 @@ pub mod flight;
 pub mod hydraulics;
 pub mod io;
 pub mod loads;
+pub mod overrides;
 pub mod periodic;
 pub mod report;
 pub mod rotor;
