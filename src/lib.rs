@@ -16,3 +16,4 @@ pub mod rotor;
 pub mod run;
 pub mod solver;
 pub mod structure;
+pub mod sweep;

@@ -190,6 +190,43 @@ impl Progress for Bars {
     }
 }
 
+/// Checks `args` as `run` does before it writes anything (options, record, decks with their
+/// overrides), without running.
+pub fn check(args: &RunArgs) -> anyhow::Result<()> {
+    let models = parse_models(&args.damper)?;
+    args.scheme
+        .parse::<Scheme>()
+        .map_err(|e: String| anyhow::anyhow!("--scheme: {e}"))?;
+    args.newton
+        .parse::<NewtonMethod>()
+        .map_err(|e: String| anyhow::anyhow!("--newton: {e}"))?;
+    run::check_run_options(args.revs, args.steps_per_rev, args.substeps)?;
+    if !matches!(args.periodic.as_str(), "shooting" | "march") {
+        bail!(
+            "--periodic: unknown method '{}' (expected shooting or march)",
+            args.periodic
+        );
+    }
+    if !(args.periodic_tol > 0.0 && args.periodic_tol.is_finite()) {
+        bail!(
+            "--periodic-tol must be positive and finite (got {})",
+            args.periodic_tol
+        );
+    }
+    let sdof = match args.model.as_str() {
+        "uh60a" | "rigid" => false,
+        "sdof" => true,
+        m => bail!("--model: unknown rotor model '{m}' (expected uh60a, rigid or sdof)"),
+    };
+    FlightRecord::read(&args.flight)
+        .with_context(|| format!("reading flight record {}", args.flight.display()))?;
+    let (_, deck) = load_decks(args, sdof)?;
+    for m in &models {
+        deck.require(*m)?;
+    }
+    Ok(())
+}
+
 pub fn run(args: RunArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let models = parse_models(&args.damper)?;
