@@ -375,6 +375,7 @@ fn rotor_check(
             periodic: crate::run::PeriodicMethod::March.name().into(),
             periodic_tol: crate::run::periodic::DEFAULT_TOL,
             initial_state: None,
+            overrides: Vec::new(),
             synthetic: rec.meta.synthetic,
             counter: rec.meta.counter.clone(),
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),

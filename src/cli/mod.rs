@@ -67,6 +67,7 @@ pub mod inspect;
 pub mod modes;
 pub mod run_cmd;
 pub mod static_cmd;
+pub mod sweep;
 pub mod verify;
 
 #[derive(Parser, Debug)]
@@ -102,6 +103,8 @@ pub enum Command {
     Run(run_cmd::RunArgs),
     /// Find what a damper model gets wrong in measured data, name the cause, extend the model.
     Diagnose(diagnose::DiagnoseArgs),
+    /// Batch forced-response runs from a plan: locally on all cores, or as Slurm array shards.
+    Sweep(sweep::SweepArgs),
 }
 
 pub fn main() -> ExitCode {
@@ -150,5 +153,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Expand(a) => expand::run(a),
         Command::Run(a) => run_cmd::run(a),
         Command::Diagnose(a) => diagnose::run(a),
+        Command::Sweep(a) => sweep::run(a),
     }
 }

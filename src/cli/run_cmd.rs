@@ -4,6 +4,7 @@
 use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
 use crate::io::OutDir;
+use crate::overrides::Override;
 use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use crate::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams, RIGID_LABEL};
 use crate::run::summary::{self, Measured, ModelFigures, RunInfo};
@@ -71,9 +72,66 @@ pub struct RunArgs {
     /// same residual test.
     #[arg(long, default_value = "modified")]
     pub newton: String,
+    /// Override a rotor-deck or damper-deck value by its dotted path, unit in the name
+    /// (repeatable): `--set damper.physical.A_orf_m2=2.0e-6`. Applied before validation, so
+    /// checked like the deck; `damper.*` keys go to `--damper-deck` when one is given.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
+    pub set: Vec<Override>,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
+    /// Print nothing (a case of `rotorsim sweep`).
+    #[arg(skip)]
+    pub quiet: bool,
+}
+
+fn parse_set(s: &str) -> Result<Override, String> {
+    Override::parse(s).map_err(|e| format!("{e:#}"))
+}
+
+/// The damper deck file `path` with the `damper.*` overrides applied, each validated.
+fn damper_deck_with(path: &std::path::Path, overrides: &[Override]) -> anyhow::Result<DamperDeck> {
+    if overrides.is_empty() {
+        return Ok(DamperDeck::from_file(path)?);
+    }
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow::anyhow!("damper deck {file}: cannot read: {e}"))?;
+    DamperDeck::from_toml_str(&text, &file)?;
+    let text = crate::overrides::apply_all(&text, &file, overrides, |t, _| {
+        DamperDeck::from_toml_str(t, &file)?;
+        Ok(())
+    })?;
+    Ok(DamperDeck::from_toml_str(&text, &file)?)
+}
+
+/// The rotor deck (None for the sdof test double) and the damper deck of `args`, `--set`
+/// overrides applied and validated.
+pub fn load_decks(args: &RunArgs, sdof: bool) -> anyhow::Result<(Option<RotorDeck>, DamperDeck)> {
+    let (damper_sets, rotor_sets): (Vec<Override>, Vec<Override>) =
+        if args.damper_deck.is_some() || sdof {
+            args.set.iter().cloned().partition(|o| o.is_damper())
+        } else {
+            (Vec::new(), args.set.clone())
+        };
+    if sdof {
+        if let Some(o) = rotor_sets.first() {
+            bail!(
+                "--set {o}: the sdof test double reads only the [damper] table (expected a damper.* key)"
+            );
+        }
+    }
+    let rotor = if sdof {
+        None
+    } else {
+        Some(RotorDeck::from_file_with(&args.rotor, &rotor_sets)?)
+    };
+    let deck = match (&args.damper_deck, &rotor) {
+        (Some(p), _) => damper_deck_with(p, &damper_sets)?,
+        (None, Some(r)) => r.damper()?,
+        (None, None) => damper_deck_with(&args.rotor, &damper_sets)?,
+    };
+    Ok((rotor, deck))
 }
 
 fn parse_models(s: &str) -> anyhow::Result<Vec<DamperModel>> {
@@ -132,6 +190,43 @@ impl Progress for Bars {
     }
 }
 
+/// Checks `args` as `run` does before it writes anything (options, record, decks with their
+/// overrides), without running.
+pub fn check(args: &RunArgs) -> anyhow::Result<()> {
+    let models = parse_models(&args.damper)?;
+    args.scheme
+        .parse::<Scheme>()
+        .map_err(|e: String| anyhow::anyhow!("--scheme: {e}"))?;
+    args.newton
+        .parse::<NewtonMethod>()
+        .map_err(|e: String| anyhow::anyhow!("--newton: {e}"))?;
+    run::check_run_options(args.revs, args.steps_per_rev, args.substeps)?;
+    if !matches!(args.periodic.as_str(), "shooting" | "march") {
+        bail!(
+            "--periodic: unknown method '{}' (expected shooting or march)",
+            args.periodic
+        );
+    }
+    if !(args.periodic_tol > 0.0 && args.periodic_tol.is_finite()) {
+        bail!(
+            "--periodic-tol must be positive and finite (got {})",
+            args.periodic_tol
+        );
+    }
+    let sdof = match args.model.as_str() {
+        "uh60a" | "rigid" => false,
+        "sdof" => true,
+        m => bail!("--model: unknown rotor model '{m}' (expected uh60a, rigid or sdof)"),
+    };
+    FlightRecord::read(&args.flight)
+        .with_context(|| format!("reading flight record {}", args.flight.display()))?;
+    let (_, deck) = load_decks(args, sdof)?;
+    for m in &models {
+        deck.require(*m)?;
+    }
+    Ok(())
+}
+
 pub fn run(args: RunArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let models = parse_models(&args.damper)?;
@@ -174,16 +269,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     };
     let record = FlightRecord::read(&args.flight)
         .with_context(|| format!("reading flight record {}", args.flight.display()))?;
-    let rotor = if sdof {
-        None
-    } else {
-        Some(RotorDeck::from_file(&args.rotor)?)
-    };
-    let deck = match (&args.damper_deck, &rotor) {
-        (Some(p), _) => DamperDeck::from_file(p)?,
-        (None, Some(r)) => r.damper()?,
-        (None, None) => DamperDeck::from_file(&args.rotor)?,
-    };
+    let (rotor, deck) = load_decks(&args, sdof)?;
     for m in &models {
         deck.require(*m)?;
     }
@@ -237,8 +323,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         None => {}
     }
     let out = OutDir::create(&args.out, &inputs)?;
-    let tty = std::io::stderr().is_terminal();
-    errln!(
+    let tty = std::io::stderr().is_terminal() && !args.quiet;
+    if !args.quiet {
+        errln!(
         "rotorsim run: {} model(s) {}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
         models.len(),
         models
@@ -258,6 +345,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             ""
         }
     );
+    }
     let popts: Vec<run::PeriodicOptions> = initial
         .into_iter()
         .map(|init| run::PeriodicOptions {
@@ -299,12 +387,19 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         periodic: method.name().into(),
         periodic_tol: args.periodic_tol,
         initial_state: args.initial_state.as_ref().map(|p| p.display().to_string()),
+        overrides: args
+            .set
+            .iter()
+            .map(|o| (o.key.clone(), o.value_text()))
+            .collect(),
         synthetic: record.meta.synthetic,
         counter: record.meta.counter.clone(),
         wall_s: t0.elapsed().as_secs_f64(),
     };
     let failed = write_outputs(&out, &info, &outcomes, &measured)?;
-    print_summary(&out, &outcomes, &measured);
+    if !args.quiet {
+        print_summary(&out, &outcomes, &measured);
+    }
     let not_periodic: Vec<String> = outcomes
         .iter()
         .filter_map(|o| o.result.as_ref().ok())

@@ -157,6 +157,7 @@ pub mod transient;
 
 use crate::flight::FlightRecord;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
+use crate::overrides::Override;
 use std::path::Path;
 
 /// Options of one forced-response run.
@@ -201,14 +202,39 @@ pub struct RotorDeck {
     pub path: std::path::PathBuf,
     /// The parsed tables.
     pub spec: deck::RotorSpec,
+    /// The deck text, overrides applied (the `[damper]` table is read from it).
+    text: String,
 }
 
 impl RotorDeck {
     pub fn from_file(path: &Path) -> anyhow::Result<Self> {
-        let spec = deck::RotorSpec::from_file(path)?;
+        Self::from_file_with(path, &[])
+    }
+    /// Reads the deck with `overrides` applied to its values before validation (`--set`): each
+    /// is validated like the deck itself, the `[damper]` table by the damper deck's rules.
+    pub fn from_file_with(path: &Path, overrides: &[Override]) -> anyhow::Result<Self> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+        let spec = deck::RotorSpec::parse(&text, &file)?;
+        if overrides.is_empty() {
+            return Ok(RotorDeck {
+                path: path.to_path_buf(),
+                spec,
+                text,
+            });
+        }
+        let text = crate::overrides::apply_all(&text, &file, overrides, |t, ov| {
+            deck::RotorSpec::parse(t, &file)?;
+            if ov.is_damper() {
+                DamperDeck::from_toml_str(t, &file)?;
+            }
+            Ok(())
+        })?;
         Ok(RotorDeck {
             path: path.to_path_buf(),
-            spec,
+            spec: deck::RotorSpec::parse(&text, &file)?,
+            text,
         })
     }
     /// The files the deck was read from: the deck and its blade section table.
@@ -216,9 +242,12 @@ impl RotorDeck {
         let dir = self.path.parent().unwrap_or(Path::new(""));
         vec![self.path.clone(), dir.join(&self.spec.blade.sections_csv)]
     }
-    /// The deck's `[damper]` table.
+    /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
-        Ok(DamperDeck::from_file(&self.path)?)
+        Ok(DamperDeck::from_toml_str(
+            &self.text,
+            &self.path.display().to_string(),
+        )?)
     }
     /// The generated multibody model deck (TOML text, docs/model_deck.md).
     pub fn expand(&self, opts: &expand::ExpandOptions) -> String {

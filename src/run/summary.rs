@@ -518,6 +518,8 @@ pub struct RunInfo {
     pub periodic_tol: f64,
     /// Saved state the models started from (`--initial-state`).
     pub initial_state: Option<String>,
+    /// Deck values overridden (`--set KEY=VALUE`), in the order given: (key, TOML value).
+    pub overrides: Vec<(String, String)>,
     pub synthetic: bool,
     pub counter: Option<String>,
     pub wall_s: f64,
@@ -569,6 +571,7 @@ pub fn summary_json(
             "periodic_tol": info.periodic_tol,
             "max_revs": info.revs,
             "initial_state": info.initial_state,
+            "overrides": info.overrides.iter().map(|(k, v)| json!({"key": k, "value": v})).collect::<Vec<_>>(),
             "periodicity_tolerance": info.periodic_tol,
             "harmonics_max_per_rev": N_HARMONICS,
         },

@@ -1,0 +1,335 @@
+//! `rotorsim sweep`: batch forced-response runs from a plan, on this machine or as the shards of
+//! a Slurm job array (docs/sweep.md).
+use super::run_cmd::{self, RunArgs};
+use crate::sweep::{self, Case, CaseRunner, Plan, SweepOptions, SweepProgress};
+use anyhow::{anyhow, bail, Context};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct SweepArgs {
+    #[command(subcommand)]
+    pub command: Option<SweepCommand>,
+    /// Sweep plan (TOML: [base], [vary], [[case]], [sweep]; docs/sweep.md).
+    #[arg(required = true)]
+    pub plan: Option<PathBuf>,
+    /// Sweep folder: DIR/cases/<case id>/ (each a `rotorsim run` result folder), DIR/sweep.csv,
+    /// DIR/sweep.html.
+    #[arg(long, required = true)]
+    pub out: Option<PathBuf>,
+    /// Cases run at once (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Run only shard K of N (K from 0 to N-1); default from SLURM_ARRAY_TASK_ID and
+    /// SLURM_ARRAY_TASK_COUNT when both are set. A shard writes only its own case folders;
+    /// `rotorsim sweep merge DIR` builds sweep.csv when all have ended.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Run again the cases that failed in an earlier sweep into DIR (otherwise listed and kept).
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// Start every case cold, ignoring the plan's warm starts (for comparisons).
+    #[arg(long)]
+    pub no_warm_start: bool,
+    /// Write an sbatch job-array script running the plan's shards to FILE, and prepare DIR;
+    /// runs nothing.
+    #[arg(long, value_name = "FILE")]
+    pub emit_slurm: Option<PathBuf>,
+    /// Array tasks of the emitted script (default: the plan's warm-start groups, at most 64).
+    #[arg(long)]
+    pub shards: Option<usize>,
+    /// CPUs per array task of the emitted script.
+    #[arg(long, default_value_t = 1)]
+    pub cpus_per_task: usize,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum SweepCommand {
+    /// Build DIR/sweep.csv and DIR/sweep.html from the case folders (after the shards ended).
+    Merge {
+        /// Sweep folder.
+        dir: PathBuf,
+    },
+}
+
+/// Runs a case in this process as `rotorsim run` would, printing nothing.
+struct Runner;
+
+/// `rotorsim run` arguments of `case` writing to `out`.
+fn run_args(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunArgs> {
+    let mut argv: Vec<String> = vec!["rotorsim".into(), "run".into()];
+    for (k, v) in &case.settings {
+        if k.contains('.') {
+            argv.push("--set".into());
+            argv.push(format!("{k}={v}"));
+            continue;
+        }
+        let flag = format!("--{}", k.replace('_', "-"));
+        match v {
+            toml::Value::Boolean(true) => argv.push(flag),
+            toml::Value::Boolean(false) => {}
+            toml::Value::String(s) => argv.extend([flag, s.clone()]),
+            v => argv.extend([flag, v.to_string()]),
+        }
+    }
+    argv.push("--out".into());
+    argv.push(out.display().to_string());
+    if let Some(p) = initial {
+        argv.push("--initial-state".into());
+        argv.push(p.display().to_string());
+    }
+    let cli = super::Cli::try_parse_from(&argv).map_err(|e| {
+        anyhow!(
+            "{}",
+            e.render()
+                .to_string()
+                .lines()
+                .next()
+                .unwrap_or("bad option")
+                .trim_start_matches("error: ")
+        )
+    })?;
+    match cli.command {
+        super::Command::Run(mut a) => {
+            a.quiet = true;
+            Ok(a)
+        }
+        _ => bail!("internal: not a run command"),
+    }
+}
+
+impl CaseRunner for Runner {
+    fn check(&self, case: &Case) -> anyhow::Result<()> {
+        run_cmd::check(&run_args(case, Path::new("unused"), None)?)
+    }
+    fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()> {
+        run_cmd::run(run_args(case, out, initial)?)
+    }
+}
+
+/// One progress bar on a terminal, plain lines otherwise.
+struct Console {
+    bar: Option<ProgressBar>,
+    done: AtomicUsize,
+    total: AtomicUsize,
+}
+
+impl SweepProgress for Console {
+    fn start(&self, to_run: usize, total: usize) {
+        self.total.store(to_run, Ordering::Relaxed);
+        if let Some(b) = &self.bar {
+            b.set_length(to_run as u64);
+            b.set_message(format!("{total} cases in this sweep"));
+        } else {
+            errln!(
+                "rotorsim sweep: {to_run} case(s) to run of {total} ({} already done or kept)",
+                total - to_run
+            );
+        }
+    }
+    fn case_done(&self, case: &Case, result: &Result<(), String>, wall_s: f64) {
+        let n = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        let total = self.total.load(Ordering::Relaxed);
+        let what = match result {
+            Ok(()) => "done".to_string(),
+            Err(e) => format!("FAILED: {e}"),
+        };
+        match &self.bar {
+            Some(b) => {
+                b.inc(1);
+                if result.is_err() {
+                    b.println(format!("case {} {what}", case.id));
+                }
+            }
+            None => errln!("[{n}/{total}] case {} {what} ({wall_s:.1} s)", case.id),
+        }
+    }
+}
+
+fn env_shard() -> anyhow::Result<Option<(usize, usize)>> {
+    match (
+        std::env::var("SLURM_ARRAY_TASK_ID"),
+        std::env::var("SLURM_ARRAY_TASK_COUNT"),
+    ) {
+        (Ok(k), Ok(n)) => sweep::plan::parse_shard(&format!("{k}/{n}"))
+            .map(Some)
+            .context("from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT"),
+        _ => Ok(None),
+    }
+}
+
+fn default_jobs() -> usize {
+    std::env::var("SLURM_CPUS_PER_TASK")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+}
+
+pub fn run(args: SweepArgs) -> anyhow::Result<()> {
+    if let Some(SweepCommand::Merge { dir }) = &args.command {
+        return merge(dir);
+    }
+    let (Some(plan_path), Some(out)) = (&args.plan, &args.out) else {
+        bail!("expected a plan file and --out DIR (or `rotorsim sweep merge DIR`)");
+    };
+    let mut plan = Plan::from_file(plan_path)?;
+    if args.no_warm_start {
+        plan.warm_start = false;
+    }
+    let runner = Runner;
+    sweep::check(&plan, &runner)?;
+    if let Some(script) = &args.emit_slurm {
+        return emit_slurm(&args, &plan, plan_path, out, script);
+    }
+    let shard = match &args.shard {
+        Some(s) => Some(sweep::plan::parse_shard(s)?),
+        None => env_shard()?,
+    };
+    sweep::prepare(out, &plan)?;
+    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let tty = std::io::stderr().is_terminal();
+    let bar = tty.then(|| {
+        let b = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template(
+                "sweep [{bar:30}] {pos}/{len} cases ({elapsed}, ETA {eta}) {msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b
+    });
+    let console = Console {
+        bar,
+        done: AtomicUsize::new(0),
+        total: AtomicUsize::new(0),
+    };
+    let t0 = Instant::now();
+    let opts = SweepOptions {
+        jobs,
+        shard,
+        retry_failed: args.retry_failed,
+    };
+    let report = sweep::execute(&plan, out, &opts, &runner, &console)?;
+    if let Some(b) = &console.bar {
+        b.finish_and_clear();
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let shard_note = shard
+        .map(|(k, n)| format!(" (shard {k}/{n})"))
+        .unwrap_or_default();
+    outln!(
+        "sweep{shard_note}: {} case(s), {} run now ({} warm-started), {} already complete, {} failed, {jobs} at once, wall {wall:.1} s",
+        report.total,
+        report.ran.len(),
+        report.warm_started,
+        report.skipped.len(),
+        report.failed().len()
+    );
+    for (id, why) in &report.failed_kept {
+        outln!("failed earlier (kept; --retry-failed runs it again): {id}: {why}");
+    }
+    for (id, r) in &report.ran {
+        if let Err(e) = r {
+            outln!("failed: {id}: {e}");
+        }
+    }
+    if shard.is_none() {
+        let rows = sweep::table::write(&plan, out)?;
+        let (ok, np, failed, not_run) = sweep::table::counts(&rows);
+        outln!(
+            "rows: {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}  plots: {}",
+            out.join("sweep.csv").display(),
+            out.join("sweep.html").display()
+        );
+    } else {
+        outln!(
+            "when every shard has ended: rotorsim sweep merge {}",
+            out.display()
+        );
+    }
+    let failed = report.failed();
+    if !failed.is_empty() {
+        bail!(
+            "{} case(s) failed: {} (their folders are marked INCOMPLETE; rerun with --retry-failed)",
+            failed.len(),
+            failed.join(", ")
+        );
+    }
+    Ok(())
+}
+
+fn merge(dir: &Path) -> anyhow::Result<()> {
+    let plan = sweep::read_plan_json(dir)?;
+    let rows = sweep::table::write(&plan, dir)?;
+    let (ok, np, failed, not_run) = sweep::table::counts(&rows);
+    outln!(
+        "merged {} case(s): rows {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}",
+        plan.cases.len(),
+        dir.join("sweep.csv").display()
+    );
+    if failed + not_run > 0 {
+        bail!(
+            "the sweep in {} is not complete: {failed} row(s) failed, {not_run} not run (sweep.csv says which)",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn emit_slurm(
+    args: &SweepArgs,
+    plan: &Plan,
+    plan_path: &Path,
+    out: &Path,
+    script: &Path,
+) -> anyhow::Result<()> {
+    let groups = plan.groups().len();
+    let shards = args.shards.unwrap_or(groups.min(64)).max(1);
+    let cwd = std::env::current_dir().context("current folder")?;
+    let abs = |p: &Path| {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            cwd.join(p)
+        }
+    };
+    let exe = std::env::current_exe().context("locating the rotorsim executable")?;
+    sweep::prepare(&abs(out), plan)?;
+    let mut extra = Vec::new();
+    if args.no_warm_start {
+        extra.push("--no-warm-start".to_string());
+    }
+    if args.retry_failed {
+        extra.push("--retry-failed".to_string());
+    }
+    let text = sweep::slurm_script(
+        &exe,
+        &cwd,
+        &abs(plan_path),
+        &abs(out),
+        shards,
+        args.cpus_per_task.max(1),
+        &extra,
+    );
+    crate::io::write_atomic(script, text.as_bytes())
+        .with_context(|| format!("writing {}", script.display()))?;
+    outln!(
+        "wrote {}: a job array of {shards} task(s) over {} case(s) in {groups} warm-start group(s); submit with `sbatch {}`, then `rotorsim sweep merge {}`",
+        script.display(),
+        plan.cases.len(),
+        script.display(),
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,319 @@
+//! Batch forced-response sweeps (`rotorsim sweep`, docs/sweep.md): a plan expands to cases, each
+//! case is a `rotorsim run` into its own result folder `DIR/cases/<id>/`, and DIR/sweep.csv and
+//! DIR/sweep.html summarize them.
+//!
+//! Scheduling. Cases run in parallel on a pool of `jobs` threads, each case's models on their
+//! own threads as in `run`, so a case's result does not depend on what runs beside it. Warm
+//! starts follow the plan's groups ([`plan::Plan::groups`]): each group's seed runs cold first,
+//! then the others start from the seed's periodic state. The groups depend on the plan only,
+//! so results are the same for any number of threads or shards.
+//!
+//! Resume. A case folder whose manifest says `complete: true` is done and skipped; one that is
+//! published incomplete is failed, listed, and run again only with `retry_failed`. DIR/plan.json
+//! holds the expanded plan; a sweep into a DIR of another plan is refused.
+//!
+//! Shards. Shard K of N runs the groups `g` with `g % N == K` and writes only their case folders
+//! (and plan.json, the same bytes for every shard), so shards never collide; [`table`] builds
+//! sweep.csv from the case folders whoever ran them.
+pub mod plan;
+pub mod table;
+
+pub use plan::{Case, Plan};
+
+use anyhow::{anyhow, bail, Context};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Runs one case; implemented by the command line (`rotorsim run` without its console output).
+pub trait CaseRunner: Sync {
+    /// Checks the case without running it: options, decks with their overrides, the record.
+    fn check(&self, case: &Case) -> anyhow::Result<()>;
+    /// Runs `case` into the result folder `out`, starting from the periodic states of the
+    /// completed case folder `initial` when given.
+    fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()>;
+}
+
+/// Progress of a sweep, reported as cases end (from any thread).
+pub trait SweepProgress: Sync {
+    /// `to_run` cases will run now, of `total` in this shard.
+    fn start(&self, to_run: usize, total: usize);
+    fn case_done(&self, case: &Case, result: &Result<(), String>, wall_s: f64);
+}
+
+/// State of a case folder.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CaseState {
+    /// Published with `complete: true`.
+    Done,
+    /// Published incomplete (the reason).
+    Failed(String),
+    /// No result folder yet.
+    Pending,
+}
+
+/// Folder of case `id` in sweep folder `dir`.
+pub fn case_dir(dir: &Path, id: &str) -> PathBuf {
+    dir.join("cases").join(id)
+}
+
+/// State of the case folder `path`, by its manifest.
+pub fn case_state(path: &Path) -> CaseState {
+    let Ok(text) = std::fs::read_to_string(path.join("manifest.json")) else {
+        return if path.join("INCOMPLETE").exists() {
+            CaseState::Failed(std::fs::read_to_string(path.join("INCOMPLETE")).unwrap_or_default())
+        } else {
+            CaseState::Pending
+        };
+    };
+    match serde_json::from_str::<serde_json::Value>(&text) {
+        Ok(m) if m["complete"] == serde_json::Value::Bool(true) => CaseState::Done,
+        Ok(m) => CaseState::Failed(
+            m["incomplete_reason"]
+                .as_str()
+                .unwrap_or("incomplete")
+                .trim()
+                .to_string(),
+        ),
+        Err(e) => CaseState::Failed(format!("unreadable manifest.json: {e}")),
+    }
+}
+
+/// How to run a sweep.
+#[derive(Clone, Debug)]
+pub struct SweepOptions {
+    /// Cases run at once.
+    pub jobs: usize,
+    /// Shard K of N (None: every case).
+    pub shard: Option<(usize, usize)>,
+    /// Run failed cases again.
+    pub retry_failed: bool,
+}
+
+/// What a sweep did.
+#[derive(Clone, Debug, Default)]
+pub struct SweepReport {
+    /// Cases of this shard.
+    pub total: usize,
+    /// Cases found complete and skipped.
+    pub skipped: Vec<String>,
+    /// Cases run now, with their error when they failed.
+    pub ran: Vec<(String, Result<(), String>)>,
+    /// Failed cases left as they were (no `retry_failed`), with the reason.
+    pub failed_kept: Vec<(String, String)>,
+    /// Cases started from a neighbour's periodic state.
+    pub warm_started: usize,
+}
+
+impl SweepReport {
+    /// Failed cases: run now and failed, or failed before and kept.
+    pub fn failed(&self) -> Vec<String> {
+        self.ran
+            .iter()
+            .filter(|(_, r)| r.is_err())
+            .map(|(id, _)| id.clone())
+            .chain(self.failed_kept.iter().map(|(id, _)| id.clone()))
+            .collect()
+    }
+}
+
+/// The expanded plan as stored in DIR/plan.json.
+pub fn plan_json(plan: &Plan) -> anyhow::Result<String> {
+    let v = serde_json::json!({
+        "format": "rotorsim sweep plan 1",
+        "keys": plan.keys,
+        "warm_start": plan.warm_start,
+        "group_size": plan.group_size,
+        "cases": plan.cases,
+    });
+    Ok(serde_json::to_string_pretty(&v)? + "\n")
+}
+
+/// Reads DIR/plan.json (`sweep merge`); `file` is the plan file named in messages.
+pub fn read_plan_json(dir: &Path) -> anyhow::Result<Plan> {
+    let p = dir.join("plan.json");
+    let text = std::fs::read_to_string(&p).map_err(|e| {
+        anyhow!(
+            "{}: cannot read ({e}); expected the folder of a `rotorsim sweep` (it writes plan.json first)",
+            p.display()
+        )
+    })?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| anyhow!("{}: {e}", p.display()))?;
+    let bad = |k: &str| anyhow!("{}: missing or malformed `{k}`", p.display());
+    Ok(Plan {
+        file: p.display().to_string(),
+        keys: serde_json::from_value(v["keys"].clone()).map_err(|_| bad("keys"))?,
+        cases: serde_json::from_value(v["cases"].clone()).map_err(|_| bad("cases"))?,
+        warm_start: v["warm_start"].as_bool().ok_or_else(|| bad("warm_start"))?,
+        group_size: v["group_size"].as_u64().ok_or_else(|| bad("group_size"))? as usize,
+    })
+}
+
+/// Creates DIR (and DIR/cases) and writes DIR/plan.json, or checks that the plan.json already
+/// there is this plan's.
+pub fn prepare(dir: &Path, plan: &Plan) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir.join("cases"))
+        .with_context(|| format!("creating sweep folder {}", dir.display()))?;
+    let json = plan_json(plan)?;
+    let p = dir.join("plan.json");
+    match std::fs::read_to_string(&p) {
+        Ok(old) if old == json => Ok(()),
+        Ok(_) => bail!(
+            "sweep folder {} holds a sweep of another plan (its plan.json differs from {}): choose another --out or remove it",
+            dir.display(),
+            plan.file
+        ),
+        Err(_) => {
+            crate::io::write_atomic(&p, json.as_bytes())?;
+            Ok(())
+        }
+    }
+}
+
+/// Checks every case with `runner` before any runs; an error names the plan file and the case.
+pub fn check(plan: &Plan, runner: &dyn CaseRunner) -> anyhow::Result<()> {
+    for c in &plan.cases {
+        runner.check(c).map_err(|e| {
+            let varied: Vec<String> = plan
+                .keys
+                .iter()
+                .filter_map(|k| Some(format!("{k} = {}", plan::display(c.settings.get(k)?))))
+                .collect();
+            anyhow!(
+                "sweep plan {}: case {} ({}): {e:#}",
+                plan.file,
+                c.id,
+                varied.join(", ")
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// Group indices of shard `shard` (all without one).
+pub fn shard_groups(n_groups: usize, shard: Option<(usize, usize)>) -> Vec<usize> {
+    (0..n_groups)
+        .filter(|g| shard.is_none_or(|(k, n)| g % n == k))
+        .collect()
+}
+
+/// Runs the plan's cases of this shard into DIR that are not done (and the failed ones with
+/// `retry_failed`). [`prepare`] and [`check`] first.
+pub fn execute(
+    plan: &Plan,
+    dir: &Path,
+    opts: &SweepOptions,
+    runner: &dyn CaseRunner,
+    progress: &dyn SweepProgress,
+) -> anyhow::Result<SweepReport> {
+    let groups = plan.groups();
+    let mine = shard_groups(groups.len(), opts.shard);
+    let mut report = SweepReport::default();
+    let needs = |i: usize, report: &mut SweepReport| -> bool {
+        let c = &plan.cases[i];
+        match case_state(&case_dir(dir, &c.id)) {
+            CaseState::Done => {
+                report.skipped.push(c.id.clone());
+                false
+            }
+            CaseState::Failed(why) if !opts.retry_failed => {
+                report.failed_kept.push((c.id.clone(), why));
+                false
+            }
+            _ => true,
+        }
+    };
+    let mut seeds = Vec::new();
+    let mut members = Vec::new();
+    for &g in &mine {
+        let gr = &groups[g];
+        report.total += 1 + gr.members.len();
+        if needs(gr.seed, &mut report) {
+            seeds.push(gr.seed);
+        }
+        for &(i, warm) in &gr.members {
+            if needs(i, &mut report) {
+                members.push((i, warm.then_some(gr.seed)));
+            }
+        }
+    }
+    progress.start(seeds.len() + members.len(), report.total);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs.max(1))
+        .build()
+        .map_err(|e| anyhow!("cannot start {} worker threads: {e}", opts.jobs))?;
+    let run_one = |i: usize, from: Option<usize>| -> (String, Result<(), String>, bool) {
+        let c = &plan.cases[i];
+        let init = from
+            .map(|s| case_dir(dir, &plan.cases[s].id))
+            .filter(|p| case_state(p) == CaseState::Done);
+        let t0 = std::time::Instant::now();
+        let r = runner
+            .run(c, &case_dir(dir, &c.id), init.as_deref())
+            .map_err(|e| format!("{e:#}"));
+        progress.case_done(c, &r, t0.elapsed().as_secs_f64());
+        (c.id.clone(), r, init.is_some())
+    };
+    for wave in [
+        seeds.iter().map(|&i| (i, None)).collect::<Vec<_>>(),
+        members,
+    ] {
+        let done: Vec<(String, Result<(), String>, bool)> =
+            pool.install(|| wave.par_iter().map(|&(i, f)| run_one(i, f)).collect());
+        for (id, r, warm) in done {
+            report.warm_started += warm as usize;
+            report.ran.push((id, r));
+        }
+    }
+    Ok(report)
+}
+
+/// An sbatch array script running shard `$SLURM_ARRAY_TASK_ID` of `shards` of the plan (each
+/// task on `cpus` CPUs), then nothing else: `rotorsim sweep merge DIR` builds sweep.csv once
+/// the array has ended.
+pub fn slurm_script(
+    exe: &Path,
+    workdir: &Path,
+    plan: &Path,
+    out: &Path,
+    shards: usize,
+    cpus: usize,
+    extra: &[String],
+) -> String {
+    let q = |p: &Path| shell_quote(&p.display().to_string());
+    let extra: String = extra
+        .iter()
+        .map(|a| format!(" {}", shell_quote(a)))
+        .collect();
+    format!(
+        "#!/bin/bash\n\
+         #SBATCH --job-name=rotorsim-sweep\n\
+         #SBATCH --array=0-{last}\n\
+         #SBATCH --ntasks=1\n\
+         #SBATCH --cpus-per-task={cpus}\n\
+         #SBATCH --output={log}/slurm-%A_%a.out\n\
+         # rotorsim sweep as a Slurm job array: task K runs shard K of {shards} (its own case\n\
+         # folders only). When the array has ended: {exe} sweep merge {outq}\n\
+         set -euo pipefail\n\
+         cd {wd}\n\
+         exec {exe} sweep {plan} --out {outq} --jobs \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\" \
+         --shard \"${{SLURM_ARRAY_TASK_ID}}/{shards}\"{extra}\n",
+        last = shards.saturating_sub(1),
+        log = q(out),
+        exe = q(exe),
+        wd = q(workdir),
+        plan = q(plan),
+        outq = q(out),
+    )
+}
+
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-=+:,@%".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}

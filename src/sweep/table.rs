@@ -1,0 +1,261 @@
+//! DIR/sweep.csv and DIR/sweep.html from the case folders (whoever ran them: this process or
+//! the shards of a cluster job).
+use super::{case_dir, case_state, CaseState, Plan};
+use crate::report::html::HtmlReport;
+use crate::report::plot::Plot;
+use serde_json::Value;
+use std::path::Path;
+
+/// Metric columns after the case id, the varied keys, `damper_model` and `status`.
+pub const METRICS: &[&str] = &[
+    "warm_start_from",
+    "rms_error_N",
+    "rms_error_rel",
+    "correlation",
+    "damper_force_min_N",
+    "damper_force_max_N",
+    "damper_force_peak_to_peak_N",
+    "periodic_residual",
+    "revolutions",
+    "wall_time_s",
+    "pitch_link_force_half_p2p_N",
+    "root_mx_half_p2p_Nm",
+    "root_my_half_p2p_Nm",
+    "root_mz_half_p2p_Nm",
+];
+
+/// Metrics plotted in sweep.html (numeric ones), with their axis label.
+const PLOTTED: &[(&str, &str)] = &[
+    ("rms_error_N", "RMS error vs measured [N]"),
+    ("correlation", "correlation with measured [-]"),
+    (
+        "damper_force_peak_to_peak_N",
+        "damper force peak-to-peak [N]",
+    ),
+    ("periodic_residual", "periodicity residual [-]"),
+    ("revolutions", "revolutions integrated"),
+    ("wall_time_s", "wall time [s]"),
+    (
+        "pitch_link_force_half_p2p_N",
+        "pitch-link force half peak-to-peak [N]",
+    ),
+    (
+        "root_mx_half_p2p_Nm",
+        "root moment mx half peak-to-peak [N m]",
+    ),
+    (
+        "root_my_half_p2p_Nm",
+        "root moment my half peak-to-peak [N m]",
+    ),
+    (
+        "root_mz_half_p2p_Nm",
+        "root moment mz half peak-to-peak [N m]",
+    ),
+];
+
+/// One row of sweep.csv.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub case_id: String,
+    pub varied: Vec<String>,
+    pub model: String,
+    pub status: String,
+    /// One per [`METRICS`], empty when not available.
+    pub metrics: Vec<String>,
+}
+
+fn num(v: &Value) -> String {
+    match v {
+        Value::Number(n) => n.to_string(),
+        Value::Bool(b) => b.to_string(),
+        _ => String::new(),
+    }
+}
+
+fn read_json(p: &Path) -> Option<Value> {
+    serde_json::from_str(&std::fs::read_to_string(p).ok()?).ok()
+}
+
+/// Rows of every case of the plan, in plan order, one per case and damper model.
+pub fn rows(plan: &Plan, dir: &Path) -> Vec<Row> {
+    let mut out = Vec::new();
+    for c in &plan.cases {
+        let varied = plan.varied(c);
+        let cd = case_dir(dir, &c.id);
+        let state = case_state(&cd);
+        let summary = match state {
+            CaseState::Pending => None,
+            _ => read_json(&cd.join("summary.json")),
+        };
+        let empty = |status: &str| Row {
+            case_id: c.id.clone(),
+            varied: varied.clone(),
+            model: String::new(),
+            status: status.into(),
+            metrics: vec![String::new(); METRICS.len()],
+        };
+        let Some(s) = summary else {
+            out.push(empty(match state {
+                CaseState::Pending => "not_run",
+                _ => "failed",
+            }));
+            continue;
+        };
+        let warm = s["options"]["initial_state"]
+            .as_str()
+            .and_then(|p| {
+                Path::new(p)
+                    .file_name()
+                    .map(|f| f.to_string_lossy().into_owned())
+            })
+            .unwrap_or_default();
+        let Some(models) = s["models"].as_object() else {
+            out.push(empty("failed"));
+            continue;
+        };
+        for (name, m) in models {
+            let status = if m["status"] != "ok" {
+                "failed"
+            } else if m["periodicity"]["converged"] == Value::Bool(true) {
+                "ok"
+            } else {
+                "not_periodic"
+            };
+            let loads = &m["loads"]["channels"];
+            let hp = |ch: &str| num(&loads[ch]["half_peak_to_peak"]);
+            let metrics = vec![
+                warm.clone(),
+                num(&m["metrics"]["rms_error"]),
+                num(&m["metrics"]["rms_error_rel"]),
+                num(&m["metrics"]["correlation"]),
+                num(&m["damper_force_N"]["min"]),
+                num(&m["damper_force_N"]["max"]),
+                num(&m["damper_force_N"]["peak_to_peak"]),
+                num(&m["periodicity"]["last"]),
+                num(&m["periodic"]["revolutions_integrated"]),
+                num(&m["wall_time_s"]["total"]),
+                hp("pitch_link_force_N"),
+                hp("root_mx_Nm"),
+                hp("root_my_Nm"),
+                hp("root_mz_Nm"),
+            ];
+            out.push(Row {
+                case_id: c.id.clone(),
+                varied: varied.clone(),
+                model: name.clone(),
+                status: status.into(),
+                metrics,
+            });
+        }
+    }
+    out
+}
+
+/// sweep.csv text.
+pub fn csv(plan: &Plan, rows: &[Row]) -> anyhow::Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["case_id".to_string()];
+    header.extend(plan.keys.iter().cloned());
+    header.push("damper_model".into());
+    header.push("status".into());
+    header.extend(METRICS.iter().map(|s| s.to_string()));
+    w.write_record(&header)?;
+    for r in rows {
+        let mut rec = vec![r.case_id.clone()];
+        rec.extend(r.varied.iter().cloned());
+        rec.push(r.model.clone());
+        rec.push(r.status.clone());
+        rec.extend(r.metrics.iter().cloned());
+        w.write_record(&rec)?;
+    }
+    Ok(String::from_utf8(
+        w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?,
+    )?)
+}
+
+/// Counts of rows by status, for messages: (ok, not periodic, failed, not run).
+pub fn counts(rows: &[Row]) -> (usize, usize, usize, usize) {
+    let n = |s: &str| rows.iter().filter(|r| r.status == s).count();
+    (n("ok"), n("not_periodic"), n("failed"), n("not_run"))
+}
+
+/// sweep.html: each plotted metric against each numeric varied key, one series per damper
+/// model, and the table.
+pub fn html(plan: &Plan, rows: &[Row]) -> String {
+    let mut h = HtmlReport::new("rotorsim sweep");
+    h.heading(1, "rotorsim sweep");
+    let (ok, np, failed, not_run) = counts(rows);
+    h.paragraph(&format!(
+        "{} cases of {}; rows (case x damper model): {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run.",
+        plan.cases.len(),
+        plan.file
+    ));
+    if failed + not_run > 0 {
+        h.notice("This sweep is NOT complete: some cases failed or have not run (status column).");
+    }
+    let mut models: Vec<&str> = rows
+        .iter()
+        .map(|r| r.model.as_str())
+        .filter(|m| !m.is_empty())
+        .collect();
+    models.sort_unstable();
+    models.dedup();
+    for (ki, key) in plan.keys.iter().enumerate() {
+        let xs: Vec<Option<f64>> = rows.iter().map(|r| r.varied[ki].parse().ok()).collect();
+        if xs.iter().all(|x| x.is_none()) {
+            h.paragraph(&format!("{key}: not numeric, not plotted (see the table)."));
+            continue;
+        }
+        h.heading(2, &format!("against {key}"));
+        for (metric, label) in PLOTTED {
+            let mi = METRICS.iter().position(|m| m == metric).unwrap_or(0);
+            let mut p = Plot::new(&format!("{label} vs {key}"), key, label);
+            let mut any = false;
+            for m in &models {
+                let (x, y): (Vec<f64>, Vec<f64>) = rows
+                    .iter()
+                    .zip(&xs)
+                    .filter(|(r, _)| r.model == *m)
+                    .filter_map(|(r, x)| Some(((*x)?, r.metrics[mi].parse::<f64>().ok()?)))
+                    .unzip();
+                if !x.is_empty() {
+                    any = true;
+                    p = p.points(m, &x, &y);
+                }
+            }
+            if !any {
+                continue;
+            }
+            match p.to_svg(720, 300) {
+                Ok(svg) => h.svg(&format!("{label} against {key}"), &svg),
+                Err(e) => h.paragraph(&format!("{label}: not plotted ({e})")),
+            };
+        }
+    }
+    let mut header: Vec<&str> = vec!["case_id"];
+    header.extend(plan.keys.iter().map(|s| s.as_str()));
+    header.extend(["damper_model", "status"]);
+    header.extend(METRICS);
+    let table: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let mut v = vec![r.case_id.clone()];
+            v.extend(r.varied.iter().cloned());
+            v.push(r.model.clone());
+            v.push(r.status.clone());
+            v.extend(r.metrics.iter().cloned());
+            v
+        })
+        .collect();
+    h.heading(2, "cases");
+    h.table(&header, &table);
+    h.finish()
+}
+
+/// Writes DIR/sweep.csv and DIR/sweep.html (each atomically); returns the rows.
+pub fn write(plan: &Plan, dir: &Path) -> anyhow::Result<Vec<Row>> {
+    let rows = rows(plan, dir);
+    crate::io::write_atomic(&dir.join("sweep.csv"), csv(plan, &rows)?.as_bytes())?;
+    crate::io::write_atomic(&dir.join("sweep.html"), html(plan, &rows).as_bytes())?;
+    Ok(rows)
+}
