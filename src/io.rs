@@ -262,6 +262,21 @@ pub struct OutDir {
 }
 
 impl OutDir {
+    /// Where the results come from, as the manifest records it: `run_id`, `rotorsim_version`,
+    /// `git_commit`, `command_line` and `inputs` (path, sha256, size). Also written into a
+    /// command's own summary so that it can travel alone.
+    pub fn provenance(&self) -> serde_json::Value {
+        serde_json::json!({
+            "run_id": self.run_id,
+            "rotorsim_version": env!("CARGO_PKG_VERSION"),
+            "git_commit": GIT_COMMIT,
+            "command_line": std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect::<Vec<_>>(),
+            "inputs": self.inputs,
+        })
+    }
+
     /// Starts a result folder at `path`: takes its lock, removes stale staging siblings of
     /// earlier killed runs, records the sha256 of `inputs` (files; a directory stands for every
     /// file under it) and creates the staging folder with an `INCOMPLETE` marker. An existing
@@ -463,20 +478,19 @@ impl OutDir {
                 outputs.push(file_entry(rel, &p).map_err(werr(&p))?);
             }
         }
-        let manifest = serde_json::json!({
+        let mut manifest = serde_json::json!({
             "run_id": self.run_id,
             "start_time": rfc3339(self.start),
             "end_time": rfc3339(SystemTime::now()),
             "complete": complete,
             "incomplete_reason": reason,
-            "rotorsim_version": env!("CARGO_PKG_VERSION"),
-            "git_commit": GIT_COMMIT,
-            "command_line": std::env::args_os()
-                .map(|a| a.to_string_lossy().into_owned())
-                .collect::<Vec<_>>(),
-            "inputs": self.inputs,
-            "outputs": outputs,
         });
+        if let (Some(m), serde_json::Value::Object(p)) =
+            (manifest.as_object_mut(), self.provenance())
+        {
+            m.extend(p);
+            m.insert("outputs".into(), serde_json::Value::Array(outputs));
+        }
         let text = serde_json::to_string_pretty(&manifest).map_err(|e| OutputError::Write {
             path: self.staging.join(MANIFEST),
             source: std::io::Error::other(e),

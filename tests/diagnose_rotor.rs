@@ -167,8 +167,8 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
     for side in ["baseline", "extended"] {
         let s = read_json(&out.join(format!("rotor_check/{side}/summary.json")));
         assert_eq!(
-            s["models"]["physical"]["metrics"]["rms_error"],
-            c[side]["metrics"]["rms_error"]
+            s["models"]["physical"]["metrics"]["rms_error_N"],
+            c[side]["metrics"]["rms_error_N"]
         );
         assert!(!out.join(format!("rotor_check/{side}/INCOMPLETE")).exists());
         // A nested result folder: its own manifest, listed in the parent's.
@@ -187,8 +187,8 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
             .any(|o| o["path"] == format!("rotor_check/{side}/manifest.json")));
     }
     // The change is the difference of the two, and the gain its relative form.
-    let b = c["baseline"]["metrics"]["rms_error"].as_f64().unwrap();
-    let e = c["extended"]["metrics"]["rms_error"].as_f64().unwrap();
+    let b = c["baseline"]["metrics"]["rms_error_N"].as_f64().unwrap();
+    let e = c["extended"]["metrics"]["rms_error_N"].as_f64().unwrap();
     assert!(b.is_finite() && e.is_finite() && b > 0.0);
     assert!((c["change"]["rms_error_N"].as_f64().unwrap() - (e - b)).abs() < 1e-9 * b);
     assert!((c["change"]["gain"].as_f64().unwrap() - (1.0 - e / b)).abs() < 1e-12);
@@ -228,8 +228,8 @@ fn extended_deck_improves_the_rigid_rotor_comparison_of_the_shipped_record() {
     let b = &c["baseline"]["metrics"];
     let e = &c["extended"]["metrics"];
     let (rb, re) = (
-        b["rms_error"].as_f64().unwrap(),
-        e["rms_error"].as_f64().unwrap(),
+        b["rms_error_N"].as_f64().unwrap(),
+        e["rms_error_N"].as_f64().unwrap(),
     );
     // measured 1250 N -> 557 N (gain 0.555); both runs periodic
     assert_eq!(c["change"]["improved"], true);
@@ -251,10 +251,7 @@ fn unknown_rotor_model_is_refused_by_name() {
     })
     .unwrap_err();
     let msg = format!("{err:#}");
-    assert!(
-        msg.contains("--rotor-model") && msg.contains("elastic"),
-        "{msg}"
-    );
+    assert!(msg.contains("--model") && msg.contains("elastic"), "{msg}");
 }
 
 /// A record without stroke, its stroke simulated by the rigid-blade reduction (the record's own

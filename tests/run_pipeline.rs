@@ -132,7 +132,7 @@ fn all_three_models_write_every_output() {
         }
         let f = &j["damper_force_N"];
         assert!(f["max"].as_f64().unwrap() > 0.0 && f["min"].as_f64().unwrap() < 0.0);
-        for k in ["rms_error", "peak_to_peak_error", "correlation"] {
+        for k in ["rms_error_N", "peak_to_peak_error_N", "correlation"] {
             assert!(j["metrics"][k].is_number(), "{m} {k}");
         }
         assert_eq!(
@@ -166,9 +166,12 @@ fn all_three_models_write_every_output() {
     // CSV: units in every column, one revolution of samples, azimuths 0..360.
     let (h, cols) = read_csv(&out.join("physical/last_rev.csv"));
     assert_eq!(
-        &h[..4],
+        &h[..7],
         &[
+            "time_s",
             "azimuth_deg",
+            "measured_damper_force_N",
+            "measured_damper_stroke_m",
             "damper_force_N",
             "damper_stroke_m",
             "damper_stroke_rate_m_s"
@@ -177,20 +180,20 @@ fn all_three_models_write_every_output() {
     for want in support::PHYSICAL_CHANNELS {
         assert!(h.iter().any(|x| x == want), "{want} missing from {h:?}");
     }
-    let units = ["_deg", "_N", "_m", "_m_s", "_Pa", "_m3_s", "_rad"];
+    let units = ["_s", "_deg", "_N", "_m", "_m_s", "_Pa", "_m3_s", "_rad"];
     for c in &h {
         assert!(
             units.iter().any(|u| c.ends_with(u)),
             "column {c} has no unit"
         );
     }
-    assert_eq!(cols[0].len(), 256);
-    assert_eq!(cols[0][0], 0.0);
-    assert!((cols[0][255] - (360.0 - 360.0 / 256.0)).abs() < 1e-9);
+    assert_eq!(cols[1].len(), 256);
+    assert_eq!(cols[1][0], 0.0);
+    assert_eq!(cols[1][255], 360.0 - 360.0 / 256.0);
     // Stroke = arm x lag angle and the stroke rate is its derivative: check d(stroke)/dt
     // against the rate by central differences (trapezoidal rule => exact for the mean rate).
     let dt = 2.0 * std::f64::consts::PI / 27.0 / 256.0;
-    let (d, v) = (&cols[2], &cols[3]);
+    let (d, v) = (&cols[5], &cols[6]);
     for i in 1..255 {
         let mean_rate = (d[i + 1] - d[i]) / dt;
         assert!(
@@ -237,13 +240,14 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
         &out,
         &["--damper", "linear", "--revs", "3"],
     ));
-    let (_, cols) = read_csv(&out.join("linear/last_rev.csv"));
+    let (h, cols) = read_csv(&out.join("linear/last_rev.csv"));
+    let force = &cols[h.iter().position(|c| c == "damper_force_N").unwrap()];
     let r = FlightRecord::read(&example()).unwrap();
     let az = r.azimuths_deg().to_vec();
     assert_eq!(az.len(), cols[0].len());
     let make = |offset: f64| -> Vec<DamperSample> {
         az.iter()
-            .zip(&cols[1])
+            .zip(force)
             .map(|(p, f)| DamperSample {
                 revolution: 0,
                 azimuth_deg: *p,
@@ -261,9 +265,9 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
         &["--damper", "linear", "--revs", "3"],
     ));
     let m = &summary(&o2)["models"]["linear"]["metrics"];
-    assert!(m["rms_error"].as_f64().unwrap() < 1e-6, "{m}");
+    assert!(m["rms_error_N"].as_f64().unwrap() < 1e-6, "{m}");
     assert!((m["correlation"].as_f64().unwrap() - 1.0).abs() < 1e-12);
-    assert!(m["peak_to_peak_error"].as_f64().unwrap().abs() < 1e-6);
+    assert!(m["peak_to_peak_error_N"].as_f64().unwrap().abs() < 1e-6);
     assert_eq!(m["samples"], 256);
 
     // A constant offset of 250 N: RMS error 250 N, no peak-to-peak error, correlation 1,
@@ -279,13 +283,13 @@ fn measured_equal_to_the_model_gives_zero_error_and_a_shift_gives_the_known_erro
     let s = summary(&o3);
     let m = &s["models"]["linear"]["metrics"];
     assert!(
-        (m["rms_error"].as_f64().unwrap() - 250.0).abs() < 1e-6,
+        (m["rms_error_N"].as_f64().unwrap() - 250.0).abs() < 1e-6,
         "{m}"
     );
-    assert!(m["peak_to_peak_error"].as_f64().unwrap().abs() < 1e-6);
+    assert!(m["peak_to_peak_error_N"].as_f64().unwrap().abs() < 1e-6);
     assert!((m["correlation"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     let res = &s["models"]["linear"]["residual"];
-    assert!((res["harmonics"][0]["amplitude"].as_f64().unwrap() - 250.0).abs() < 1e-6);
+    assert!((res["harmonics"][0]["amplitude_N"].as_f64().unwrap() - 250.0).abs() < 1e-6);
     for d in [out, o2, o3] {
         let _ = std::fs::remove_dir_all(d);
     }
@@ -371,7 +375,7 @@ fn a_damper_channel_too_coarse_to_compare_runs_without_metrics() {
     );
     let m = &s["models"]["nonlinear"];
     assert_eq!(m["status"], "ok");
-    assert!(m["metrics"]["rms_error"].is_null());
+    assert!(m["metrics"]["rms_error_N"].is_null());
     assert!(m["metrics"]["note"].is_string());
     assert!(s["closest"].is_null());
     assert!(String::from_utf8_lossy(&o.stdout).contains("no comparison metrics"));
@@ -537,11 +541,12 @@ fn short_run_of_the_uh60a_rotor_with_the_three_dampers() {
         assert_eq!(j["status"], "ok", "{m}: {j}");
         assert_eq!(j["steps"], 256);
         assert_eq!(j["periodicity"]["history"].as_array().unwrap().len(), 2);
-        assert!(j["metrics"]["rms_error"].as_f64().unwrap().is_finite());
+        assert!(j["metrics"]["rms_error_N"].as_f64().unwrap().is_finite());
         // The damper works against the lag motion: force and stroke rate are anti-correlated.
         let (h, cols) = read_csv(&out.join(m).join("last_rev.csv"));
         assert_eq!(cols[0].len(), 128);
-        let (f, v) = (&cols[1], &cols[3]);
+        let col = |name: &str| &cols[h.iter().position(|c| c == name).unwrap()];
+        let (f, v) = (col("damper_force_N"), col("damper_stroke_rate_m_s"));
         let fv: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
         assert!(fv < 0.0, "{m}: damper force does positive work");
         // Blade loads (docs/loads.md): the channels in last_rev.csv and summary.json, the
@@ -679,5 +684,71 @@ fn a_run_that_is_not_periodic_says_so_and_fails_only_when_asked() {
         summary(&out)["models"]["linear"]["periodic"]["converged"],
         true
     );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn last_rev_joins_the_record_and_all_revs_holds_every_revolution() {
+    // last_rev.csv: time_s, azimuths exactly k 360/N, the record's revolution-averaged force
+    // and stroke on them (averaged here from the record's own CSV); --write-all-revs: every
+    // revolution, the last one being the reported revolution.
+    let out = tmp("last-rev-join");
+    ok(&run_sdof(
+        &example(),
+        &out,
+        &["--damper", "linear", "--write-all-revs"],
+    ));
+    let (h, c) = read_csv(&out.join("linear/last_rev.csv"));
+    assert_eq!(
+        &h[..4],
+        [
+            "time_s",
+            "azimuth_deg",
+            "measured_damper_force_N",
+            "measured_damper_stroke_m"
+        ]
+    );
+    let n = c[0].len();
+    assert_eq!(n, 256);
+    let (rh, rec) = read_csv(&repo().join("flightdata/c8534like.damper.csv"));
+    let col = |name: &str| &rec[rh.iter().position(|c| c == name).unwrap()];
+    let (ra, rf, rd) = (
+        col("azimuth_deg"),
+        col("damper_force_N"),
+        col("damper_stroke_m"),
+    );
+    let period = summary(&out)["models"]["linear"]["period_s"]
+        .as_f64()
+        .unwrap();
+    for k in 0..n {
+        assert_eq!(c[1][k], k as f64 * 360.0 / n as f64, "row {k}");
+        if k > 0 {
+            assert!((c[0][k] - c[0][k - 1] - period / n as f64).abs() < 1e-12);
+        }
+        let same: Vec<usize> = (0..ra.len())
+            .filter(|&i| (ra[i] - c[1][k]).abs() < 1e-6)
+            .collect();
+        assert!(!same.is_empty(), "the record has azimuth {}", c[1][k]);
+        let avg = |v: &[f64]| same.iter().map(|&i| v[i]).sum::<f64>() / same.len() as f64;
+        assert!((c[2][k] - avg(rf)).abs() <= 1e-9 * avg(rf).abs(), "row {k}");
+        assert!((c[3][k] - avg(rd)).abs() <= 1e-9 * avg(rd).abs(), "row {k}");
+    }
+    let (ah, all) = read_csv(&out.join("linear/all_revs.csv"));
+    assert_eq!(
+        &ah[..4],
+        ["revolution", "shooting_iterate", "time_s", "azimuth_deg"]
+    );
+    assert_eq!(all[0].len() % n, 0);
+    let revs = all[0].len() / n;
+    assert!(revs >= 2, "{revs}");
+    let f_all = &all[ah.iter().position(|c| c == "damper_force_N").unwrap()];
+    let f_last = &c[h.iter().position(|c| c == "damper_force_N").unwrap()];
+    for j in 0..n {
+        let i = (revs - 1) * n + j;
+        assert_eq!(all[0][i], revs as f64);
+        assert_eq!(all[3][i], c[1][j]);
+        assert_eq!(all[2][i], c[0][j]);
+        assert_eq!(f_all[i], f_last[j], "sample {j}");
+    }
     let _ = std::fs::remove_dir_all(&out);
 }

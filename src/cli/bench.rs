@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Damper deck (any TOML file with a [damper] table, e.g. rotors/uh60a.toml).
-    #[arg(long)]
+    #[arg(long = "damper-deck", alias = "deck")]
     pub deck: PathBuf,
     /// Damper model: physical, linear, nonlinear, or all (default: the deck's `model`).
     #[arg(long)]
@@ -34,8 +34,8 @@ pub struct BenchArgs {
     /// Hydraulic sub-steps per step.
     #[arg(long, default_value_t = 25)]
     pub substeps: usize,
-    /// Sub-step integrator: rk4 or implicit.
-    #[arg(long, default_value = "rk4")]
+    /// Hydraulic sub-step scheme: rk4 or implicit.
+    #[arg(long = "scheme", alias = "integrator", default_value = "rk4")]
     pub integrator: String,
     /// Measured bench test(s) to replay instead of the harmonic sweep (bench CSV, FORMATS.md).
     #[arg(long)]

@@ -22,12 +22,12 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
     /// Damper deck of the baseline model (any TOML file with a [damper] table).
-    #[arg(long)]
+    #[arg(long = "damper-deck", alias = "deck")]
     pub deck: Option<PathBuf>,
     /// Measured bench test(s) (bench CSV of FORMATS.md, with force).
     #[arg(long)]
     pub measured: Vec<PathBuf>,
-    /// Rotor deck (flight-record diagnosis; its [damper] table is the baseline unless --deck).
+    /// Rotor deck (flight-record diagnosis; its [damper] table is the baseline unless --damper-deck).
     #[arg(long)]
     pub rotor: Option<PathBuf>,
     /// Flight record (MCAP file or CSV stem, e.g. flightdata/c8534like).
@@ -65,7 +65,7 @@ pub struct DiagnoseArgs {
     pub check_revs: usize,
     /// Rotor model of the rotor runs: uh60a (the multibody model of the rotor deck) or rigid
     /// (its rigid-blade reduction, as `rotorsim run --model rigid`; seconds instead of minutes).
-    #[arg(long, default_value = "uh60a")]
+    #[arg(long = "model", alias = "rotor-model", default_value = "uh60a")]
     pub rotor_model: String,
 }
 
@@ -380,7 +380,7 @@ fn rotor_check(
             counter: rec.meta.counter.clone(),
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
         };
-        let failed = super::run_cmd::write_outputs(&sub, &info, &[outcome], &measured)?;
+        let failed = super::run_cmd::write_outputs(&sub, &info, &[outcome], &measured)?.failed;
         if failed.is_empty() {
             sub.finish()?;
         } else {
@@ -445,8 +445,8 @@ fn rotor_check(
             "command": p.3,
             "summary": format!("rotor_check/{}/summary.json", p.0),
             "run": run_json(p.1, &opts),
-            "metrics": p.4,
-            "stroke_check": st,
+            "metrics": summary::with_unit(serde_json::to_value(&p.4).unwrap_or_default(), "N"),
+            "stroke_check": summary::with_unit(serde_json::to_value(st).unwrap_or_default(), "m"),
         })
     };
     let json = json!({
@@ -597,7 +597,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     }
     if !matches!(args.rotor_model.as_str(), "uh60a" | "rigid") {
         bail!(
-            "--rotor-model: unknown rotor model '{}' (expected uh60a or rigid)",
+            "--model: unknown rotor model '{}' (expected uh60a or rigid)",
             args.rotor_model
         );
     }
@@ -613,7 +613,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
                 .deck
                 .clone()
                 .or(args.rotor.clone())
-                .context("--flight needs --rotor ROTOR (or --deck DECK) for the baseline damper")?;
+                .context("--flight needs --rotor ROTOR (or --damper-deck DECK) for the baseline damper")?;
             let deck = DamperDeck::from_file(&deck_path)?;
             deck_label = deck_path.display().to_string();
             let rec = FlightRecord::read(fl)?;
@@ -655,7 +655,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
             (deck, vec![m], src)
         }
         (None, false) => {
-            let deck_path = args.deck.clone().context("--measured needs --deck DECK")?;
+            let deck_path = args.deck.clone().context("--measured needs --damper-deck DECK")?;
             let deck = DamperDeck::from_file(&deck_path)?;
             let data = args
                 .measured
@@ -679,7 +679,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         }
         (Some(_), false) => bail!("give either --flight or --measured, not both"),
         (None, true) => bail!(
-            "nothing to diagnose: give --deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
+            "nothing to diagnose: give --damper-deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
         ),
     };
     let opts = DiagnoseOptions {

@@ -70,11 +70,42 @@ pub mod static_cmd;
 pub mod sweep;
 pub mod verify;
 
+/// Exit status, the same for every command (also in docs/run.md).
+macro_rules! exit_note {
+    () => {
+        "Exit status: 0 when the command did what was asked; 1 when it could not (bad input, a \
+failed model, a numerical failure, a run that is not periodic under --require-periodic, stdout \
+lost), with the reason on stderr; 2 for a command line that cannot be parsed (unknown option, \
+missing value)."
+    };
+}
+
+/// A command's outputs, then what every result folder holds, then the exit status.
+macro_rules! writes {
+    ($own:literal) => {
+        concat!(
+            $own,
+            "\n\nEvery result folder also holds manifest.json (inputs and outputs with their \
+sha256, command line, version, `complete`); a folder that did not finish holds an INCOMPLETE \
+marker.\n\n",
+            exit_note!()
+        )
+    };
+}
+
+/// Output to stdout only, then the exit status.
+macro_rules! prints {
+    ($own:literal) => {
+        concat!($own, "\n\n", exit_note!())
+    };
+}
+
 #[derive(Parser, Debug)]
 #[command(
     name = "rotorsim",
     version,
-    about = "Rotor-blade loads with physics-based hydraulic lead-lag dampers"
+    about = "Rotor-blade loads with physics-based hydraulic lead-lag dampers",
+    after_help = exit_note!()
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -84,26 +115,67 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Virtual damper test bench: harmonic sweeps or replay of measured bench tests.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: peaks.csv (peak force per amplitude and model), history CSVs (time \
+histories), peak_force_vs_velocity.svg (paper Fig. 13), time_history.svg; with --measured: \
+replay_<test>.csv, loop_<test>.svg and replay_summary.csv."
+    ))]
     Bench(bench::BenchArgs),
     /// Nonlinear static analysis of a model deck.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: static.csv (every sensor), nodes.csv and node_names.csv (the deformed \
+configuration), tangent_check.txt with --check-tangent."
+    ))]
     Static(static_cmd::StaticArgs),
     /// Dynamic (generalized-alpha) analysis of a model deck.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: sensors.csv (time histories of every sensor), summary.json (steps, Newton \
+iterations, wall time, `complete`); with [[hydraulic]] devices plots.svg and one SVG per \
+paper figure 9-12 of each device."
+    ))]
     Dynamic(dynamic::DynamicArgs),
     /// Natural frequencies and mode shapes (model deck, or rotor deck fan plot).
+    #[command(after_long_help = writes!(
+        "Writes DIR/: modes.csv and mode_shapes.csv (model deck); fan.csv, fan.svg and, with a \
+reference table, fan_comparison.csv (rotor deck)."
+    ))]
     Modes(modes::ModesArgs),
     /// Run the verification suite and write verify.json.
+    #[command(after_long_help = writes!("Writes DIR/verify.json: every check with its \
+reference, value, tolerance and pass/fail."))]
     Verify(verify::VerifyArgs),
     /// Convert a flight record between the CSV triple and MCAP.
+    #[command(after_long_help = prints!("Writes the converted record (STEM.meta.json, \
+STEM.airloads.csv, STEM.damper.csv, or FILE.mcap)."))]
     Convert(convert::ConvertArgs),
     /// Print what a flight record holds.
+    #[command(after_long_help = prints!("Writes nothing; prints to stdout."))]
     Inspect(inspect::InspectArgs),
     /// Print the multibody model deck generated from a rotor deck.
+    #[command(after_long_help = prints!("Writes nothing; prints the deck (TOML) to stdout."))]
     Expand(expand::ExpandArgs),
     /// Forced response of a rotor to a flight record, to a periodic solution, with report.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: report.html (verdict, figures, tables: open this first), summary.json \
+(every figure, with provenance), result.mcap (for a viewer such as Foxglove), and per damper \
+model <model>/last_rev.csv (the periodic revolution with the measurement), \
+<model>/periodic_state.json (for --initial-state) and, with --write-all-revs, \
+<model>/all_revs.csv. The last lines printed are the verdict and the files to open."
+    ))]
     Run(run_cmd::RunArgs),
     /// Find what a damper model gets wrong in measured data, name the cause, extend the model.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: diagnosis.json (cause, parameters, validation, candidates), \
+diagnosis.html (evidence and figures), extended_deck.toml (also to --write-deck FILE); with \
+--rotor-check the rotor runs of both decks in rotor_check/baseline/ and rotor_check/extended/."
+    ))]
     Diagnose(diagnose::DiagnoseArgs),
     /// Batch forced-response runs from a plan: locally on all cores, or as Slurm array shards.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: plan.json (the expanded plan), cases/<id>/ (what `run` writes, per case), \
+sweep.csv (one row per case and damper model) and sweep.html; --emit-slurm FILE writes the \
+sbatch array script only."
+    ))]
     Sweep(sweep::SweepArgs),
 }
 

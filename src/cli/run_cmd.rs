@@ -51,6 +51,10 @@ pub struct RunArgs {
     /// Exit non-zero when a model does not reach the periodicity tolerance.
     #[arg(long)]
     pub require_periodic: bool,
+    /// Also write <model>/all_revs.csv: every revolution integrated on the way to the periodic
+    /// solution (marched revolutions and accepted shooting iterates, not perturbed ones).
+    #[arg(long)]
+    pub write_all_revs: bool,
     /// Structural steps per revolution.
     #[arg(long, default_value_t = 256)]
     pub steps_per_rev: usize,
@@ -187,6 +191,54 @@ impl Progress for Bars {
         } else {
             b.abandon_with_message(format!("FAILED: {message}"));
         }
+    }
+}
+
+/// Seconds between plain progress lines when stderr is not a terminal (logs, batch jobs).
+const PLAIN_PROGRESS_EVERY_S: f64 = 5.0;
+
+/// Plain progress lines on a stderr that is not a terminal: per model, a line at most every
+/// `every` seconds (revolution, periodicity, elapsed time), and one when it ends.
+struct Lines {
+    names: Vec<&'static str>,
+    every: f64,
+    start: Instant,
+    last: std::sync::Mutex<Vec<f64>>,
+}
+
+impl Lines {
+    fn new(models: &[DamperModel], every: f64) -> Self {
+        Lines {
+            names: models.iter().map(|m| m.name()).collect(),
+            every,
+            start: Instant::now(),
+            last: std::sync::Mutex::new(vec![f64::NEG_INFINITY; models.len()]),
+        }
+    }
+}
+
+impl Progress for Lines {
+    fn revolution(&self, i: usize, rev: usize, revs: usize, m: Option<f64>) {
+        let now = self.start.elapsed().as_secs_f64();
+        let due = match self.last.lock() {
+            Ok(mut last) if now - last[i] >= self.every => {
+                last[i] = now;
+                true
+            }
+            _ => false,
+        };
+        if due {
+            errln!(
+                "{}: revolution {rev} of at most {revs}, periodicity {}, {now:.0} s",
+                self.names[i],
+                fmt_measure(m)
+            );
+        }
+    }
+    fn finished(&self, i: usize, ok: bool, message: &str) {
+        let now = self.start.elapsed().as_secs_f64();
+        let state = if ok { "done" } else { "FAILED" };
+        errln!("{}: {state} after {now:.1} s: {message}", self.names[i]);
     }
 }
 
@@ -355,13 +407,17 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             stop_early: true,
             initial_state: init,
             min_floquet_dirs: 0,
+            keep_all_revs: args.write_all_revs,
         })
         .collect();
-    let outcomes = if tty {
+    let outcomes = if args.quiet {
+        run::run_models(&models, &popts, &build, &Silent)
+    } else if tty {
         let bars = Bars::new(&models, args.revs);
         run::run_models(&models, &popts, &build, &bars)
     } else {
-        run::run_models(&models, &popts, &build, &Silent)
+        let lines = Lines::new(&models, PLAIN_PROGRESS_EVERY_S);
+        run::run_models(&models, &popts, &build, &lines)
     };
     let info = RunInfo {
         rotor: args.rotor.display().to_string(),
@@ -396,9 +452,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         counter: record.meta.counter.clone(),
         wall_s: t0.elapsed().as_secs_f64(),
     };
-    let failed = write_outputs(&out, &info, &outcomes, &measured)?;
+    let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
     if !args.quiet {
-        print_summary(&out, &outcomes, &measured);
+        print_summary(&outcomes, &measured);
     }
     let not_periodic: Vec<String> = outcomes
         .iter()
@@ -406,6 +462,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         .filter(|r| !r.converged())
         .map(|r| format!("{} (residual {})", r.label, fmt_measure(r.last_measure())))
         .collect();
+    if !args.quiet {
+        print_verdict(&out, &verdict, &outcomes);
+    }
     if failed.is_empty() && args.require_periodic && !not_periodic.is_empty() {
         let summary_path = out.file("summary.json");
         out.finish()?;
@@ -428,13 +487,21 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     }
 }
 
-/// Writes every output; returns the failures ("model: error").
+/// What [`write_outputs`] reports back.
+pub struct Written {
+    /// The failures ("model: error").
+    pub failed: Vec<String>,
+    /// Which model comes closest to the measured force, and by how much (None without one).
+    pub verdict: Option<String>,
+}
+
+/// Writes every output.
 pub fn write_outputs(
     out: &OutDir,
     info: &RunInfo,
     outcomes: &[ModelOutcome],
     measured: &Result<Measured, String>,
-) -> anyhow::Result<Vec<String>> {
+) -> anyhow::Result<Written> {
     let meas = measured.as_ref().ok();
     let figs: Vec<Option<Result<ModelFigures, String>>> = outcomes
         .iter()
@@ -450,7 +517,10 @@ pub fn write_outputs(
         match (&o.result, f) {
             (Err(e), _) | (Ok(_), Some(Err(e))) => failed.push(format!("{}: {e}", o.model.name())),
             (Ok(r), _) => {
-                summary::write_last_rev(out, r)?;
+                summary::write_last_rev(out, r, meas)?;
+                if !r.all_revs.is_empty() {
+                    summary::write_all_revs(out, r)?;
+                }
                 summary::write_periodic_state(out, r)?;
             }
         }
@@ -464,7 +534,10 @@ pub fn write_outputs(
         })
         .collect();
     let rank = summary::ranking(&metrics);
-    let json = summary::summary_json(info, outcomes, &figs, measured, rank.as_ref());
+    let mut json = summary::summary_json(info, outcomes, &figs, measured, rank.as_ref());
+    if let (Some(j), serde_json::Value::Object(p)) = (json.as_object_mut(), out.provenance()) {
+        j.extend(p);
+    }
     out.write(
         "summary.json",
         serde_json::to_string_pretty(&json)?.as_bytes(),
@@ -477,10 +550,13 @@ pub fn write_outputs(
         .collect();
     let mcap = run::mcap_out::mcap_bytes(&ok, meas, info.synthetic)?;
     out.write("result.mcap", &mcap)?;
-    Ok(failed)
+    Ok(Written {
+        failed,
+        verdict: rank.map(|r| r.statement),
+    })
 }
 
-fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Measured, String>) {
+fn print_summary(outcomes: &[ModelOutcome], measured: &Result<Measured, String>) {
     for o in outcomes {
         match &o.result {
             Ok(r) => {
@@ -536,9 +612,27 @@ fn print_summary(out: &OutDir, outcomes: &[ModelOutcome], measured: &Result<Meas
     if let Err(note) = measured {
         outln!("note: {note}");
     }
+}
+
+/// The last lines of a run: the verdict and the files to open (paths as published).
+fn print_verdict(out: &OutDir, verdict: &Option<String>, outcomes: &[ModelOutcome]) {
+    if let Some(v) = verdict {
+        outln!("verdict: {v}");
+    }
+    let published = |name: &str| out.published_path(&out.file(name)).display().to_string();
     outln!(
-        "summary: {}  report: {}",
-        out.file("summary.json").display(),
-        out.file("report.html").display()
+        "open: {} (verdict, figures, tables)",
+        published("report.html")
     );
+    outln!(
+        "      {} (every figure), {} (for a viewer such as Foxglove)",
+        published("summary.json"),
+        published("result.mcap")
+    );
+    for o in outcomes.iter().filter(|o| o.result.is_ok()) {
+        outln!(
+            "      {} (the periodic revolution, with the measurement)",
+            published(&format!("{}/last_rev.csv", o.model.name()))
+        );
+    }
 }

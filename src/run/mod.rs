@@ -51,8 +51,12 @@ pub struct ModelRun {
     pub periodic_state: Option<SimState>,
     /// Channel names (with units), [`crate::rotor::BASE_CHANNELS`] first.
     pub channel_names: Vec<String>,
-    /// Azimuth of each sample of the last revolution [deg], in [0, 360).
+    /// Azimuth of each sample of the last revolution [deg], in [0, 360): k 360/N exactly.
     pub azimuth_deg: Vec<f64>,
+    /// Model time of each sample of the last revolution [s] (t = 0 at psi = 0 of the first).
+    pub time_s: Vec<f64>,
+    /// Every revolution along the way, when asked for (`PeriodicOptions::keep_all_revs`).
+    pub all_revs: Vec<KeptRevolution>,
     /// `last_rev[c][i]`: channel `c` at sample `i` of the last revolution.
     pub last_rev: Vec<Vec<f64>>,
     pub force_limits_n: Option<(f64, f64)>,
@@ -67,6 +71,17 @@ pub struct ModelRun {
     pub loads_check: Option<loads::EquilibriumCheck>,
     /// Identical blades of the rotor (for the hub loads).
     pub blades: Option<usize>,
+}
+
+/// One revolution kept along the way to the periodic solution.
+#[derive(Clone, Debug)]
+pub struct KeptRevolution {
+    /// 0 for a marched revolution, k for the k-th accepted shooting iterate.
+    pub shooting_iterate: usize,
+    /// Model time at its first sample [s].
+    pub start_t_s: f64,
+    /// `samples[c][i]`: channel `c` at sample `i` (azimuths as in [`ModelRun::azimuth_deg`]).
+    pub samples: Vec<Vec<f64>>,
 }
 
 impl ModelRun {
@@ -264,12 +279,23 @@ pub fn drive_periodic(
             o.max_revs
         )
     };
+    let mut kept: Vec<KeptRevolution> = vec![];
+    let keep = |kept: &mut Vec<KeptRevolution>, rev: &Revolution, iterate: usize| {
+        if o.keep_all_revs {
+            kept.push(KeptRevolution {
+                shooting_iterate: iterate,
+                start_t_s: rev.start_t_s,
+                samples: rev.samples.clone(),
+            });
+        }
+    };
     // March: all of it, or until shooting starts.
     let mut shoot_from: Option<SimState> = None;
     while periods < o.max_revs {
         let periodic = sim.time_s() >= periodic_from;
         let st0 = if can_save { sim.save_state() } else { None };
         integrate(sim, &mut rev, &march_label(periods + 1))?;
+        keep(&mut kept, &rev, 0);
         periods += 1;
         in_periodic += usize::from(periodic);
         info.residual_by_channel = rev.residual(&mon);
@@ -297,6 +323,9 @@ pub fn drive_periodic(
             .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
         let label = format!("{} model", model.name());
         let mut map = SimMap::new(sim, mon.clone(), st0, end, rev, periods, progress, label);
+        if o.keep_all_revs {
+            map.kept = Some(vec![]);
+        }
         info.residual_history = vec![max_nan(&map.residual_by_channel)];
         let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
         periods = map.periods;
@@ -309,6 +338,9 @@ pub fn drive_periodic(
         info.method_used = PeriodicMethod::Shooting;
         let (start, end) = (map.start.clone(), map.end.clone());
         rev = std::mem::replace(&mut map.rev, Revolution::new(0, 0));
+        for (k, r) in map.kept.take().unwrap_or_default().iter().enumerate() {
+            keep(&mut kept, r, k + 1);
+        }
         drop(map);
         start_state = Some(start);
         let mut mult: Vec<_> = out
@@ -354,6 +386,7 @@ pub fn drive_periodic(
             while periods < o.max_revs {
                 let st0 = sim.save_state();
                 integrate(sim, &mut rev, &march_label(periods + 1))?;
+                keep(&mut kept, &rev, 0);
                 periods += 1;
                 info.residual_by_channel = rev.residual(&mon);
                 let r = max_nan(&info.residual_by_channel);
@@ -394,8 +427,10 @@ pub fn drive_periodic(
         periodic: info,
         periodic_state: start_state,
         channel_names: names,
+        time_s: (0..n).map(|j| rev.start_t_s + j as f64 * dt).collect(),
         azimuth_deg: rev.azimuth,
         last_rev: rev.samples,
+        all_revs: kept,
         force_limits_n: sim.force_limits_n(),
         relief_regulation: sim.relief_regulation(),
         timing,

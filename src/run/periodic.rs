@@ -44,6 +44,8 @@ pub struct PeriodicOptions {
     pub initial_state: Option<PeriodicStateFile>,
     /// Directions of the shooting subspace at least (more Floquet multipliers).
     pub min_floquet_dirs: usize,
+    /// Keep every revolution along the way (marched ones and accepted shooting iterates).
+    pub keep_all_revs: bool,
 }
 
 impl PeriodicOptions {
@@ -56,6 +58,7 @@ impl PeriodicOptions {
             stop_early: false,
             initial_state: None,
             min_floquet_dirs: 0,
+            keep_all_revs: false,
         }
     }
     /// Shooting to `tol`, at most `max_revs` revolutions.
@@ -67,6 +70,7 @@ impl PeriodicOptions {
             stop_early: true,
             initial_state: None,
             min_floquet_dirs: 0,
+            keep_all_revs: false,
         }
     }
 }
@@ -112,6 +116,7 @@ pub struct PeriodicInfo {
 }
 
 /// Samples of one revolution: channel values at the start of every step, and at its end.
+#[derive(Clone)]
 pub(super) struct Revolution {
     pub samples: Vec<Vec<f64>>,
     pub azimuth: Vec<f64>,
@@ -167,7 +172,14 @@ pub(super) fn integrate(
         if j == 0 && psi > 359.0 {
             psi = 0.0;
         }
-        rev.azimuth[j] = psi;
+        // sample j of a revolution is at k 360/N: written exactly, so that outputs join the
+        // record's azimuths (the integrated azimuth carries ~1e-8 deg of rounding)
+        let exact = j as f64 * 360.0 / n as f64;
+        rev.azimuth[j] = if (psi - exact).abs() < 1e-6 {
+            exact
+        } else {
+            psi
+        };
         sim.step().map_err(|e| {
             e.context(format!(
                 "{what}, step {j} of {n} (t = {:.6} s)",
@@ -193,6 +205,8 @@ pub(super) struct SimMap<'a> {
     pub residual_by_channel: Vec<f64>,
     pub progress: &'a dyn Fn(usize, Option<f64>),
     pub label: String,
+    /// Accepted iterates, when the run keeps every revolution.
+    pub kept: Option<Vec<Revolution>>,
 }
 
 impl<'a> SimMap<'a> {
@@ -221,6 +235,7 @@ impl<'a> SimMap<'a> {
             residual_by_channel,
             progress,
             label,
+            kept: None,
         }
     }
 
@@ -270,6 +285,9 @@ impl PeriodMap for SimMap<'_> {
             self.step_change = Some(max_nan(&rev.change_from(&self.rev, &self.mon)));
             self.rev = rev;
             self.residual_by_channel = self.rev.residual(&self.mon);
+            if let Some(k) = &mut self.kept {
+                k.push(self.rev.clone());
+            }
         }
     }
     fn residual(&self) -> f64 {

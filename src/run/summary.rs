@@ -592,7 +592,7 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         _ => json!({"applies": false, "note": "this model has no force limits"}),
     };
     let metrics = match (&f.metrics, measured) {
-        (Some(m), _) => serde_json::to_value(m).unwrap_or(Value::Null),
+        (Some(m), _) => with_unit(serde_json::to_value(m).unwrap_or(Value::Null), "N"),
         (None, Err(note)) => json!({"note": note}),
         (None, Ok(_)) => Value::Null,
     };
@@ -634,10 +634,48 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         },
         "cost_per_step_s": t.total_s / steps,
         "metrics": metrics,
-        "residual": f.residual,
-        "stroke_check": f.stroke,
+        "residual": with_unit(serde_json::to_value(&f.residual).unwrap_or(Value::Null), "N"),
+        "stroke_check": with_unit(serde_json::to_value(&f.stroke).unwrap_or(Value::Null), "m"),
         "channels": r.channel_names,
     })
+}
+
+/// Members of a metrics-like object in `unit`, suffixed with it (summary.json's rule: every
+/// dimensional value's key ends with its unit; `rms_at_best_shift_n` becomes
+/// `rms_at_best_shift_N`); harmonic lists get `amplitude_<unit>`, `cos_<unit>`, `sin_<unit>`.
+/// Already suffixed keys and dimensionless ones (ratios, correlation, counts, phases in deg)
+/// are left alone.
+pub fn with_unit(v: Value, unit: &str) -> Value {
+    const DIMENSIONAL: [&str; 11] = [
+        "rms_error",
+        "max_abs_error",
+        "peak_to_peak_model",
+        "peak_to_peak_measured",
+        "peak_to_peak_error",
+        "mean_model",
+        "mean_measured",
+        "amplitude",
+        "cos",
+        "sin",
+        "rms_at_best_shift",
+    ];
+    match v {
+        Value::Object(map) => Value::Object(
+            map.into_iter()
+                .map(|(k, v)| {
+                    let base = k.strip_suffix("_n").unwrap_or(&k);
+                    let k = if DIMENSIONAL.contains(&base) {
+                        format!("{base}_{unit}")
+                    } else {
+                        k
+                    };
+                    (k, with_unit(v, unit))
+                })
+                .collect(),
+        ),
+        Value::Array(a) => Value::Array(a.into_iter().map(|x| with_unit(x, unit)).collect()),
+        other => other,
+    }
 }
 
 /// summary.json `periodic` of one model.
@@ -727,11 +765,30 @@ pub fn write_periodic_state(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// DIR/<model>/last_rev.csv: azimuth_deg then every channel (units in the names).
-pub fn write_last_rev(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
-    let mut header: Vec<&str> = vec!["azimuth_deg"];
+/// DIR/<model>/last_rev.csv: time_s, azimuth_deg (k 360/N exactly), the record's measured
+/// damper force and stroke on those azimuths where it has them, then every channel (units in
+/// the names).
+pub fn write_last_rev(
+    out: &OutDir,
+    r: &ModelRun,
+    measured: Option<&Measured>,
+) -> anyhow::Result<()> {
+    let on_model = |m: &Measured, values: &[f64]| -> Vec<f64> {
+        periodic_resample(&m.azimuth_deg, values, &r.azimuth_deg)
+    };
+    let force = measured.map(|m| on_model(m, &m.force_n));
+    let stroke = measured.and_then(|m| m.stroke_m.as_deref().map(|d| on_model(m, d)));
+    let mut header: Vec<&str> = vec!["time_s", "azimuth_deg"];
+    let mut cols: Vec<&[f64]> = vec![&r.time_s, &r.azimuth_deg];
+    if let Some(f) = &force {
+        header.push("measured_damper_force_N");
+        cols.push(f);
+    }
+    if let Some(d) = &stroke {
+        header.push("measured_damper_stroke_m");
+        cols.push(d);
+    }
     header.extend(r.channel_names.iter().map(|s| s.as_str()));
-    let mut cols: Vec<&[f64]> = vec![&r.azimuth_deg];
     cols.extend(r.last_rev.iter().map(|c| c.as_slice()));
     out.write(
         &format!("{}/last_rev.csv", r.model),
@@ -740,9 +797,90 @@ pub fn write_last_rev(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// DIR/<model>/all_revs.csv: every revolution kept along the way (`--write-all-revs`), one
+/// row per sample: revolution (1, 2, ... in the order integrated), shooting_iterate (0 for a
+/// marched revolution, k for the k-th accepted shooting iterate), time_s, azimuth_deg, then
+/// every channel.
+pub fn write_all_revs(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
+    let n = r.azimuth_deg.len();
+    let rows = r.all_revs.len() * n;
+    let mut rev = Vec::with_capacity(rows);
+    let mut iterate = Vec::with_capacity(rows);
+    let mut time = Vec::with_capacity(rows);
+    let mut azimuth = Vec::with_capacity(rows);
+    let mut channels = vec![Vec::with_capacity(rows); r.channel_names.len()];
+    let dt = r.period_s / n as f64;
+    for (k, kr) in r.all_revs.iter().enumerate() {
+        for j in 0..n {
+            rev.push((k + 1) as f64);
+            iterate.push(kr.shooting_iterate as f64);
+            time.push(kr.start_t_s + j as f64 * dt);
+            azimuth.push(r.azimuth_deg[j]);
+            for (c, col) in channels.iter_mut().enumerate() {
+                col.push(kr.samples[c][j]);
+            }
+        }
+    }
+    let mut header: Vec<&str> = vec!["revolution", "shooting_iterate", "time_s", "azimuth_deg"];
+    header.extend(r.channel_names.iter().map(|s| s.as_str()));
+    let mut cols: Vec<&[f64]> = vec![&rev, &iterate, &time, &azimuth];
+    cols.extend(channels.iter().map(|c| c.as_slice()));
+    out.write(
+        &format!("{}/all_revs.csv", r.model),
+        csv_from_columns(&header, &cols).as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// `values` on azimuths `from` (one revolution, increasing in [0, 360)) at azimuths `to`:
+/// exact where an azimuth coincides (within 1e-9 deg), periodic linear interpolation between.
+fn periodic_resample(from: &[f64], values: &[f64], to: &[f64]) -> Vec<f64> {
+    let n = from.len();
+    to.iter()
+        .map(|&psi| {
+            // first sample at or after psi
+            let k = from.partition_point(|&a| a < psi - 1e-9);
+            if k < n && (from[k] - psi).abs() <= 1e-9 {
+                return values[k];
+            }
+            let (i0, i1) = if k == 0 || k == n {
+                (n - 1, 0)
+            } else {
+                (k - 1, k)
+            };
+            let a0 = from[i0];
+            let mut a1 = from[i1];
+            if a1 <= a0 {
+                a1 += 360.0;
+            }
+            let mut p = psi;
+            if p < a0 {
+                p += 360.0;
+            }
+            let w = (p - a0) / (a1 - a0);
+            values[i0] + w * (values[i1] - values[i0])
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn measured_values_are_exact_on_shared_azimuths_and_periodic_linear_between() {
+        let from: Vec<f64> = (0..8).map(|k| k as f64 * 45.0).collect();
+        let values: Vec<f64> = (0..8).map(|k| k as f64).collect();
+        let same = periodic_resample(&from, &values, &from);
+        assert_eq!(same, values);
+        let to = [22.5, 337.5, 350.0, 0.0, 10.0];
+        let got = periodic_resample(&from, &values, &to);
+        // between 315 deg (7) and 360 = 0 deg (0), linear; 10 deg between 0 and 45
+        let want = [0.5, 3.5, 7.0 * (1.0 - 35.0 / 45.0), 0.0, 10.0 / 45.0];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12, "{got:?} vs {want:?}");
+        }
+    }
 
     /// `K* = -F1/d1` on analytic laws, stroke `d = D cos(psi - 40 deg)`: a spring `F = -k d`
     /// gives `K* = k`; a dashpot `F = -c d'` (d' = -D Omega sin(psi - 40 deg)) gives `i c Omega`;

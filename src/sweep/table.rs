@@ -125,7 +125,7 @@ pub fn rows(plan: &Plan, dir: &Path) -> Vec<Row> {
             let hp = |ch: &str| num(&loads[ch]["half_peak_to_peak"]);
             let metrics = vec![
                 warm.clone(),
-                num(&m["metrics"]["rms_error"]),
+                num(&m["metrics"]["rms_error_N"]),
                 num(&m["metrics"]["rms_error_rel"]),
                 num(&m["metrics"]["correlation"]),
                 num(&m["damper_force_N"]["min"]),
