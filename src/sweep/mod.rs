@@ -78,6 +78,21 @@ pub fn case_state(path: &Path) -> CaseState {
     }
 }
 
+/// Whether every model of the case folder `path` reached its periodicity tolerance (by its
+/// summary.json; false when it cannot be read).
+fn all_periodic(path: &Path) -> bool {
+    let Ok(text) = std::fs::read_to_string(path.join("summary.json")) else {
+        return false;
+    };
+    let Ok(s) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
+    s["models"].as_object().is_some_and(|m| {
+        m.values()
+            .all(|v| v["periodic"]["converged"] == serde_json::Value::Bool(true))
+    })
+}
+
 /// How to run a sweep.
 #[derive(Clone, Debug)]
 pub struct SweepOptions {
@@ -211,7 +226,14 @@ pub fn execute(
     let mut report = SweepReport::default();
     let needs = |i: usize, report: &mut SweepReport| -> bool {
         let c = &plan.cases[i];
-        match case_state(&case_dir(dir, &c.id)) {
+        let mut state = case_state(&case_dir(dir, &c.id));
+        // a case that asked for periodicity and did not reach it is published complete (its
+        // best revolution), but it has not done what was asked: failed for the resume
+        let requires = c.option("require_periodic") == Some(&toml::Value::Boolean(true));
+        if state == CaseState::Done && requires && !all_periodic(&case_dir(dir, &c.id)) {
+            state = CaseState::Failed("not periodic (require_periodic)".into());
+        }
+        match state {
             CaseState::Done => {
                 report.skipped.push(c.id.clone());
                 false
