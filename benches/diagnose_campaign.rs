@@ -1,5 +1,6 @@
 //! Diagnosis of a 6-test SYNTHETIC bench campaign (8 cycles each, 2 kHz, 1% noise, hidden seal
-//! friction): all candidates fitted, ranked and validated. Issue #7 target: < 30 s on 2 cores.
+//! friction): all candidates fitted, ranked and validated; and an 8-test campaign with two
+//! hidden effects, pair stage included. Target: < 30 s on 2 cores.
 //! `cargo bench --bench diagnose_campaign`
 #[path = "../tests/diagnose_support/mod.rs"]
 mod support;
@@ -18,6 +19,23 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let o = diagnose(black_box(&base), black_box(&data), &opts).unwrap();
             assert_eq!(o.diagnosis.cause, "seal_friction");
+            o
+        })
+    });
+    // 8 tests with two hidden effects (friction and entrained air): the pair stage runs.
+    let two = Cause::EntrainedAir.apply(&h.deck, &[0.01]);
+    let data8 = support::campaign(
+        &two,
+        &[1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0],
+        8,
+        2000.0,
+        0.01,
+        2,
+    );
+    g.bench_function("8_tests_8_cycles_2kHz_two_effects", |b| {
+        b.iter(|| {
+            let o = diagnose(black_box(&base), black_box(&data8), &opts).unwrap();
+            assert!(!o.diagnosis.companions.is_empty(), "pair stage ran");
             o
         })
     });

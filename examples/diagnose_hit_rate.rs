@@ -12,8 +12,8 @@ fn main() {
     let first: u64 = a.get(4).and_then(|s| s.parse().ok()).unwrap_or(0);
     let verbose = a.iter().any(|s| s == "-v");
     let base = support::nominal_deck();
-    let (mut named, mut recovered, mut positive) = (0, 0, 0);
-    println!("seed,true_cause,true_value,named,fitted_value,rel_error,gain,hit");
+    let (mut named, mut recovered, mut positive, mut covered) = (0, 0, 0, 0);
+    println!("seed,true_cause,true_value,named,fitted_value,rel_error,gain,interval_lo,interval_hi,covered,hit");
     for seed in first..first + seeds {
         let h = support::draw(seed);
         let data = support::standard(&h.deck, cycles, rate, seed);
@@ -34,18 +34,29 @@ fn main() {
         named += ok_name as u32;
         recovered += ok_par as u32;
         positive += (ok_name && d.gain > 0.0) as u32;
+        // The 95% interval of the recovered parameter covers the truth.
+        let [lo, hi] = d
+            .parameter_intervals
+            .get(h.param)
+            .copied()
+            .unwrap_or([f64::NAN, f64::NAN]);
+        let cov = ok_name && lo <= h.value && h.value <= hi;
+        covered += cov as u32;
         println!(
-            "{seed},{},{:.4e},{},{:.4e},{:.3},{:.3},{}",
+            "{seed},{},{:.4e},{},{:.4e},{:.3},{:.3},{:.4e},{:.4e},{},{}",
             h.cause.name(),
             h.value,
             d.cause,
             fitted,
             rel,
             d.gain,
+            lo,
+            hi,
+            cov,
             ok_par && d.gain > 0.0
         );
     }
     println!(
-        "seeds {seeds}: cause named {named}/{seeds}, parameter within tolerance {recovered}/{seeds}, named with positive held-out gain {positive}/{seeds}"
+        "seeds {seeds}: cause named {named}/{seeds}, parameter within tolerance {recovered}/{seeds}, named with positive held-out gain {positive}/{seeds}, 95% interval covers the truth {covered}/{seeds}"
     );
 }

@@ -23,7 +23,10 @@ fn run(h: &support::Hidden, seed: u64) -> rotorsim::diagnose::Outcome {
 }
 
 fn assert_found(h: &support::Hidden, seed: u64) {
-    let o = run(h, seed);
+    check_found(h, seed, &run(h, seed));
+}
+
+fn check_found(h: &support::Hidden, seed: u64, o: &rotorsim::diagnose::Outcome) {
     let d = &o.diagnosis;
     assert_eq!(d.cause, h.cause.name(), "seed {seed}: {h:?}\n{d:#?}");
     let got = d.parameters[h.param];
@@ -188,4 +191,32 @@ fn generator_is_seeded_and_noisy_at_one_percent() {
         (rms / peak - 0.01).abs() < 0.001,
         "noise {rms} vs peak {peak}"
     );
+}
+
+/// Free play as in hardware, a gap behind a contact stiffness: named as such (not as a mount
+/// compliance), the gap recovered, every parameter reported with a 95% interval, and the limit
+/// the data support stated.
+#[test]
+fn compliant_free_play_is_found_with_its_gap() {
+    for (i, u) in [0.3, 0.7].into_iter().enumerate() {
+        let h = support::hidden(Cause::CompliantFreePlay, u);
+        let o = run(&h, 200 + i as u64);
+        let d = &o.diagnosis;
+        check_found(&h, 200 + i as u64, &o);
+        assert!(d.free_play_limit.is_some());
+        let k_true = h
+            .deck
+            .extensions
+            .free_play_contact_stiffness_n_per_m
+            .unwrap();
+        let k = d.parameters["contact_stiffness_N_per_m"];
+        assert!(
+            (k - k_true).abs() < 0.25 * k_true,
+            "stiffness {k:e} vs {k_true:e}"
+        );
+        for (k, v) in &d.parameters {
+            let [lo, hi] = d.parameter_intervals[k];
+            assert!(lo <= *v && *v <= hi, "{k} = {v} outside [{lo}, {hi}]");
+        }
+    }
 }

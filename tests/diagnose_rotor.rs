@@ -218,7 +218,7 @@ fn extended_deck_improves_the_rigid_rotor_comparison_of_the_shipped_record() {
     })
     .unwrap();
     let j = read_json(&out.join("diagnosis.json"));
-    assert_eq!(j["cause"], "mount_compliance");
+    assert_eq!(j["cause"], "compliant_free_play");
     let c = &j["rotor_check"];
     assert!(c["rotor_model"].as_str().unwrap().contains("rigid-blade"));
     assert!(c["extended"]["command"]
@@ -258,7 +258,8 @@ fn unknown_rotor_model_is_refused_by_name() {
 /// blade model, `--rotor-model rigid`): the diagnosis finds the mount compliance it finds with
 /// the measured stroke (5.028e7 N/m, docs/diagnosis.md), the recalibration beside it taking up
 /// the reduction's 2.7% smaller 1/rev stroke. Measured: mount_compliance+recalibration,
-/// 5.018e7 N/m, held-out gain 0.694.
+/// 5.018e7 N/m, held-out gain 0.694 (the compliant free play is within a BIC of 10 of the pure
+/// compliance here and gives way to it).
 #[test]
 fn record_without_stroke_through_the_rigid_reduction_finds_the_mount() {
     let dir = tmp("nostroke-rigid");
@@ -282,5 +283,22 @@ fn record_without_stroke_through_the_rigid_reduction_finds_the_mount() {
     );
     let k = j["parameters"]["mount_stiffness_N_per_m"].as_f64().unwrap();
     assert!((k / 5.028e7 - 1.0).abs() < 0.02, "mount stiffness {k}");
+    // The compliant free play gave way to its pure-compliance limit, and the JSON says why the
+    // companion was kept.
+    assert!(j["free_play_limit"]
+        .as_str()
+        .unwrap()
+        .contains("pure-compliance limit"));
+    let kept: Vec<_> = j["companions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["kept"] == true)
+        .collect();
+    assert_eq!(kept.len(), 1);
+    assert!(kept[0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("earns its parameters"));
     assert!(j["gain"].as_f64().unwrap() > 0.5);
 }

@@ -458,3 +458,108 @@ fn series_mount_balances_force_across_a_kinked_device_law() {
     }
     assert!(worst <= 0.1 + 1e-9, "largest force mismatch {worst} N");
 }
+
+/// Harmonic stroking `d = a sin(w t)`, `n` steps per cycle, `cycles` cycles: end-of-step forces.
+fn drive(dev: &mut dyn Device, a: f64, w: f64, n: usize, cycles: usize) -> Vec<(f64, f64)> {
+    let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+    (0..cycles * n)
+        .map(|i| {
+            let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+            let d1 = a * (w * t1).sin();
+            let sf = dev.trial_step(t0, dt, a * (w * t0).sin(), d1).unwrap();
+            dev.commit();
+            (d1, sf.force_end)
+        })
+        .collect()
+}
+
+/// Zero gap: the compliant free play is a pure series compliance, the SeriesMount's result (both
+/// solves balance the force to 0.1 N), on the hydraulic damper and on a dashpot.
+#[test]
+fn compliant_free_play_with_zero_gap_is_the_series_mount() {
+    let k = 5.0e7;
+    let play = deck_with(&format!("free_play_contact_stiffness_N_per_m = {k}"));
+    let mount = deck_with(&format!("mount_stiffness_N_per_m = {k}"));
+    let mut a = play.build(DamperModel::Physical, opts()).unwrap();
+    let mut b = mount.build(DamperModel::Physical, opts()).unwrap();
+    let (w, n) = (27.02, 512);
+    let fa = drive(a.as_mut(), 3.0e-3, w, n, 3);
+    let fb = drive(b.as_mut(), 3.0e-3, w, n, 3);
+    let peak = fb.iter().map(|x| x.1.abs()).fold(0.0, f64::max);
+    let worst = fa
+        .iter()
+        .zip(&fb)
+        .map(|(x, y)| (x.1 - y.1).abs())
+        .fold(0.0, f64::max);
+    assert!(peak > 5e3, "peak {peak} N");
+    assert!(worst < 0.5, "largest difference {worst} N of {peak} N");
+    let mut c = CompliantFreePlay::new(Box::new(LinearDashpot::new(1.0e5)), 0.0, k);
+    let mut d = SeriesMount::new(Box::new(LinearDashpot::new(1.0e5)), k);
+    let fc = drive(&mut c, 3.0e-3, w, n, 3);
+    let fd = drive(&mut d, 3.0e-3, w, n, 3);
+    for (x, y) in fc.iter().zip(&fd) {
+        assert!((x.1 - y.1).abs() < 0.3, "{} vs {}", x.1, y.1);
+    }
+}
+
+/// Infinite contact stiffness on a dashpot: the rigid play operator of `FreePlay`, whose piston
+/// stroke gives the dashpot force `-c (d_h,f - d_h,i)/dt` (zero while the gap is open). The
+/// remaining difference is the contact's deflection F/k per step, c |dF|/(k dt) << 1 N here.
+#[test]
+fn compliant_free_play_with_infinite_stiffness_is_the_rigid_gap() {
+    let (c, gap, k) = (1.0e5, 0.4e-3, 1.0e13);
+    let (a, w, n) = (2.0e-3, 27.02, 1024);
+    let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+    let mut dev = CompliantFreePlay::new(Box::new(LinearDashpot::new(c)), gap, k);
+    let f = drive(&mut dev, a, w, n, 3);
+    let rigid = FreePlay { gap };
+    let mut d_h = 0.0;
+    let mut inside = 0;
+    for (i, &(d, fc)) in f.iter().enumerate() {
+        let (next, contact) = rigid.follow(d_h, d);
+        let fr = -c * (next - d_h) / dt;
+        d_h = next;
+        if i > n {
+            assert!((fc - fr).abs() < 1.0, "step {i}: {fc} vs rigid {fr} N");
+            if !contact {
+                inside += 1;
+                assert!(fc.abs() <= 0.1, "step {i}: {fc} N inside the gap");
+            }
+        }
+    }
+    assert!(inside > 40, "{inside} steps inside the gap");
+}
+
+/// A gap behind a contact spring on the hydraulic damper: the link force balances the damper's
+/// at every step, `F = k dz(d_h - d)` with the dead band of half the gap, and no force is carried
+/// while the link is inside the gap.
+#[test]
+fn compliant_free_play_balances_the_link_force() {
+    let (gap, k) = (0.2e-3, 2.0e8);
+    let dk = deck_with(&format!(
+        "free_play_m = {gap}\nfree_play_contact_stiffness_N_per_m = {k}"
+    ));
+    assert_eq!(dk.extensions.free_play_contact_stiffness_n_per_m, Some(k));
+    let back = DamperDeck::from_toml_str(&dk.to_toml(), "back").unwrap();
+    assert_eq!(back.extensions, dk.extensions);
+    let inner = dk
+        .physical_device(opts())
+        .expect("physical damper of the nominal deck");
+    let mut dev = CompliantFreePlay::new(Box::new(inner), gap, k);
+    let (a, w, n) = (2.0e-3, 27.02, 512);
+    let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+    let (mut worst, mut open) = (0.0f64, 0);
+    for i in 0..3 * n {
+        let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+        let d1 = a * (w * t1).sin();
+        let sf = dev.trial_step(t0, dt, a * (w * t0).sin(), d1).unwrap();
+        dev.commit();
+        let (fl, contact) = dev.link_force(dev.device_stroke() - d1);
+        worst = worst.max((sf.force_end - fl).abs());
+        if !contact {
+            open += 1;
+        }
+    }
+    assert!(worst <= 1.0, "largest force mismatch {worst} N");
+    assert!(open > 10, "{open} steps with the gap open");
+}

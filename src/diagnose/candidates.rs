@@ -20,6 +20,8 @@ pub enum Cause {
     AccumulatorBleed,
     /// Re-calibration of the orifice area (C_d A_orf) and relief-valve flow-area coefficient a.
     Recalibration,
+    /// Free play behind a contact stiffness (gap and stiffness fitted together).
+    CompliantFreePlay,
 }
 
 /// One fitted parameter: name (with unit), bounds, starting values (multi-start).
@@ -39,9 +41,10 @@ pub struct Scales {
 }
 
 impl Cause {
-    pub const CANDIDATES: [Cause; 10] = [
+    pub const CANDIDATES: [Cause; 11] = [
         Cause::SealFriction,
         Cause::FreePlay,
+        Cause::CompliantFreePlay,
         Cause::EntrainedAir,
         Cause::EntrainedAirByChamber,
         Cause::AreaAsymmetry,
@@ -65,6 +68,7 @@ impl Cause {
             Cause::MountCompliance => "mount_compliance",
             Cause::EntrainedAirByChamber => "entrained_air_by_chamber",
             Cause::Recalibration => "recalibration",
+            Cause::CompliantFreePlay => "compliant_free_play",
         }
     }
 
@@ -92,6 +96,14 @@ impl Cause {
                     1.5 * a,
                     vec![0.03 * a, 0.15 * a, 0.5 * a],
                 )]
+            }
+            Cause::CompliantFreePlay => {
+                let a = s.min_amplitude_m;
+                // Up to 1e11 N/m: far stiffer than the oil column (~1e8), the rigid-gap limit.
+                vec![
+                    p("gap_m", 1e-3 * a, 1.5 * a, vec![0.03 * a, 0.15 * a]),
+                    p("contact_stiffness_N_per_m", 1e6, 1e11, vec![5e7, 1e9]),
+                ]
             }
             Cause::EntrainedAir => vec![p("air_fraction", 1e-5, 0.3, vec![3e-3, 3e-2])],
             Cause::EntrainedAirByChamber => vec![
@@ -139,6 +151,10 @@ impl Cause {
             Cause::None => {}
             Cause::SealFriction => d.extensions.friction = Some(SealFriction::coulomb(x[0])),
             Cause::FreePlay => d.extensions.free_play = Some(FreePlay { gap: x[0] }),
+            Cause::CompliantFreePlay => {
+                d.extensions.free_play = Some(FreePlay { gap: x[0] });
+                d.extensions.free_play_contact_stiffness_n_per_m = Some(x[1]);
+            }
             Cause::EntrainedAir => {
                 c.ext.air = Some(EntrainedAir {
                     fraction: x[0],

@@ -204,6 +204,11 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             "free play of {:.3} mm in the attachments: no force is transmitted while the stroke crosses the gap after each reversal",
             1e3 * p("gap_m")
         ),
+        "compliant_free_play" => format!(
+            "free play of {:.3} mm behind a contact stiffness of {:.3e} N/m (rod ends, bearings): no force while the gap is open after each reversal, then a force built up through the contact's compliance",
+            1e3 * p("gap_m"),
+            p("contact_stiffness_N_per_m")
+        ),
         "entrained_air" => format!(
             "entrained air {:.2}% by volume at p_s: the oil is soft near the background pressure, so the force lags and dwells near zero after each reversal",
             100.0 * p("air_fraction")

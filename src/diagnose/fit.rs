@@ -68,11 +68,25 @@ pub struct Candidate {
     pub bic: f64,
     pub parameters: BTreeMap<String, f64>,
     pub held_out_rms_N: f64,
+    /// 95% interval `[lo, hi]` of every fitted parameter (Jacobian of the fit with the noise).
+    pub intervals: BTreeMap<String, [f64; 2]>,
     pub k: usize,
     pub fit_evaluations: usize,
     /// Fit failure (model failure at every start), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
+}
+
+/// A companion tried beside the best single cause (extra key `companions`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Companion {
+    pub pair: String,
+    pub companion: String,
+    /// Passes both tests against the single cause (lower BIC, held-out gain above threshold).
+    pub passes: bool,
+    /// The pair is the chosen cause.
+    pub kept: bool,
+    pub reason: String,
 }
 
 /// Per-test summary (extra key `tests`).
@@ -93,6 +107,16 @@ pub struct TestSummary {
 pub struct Diagnosis {
     pub cause: String,
     pub parameters: BTreeMap<String, f64>,
+    /// 95% interval of every parameter of the cause.
+    pub parameter_intervals: BTreeMap<String, [f64; 2]>,
+    /// Which limit of free play behind a contact stiffness the data support, when a compliant
+    /// or gap cause is in play.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub free_play_limit: Option<String>,
+    /// Whether companions were tried for the best single cause, and why.
+    pub pair_stage: String,
+    /// Every companion tried, kept or dropped and why.
+    pub companions: Vec<Companion>,
     pub baseline_rms_N: f64,
     pub extended_rms_N: f64,
     pub gain: f64,
@@ -222,23 +246,107 @@ struct Problem<'a> {
     evals: std::cell::Cell<usize>,
 }
 
+/// Residuals `(model - measured)/scale` over `windows` of the deck with a cause applied at `x`.
+#[allow(clippy::too_many_arguments)]
+fn residuals_x(
+    cause: &[Cause],
+    scales: Scales,
+    base: &DamperDeck,
+    x: &[f64],
+    data: &[Measurement],
+    windows: &[Window],
+    max_h: f64,
+    scale: f64,
+) -> Option<DVector<f64>> {
+    let deck = apply_all(cause, base, scales, x);
+    let n: usize = windows.iter().map(|w| w.to - w.from).sum();
+    let mut r = DVector::zeros(n);
+    let mut buf = Vec::new();
+    let mut i = 0;
+    for w in windows {
+        let m = &data[w.test];
+        simulate(&deck, m, w.to, max_h, &mut buf).ok()?;
+        for (b, f) in buf[w.from..w.to].iter().zip(&m.force_n[w.from..w.to]) {
+            r[i] = (b - f) / scale;
+            i += 1;
+        }
+    }
+    Some(r)
+}
+
+/// Normal quantile of a two-sided 95% interval.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// 95% intervals of fitted parameters from the Jacobian of the fit residuals: the covariance
+/// of `ln x` is `s^2 (J^T J)^-1`, J by central differences in `ln x` (step 1%, the residual is
+/// only piecewise smooth), `s` the measured noise sigma or, where the fit leaves a larger
+/// residual (model-form error), the residual's own RMS (so that an imperfect fit widens its
+/// intervals rather than claiming the noise's precision). Returns `[lo, hi]` per parameter
+/// (`[0, inf]` where the data do not constrain it).
+#[allow(clippy::too_many_arguments)]
+fn intervals(
+    cause: &[Cause],
+    scales: Scales,
+    base: &DamperDeck,
+    x: &[f64],
+    data: &[Measurement],
+    windows: &[Window],
+    max_h: f64,
+    sigma: f64,
+    rss: f64,
+) -> Vec<[f64; 2]> {
+    let k = x.len();
+    let unbounded = vec![[0.0, f64::INFINITY]; k];
+    let n: usize = windows.iter().map(|w| w.to - w.from).sum();
+    if k == 0 || n <= k {
+        return unbounded;
+    }
+    let h: f64 = 0.01;
+    let mut j = nalgebra::DMatrix::zeros(n, k);
+    for c in 0..k {
+        let mut xp = x.to_vec();
+        let mut xm = x.to_vec();
+        xp[c] *= h.exp();
+        xm[c] *= (-h).exp();
+        let (Some(rp), Some(rm)) = (
+            residuals_x(cause, scales, base, &xp, data, windows, max_h, 1.0),
+            residuals_x(cause, scales, base, &xm, data, windows, max_h, 1.0),
+        ) else {
+            return unbounded;
+        };
+        j.set_column(c, &((rp - rm) / (2.0 * h)));
+    }
+    let s2 = sigma.powi(2).max(rss / (n - k) as f64);
+    let Some(cov) = (j.transpose() * &j).try_inverse() else {
+        return unbounded;
+    };
+    (0..k)
+        .map(|c| {
+            let v = s2 * cov[(c, c)];
+            if v.is_finite() && v >= 0.0 {
+                let sd = v.sqrt();
+                // exp overflows to inf for an unconstrained parameter: reported as such.
+                [x[c] * (-Z95 * sd).exp(), x[c] * (Z95 * sd).exp()]
+            } else {
+                [0.0, f64::INFINITY]
+            }
+        })
+        .collect()
+}
+
 impl Problem<'_> {
     fn residuals_at(&self, z: &[f64]) -> Option<DVector<f64>> {
         self.evals.set(self.evals.get() + 1);
-        let deck = apply_all(self.cause, self.base, self.scales, &to_x(self.spec, z));
-        let n: usize = self.windows.iter().map(|w| w.to - w.from).sum();
-        let mut r = DVector::zeros(n);
-        let mut buf = Vec::new();
-        let mut i = 0;
-        for w in self.windows {
-            let m = &self.data[w.test];
-            simulate(&deck, m, w.to, self.max_h, &mut buf).ok()?;
-            for (b, f) in buf[w.from..w.to].iter().zip(&m.force_n[w.from..w.to]) {
-                r[i] = (b - f) / self.scale;
-                i += 1;
-            }
-        }
-        Some(r)
+        residuals_x(
+            self.cause,
+            self.scales,
+            self.base,
+            &to_x(self.spec, z),
+            self.data,
+            self.windows,
+            self.max_h,
+            self.scale,
+        )
     }
 }
 
@@ -525,6 +633,7 @@ pub fn diagnose(
                     bic: f64::INFINITY,
                     parameters: BTreeMap::new(),
                     held_out_rms_N: f64::NAN,
+                    intervals: BTreeMap::new(),
                     k: spec.len(),
                     fit_evaluations: ev,
                     failure: None,
@@ -534,8 +643,20 @@ pub fn diagnose(
                     return (row, None, base.clone(), vec![]);
                 };
                 let deck = apply_all(c, base, scales, &f.x);
-                for (p, x) in spec.iter().zip(&f.x) {
+                let iv = intervals(
+                    c,
+                    scales,
+                    base,
+                    &f.x,
+                    data,
+                    &fit_w,
+                    opts.max_substep_s,
+                    sigma,
+                    f.rss,
+                );
+                for ((p, x), i) in spec.iter().zip(&f.x).zip(iv) {
                     row.parameters.insert(p.name.into(), *x);
+                    row.intervals.insert(p.name.into(), i);
                 }
                 match sim_all(&deck) {
                     Ok(sim) => {
@@ -554,14 +675,38 @@ pub fn diagnose(
     };
     let mut evaluated = stage(&singles);
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+    // A compliant free play that is not decisively better than one of its limits gives way to
+    // that limit (one parameter fewer): it moves behind the limit and may not be chosen.
+    let demoted = demote_compliant_play(&mut evaluated);
     let threshold = 0.05 * sigma + 3.0 * sigma / (2.0 * n_held.max(1) as f64).sqrt();
     // Stage 2: when the best single cause leaves a systematic residual (held-out RMS above
-    // 1.5 sigma) and itself passes, pair it with each of the next three singles (joint fit,
-    // starting from its own fitted value): effects do come together (the paper's conclusions).
+    // 1.5 sigma) and itself passes, pair it with every other single cause (joint fit, starting
+    // from its own fitted value): effects do come together (the paper's conclusions).
     let mut pair_ref: Option<(f64, f64)> = None;
+    let mut companions: Vec<Companion> = Vec::new();
+    let mut pair_stage = String::from("no single cause passes: no companion is tried");
     if let Some((row, Some(_), _, x1)) = evaluated.first() {
         let first_ok = row.bic < base_bic && base_held - row.held_out_rms_N > threshold;
-        if first_ok && row.held_out_rms_N > 1.5 * sigma && opts.pairs {
+        let systematic = row.held_out_rms_N > 1.5 * sigma;
+        pair_stage = if !first_ok {
+            format!(
+                "the best single cause ({}) does not pass: no companion is tried",
+                row.cause
+            )
+        } else if !systematic {
+            format!(
+                "{} leaves a held-out RMS of {:.1} N, within 1.5 noise sigma ({:.1} N): no systematic residual left for a companion",
+                row.cause, row.held_out_rms_N, 1.5 * sigma
+            )
+        } else if !opts.pairs {
+            "pairs switched off".into()
+        } else {
+            format!(
+                "{} leaves a held-out RMS of {:.1} N, above 1.5 noise sigma ({:.1} N): paired with every other applicable cause",
+                row.cause, row.held_out_rms_N, 1.5 * sigma
+            )
+        };
+        if first_ok && systematic && opts.pairs {
             let c1 = singles
                 .iter()
                 .find(|(c, _)| combined_name(c) == row.cause)
@@ -576,11 +721,7 @@ pub fn diagnose(
                             .iter()
                             .find(|(c, _)| combined_name(c) == e.0.cause)?
                             .0[0];
-                        // Two forms of the same element are not a pair.
-                        let air = |c: Cause| {
-                            matches!(c, Cause::EntrainedAir | Cause::EntrainedAirByChamber)
-                        };
-                        if air(c1) && air(c2) {
+                        if nested(c1, c2) {
                             return None;
                         }
                         let mut spec = combined_params(&[c1, c2], base, scales)?;
@@ -589,14 +730,41 @@ pub fn diagnose(
                         }
                         Some((vec![c1, c2], spec))
                     })
-                    .take(3)
                     .collect();
                 pair_ref = Some((row.bic, row.held_out_rms_N));
-                evaluated.extend(stage(&pairs));
+                let ev = stage(&pairs);
+                for e in &ev {
+                    let r = &e.0;
+                    let d_bic = row.bic - r.bic;
+                    let d_held = row.held_out_rms_N - r.held_out_rms_N;
+                    let by_bic = d_bic > 0.0;
+                    let by_held = d_held > threshold;
+                    let reason = format!(
+                        "BIC {} by {:.1} ({}); held-out RMS {} by {:.1} N against a threshold of {:.1} N ({})",
+                        if by_bic { "lower" } else { "higher" },
+                        d_bic.abs(),
+                        if by_bic { "earns its parameters" } else { "does not earn its parameters" },
+                        if d_held >= 0.0 { "lower" } else { "higher" },
+                        d_held.abs(),
+                        threshold,
+                        if by_held { "improves held-out data" } else { "no held-out improvement" },
+                    );
+                    companions.push(Companion {
+                        pair: r.cause.clone(),
+                        companion: r.cause.split('+').nth(1).unwrap_or_default().to_string(),
+                        passes: e.1.is_some() && by_bic && by_held,
+                        kept: false,
+                        reason,
+                    });
+                }
+                evaluated.extend(ev);
             }
         }
     }
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+    if let Some(d) = &demoted {
+        demote_behind(&mut evaluated, d);
+    }
 
     // Choice: the lowest BIC, if it beats the baseline's BIC and improves the held-out RMS by
     // more than the noise-level threshold.
@@ -607,17 +775,20 @@ pub fn diagnose(
         } else {
             (base_bic, base_held)
         };
-        sim.is_some() && row.bic < ref_bic && ref_held - row.held_out_rms_N > threshold
+        sim.is_some()
+            && Some(&row.cause) != demoted.as_ref()
+            && row.bic < ref_bic
+            && ref_held - row.held_out_rms_N > threshold
     });
     // Only the lowest-BIC candidate may be chosen, unless it is a pair that fails its own test
-    // (then the best single is next in line).
+    // (then the best single is next in line) or a demoted compliant free play.
     let chosen = chosen.filter(|c| {
         evaluated
             .iter()
             .take_while(|e| !std::ptr::eq(*e, *c))
-            .all(|e| e.0.cause.contains('+'))
+            .all(|e| e.0.cause.contains('+') || Some(&e.0.cause) == demoted.as_ref())
     });
-    let (cause, params, ext_sim, ext_deck, ext_rms, ext_held) = match chosen {
+    let (cause, params, ext_sim, ext_deck, ext_rms, ext_held, param_iv) = match chosen {
         Some((row, Some(sim), deck, _)) => (
             row.cause.clone(),
             row.parameters.clone(),
@@ -625,6 +796,7 @@ pub fn diagnose(
             deck.clone(),
             row.rms_N,
             row.held_out_rms_N,
+            row.intervals.clone(),
         ),
         _ => (
             "none".to_string(),
@@ -633,8 +805,17 @@ pub fn diagnose(
             base.clone(),
             base_rms,
             base_held,
+            BTreeMap::new(),
         ),
     };
+    let free_play_limit = free_play_limit(&cause, &evaluated);
+    for c in &mut companions {
+        c.kept = c.pair == cause;
+        if c.passes && !c.kept {
+            c.reason
+                .push_str("; passes, but another pair has the lower BIC");
+        }
+    }
     if one_amp {
         let mut singles_ev = evaluated.iter().filter(|e| !e.0.cause.contains('+'));
         if let (Some(a), Some(b)) = (singles_ev.next(), singles_ev.next()) {
@@ -691,6 +872,10 @@ pub fn diagnose(
         gain: 1.0 - ext_held / base_held,
         cause,
         parameters: params,
+        parameter_intervals: param_iv,
+        free_play_limit,
+        pair_stage,
+        companions,
         baseline_rms_N: base_rms,
         extended_rms_N: ext_rms,
         validation: Validation {
@@ -712,4 +897,99 @@ pub fn diagnose(
         extended: ext_deck,
         curves,
     })
+}
+
+/// Two forms of the same element (or one nesting the other) are not a pair.
+fn nested(a: Cause, b: Cause) -> bool {
+    let air = |c| matches!(c, Cause::EntrainedAir | Cause::EntrainedAirByChamber);
+    let play = |c| matches!(c, Cause::CompliantFreePlay);
+    let series = |c| matches!(c, Cause::FreePlay | Cause::MountCompliance);
+    (air(a) && air(b)) || (play(a) && series(b)) || (series(a) && play(b))
+}
+
+/// The limit a compliant free play gives way to: its BIC is within [`BIC_STRONG`] of exactly
+/// one limit (pure compliance or rigid gap) and decisively below the other. The limit then
+/// takes the lead of the ranking and the compliant row follows it; returns the demoted name.
+fn demote_compliant_play(evaluated: &mut [Evaluated]) -> Option<String> {
+    let bic = |n: &str| {
+        evaluated
+            .iter()
+            .find(|e| e.0.cause == n && e.1.is_some())
+            .map(|e| e.0.bic)
+    };
+    let c = bic("compliant_free_play")?;
+    let m = bic("mount_compliance").unwrap_or(f64::INFINITY);
+    let r = bic("free_play").unwrap_or(f64::INFINITY);
+    let near_m = m - c <= BIC_STRONG;
+    let near_r = r - c <= BIC_STRONG;
+    if near_m == near_r {
+        return None;
+    }
+    let name = "compliant_free_play".to_string();
+    demote_behind(evaluated, &name);
+    Some(name)
+}
+
+/// Moves a row just behind the best of its limits (`mount_compliance`, `free_play`) when it is
+/// ahead of them.
+fn demote_behind(evaluated: &mut [Evaluated], name: &str) {
+    let Some(i) = evaluated.iter().position(|e| e.0.cause == name) else {
+        return;
+    };
+    let Some(j) = evaluated
+        .iter()
+        .position(|e| e.0.cause == "mount_compliance" || e.0.cause == "free_play")
+    else {
+        return;
+    };
+    if j > i {
+        evaluated[i..=j].rotate_left(1);
+    }
+}
+
+/// Strong evidence on the BIC scale (a difference of 10: odds of ~150 to 1).
+const BIC_STRONG: f64 = 10.0;
+
+/// Which limit of a gap behind a contact stiffness the data support: the compliant free play
+/// nests the pure compliance (gap -> 0, `mount_compliance`) and the rigid gap (stiffness -> inf,
+/// `free_play`); compared by BIC, with the fitted intervals.
+fn free_play_limit(cause: &str, evaluated: &[Evaluated]) -> Option<String> {
+    let names = ["compliant_free_play", "mount_compliance", "free_play"];
+    if !cause.split('+').any(|c| names.contains(&c)) {
+        return None;
+    }
+    let row = |n: &str| {
+        evaluated
+            .iter()
+            .map(|e| &e.0)
+            .find(|r| r.cause == n && r.bic.is_finite())
+    };
+    let cfp = row(names[0])?;
+    let (gap, k) = (
+        cfp.parameters.get("gap_m")?,
+        cfp.parameters.get("contact_stiffness_N_per_m")?,
+    );
+    let iv = |p: &str| {
+        cfp.intervals
+            .get(p)
+            .copied()
+            .unwrap_or([0.0, f64::INFINITY])
+    };
+    let (gi, ki) = (iv("gap_m"), iv("contact_stiffness_N_per_m"));
+    let d_mount = row(names[1]).map_or(f64::INFINITY, |r| r.bic - cfp.bic);
+    let d_rigid = row(names[2]).map_or(f64::INFINITY, |r| r.bic - cfp.bic);
+    let fitted = format!(
+        "gap {gap:.3e} m (95% {:.3e}-{:.3e}) behind a contact stiffness {k:.3e} N/m (95% {:.3e}-{:.3e}); BIC below pure compliance by {d_mount:.1}, below the rigid gap by {d_rigid:.1}",
+        gi[0], gi[1], ki[0], ki[1]
+    );
+    let verdict = if d_mount > BIC_STRONG && d_rigid > BIC_STRONG {
+        "the data support a gap behind a finite contact stiffness (neither limit)"
+    } else if d_mount <= BIC_STRONG && d_rigid <= BIC_STRONG {
+        "the data cannot tell the pure-compliance and rigid-gap limits from a compliant gap"
+    } else if d_mount <= BIC_STRONG {
+        "the data support the pure-compliance limit (no gap resolved: mount_compliance)"
+    } else {
+        "the data support the rigid-gap limit (contact stiffness not resolved: free_play)"
+    };
+    Some(format!("{verdict}: {fitted}"))
 }

@@ -23,7 +23,10 @@ pub fn html_with(
     let params: Vec<String> = d
         .parameters
         .iter()
-        .map(|(k, v)| format!("{k} = {v:.6e}"))
+        .map(|(k, v)| match d.parameter_intervals.get(k) {
+            Some([lo, hi]) => format!("{k} = {v:.6e}, 95% interval {lo:.4e} - {hi:.4e}"),
+            None => format!("{k} = {v:.6e}"),
+        })
         .collect();
     r.paragraph(&format!(
         "Cause: {}{}. RMS error over all compared samples: baseline {:.1} N, extended {:.1} N. Validation ({}): baseline {:.1} N, extended {:.1} N, gain {:.3}.",
@@ -36,6 +39,9 @@ pub fn html_with(
         d.validation.extended_rms_N,
         d.gain
     ));
+    if let Some(l) = &d.free_play_limit {
+        r.paragraph(&format!("Free play: {l}."));
+    }
     for l in &d.limitations {
         r.notice(l);
     }
@@ -55,7 +61,10 @@ pub fn html_with(
                 format!("{:.1}", c.held_out_rms_N),
                 c.parameters
                     .iter()
-                    .map(|(k, v)| format!("{k} = {v:.4e}"))
+                    .map(|(k, v)| match c.intervals.get(k) {
+                        Some([lo, hi]) => format!("{k} = {v:.4e} (95% {lo:.3e} - {hi:.3e})"),
+                        None => format!("{k} = {v:.4e}"),
+                    })
                     .collect::<Vec<_>>()
                     .join(", "),
                 c.failure.clone().unwrap_or_default(),
@@ -69,7 +78,7 @@ pub fn html_with(
             "BIC",
             "RMS all [N]",
             "RMS held-out [N]",
-            "parameters",
+            "parameters (95% interval)",
             "failure",
         ],
         &rows,

@@ -4,7 +4,8 @@ use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
 use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
 use super::extensions::{
-    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction, SeriesMount,
+    CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage,
+    SealFriction, SeriesMount,
 };
 use super::fluid::Fluid;
 use super::integrators::IntegratorOptions;
@@ -104,6 +105,8 @@ pub struct DeviceExtensions {
     pub free_play: Option<FreePlay>,
     /// Stiffness of elastic mounts in series [N/m].
     pub mount_stiffness_n_per_m: Option<f64>,
+    /// Contact stiffness behind the free play [N/m] (None: a rigid gap).
+    pub free_play_contact_stiffness_n_per_m: Option<f64>,
 }
 
 /// Keys of `[damper.physical.extensions]` (all optional; absent or 0 = off).
@@ -119,6 +122,7 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "air_fraction_0",
     "air_fraction_1",
     "mount_stiffness_N_per_m",
+    "free_play_contact_stiffness_N_per_m",
 ];
 
 struct Ctx<'a> {
@@ -563,6 +567,11 @@ impl DamperDeck {
                 "a positive stiffness in N/m (absent: rigid mounts)",
                 positive,
             )?,
+            free_play_contact_stiffness_n_per_m: opt(
+                "free_play_contact_stiffness_N_per_m",
+                "a positive stiffness in N/m (absent: a rigid gap)",
+                positive,
+            )?,
             ..Default::default()
         };
         let f_c = f_c.unwrap_or(0.0);
@@ -645,10 +654,22 @@ impl DamperDeck {
             DamperModel::Physical => {
                 let dev = self.physical_device(opts)?;
                 let e = self.extensions;
-                let dev: Box<dyn Device> = if e.friction.is_some() || e.free_play.is_some() {
-                    Box::new(ExtendedDamper::new(dev, e.friction, e.free_play))
+                // A contact stiffness turns the rigid gap into the compliant one (outside friction).
+                let rigid_play = e
+                    .free_play
+                    .filter(|_| e.free_play_contact_stiffness_n_per_m.is_none());
+                let dev: Box<dyn Device> = if e.friction.is_some() || rigid_play.is_some() {
+                    Box::new(ExtendedDamper::new(dev, e.friction, rigid_play))
                 } else {
                     Box::new(dev)
+                };
+                let dev: Box<dyn Device> = match e.free_play_contact_stiffness_n_per_m {
+                    Some(k) => Box::new(CompliantFreePlay::new(
+                        dev,
+                        e.free_play.map_or(0.0, |p| p.gap),
+                        k,
+                    )),
+                    None => dev,
                 };
                 match e.mount_stiffness_n_per_m {
                     Some(k) => Box::new(SeriesMount::new(dev, k)),
@@ -756,6 +777,9 @@ impl DamperDeck {
             }
             if let Some(p) = e.free_play {
                 ext.push(("free_play_m", p.gap));
+            }
+            if let Some(k) = e.free_play_contact_stiffness_n_per_m {
+                ext.push(("free_play_contact_stiffness_N_per_m", k));
             }
             if let Some(k) = e.mount_stiffness_n_per_m {
                 ext.push(("mount_stiffness_N_per_m", k));

@@ -7,7 +7,9 @@
 //! - [`EntrainedAir`]: free air in the oil, isothermal, giving a pressure-dependent effective
 //!   bulk modulus (replaces Eq. 3 in the chambers);
 //! - [`Leakage`]: laminar leakage past the piston seal, `Q = k (p0 - p1)`, in parallel with the
-//!   orifice.
+//!   orifice;
+//! - [`SeriesMount`]: elastic mounts in series;
+//! - [`CompliantFreePlay`]: a gap behind a contact stiffness (free play as in hardware).
 //!
 //! Area asymmetry (`A1_m2`) and relief-valve asymmetry (`F_p_N` per valve) are parameters of the
 //! existing elements. [`ExtendedDamper`] composes a [`CircuitDevice`] with friction and free play.
@@ -500,6 +502,233 @@ impl Device for SeriesMount {
     fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
         if v.len() < 2 {
             return super::check_state_len("series mount", v, 2);
+        }
+        self.inner.set_state_values(&v[2..])?;
+        self.d_h = v[0];
+        self.fresh = v[1] != 0.0;
+        self.trial = None;
+        Ok(())
+    }
+}
+
+/// Free play as in hardware: a gap of total width `gap` in series with a contact stiffness `k`
+/// (rod-end and bearing stiffness behind the gap). The link force is a dead-band spring of the
+/// link deflection `e = d_h - d`: `F = k (e - g/2)` for `e > g/2`, `k (e + g/2)` for `e < -g/2`,
+/// zero inside the gap. Quasi-static: the moving mass between gap and contact is neglected, so
+/// the device force equals the link force at every instant (inside the gap the piston drifts so
+/// that the damper's own force is zero). This is the limit the damper itself enforces: with a
+/// rod-end mass m of a few kg and the damper's ~1e5 N s/m, the mass relaxes in m/c ~ 1e-5 s, far
+/// below a stroke period, and the contact mode is at least critically damped (c >= 2 sqrt(k m))
+/// up to k ~ 1e9 N/m; so contact damping adds nothing this model would resolve.
+/// Each step solves `H(x) = k dz(x - d_f) - F(x) = 0` for the device stroke x; H increases in x
+/// for a passive device (dF/dx < 0), so Newton steps safeguarded by a bracket converge to a force
+/// mismatch of 0.1 N. Limits: `gap = 0` is [`SeriesMount`]; `k -> infinity` is the play operator
+/// of [`FreePlay`] on a memoryless device (a dashpot); on the hydraulic damper the rigid
+/// [`FreePlay`] instead holds the piston still while the gap is open.
+#[derive(Debug, Clone)]
+pub struct CompliantFreePlay {
+    inner: Box<dyn Device>,
+    half_gap: f64,
+    k: f64,
+    d_h: f64,
+    fresh: bool,
+    trial: Option<f64>,
+}
+
+/// Iterations of the compliant free-play solve.
+const PLAY_MAX_ITER: usize = 80;
+
+impl CompliantFreePlay {
+    pub fn new(inner: Box<dyn Device>, gap_m: f64, k_n_per_m: f64) -> Self {
+        Self {
+            inner,
+            half_gap: 0.5 * gap_m,
+            k: k_n_per_m,
+            d_h: 0.0,
+            fresh: true,
+            trial: None,
+        }
+    }
+
+    /// Device stroke behind the gap and contact at the committed state [m].
+    pub fn device_stroke(&self) -> f64 {
+        self.d_h
+    }
+
+    /// Link force of a link deflection `e = d_h - d` [N] and whether the gap is closed.
+    #[inline]
+    pub fn link_force(&self, e: f64) -> (f64, bool) {
+        if e > self.half_gap {
+            (self.k * (e - self.half_gap), true)
+        } else if e < -self.half_gap {
+            (self.k * (e + self.half_gap), true)
+        } else {
+            (0.0, false)
+        }
+    }
+}
+
+impl Device for CompliantFreePlay {
+    fn trial_step(
+        &mut self,
+        t_i: f64,
+        dt: f64,
+        d_i: f64,
+        d_f: f64,
+    ) -> Result<StepForce, HydraulicError> {
+        check_step(t_i, dt, d_i, d_f)?;
+        if self.fresh {
+            // Link deflection carrying the device's initial force (centred when it is zero).
+            let f = self.inner.committed_force();
+            let e = if f > 0.0 {
+                self.half_gap + f / self.k
+            } else if f < 0.0 {
+                -self.half_gap + f / self.k
+            } else {
+                0.0
+            };
+            self.d_h = d_i + e;
+        }
+        let dh_i = self.d_h;
+        let tol = 0.1;
+        let eval = |me: &mut Self, x: f64| -> Result<(f64, bool, StepForce), HydraulicError> {
+            let sf = me.inner.trial_step(t_i, dt, dh_i, x)?;
+            let (fl, contact) = me.link_force(x - d_f);
+            Ok((fl - sf.force_end, contact, sf))
+        };
+        // Bracket: H(lo) < 0 < H(hi); best iterate kept for a stall at a valve switch.
+        let mut lo: Option<(f64, f64)> = None;
+        let mut hi: Option<(f64, f64)> = None;
+        let mut best = (f64::NAN, f64::INFINITY);
+        // Start: the link keeps its deflection.
+        let mut x = d_f + (dh_i - d_i);
+        let mut prev = f64::INFINITY;
+        let mut step = 1e-6_f64.max(tol / self.k);
+        for _ in 0..PLAY_MAX_ITER {
+            let (h, contact, sf) = eval(self, x)?;
+            if h.abs() <= tol {
+                self.trial = Some(x);
+                let kd = -sf.dforce_dstroke;
+                let dl = if contact {
+                    -(kd * self.k) / (kd + self.k)
+                } else {
+                    0.0
+                };
+                return Ok(StepForce {
+                    dforce_dstroke: dl,
+                    ..sf
+                });
+            }
+            if h.abs() < best.1 {
+                best = (x, h.abs());
+            }
+            if h < 0.0 {
+                lo = Some((x, h));
+            } else {
+                hi = Some((x, h));
+            }
+            let slope = if contact { self.k } else { 0.0 } - sf.dforce_dstroke;
+            let newton = x - h / slope;
+            x = match (lo, hi) {
+                (Some((a, ga)), Some((b, gb))) => {
+                    let inside = newton.is_finite() && newton > a.min(b) && newton < a.max(b);
+                    if inside && h.abs() < 0.5 * prev {
+                        newton
+                    } else {
+                        // Regula falsi with a bisection guard.
+                        let rf = (a * gb - b * ga) / (gb - ga);
+                        let mid = 0.5 * (a + b);
+                        if rf.is_finite() && (rf - mid).abs() < 0.25 * (b - a).abs() {
+                            rf
+                        } else {
+                            mid
+                        }
+                    }
+                }
+                _ => {
+                    if newton.is_finite() && slope > 0.0 && h.abs() < 0.5 * prev {
+                        newton
+                    } else {
+                        step *= 2.0;
+                        if h > 0.0 {
+                            x - step
+                        } else {
+                            x + step
+                        }
+                    }
+                }
+            };
+            if let (Some((a, _)), Some((b, _))) = (lo, hi) {
+                if (b - a).abs() <= 4.0 * f64::EPSILON * a.abs().max(1e-3) {
+                    break;
+                }
+            }
+            prev = h.abs();
+        }
+        // A stall within 1 N of force balance (a valve switching inside the step) is accepted.
+        if best.1 <= 1.0 {
+            let (_, contact, sf) = eval(self, best.0)?;
+            self.trial = Some(best.0);
+            let kd = -sf.dforce_dstroke;
+            let dl = if contact {
+                -(kd * self.k) / (kd + self.k)
+            } else {
+                0.0
+            };
+            return Ok(StepForce {
+                dforce_dstroke: dl,
+                ..sf
+            });
+        }
+        Err(HydraulicError::BadStep {
+            t: t_i + dt,
+            reason: format!(
+                "compliant free-play solve did not converge in {PLAY_MAX_ITER} iterations (force mismatch {:.3e} N)",
+                best.1
+            ),
+        })
+    }
+
+    fn commit(&mut self) {
+        if let Some(x) = self.trial.take() {
+            self.inner.commit();
+            self.d_h = x;
+            self.fresh = false;
+        }
+    }
+
+    fn channel_names(&self) -> &'static [&'static str] {
+        self.inner.channel_names()
+    }
+
+    fn channels(&self, out: &mut [f64]) {
+        self.inner.channels(out)
+    }
+
+    fn committed_force(&self) -> f64 {
+        self.inner.committed_force()
+    }
+
+    fn clone_device(&self) -> Box<dyn Device> {
+        Box::new(self.clone())
+    }
+
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.d_h = 0.0;
+        self.fresh = true;
+        self.trial = None;
+    }
+
+    fn state_values(&self) -> Vec<f64> {
+        let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
+        v.extend(self.inner.state_values());
+        v
+    }
+
+    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+        if v.len() < 2 {
+            return super::check_state_len("compliant free play", v, 2);
         }
         self.inner.set_state_values(&v[2..])?;
         self.d_h = v[0];

@@ -21,7 +21,8 @@ pub use dashpot::{LinearDashpot, NonlinearDashpot};
 pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError, DeviceExtensions};
 pub use elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 pub use extensions::{
-    EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage, SealFriction, SeriesMount,
+    CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage,
+    SealFriction, SeriesMount,
 };
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};

@@ -113,6 +113,12 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
             let v = loglerp(2e-12, 2e-11);
             ("accumulator_bleed_m3_per_s_Pa", v, 0.25, vec![v])
         }
+        Cause::CompliantFreePlay => {
+            // Gap 0.05-0.3 mm; contact stiffness 5e7-1e9 N/m (log), running the other way.
+            let g = lerp(0.05e-3, 0.3e-3);
+            let k = 5e7 * (1e9f64 / 5e7).powf(1.0 - u);
+            ("gap_m", g, 0.25, vec![g, k])
+        }
         Cause::Recalibration => {
             let a = c.orifice.unwrap().area * lerp(0.7, 1.4);
             ("A_orf_m2", a, 0.1, vec![a, c.relief[0].unwrap().a])
