@@ -242,6 +242,7 @@ const CASES: &[Case] = &[
     case("bench csv empty", bench_csv!(""), BENCH_M, &["t.csv"]),
     case("bench csv header only", bench_csv!("time_s,stroke_m,force_N\n"), DIAG_M, &["t.csv", "two samples"]),
     case("bench csv short row", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.001\n0.002,0.001,1\n"), BENCH_M, &["t.csv", "line 3"]),
+    case("bench csv sampled too coarsely (diagnose)", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.01,0.001,50\n0.02,0.0,0\n0.03,-0.001,-50\n0.04,0.0,0\n0.05,0.001,50\n0.06,0.0,0\n0.07,-0.001,-50\n0.08,0.0,0\n0.09,0.001,50\n0.10,0.0,0\n"), DIAG_M, &["t.csv", "sample rate"]),
     case("bench csv no force (diagnose)", bench_csv!("time_s,stroke_m\n0.0,0.0\n0.001,0.001\n0.002,0.002\n"), DIAG_M, &["t.csv", "force"]),
     case("bench csv missing file", &[], BENCH_M, &["t.csv"]),
     case("bench csv is a folder", &[("t.csv", Dir, &[])], DIAG_M, &["t.csv"]),
