@@ -56,7 +56,10 @@ fn velocity_factor(unit: &str) -> anyhow::Result<f64> {
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let deck = DamperDeck::from_file(&args.deck)?;
-    let scheme: Scheme = args.integrator.parse().map_err(anyhow::Error::msg)?;
+    let scheme: Scheme = args
+        .integrator
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--integrator {}: {e}", args.integrator))?;
     if args.substeps == 0 || args.steps_per_cycle < 4 || args.cycles == 0 {
         bail!("--substeps and --cycles must be >= 1 and --steps-per-cycle >= 4");
     }
@@ -82,7 +85,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             DamperModel::Linear,
             DamperModel::Nonlinear,
         ],
-        Some(s) => vec![s.parse().map_err(anyhow::Error::msg)?],
+        Some(s) => vec![s
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--damper {s}: {e}"))?],
     };
     // Build every device first so that a deck error leaves no output at all.
     let devices = models

@@ -662,8 +662,12 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
                 .iter()
                 .map(|p| {
                     let t = read_bench_csv(p)?;
-                    Measurement::from_bench(&t)
-                        .with_context(|| format!("bench file {}", p.display()))
+                    let m = Measurement::from_bench(&t)
+                        .with_context(|| format!("bench file {}", p.display()))?;
+                    // a test unfit for a diagnosis is named by its file
+                    crate::diagnose::check_measurements(std::slice::from_ref(&m))
+                        .with_context(|| format!("bench file {}", p.display()))?;
+                    Ok(m)
                 })
                 .collect::<anyhow::Result<Vec<_>>>()?;
             let src = format!(

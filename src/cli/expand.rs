@@ -27,7 +27,21 @@ pub struct ExpandArgs {
 }
 
 pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
+    if args.revs == 0 {
+        anyhow::bail!("--revs 0: expected at least 1 revolution");
+    }
+    if args.substeps == 0 {
+        anyhow::bail!("--substeps 0: expected at least 1 sub-step per step");
+    }
     let deck = RotorDeck::from_file(&args.rotor)?;
+    // the printed deck refers to the section table: it must be readable
+    let sections = deck.input_files()[1].clone();
+    crate::structure::section::SectionTable::from_csv(&sections).map_err(|e| {
+        anyhow::anyhow!(
+            "rotor deck {}, blade.sections_csv: {e}",
+            args.rotor.display()
+        )
+    })?;
     // the [damper] table must be readable too (it is part of the rotor)
     let damper = deck.damper()?;
     let controls = match &args.flight {
@@ -40,13 +54,15 @@ pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
     let model = match &args.damper {
-        Some(m) => m.parse::<DamperModel>().map_err(anyhow::Error::msg)?,
+        Some(m) => m
+            .parse::<DamperModel>()
+            .map_err(|e| anyhow::anyhow!("--damper {m}: {e}"))?,
         None => damper.model,
     };
     damper.require(model)?;
     let text = deck.expand(&ExpandOptions {
         controls,
-        table_revs: args.revs.max(1),
+        table_revs: args.revs,
         hydraulic: Some(HydraulicRef {
             deck: deck_name,
             model: model.name().into(),

@@ -233,6 +233,9 @@ pub fn default_reference(rotor_deck: &std::path::Path) -> PathBuf {
 
 fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     use crate::rotor::fan::{fan, read_reference, TRACKED};
+    if args.count == 0 {
+        anyhow::bail!("--count 0: expected at least 1 mode per speed");
+    }
     let deck = crate::rotor::RotorDeck::from_file(path)?;
     let fractions = parse_speeds(&args.speeds)?;
     let mut inputs = deck.input_files();

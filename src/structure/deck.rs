@@ -288,7 +288,7 @@ fn rho_default() -> f64 {
     0.9
 }
 
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicDeck {
     #[serde(default)]
@@ -307,6 +307,21 @@ pub struct DynamicDeck {
     /// Start from the static equilibrium of the deck's loads at t = 0.
     #[serde(default)]
     pub start_from_static: bool,
+}
+
+/// Without a `[dynamic]` table: the defaults of its keys (time step and end time absent).
+impl Default for DynamicDeck {
+    fn default() -> Self {
+        DynamicDeck {
+            time_step_s: None,
+            end_time_s: None,
+            rho_inf: rho_default(),
+            output_every: 1,
+            max_iterations: max_it(),
+            initial_omega_rad_s: None,
+            start_from_static: false,
+        }
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -432,10 +447,271 @@ pub fn load_deck_within(
 }
 
 fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
-    toml::from_str(text).map_err(|e| DeckError::Parse {
+    let deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
         file: file.into(),
         msg: e.to_string().trim_end().to_string(),
-    })
+    })?;
+    validate(&deck).map_err(|(key, msg)| DeckError::Invalid {
+        file: file.into(),
+        key,
+        msg,
+    })?;
+    Ok(deck)
+}
+
+/// A value check: Err names the key and says what was expected.
+type Check = Result<(), (String, String)>;
+
+fn finite(key: &str, x: f64) -> Check {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err((key.into(), format!("{x}: expected a finite number")))
+    }
+}
+
+fn non_negative(key: &str, x: f64) -> Check {
+    if x.is_finite() && x >= 0.0 {
+        Ok(())
+    } else {
+        Err((key.into(), format!("{x}: expected a finite number >= 0")))
+    }
+}
+
+fn positive(key: &str, x: f64) -> Check {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err((key.into(), format!("{x}: expected a finite number > 0")))
+    }
+}
+
+fn finite3(key: &str, v: [f64; 3]) -> Check {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err((key.into(), format!("{v:?}: expected three finite numbers")))
+    }
+}
+
+fn direction(key: &str, v: [f64; 3]) -> Check {
+    finite3(key, v)?;
+    if dot(v, v).sqrt() > 0.0 {
+        Ok(())
+    } else {
+        Err((key.into(), format!("{v:?}: expected a non-zero direction")))
+    }
+}
+
+fn counted(key: &str, n: usize) -> Check {
+    if n >= 1 {
+        Ok(())
+    } else {
+        Err((key.into(), "0: expected at least 1".into()))
+    }
+}
+
+/// `[[t_s, value], ...]`: finite pairs with non-decreasing times.
+fn time_pairs(key: &str, t: &Option<Vec<[f64; 2]>>) -> Check {
+    let Some(t) = t else { return Ok(()) };
+    if let Some(p) = t.iter().find(|p| !p[0].is_finite() || !p[1].is_finite()) {
+        return Err((
+            key.into(),
+            format!("{p:?}: expected finite [t_s, value] pairs"),
+        ));
+    }
+    if let Some(w) = t.windows(2).find(|w| w[1][0] < w[0][0]) {
+        return Err((
+            key.into(),
+            format!(
+                "time {} after {}: expected non-decreasing times",
+                w[1][0], w[0][0]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn named(key: &str, name: &str) -> Check {
+    if name.trim().is_empty() {
+        Err((format!("{key}.name"), "expected a non-empty name".into()))
+    } else {
+        Ok(())
+    }
+}
+
+/// Every value of the deck that its type does not already constrain: finite numbers, signs,
+/// ranges and the consistency of values within one table. Node, joint and beam references are
+/// checked when the model is built.
+fn validate(d: &Deck) -> Check {
+    finite3("gravity_m_s2", d.gravity_m_s2)?;
+    for (i, n) in d.nodes.iter().enumerate() {
+        let key = format!("node[{i}] `{}`", n.name);
+        named(&key, &n.name)?;
+        finite3(&format!("{key}.position_m"), n.position_m)?;
+        finite3(&format!("{key}.rotation_vector_rad"), n.rotation_vector_rad)?;
+    }
+    for (i, b) in d.beams.iter().enumerate() {
+        let key = format!("beam[{i}] `{}`", b.name);
+        named(&key, &b.name)?;
+        counted(&format!("{key}.elements"), b.elements)?;
+        non_negative(&format!("{key}.damping_mu_s"), b.damping_mu_s)?;
+        direction(&format!("{key}.e2_direction"), b.e2_direction)?;
+        if let Some(a) = b.start_m {
+            finite3(&format!("{key}.start_m"), a)?;
+        }
+        if let Some(e) = b.end_m {
+            finite3(&format!("{key}.end_m"), e)?;
+        }
+        if let (Some(a), Some(e)) = (b.start_m, b.end_m) {
+            let t = sub(e, a);
+            let len = dot(t, t).sqrt();
+            if len <= 0.0 {
+                return Err((
+                    format!("{key}.end_m"),
+                    format!("{e:?} equals start_m: expected a beam of positive length"),
+                ));
+            }
+            let e2 = b.e2_direction;
+            let c = cross(t, e2);
+            if dot(c, c).sqrt() <= 1e-9 * len * dot(e2, e2).sqrt() {
+                return Err((
+                    format!("{key}.e2_direction"),
+                    format!("{e2:?} is along the beam axis: expected a direction across it"),
+                ));
+            }
+        }
+        if let Some(arc) = &b.arc {
+            let k = format!("{key}.arc");
+            finite3(&format!("{k}.center_m"), arc.center_m)?;
+            positive(&format!("{k}.radius_m"), arc.radius_m)?;
+            finite(&format!("{k}.start_deg"), arc.start_deg)?;
+            finite(&format!("{k}.end_deg"), arc.end_deg)?;
+            if arc.start_deg == arc.end_deg {
+                return Err((
+                    format!("{k}.end_deg"),
+                    "equals start_deg: expected an arc of positive length".into(),
+                ));
+            }
+            direction(&format!("{k}.normal"), arc.normal)?;
+            let n = arc.normal;
+            let z = arc.zero_direction;
+            direction(&format!("{k}.zero_direction"), z)?;
+            let c = cross(n, z);
+            if dot(c, c).sqrt() <= 1e-9 * dot(n, n).sqrt() * dot(z, z).sqrt() {
+                return Err((
+                    format!("{k}.zero_direction"),
+                    format!("{z:?} is along the normal: expected a direction in the arc plane"),
+                ));
+            }
+        }
+    }
+    for (i, r) in d.rigid_bodies.iter().enumerate() {
+        let key = format!("rigid_body[{i}] `{}`", r.name);
+        named(&key, &r.name)?;
+        non_negative(&format!("{key}.mass_kg"), r.mass_kg)?;
+        finite3(&format!("{key}.cm_offset_m"), r.cm_offset_m)?;
+        if r.inertia_kgm2.iter().flatten().any(|x| !x.is_finite()) {
+            return Err((
+                format!("{key}.inertia_kgm2"),
+                format!("{:?}: expected finite numbers", r.inertia_kgm2),
+            ));
+        }
+        if (0..3).any(|k| r.inertia_kgm2[k][k] < 0.0) {
+            return Err((
+                format!("{key}.inertia_kgm2"),
+                format!(
+                    "{:?}: expected non-negative diagonal moments of inertia",
+                    r.inertia_kgm2
+                ),
+            ));
+        }
+    }
+    for (i, j) in d.joints.iter().enumerate() {
+        let key = format!("joint[{i}] `{}`", j.name);
+        named(&key, &j.name)?;
+        if let Some(p) = j.position_m {
+            finite3(&format!("{key}.position_m"), p)?;
+        }
+        direction(&format!("{key}.axis"), j.axis)?;
+        direction(&format!("{key}.x_direction"), j.x_direction)?;
+        non_negative(&format!("{key}.stiffness_Nm_per_rad"), j.stiffness)?;
+        non_negative(&format!("{key}.damping_Nms_per_rad"), j.damping)?;
+        if let Some(w) = j.omega_rad_s {
+            finite(&format!("{key}.omega_rad_s"), w)?;
+        }
+        time_pairs(&format!("{key}.angle_table"), &j.angle_table)?;
+        if let Some(u) = j.displacement_m {
+            finite3(&format!("{key}.displacement_m"), u)?;
+        }
+        time_pairs(&format!("{key}.displacement_table"), &j.displacement_table)?;
+    }
+    for (i, l) in d.loads.iter().enumerate() {
+        let key = format!("load[{i}] `{}`", l.name);
+        named(&key, &l.name)?;
+        finite3(&format!("{key}.force_N"), l.force)?;
+        finite3(&format!("{key}.moment_Nm"), l.moment)?;
+        time_pairs(&format!("{key}.time_table"), &l.time_table)?;
+    }
+    for (i, l) in d.distributed_loads.iter().enumerate() {
+        let key = format!("distributed_load[{i}]");
+        finite3(&format!("{key}.force_N_per_m"), l.force)?;
+        finite3(&format!("{key}.moment_Nm_per_m"), l.moment)?;
+        time_pairs(&format!("{key}.time_table"), &l.time_table)?;
+    }
+    for (i, s) in d.sensors.iter().enumerate() {
+        let key = format!("sensor[{i}] `{}`", s.name);
+        named(&key, &s.name)?;
+        if let Some(first) = d.sensors[..i].iter().position(|o| o.name == s.name) {
+            return Err((
+                format!("{key}.name"),
+                format!(
+                    "`{}` also names sensor[{first}]: expected unique sensor names",
+                    s.name
+                ),
+            ));
+        }
+        if let Some(x) = s.s_m {
+            non_negative(&format!("{key}.s_m"), x)?;
+        }
+    }
+    for (i, h) in d.hydraulics.iter().enumerate() {
+        let key = format!("hydraulic[{i}] `{}`", h.name);
+        if let Some(l) = h.reference_length_m {
+            positive(&format!("{key}.reference_length_m"), l)?;
+        }
+    }
+    let st = &d.statics;
+    counted("static.load_steps", st.load_steps)?;
+    counted("static.max_iterations", st.max_iterations)?;
+    if let Some(w) = st.omega_rad_s {
+        finite3("static.omega_rad_s", w)?;
+    }
+    let dy = &d.dynamic;
+    if let Some(h) = dy.time_step_s {
+        positive("dynamic.time_step_s", h)?;
+    }
+    if let Some(t) = dy.end_time_s {
+        positive("dynamic.end_time_s", t)?;
+    }
+    if !(0.0..=1.0).contains(&dy.rho_inf) {
+        return Err((
+            "dynamic.rho_inf".into(),
+            format!("{}: expected a number in [0, 1]", dy.rho_inf),
+        ));
+    }
+    counted("dynamic.output_every", dy.output_every)?;
+    counted("dynamic.max_iterations", dy.max_iterations)?;
+    if let Some(w) = dy.initial_omega_rad_s {
+        finite3("dynamic.initial_omega_rad_s", w)?;
+    }
+    let mo = &d.modes;
+    counted("modes.count", mo.count)?;
+    direction("modes.axis", mo.axis)?;
+    for &w in &mo.speeds_rad_s {
+        finite("modes.speeds_rad_s", w)?;
+    }
+    Ok(())
 }
 
 /// Parse deck text (`file` names it in errors; relative CSV paths resolve against `base`).
@@ -689,6 +965,20 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
                 let ids = m.beams.get(b).cloned().ok_or_else(|| {
                     inv(format!("{key}.beam"), format!("beam `{b}` does not exist"))
                 })?;
+                let s_m = s.s_m.unwrap_or(0.0);
+                let len = ids
+                    .iter()
+                    .filter_map(|&id| match &m.elements[id] {
+                        Element::Beam(e) => Some(e.s_range[1]),
+                        _ => None,
+                    })
+                    .fold(0.0, f64::max);
+                if s_m > len * (1.0 + 1e-9) {
+                    return Err(inv(
+                        format!("{key}.s_m"),
+                        format!("{s_m}: expected a station on beam `{b}`, 0 to {len} m"),
+                    ));
+                }
                 SensorKind::Section {
                     elements: ids,
                     s_m: s.s_m.unwrap_or(0.0),

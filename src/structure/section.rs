@@ -265,18 +265,21 @@ impl SectionTable {
         }
         for (i, st) in stations.iter().enumerate() {
             let a = st.as_array();
-            if a.iter().any(|x| !x.is_finite())
-                || st.ea <= 0.0
-                || st.ei2 <= 0.0
-                || st.ei3 <= 0.0
-                || st.gj <= 0.0
-                || st.ga2 <= 0.0
-                || st.ga3 <= 0.0
-                || st.m < 0.0
-            {
+            for (k, (&x, col)) in a.iter().zip(SECTION_COLUMNS).enumerate() {
+                // EA, EI2, EI3, GJ, GA2, GA3 are stiffnesses; m, I1, I2, I3 mass properties
+                let expected = match k {
+                    1..=6 if !(x.is_finite() && x > 0.0) => "a positive finite stiffness",
+                    7..=10 if !(x.is_finite() && x >= 0.0) => "a non-negative finite mass property",
+                    _ if !x.is_finite() => "a finite value",
+                    _ => continue,
+                };
                 return Err(SectionError::Invalid {
                     file: source.into(),
-                    msg: format!("station {} (s_m = {}): stiffnesses must be positive and finite, mass non-negative", i + 1, st.s_m),
+                    msg: format!(
+                        "station {} (s_m = {}): {col} = {x}: expected {expected}",
+                        i + 1,
+                        st.s_m
+                    ),
                 });
             }
         }

@@ -1,0 +1,483 @@
+//! A catalogue of bad inputs across every command of the binary. Each case writes its files
+//! (shipped decks and records with edits, or inline text) into a fresh folder, runs the binary
+//! and asserts: no panic, a non-zero exit within the time limit, and a message that names the
+//! file and the key or line (the expected substrings). Adding a case is one line of `CASES`.
+//! Every failing case is listed, not only the first.
+//!
+//! In `args` and `expect`, `{T}` is the case's folder and `{R}` the package root. Shipped rotor
+//! decks refer to `data/...` and model decks to `../../rotors/...` relative to themselves: the
+//! copies refer to the shipped files by absolute path.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+mod support;
+use support::{root, tmp};
+
+/// Where a case's file comes from.
+#[derive(Clone, Copy)]
+enum Src {
+    /// A shipped file (path relative to the package root).
+    Repo(&'static str),
+    /// Inline text.
+    Text(&'static str),
+    /// The first N bytes of a shipped file.
+    Trunc(&'static str, usize),
+    /// A shipped CSV record triple (stem relative to the package root): dst is the new stem;
+    /// each edit applies to the first of the three files that holds it.
+    Record(&'static str),
+    /// An empty folder.
+    Dir,
+}
+use Src::*;
+
+/// A file of a case: destination name in the case folder, source, and edits (first
+/// occurrence of `from` replaced by `to`; an edit that matches nothing fails the case).
+type F = (&'static str, Src, &'static [(&'static str, &'static str)]);
+
+struct Case {
+    name: &'static str,
+    files: &'static [F],
+    args: &'static [&'static str],
+    expect: &'static [&'static str],
+}
+
+const fn case(
+    name: &'static str,
+    files: &'static [F],
+    args: &'static [&'static str],
+    expect: &'static [&'static str],
+) -> Case {
+    Case {
+        name,
+        files,
+        args,
+        expect,
+    }
+}
+
+const UH60A: &str = "rotors/uh60a.toml";
+const DAMPER: &str = "flightdata/damper_nominal.toml";
+const CANT: &str = "docs/examples/cantilever.toml";
+const ACT: &str = "docs/examples/actuator_pitch_beam.toml";
+/// Three cycles of a 25 Hz stroke of 1 mm with the force of a linear damper.
+const BENCH_OK: &str = "time_s,stroke_m,force_N\n0.000,0.000000e+00,10681.415\n0.001,1.564345e-04,10549.909\n0.002,3.090170e-04,10158.629\n0.003,4.539905e-04,9517.210\n0.004,5.877853e-04,8641.446\n0.005,7.071068e-04,7552.901\n0.006,8.090170e-04,6278.378\n0.007,8.910065e-04,4849.261\n0.008,9.510565e-04,3300.739\n0.009,9.876883e-04,1670.941\n0.010,1.000000e-03,0.000\n0.011,9.876883e-04,-1670.941\n0.012,9.510565e-04,-3300.739\n0.013,8.910065e-04,-4849.261\n0.014,8.090170e-04,-6278.378\n0.015,7.071068e-04,-7552.901\n0.016,5.877853e-04,-8641.446\n0.017,4.539905e-04,-9517.210\n0.018,3.090170e-04,-10158.629\n0.019,1.564345e-04,-10549.909\n0.020,1.224647e-19,-10681.415\n0.021,-1.564345e-04,-10549.909\n0.022,-3.090170e-04,-10158.629\n0.023,-4.539905e-04,-9517.210\n0.024,-5.877853e-04,-8641.446\n0.025,-7.071068e-04,-7552.901\n0.026,-8.090170e-04,-6278.378\n0.027,-8.910065e-04,-4849.261\n0.028,-9.510565e-04,-3300.739\n0.029,-9.876883e-04,-1670.941\n0.030,-1.000000e-03,-0.000\n0.031,-9.876883e-04,1670.941\n0.032,-9.510565e-04,3300.739\n0.033,-8.910065e-04,4849.261\n0.034,-8.090170e-04,6278.378\n0.035,-7.071068e-04,7552.901\n0.036,-5.877853e-04,8641.446\n0.037,-4.539905e-04,9517.210\n0.038,-3.090170e-04,10158.629\n0.039,-1.564345e-04,10549.909\n0.040,-2.449294e-19,10681.415\n0.041,1.564345e-04,10549.909\n0.042,3.090170e-04,10158.629\n0.043,4.539905e-04,9517.210\n0.044,5.877853e-04,8641.446\n0.045,7.071068e-04,7552.901\n0.046,8.090170e-04,6278.378\n0.047,8.910065e-04,4849.261\n0.048,9.510565e-04,3300.739\n0.049,9.876883e-04,1670.941\n0.050,1.000000e-03,-0.000\n0.051,9.876883e-04,-1670.941\n0.052,9.510565e-04,-3300.739\n0.053,8.910065e-04,-4849.261\n0.054,8.090170e-04,-6278.378\n0.055,7.071068e-04,-7552.901\n0.056,5.877853e-04,-8641.446\n0.057,4.539905e-04,-9517.210\n0.058,3.090170e-04,-10158.629\n0.059,1.564345e-04,-10549.909\n0.060,3.673940e-19,-10681.415\n0.061,-1.564345e-04,-10549.909\n0.062,-3.090170e-04,-10158.629\n0.063,-4.539905e-04,-9517.210\n0.064,-5.877853e-04,-8641.446\n0.065,-7.071068e-04,-7552.901\n0.066,-8.090170e-04,-6278.378\n0.067,-8.910065e-04,-4849.261\n0.068,-9.510565e-04,-3300.739\n0.069,-9.876883e-04,-1670.941\n0.070,-1.000000e-03,0.000\n0.071,-9.876883e-04,1670.941\n0.072,-9.510565e-04,3300.739\n0.073,-8.910065e-04,4849.261\n0.074,-8.090170e-04,6278.378\n0.075,-7.071068e-04,7552.901\n0.076,-5.877853e-04,8641.446\n0.077,-4.539905e-04,9517.210\n0.078,-3.090170e-04,10158.629\n0.079,-1.564345e-04,10549.909\n0.080,-4.898587e-19,10681.415\n0.081,1.564345e-04,10549.909\n0.082,3.090170e-04,10158.629\n0.083,4.539905e-04,9517.210\n0.084,5.877853e-04,8641.446\n0.085,7.071068e-04,7552.901\n0.086,8.090170e-04,6278.378\n0.087,8.910065e-04,4849.261\n0.088,9.510565e-04,3300.739\n0.089,9.876883e-04,1670.941\n0.090,1.000000e-03,0.000\n0.091,9.876883e-04,-1670.941\n0.092,9.510565e-04,-3300.739\n0.093,8.910065e-04,-4849.261\n0.094,8.090170e-04,-6278.378\n0.095,7.071068e-04,-7552.901\n0.096,5.877853e-04,-8641.446\n0.097,4.539905e-04,-9517.210\n0.098,3.090170e-04,-10158.629\n0.099,1.564345e-04,-10549.909\n0.100,-1.164033e-18,-10681.415\n0.101,-1.564345e-04,-10549.909\n0.102,-3.090170e-04,-10158.629\n0.103,-4.539905e-04,-9517.210\n0.104,-5.877853e-04,-8641.446\n0.105,-7.071068e-04,-7552.901\n0.106,-8.090170e-04,-6278.378\n0.107,-8.910065e-04,-4849.261\n0.108,-9.510565e-04,-3300.739\n0.109,-9.876883e-04,-1670.941\n0.110,-1.000000e-03,0.000\n0.111,-9.876883e-04,1670.941\n0.112,-9.510565e-04,3300.739\n0.113,-8.910065e-04,4849.261\n0.114,-8.090170e-04,6278.378\n0.115,-7.071068e-04,7552.901\n0.116,-5.877853e-04,8641.446\n0.117,-4.539905e-04,9517.210\n0.118,-3.090170e-04,10158.629\n0.119,-1.564345e-04,10549.909\n0.120,-7.347881e-19,10681.415\n";
+
+/// run on the rigid reduction with a rotor deck r.toml.
+const RUN_R: &[&str] = &[
+    "run",
+    "--model",
+    "rigid",
+    "--rotor",
+    "{T}/r.toml",
+    "--revs",
+    "3",
+    "--out",
+    "{T}/out",
+];
+const EXPAND_R: &[&str] = &["expand", "--rotor", "{T}/r.toml"];
+const MODES_R: &[&str] = &[
+    "modes",
+    "--rotor",
+    "{T}/r.toml",
+    "--speeds",
+    "1",
+    "--out",
+    "{T}/out",
+];
+const BENCH_D: &[&str] = &[
+    "bench",
+    "--deck",
+    "{T}/d.toml",
+    "--peak-velocity",
+    "1",
+    "--cycles",
+    "2",
+    "--out",
+    "{T}/out",
+];
+const STATIC_M: &[&str] = &["static", "{T}/m.toml", "--out", "{T}/out"];
+const DYN_M: &[&str] = &["dynamic", "{T}/m.toml", "--out", "{T}/out"];
+const MODES_M: &[&str] = &["modes", "{T}/m.toml", "--out", "{T}/out"];
+const BENCH_M: &[&str] = &[
+    "bench",
+    "--deck",
+    "{R}/flightdata/damper_nominal.toml",
+    "--measured",
+    "{T}/t.csv",
+    "--out",
+    "{T}/out",
+];
+const DIAG_M: &[&str] = &[
+    "diagnose",
+    "--deck",
+    "{R}/flightdata/damper_nominal.toml",
+    "--measured",
+    "{T}/t.csv",
+    "--out",
+    "{T}/out",
+];
+const INSPECT: &[&str] = &["inspect", "{T}/rec"];
+const RUN_FLIGHT: &[&str] = &[
+    "run", "--model", "rigid", "--flight", "{T}/rec", "--revs", "3", "--out", "{T}/out",
+];
+
+const R: &[F] = &[("r.toml", Repo(UH60A), &[])];
+macro_rules! rotor {
+    ($from:expr, $to:expr) => {
+        &[("r.toml", Repo(UH60A), &[($from, $to)])]
+    };
+}
+macro_rules! damper {
+    ($from:expr, $to:expr) => {
+        &[("d.toml", Repo(DAMPER), &[($from, $to)])]
+    };
+}
+macro_rules! cant {
+    ($from:expr, $to:expr) => {
+        &[("m.toml", Repo(CANT), &[($from, $to)])]
+    };
+}
+macro_rules! act {
+    ($from:expr, $to:expr) => {
+        &[("m.toml", Repo(ACT), &[($from, $to)])]
+    };
+}
+macro_rules! bench_csv {
+    ($text:expr) => {
+        &[("t.csv", Text($text), &[])]
+    };
+}
+macro_rules! record {
+    ($from:expr, $to:expr) => {
+        &[("rec", Record("flightdata/c8534like"), &[($from, $to)])]
+    };
+}
+
+#[rustfmt::skip]
+const CASES: &[Case] = &[
+    // ---- rotor decks (run, expand, modes --rotor) ----
+    case("rotor omega NaN", rotor!("omega_rad_s = 27.0", "omega_rad_s = nan"), RUN_R, &["r.toml", "rotor.omega_rad_s"]),
+    case("rotor radius negative", rotor!("radius_m = 8.1786", "radius_m = -8.1786"), EXPAND_R, &["r.toml", "radius_m"]),
+    case("rotor blades zero", rotor!("blades = 4 ", "blades = 0 "), MODES_R, &["r.toml", "rotor.blades"]),
+    case("rotor blades wrong type", rotor!("blades = 4 ", "blades = \"four\" "), EXPAND_R, &["r.toml", "blades"]),
+    case("rotor unknown key", rotor!("[rotor]\n", "[rotor]\nomega_rpm = 258.0\n"), EXPAND_R, &["r.toml", "omega_rpm"]),
+    case("rotor missing key", rotor!("radius_m = 8.1786", ""), EXPAND_R, &["r.toml", "radius_m"]),
+    case("rotor blade elements zero", rotor!("elements = 13", "elements = 0"), EXPAND_R, &["r.toml", "blade.elements"]),
+    case("rotor root beyond tip", rotor!("root_r_m = 0.8178", "root_r_m = 9.5"), EXPAND_R, &["r.toml", "root_r_m"]),
+    case("rotor hinge outboard of horn", rotor!("hinge_r_m = 0.381", "hinge_r_m = 0.9"), EXPAND_R, &["r.toml", "hinge_r_m"]),
+    case("rotor sections csv missing", rotor!("sections_csv = \"data/blade_sections_yeo.csv\"", "sections_csv = \"data/no_such_sections.csv\""), EXPAND_R, &["no_such_sections.csv"]),
+    case("rotor twist not increasing", rotor!("[1.68344, 9.823]", "[1.0, 9.823]"), EXPAND_R, &["r.toml", "twist_deg"]),
+    case("rotor lag stiffness negative", rotor!("lag_stiffness_Nm_per_rad = 20400.0", "lag_stiffness_Nm_per_rad = -20400.0"), RUN_R, &["r.toml", "bearing.lag_stiffness_Nm_per_rad"]),
+    case("rotor link length zero", rotor!("link_length_m = 0.45", "link_length_m = 0.0"), EXPAND_R, &["r.toml", "link_length_m"]),
+    case("rotor damper arm NaN", rotor!("arm_m = 0.175", "arm_m = nan"), RUN_R, &["r.toml", "arm_m"]),
+    case("rotor damping gain inf", rotor!("perturbation_damping_gain = 0.01", "perturbation_damping_gain = inf"), EXPAND_R, &["r.toml", "perturbation_damping_gain"]),
+    case("rotor airload frame unknown", rotor!("airload_frame = \"control_pitch\"", "airload_frame = \"sideways\""), EXPAND_R, &["r.toml", "airload_frame"]),
+    case("rotor TOML syntax", rotor!("[bearing]", "[bearing"), EXPAND_R, &["r.toml", "line"]),
+    case("rotor segment elements negative", rotor!("segment1 = { elements = 3", "segment1 = { elements = -3"), EXPAND_R, &["r.toml", "elements"]),
+    case("rotor damper orifice negative", rotor!("A_orf_m2 = 1.8e-6", "A_orf_m2 = -1.8e-6"), RUN_R, &["r.toml", "A_orf_m2"]),
+    case("rotor cyclic ramp negative", rotor!("cyclic_ramp_revs = 2.0", "cyclic_ramp_revs = -2.0"), EXPAND_R, &["r.toml", "cyclic_ramp_revs"]),
+    // ---- damper decks (bench, diagnose, run --damper-deck) ----
+    case("damper model unknown", damper!("model = \"physical\"", "model = \"magic\""), BENCH_D, &["d.toml", "model"]),
+    case("damper linear c negative", damper!("c_N_s_per_m = 68000.0", "c_N_s_per_m = -68000.0"), BENCH_D, &["d.toml", "c_N_s_per_m"]),
+    case("damper nonlinear velocities unsorted", damper!("[0.0, 0.05, 0.10, 0.20, 0.40]", "[0.0, 0.10, 0.05, 0.20, 0.40]"), BENCH_D, &["d.toml", "velocity_m_s"]),
+    case("damper nonlinear lengths differ", damper!("14000.0, 15500.0]", "14000.0]"), BENCH_D, &["d.toml", "force_N"]),
+    case("damper V0 zero", damper!("V0_m3 = 6.0e-5", "V0_m3 = 0.0"), BENCH_D, &["d.toml", "V0_m3"]),
+    case("damper rho NaN", damper!("rho_kg_m3 = 850.0", "rho_kg_m3 = nan"), BENCH_D, &["d.toml", "rho_kg_m3"]),
+    case("damper Cd zero", damper!("Cd = 0.611", "Cd = 0.0"), BENCH_D, &["d.toml", "Cd"]),
+    case("damper relief mass negative", damper!("m_kg = 0.01", "m_kg = -0.01"), BENCH_D, &["d.toml", "relief_valve_0", "m_kg"]),
+    case("damper missing key", damper!("A0_m2 = 1.6e-3\n", ""), BENCH_D, &["d.toml", "A0_m2"]),
+    case("damper unknown key", damper!("Cd = 0.611\n", "Cd = 0.611\nCx = 1.0\n"), BENCH_D, &["d.toml", "Cx"]),
+    case("damper laminar dp zero", damper!("dp_laminar_Pa = 1.0e3", "dp_laminar_Pa = 0.0"), BENCH_D, &["d.toml", "dp_laminar_Pa"]),
+    case("damper check valve inf", damper!("check_valve_area_m2 = 5.0e-6", "check_valve_area_m2 = inf"), BENCH_D, &["d.toml", "check_valve_area_m2"]),
+    case("damper relief spring NaN", damper!("k_N_per_m = 2.0e4", "k_N_per_m = nan"), BENCH_D, &["d.toml", "k_N_per_m"]),
+    case("damper wrong type", damper!("p_s_Pa = 5.0e5", "p_s_Pa = \"high\""), &["run", "--model", "rigid", "--damper-deck", "{T}/d.toml", "--revs", "3", "--out", "{T}/out"], &["d.toml", "p_s_Pa"]),
+    case("damper no [damper] table", &[("d.toml", Repo(CANT), &[])], BENCH_D, &["d.toml", "[damper]"]),
+    case("damper deck diagnose bulk negative", &[("d.toml", Repo(DAMPER), &[("bulk_alpha_per_Pa = 6.667e-10", "bulk_alpha_per_Pa = -1.0")]), ("t.csv", Text(BENCH_OK), &[])], &["diagnose", "--deck", "{T}/d.toml", "--measured", "{T}/t.csv", "--out", "{T}/out"], &["d.toml", "bulk_alpha_per_Pa"]),
+    case("damper deck missing (run)", &[], &["run", "--model", "rigid", "--damper-deck", "{T}/none.toml", "--out", "{T}/out"], &["none.toml"]),
+    // ---- model decks (static, dynamic, modes) ----
+    case("model EA NaN", cant!("EA_N = 1e6", "EA_N = nan"), STATIC_M, &["m.toml", "EA_N"]),
+    case("model mass negative", cant!("m_kg_per_m = 1.0", "m_kg_per_m = -1.0"), STATIC_M, &["m.toml", "m_kg_per_m"]),
+    case("model inertia negative", cant!("I2_kgm = 5e-5", "I2_kgm = -5e-5"), DYN_M, &["m.toml", "I2_kgm"]),
+    case("model elements zero", cant!("elements = 8", "elements = 0"), STATIC_M, &["m.toml", "elements"]),
+    case("model beam of zero length", cant!("end_m = [10.0, 0.0, 0.0]", "end_m = [0.0, 0.0, 0.0]"), STATIC_M, &["m.toml", "end_m"]),
+    case("model start NaN", cant!("start_m = [0.0, 0.0, 0.0]", "start_m = [nan, 0.0, 0.0]"), STATIC_M, &["m.toml", "start_m"]),
+    case("model e2 along beam", cant!("e2_direction = [0.0, 1.0, 0.0]", "e2_direction = [1.0, 0.0, 0.0]"), STATIC_M, &["m.toml", "e2_direction"]),
+    case("model joint type unknown", cant!("type = \"clamp\"", "type = \"weld\""), STATIC_M, &["m.toml", "weld"]),
+    case("model joint node unknown", cant!("node_b = \"beam.n0\"", "node_b = \"beam.n99\""), STATIC_M, &["m.toml", "beam.n99"]),
+    case("model sensor node unknown", cant!("name = \"tip\"\nnode = \"beam.n24\"", "name = \"tip\"\nnode = \"beam.n77\""), STATIC_M, &["m.toml", "beam.n77"]),
+    case("model sensor beyond beam", cant!("s_m = 0.0", "s_m = 20.0"), STATIC_M, &["m.toml", "s_m"]),
+    case("model sensor name duplicate", cant!("name = \"root_reaction\"", "name = \"tip\""), STATIC_M, &["m.toml", "sensor", "tip"]),
+    case("model sensor name empty", cant!("name = \"root_reaction\"", "name = \"\""), STATIC_M, &["m.toml", "sensor", "name"]),
+    case("model load NaN", cant!("force_N = [0.0, 0.0, 0.05]", "force_N = [0.0, 0.0, nan]"), STATIC_M, &["m.toml", "force_N"]),
+    case("model load table unsorted", cant!("[0.1, 1.0], [0.1000001, 0.0]", "[0.1, 1.0], [0.05, 0.0]"), DYN_M, &["m.toml", "time_table"]),
+    case("model static load steps zero", cant!("load_steps = 2", "load_steps = 0"), STATIC_M, &["m.toml", "load_steps"]),
+    case("model dynamic step zero", cant!("time_step_s = 0.1", "time_step_s = 0.0"), DYN_M, &["m.toml", "time_step_s"]),
+    case("model dynamic step negative", cant!("time_step_s = 0.1", "time_step_s = -0.1"), DYN_M, &["m.toml", "time_step_s"]),
+    case("model dynamic rho_inf > 1", cant!("rho_inf = 0.9", "rho_inf = 2.0"), DYN_M, &["m.toml", "rho_inf"]),
+    case("model dynamic end NaN", cant!("end_time_s = 40.0", "end_time_s = nan"), DYN_M, &["m.toml", "end_time_s"]),
+    case("model dynamic end 1e12 (cost guard)", cant!("end_time_s = 40.0", "end_time_s = 1e12"), DYN_M, &["m.toml", "end_time_s"]),
+    case("model dynamic table missing", cant!("[dynamic]\ntime_step_s = 0.1\nend_time_s = 40.0\nrho_inf = 0.9\nstart_from_static = true", ""), DYN_M, &["m.toml", "dynamic.time_step_s"]),
+    case("model modes count zero", cant!("[static]", "[modes]\ncount = 0\n\n[static]"), MODES_M, &["m.toml", "count"]),
+    case("model modes axis zero", cant!("[static]", "[modes]\naxis = [0.0, 0.0, 0.0]\n\n[static]"), MODES_M, &["m.toml", "axis"]),
+    case("model modes speed NaN", cant!("[static]", "[modes]\nspeeds_rad_s = [0.0, nan]\n\n[static]"), MODES_M, &["m.toml", "speeds_rad_s"]),
+    case("model unknown top-level key", cant!("title = ", "titel = \"x\"\ntitle = "), STATIC_M, &["m.toml", "titel"]),
+    case("model TOML syntax", cant!("[[joint]]", "[[joint]"), STATIC_M, &["m.toml", "line"]),
+    case("model revolute axis zero", act!("axis = [0.0, 1.0, 0.0]", "axis = [0.0, 0.0, 0.0]"), DYN_M, &["m.toml", "axis"]),
+    case("model rigid body mass negative", act!("mass_kg = 10.0", "mass_kg = -10.0"), DYN_M, &["m.toml", "mass_kg"]),
+    case("model rigid body inertia NaN", act!("inertia_kgm2 = [[0.0,", "inertia_kgm2 = [[nan,"), DYN_M, &["m.toml", "inertia_kgm2"]),
+    case("model hydraulic deck missing", act!("deck = \"../../rotors/paper_table1_actuator_extend.toml\"", "deck = \"../../rotors/no_such_actuator.toml\""), DYN_M, &["m.toml", "no_such_actuator.toml"]),
+    case("model hydraulic substeps zero", act!("substeps = 48", "substeps = 0"), DYN_M, &["m.toml", "substeps"]),
+    case("model hydraulic scheme unknown", act!("scheme = \"rk4\"", "scheme = \"euler\""), DYN_M, &["m.toml", "scheme"]),
+    case("model hydraulic table unsorted", act!("[0.5, 1.0], [1.0, 0.0]", "[0.5, 1.0], [0.2, 0.0]"), DYN_M, &["m.toml", "orifice_area_table"]),
+    case("model hydraulic node unknown", act!("node_b = \"horn.n3\"", "node_b = \"horn.n9\""), DYN_M, &["m.toml", "horn.n9"]),
+    case("model hydraulic position NaN", act!("position_m = [-0.16, 0.0, -0.2]", "position_m = [-0.16, nan, -0.2]"), DYN_M, &["m.toml", "position_m"]),
+    case("model output_every zero", act!("output_every = 5", "output_every = 0"), DYN_M, &["m.toml", "output_every"]),
+    // ---- bench CSV (bench --measured, diagnose --measured) ----
+    case("bench csv no stroke column", bench_csv!("time_s,force_N\n0,0\n0.001,1\n"), BENCH_M, &["t.csv", "stroke_m"]),
+    case("bench csv time not increasing", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.002,0.001,1\n0.001,0.002,2\n"), BENCH_M, &["t.csv", "line 4", "time"]),
+    case("bench csv NaN stroke", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.001,nan,1\n0.002,0.002,2\n"), BENCH_M, &["t.csv", "line 3", "stroke_m"]),
+    case("bench csv unknown unit", bench_csv!("time_s,stroke_ft,force_N\n0.0,0.0,0\n0.001,0.001,1\n"), BENCH_M, &["t.csv", "stroke_ft"]),
+    case("bench csv not a number", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.001,abc,1\n"), DIAG_M, &["t.csv", "line 3", "abc"]),
+    case("bench csv empty", bench_csv!(""), BENCH_M, &["t.csv"]),
+    case("bench csv header only", bench_csv!("time_s,stroke_m,force_N\n"), DIAG_M, &["t.csv", "two samples"]),
+    case("bench csv short row", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.001\n0.002,0.001,1\n"), BENCH_M, &["t.csv", "line 3"]),
+    case("bench csv sampled too coarsely (diagnose)", bench_csv!("time_s,stroke_m,force_N\n0.0,0.0,0\n0.01,0.001,50\n0.02,0.0,0\n0.03,-0.001,-50\n0.04,0.0,0\n0.05,0.001,50\n0.06,0.0,0\n0.07,-0.001,-50\n0.08,0.0,0\n0.09,0.001,50\n0.10,0.0,0\n"), DIAG_M, &["t.csv", "sample rate"]),
+    case("bench csv no force (diagnose)", bench_csv!("time_s,stroke_m\n0.0,0.0\n0.001,0.001\n0.002,0.002\n"), DIAG_M, &["t.csv", "force"]),
+    case("bench csv missing file", &[], BENCH_M, &["t.csv"]),
+    case("bench csv is a folder", &[("t.csv", Dir, &[])], DIAG_M, &["t.csv"]),
+    case("bench csv duplicate quantity", bench_csv!("time_s,stroke_m,stroke_in,force_N\n0.0,0.0,0.0,0\n0.001,0.001,0.04,1\n"), BENCH_M, &["t.csv", "stroke"]),
+    // ---- flight records (inspect, convert, run, diagnose) ----
+    case("record missing", &[], INSPECT, &["rec"]),
+    case("record meta wrong type", record!("\"rotor_speed_rad_s\": 27.0", "\"rotor_speed_rad_s\": \"fast\""), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
+    case("record meta negative speed", record!("\"rotor_speed_rad_s\": 27.0", "\"rotor_speed_rad_s\": -27.0"), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
+    case("record meta missing key", record!("\"rotor_speed_rad_s\": 27.0,", ""), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
+    case("record meta not JSON", record!("\"counter\": \"8534-like\",", "\"counter\" \"8534-like\","), INSPECT, &["rec.meta.json", "line"]),
+    case("record airloads wrong column", record!("normal_force_N_per_m", "normal_force_X"), INSPECT, &["rec.airloads.csv", "normal_force"]),
+    case("record damper NaN", record!("0,1.406250,14125.110", "0,1.406250,nan"), INSPECT, &["rec.damper.csv", "line 3"]),
+    case("record damper row deleted", record!("0,1.406250,14125.110,1.296075813e-02\n", ""), RUN_FLIGHT, &["rec.damper.csv"]),
+    case("record airloads not a number", record!("0,0.000000,0.4000,1812.761", "0,0.000000,0.4000,x1812"), &["convert", "{T}/rec", "{T}/out.mcap"], &["rec.airloads.csv", "line 3"]),
+    case("record meta disagrees with data", record!("\"revolutions\": 5", "\"revolutions\": 7"), INSPECT, &["rec.meta.json", "revolutions"]),
+    case("mcap garbage", &[("rec.mcap", Text("this is not an mcap file\n"), &[])], &["inspect", "{T}/rec.mcap"], &["rec.mcap"]),
+    case("mcap truncated (convert)", &[("rec.mcap", Trunc("flightdata/c8534like.mcap", 70000), &[])], &["convert", "{T}/rec.mcap", "{T}/out"], &["rec.mcap"]),
+    case("mcap truncated (run)", &[("rec.mcap", Trunc("flightdata/c8534like.mcap", 2000), &[])], &["run", "--model", "rigid", "--flight", "{T}/rec.mcap", "--revs", "3", "--out", "{T}/out"], &["rec.mcap"]),
+    case("mcap empty (diagnose)", &[("rec.mcap", Text(""), &[])], &["diagnose", "--rotor", "{R}/rotors/uh60a.toml", "--flight", "{T}/rec.mcap", "--out", "{T}/out"], &["rec.mcap"]),
+    // ---- paths ----
+    case("model deck missing", &[], STATIC_M, &["m.toml"]),
+    case("model deck is a folder", &[("m.toml", Dir, &[])], DYN_M, &["m.toml"]),
+    case("rotor deck is a folder", &[("r.toml", Dir, &[])], EXPAND_R, &["r.toml"]),
+    case("rotor deck missing (modes)", &[], MODES_R, &["r.toml"]),
+    case("out under a file (run)", &[("f", Text("x"), &[])], &["run", "--model", "rigid", "--revs", "3", "--out", "{T}/f/out"], &["{T}/f"]),
+    case("out is a file (static)", &[("m.toml", Repo(CANT), &[]), ("o", Text("x"), &[])], &["static", "{T}/m.toml", "--out", "{T}/o"], &["{T}/o"]),
+    case("out under a file (verify)", &[("f", Text("x"), &[])], &["verify", "--out", "{T}/f/v"], &["{T}/f"]),
+    case("out under a file (bench)", &[("f", Text("x"), &[])], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--peak-velocity", "1", "--cycles", "2", "--out", "{T}/f/b"], &["{T}/f"]),
+    case("out is a non-result folder", &[("o/notes.txt", Text("mine"), &[])], &["run", "--model", "rigid", "--revs", "3", "--out", "{T}/o"], &["{T}/o"]),
+    case("convert output under a file", &[("f", Text("x"), &[])], &["convert", "{R}/flightdata/c8534like", "{T}/f/x.mcap"], &["{T}/f"]),
+    case("initial state missing", &[], &["run", "--model", "rigid", "--revs", "3", "--initial-state", "{T}/state.json", "--out", "{T}/out"], &["state.json"]),
+    case("out under a file (dynamic)", &[("m.toml", Repo(CANT), &[]), ("f", Text("x"), &[])], &["dynamic", "{T}/m.toml", "--out", "{T}/f/d"], &["{T}/f"]),
+    // ---- options ----
+    case("run revs not a number", &[], &["run", "--revs", "abc", "--out", "{T}/out"], &["--revs", "abc"]),
+    case("run revs 1e9 (cost guard)", &[], &["run", "--model", "rigid", "--revs", "1000000000", "--out", "{T}/out"], &["--revs"]),
+    case("run damper unknown", &[], &["run", "--damper", "magic", "--out", "{T}/out"], &["--damper", "magic"]),
+    case("run periodic-tol negative", &[], &["run", "--model", "rigid", "--periodic-tol=-1", "--out", "{T}/out"], &["--periodic-tol"]),
+    case("run periodic-tol NaN", &[], &["run", "--model", "rigid", "--periodic-tol", "nan", "--out", "{T}/out"], &["--periodic-tol"]),
+    case("run steps-per-rev zero", &[], &["run", "--model", "rigid", "--steps-per-rev", "0", "--out", "{T}/out"], &["--steps-per-rev"]),
+    case("run substeps zero", &[], &["run", "--model", "rigid", "--substeps", "0", "--out", "{T}/out"], &["--substeps"]),
+    case("run scheme unknown", &[], &["run", "--scheme", "euler", "--out", "{T}/out"], &["--scheme", "euler"]),
+    case("run model unknown", &[], &["run", "--model", "stiff", "--out", "{T}/out"], &["--model", "stiff"]),
+    case("run newton unknown", &[], &["run", "--newton", "half", "--out", "{T}/out"], &["--newton", "half"]),
+    case("run periodic unknown", &[], &["run", "--periodic", "guess", "--out", "{T}/out"], &["--periodic", "guess"]),
+    case("run steps-per-rev huge (cost guard)", &[], &["run", "--model", "rigid", "--steps-per-rev", "4000000000", "--revs", "3", "--out", "{T}/out"], &["--steps-per-rev"]),
+    case("bench omega NaN", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--omega", "nan", "--out", "{T}/out"], &["--omega"]),
+    case("bench omega negative", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--omega=-27", "--out", "{T}/out"], &["--omega"]),
+    case("bench peak velocity list", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--peak-velocity", "1,x", "--out", "{T}/out"], &["--peak-velocity", "x"]),
+    case("bench peak velocity negative", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--peak-velocity=-1", "--out", "{T}/out"], &["--peak-velocity"]),
+    case("bench velocity unit unknown", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--velocity-unit", "furlong/s", "--out", "{T}/out"], &["--velocity-unit", "furlong"]),
+    case("bench cycles zero", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--cycles", "0", "--out", "{T}/out"], &["--cycles"]),
+    case("bench integrator unknown", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--integrator", "euler", "--out", "{T}/out"], &["--integrator", "euler"]),
+    case("bench damper unknown", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--damper", "magic", "--out", "{T}/out"], &["--damper", "magic"]),
+    case("bench cycles huge (cost guard)", &[], &["bench", "--deck", "{R}/flightdata/damper_nominal.toml", "--cycles", "1000000000", "--out", "{T}/out"], &["--cycles"]),
+    case("modes speeds malformed", R, &["modes", "--rotor", "{T}/r.toml", "--speeds", "1:a", "--out", "{T}/out"], &["--speeds"]),
+    case("modes speeds step zero", R, &["modes", "--rotor", "{T}/r.toml", "--speeds", "0:1:0", "--out", "{T}/out"], &["--speeds"]),
+    case("modes count zero", R, &["modes", "--rotor", "{T}/r.toml", "--count", "0", "--out", "{T}/out"], &["--count"]),
+    case("modes without a deck", &[], &["modes", "--out", "{T}/out"], &["<DECK>"]),
+    case("expand revs zero", R, &["expand", "--rotor", "{T}/r.toml", "--revs", "0"], &["--revs"]),
+    case("expand damper unknown", R, &["expand", "--rotor", "{T}/r.toml", "--damper", "all"], &["--damper"]),
+    case("expand flight missing", R, &["expand", "--rotor", "{T}/r.toml", "--flight", "{T}/nothing"], &["nothing"]),
+    case("diagnose max-substep negative", bench_csv!(BENCH_OK), &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--measured", "{T}/t.csv", "--max-substep=-1", "--out", "{T}/out"], &["--max-substep"]),
+    case("diagnose fit-cycles zero", bench_csv!(BENCH_OK), &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--measured", "{T}/t.csv", "--fit-cycles", "0", "--out", "{T}/out"], &["--fit-cycles"]),
+    case("diagnose rotor model unknown", &[], &["diagnose", "--rotor", "{R}/rotors/uh60a.toml", "--flight", "{R}/flightdata/c8534like", "--rotor-model", "sdof", "--out", "{T}/out"], &["--rotor-model"]),
+    case("diagnose nothing to diagnose", &[], &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--out", "{T}/out"], &["--measured"]),
+    case("unknown command", &[], &["simulate"], &["simulate"]),
+];
+
+fn subst(s: &str, t: &Path) -> String {
+    s.replace("{T}", &t.display().to_string())
+        .replace("{R}", &root().display().to_string())
+}
+
+/// Copies of shipped decks refer to shipped files by absolute path.
+fn absolutize(text: String) -> String {
+    let r = root();
+    text.replace(
+        "sections_csv = \"data/",
+        &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
+    )
+    .replace(
+        "deck = \"../../rotors/",
+        &format!("deck = \"{}/", r.join("rotors").display()),
+    )
+}
+
+/// Writes a case's files; Err names an edit that matched nothing.
+fn write_files(dir: &Path, files: &[F]) -> Result<(), String> {
+    for &(dst, src, edits) in files {
+        let path = dir.join(dst);
+        if let Some(p) = path.parent() {
+            std::fs::create_dir_all(p).unwrap();
+        }
+        let mut texts: Vec<(PathBuf, String)> = match src {
+            Repo(p) => vec![(
+                path.clone(),
+                std::fs::read_to_string(root().join(p)).unwrap(),
+            )],
+            Text(t) => vec![(path.clone(), t.to_string())],
+            Trunc(p, n) => {
+                let b = std::fs::read(root().join(p)).unwrap();
+                std::fs::write(&path, &b[..n.min(b.len())]).unwrap();
+                vec![]
+            }
+            Record(stem) => ["meta.json", "airloads.csv", "damper.csv"]
+                .iter()
+                .map(|ext| {
+                    let s = std::fs::read_to_string(root().join(format!("{stem}.{ext}"))).unwrap();
+                    (dir.join(format!("{dst}.{ext}")), s)
+                })
+                .collect(),
+            Dir => {
+                std::fs::create_dir_all(&path).unwrap();
+                vec![]
+            }
+        };
+        for &(from, to) in edits {
+            let Some(t) = texts.iter_mut().find(|(_, t)| t.contains(from)) else {
+                return Err(format!("edit `{from}` matches nothing in {dst}"));
+            };
+            t.1 = t.1.replacen(from, to, 1);
+        }
+        for (p, t) in texts {
+            std::fs::write(p, absolutize(t)).unwrap();
+        }
+    }
+    Ok(())
+}
+
+const LIMIT: Duration = Duration::from_secs(30);
+
+/// Runs one case; Err says how it failed.
+fn run_case(i: usize, c: &Case) -> Result<(), String> {
+    let dir = tmp(&format!("bad{i}"));
+    write_files(&dir, c.files)?;
+    let args: Vec<String> = c.args.iter().map(|a| subst(a, &dir)).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .args(&args)
+        .current_dir(root())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = std::io::Read::read_to_string(&mut stderr, &mut s);
+        s
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break Some(s);
+        }
+        if start.elapsed() > LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let err = reader.join().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let Some(status) = status else {
+        return Err(format!("still running after {LIMIT:?} (hang)"));
+    };
+    let mut why = Vec::new();
+    if status.code() == Some(101) || err.contains("panicked") {
+        why.push("panicked".to_string());
+    }
+    if status.success() {
+        why.push("exit 0 (wrong success)".to_string());
+    }
+    if status.code().is_none() {
+        why.push(format!("killed by a signal ({status})"));
+    }
+    for e in c.expect {
+        let e = subst(e, &dir);
+        if !err.contains(&e) {
+            why.push(format!("message lacks `{e}`"));
+        }
+    }
+    if why.is_empty() {
+        Ok(())
+    } else {
+        // the last lines of stderr: the error, not the progress before it
+        let lines: Vec<&str> = err.trim().lines().collect();
+        let tail = match lines.iter().position(|l| l.starts_with("error")) {
+            Some(k) => lines[k..].join("\n              "),
+            None => lines[lines.len().saturating_sub(2)..].join("\n              "),
+        };
+        Err(format!("{}\n      stderr: {tail}", why.join("; ")))
+    }
+}
+
+#[test]
+fn every_bad_input_is_refused_with_file_and_key_named() {
+    assert!(CASES.len() >= 60, "{} cases", CASES.len());
+    let only = std::env::var("BAD_INPUTS_ONLY").ok();
+    let failures = std::sync::Mutex::new(Vec::new());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(c) = CASES.get(i) else { break };
+                if only.as_deref().is_some_and(|o| !c.name.contains(o)) {
+                    continue;
+                }
+                if let Err(e) = run_case(i, c) {
+                    failures
+                        .lock()
+                        .unwrap()
+                        .push(format!("  [{i}] {}: {e}", c.name));
+                }
+            });
+        }
+    });
+    let mut f = failures.into_inner().unwrap();
+    f.sort();
+    assert!(
+        f.is_empty(),
+        "{} of {} bad inputs not refused as they should be:\n{}",
+        f.len(),
+        CASES.len(),
+        f.join("\n")
+    );
+}
+
+#[test]
+fn case_names_are_unique() {
+    let mut names: Vec<_> = CASES.iter().map(|c| c.name).collect();
+    names.sort_unstable();
+    let n = names.len();
+    names.dedup();
+    assert_eq!(names.len(), n, "two cases share a name");
+}
