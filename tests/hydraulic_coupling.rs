@@ -73,7 +73,7 @@ b = 0.0
 "#;
 
 fn damper_deck() -> DamperDeck {
-    DamperDeck::from_toml_str(DAMPER_DECK, "FORMATS.md example").unwrap()
+    DamperDeck::from_toml_str(DAMPER_DECK, "docs/formats.md example").unwrap()
 }
 
 /// One converged step as seen by the element.
