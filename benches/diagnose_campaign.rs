@@ -1,5 +1,5 @@
 //! Diagnosis of a 6-test SYNTHETIC bench campaign (8 cycles each, 2 kHz, 1% noise, hidden seal
-//! friction): all candidates fitted, ranked and validated. Issue #7 target: < 30 s on 2 cores.
+//! friction): all candidates fitted, ranked and validated. Target: < 30 s on 2 cores.
 //! `cargo bench --bench diagnose_campaign`
 #[path = "../tests/diagnose_support/mod.rs"]
 mod support;

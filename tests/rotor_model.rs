@@ -1,4 +1,4 @@
-//! UH-60A rotor forced response (issue #6): the model builds with each damper model, runs two
+//! UH-60A rotor forced response: the model builds with each damper model, runs two
 //! revolutions under the shipped flight record, and the damper coupling obeys its conventions
 //! (docs/formats.md: stroke positive in extension, force positive pushing the ends apart).
 //! Run: `cargo test --release --test rotor_model`.

@@ -1,4 +1,4 @@
-//! `rotorsim run` end to end (issue #6), with the lag-hinge test double (`--model sdof`) so the
+//! `rotorsim run` end to end, with the lag-hinge test double (`--model sdof`) so the
 //! pipeline is exercised in seconds: outputs, keys, units, periodicity, known-answer metrics,
 //! bad inputs.
 use rotorsim::flight::{DamperSample, FlightRecord};
