@@ -1,4 +1,4 @@
-//! Benchmark of the paper's bench sweep (issue #2): 8 amplitudes x 10 cycles x 256 steps per
+//! Benchmark of the paper's bench sweep: 8 amplitudes x 10 cycles x 256 steps per
 //! cycle x 25 RK4 sub-steps on the shipped UH-60A-like damper, one thread, no history kept.
 //! `cargo bench --bench bench_sweep`; figures in docs/performance.md.
 use criterion::{criterion_group, criterion_main, Criterion};

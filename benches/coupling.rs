@@ -1,4 +1,4 @@
-//! Benchmark (issue 4): cost per structural step of the paper's first example
+//! Benchmark: cost per structural step of the paper's first example
 //! (docs/examples/actuator_pitch_beam.toml: 4 cubic beam elements, revolute joint, hydraulic
 //! actuator with 48 RK4 sub-steps, dt = 1e-4 s) on one core, with the share spent in the device.
 //! Variants: the implicit hydraulic scheme (N = 4) and the paper's F_m (applied_force = "mean",

@@ -1,4 +1,4 @@
-//! Benchmark (issue #3): 40-element cantilever released from a static tip deflection,
+//! Benchmark: 40-element cantilever released from a static tip deflection,
 //! generalized-alpha steps on one core. Reports cost per step; iterations per step are printed
 //! so that the cost per Newton iteration follows.
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -1,4 +1,4 @@
-//! `rotorsim diagnose` end to end: the shipped (SYNTHETIC) flight record, the FORMATS.md JSON
+//! `rotorsim diagnose` end to end: the shipped (SYNTHETIC) flight record, the docs/formats.md JSON
 //! keys, the written deck through `rotorsim bench`, and the clear errors.
 use rotorsim::cli::bench::{run as bench, BenchArgs};
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};

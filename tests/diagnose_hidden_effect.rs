@@ -1,5 +1,4 @@
-//! Issue #7 "must hold": hidden effects in SYNTHETIC bench data are found, named, their
-//! parameter recovered within tolerance, with a positive held-out gain; no effect gives `none`;
+//! Hidden effects in SYNTHETIC bench data are found, named, their parameter recovered within tolerance, with a positive held-out gain; no effect gives `none`;
 //! bad or insufficient data gets a clear message. Larger seed sweep:
 //! `cargo run --release --example diagnose_hit_rate -- 40 4 2000`.
 mod diagnose_support;

@@ -199,7 +199,7 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
     assert!(html.contains("Rotor-level check (before / after)"));
 }
 
-/// The must-hold of issue #7 on the shipped record: the extended deck the diagnosis writes
+/// On the shipped record, the extended deck the diagnosis writes
 /// improves the rotor-level comparison. Rotor model: the rigid-blade reduction of the rotor deck
 /// (`--rotor-model rigid`), the blade model the record was generated with (its meta: one rigid
 /// blade on coincident hinges); tests/rotor_rigid.rs checks that it reproduces the record's

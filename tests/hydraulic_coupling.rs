@@ -1,4 +1,4 @@
-//! Hydraulic device coupled to the structure (issue 4, paper Eqs. 9-16): discrete work identity,
+//! Hydraulic device coupled to the structure (paper Eqs. 9-16): discrete work identity,
 //! Eq. (15) tangent vs finite differences, a mass on a dashpot vs the analytic decay, invariance
 //! of the structural time grid under the hydraulic integrator, deck support.
 // Component loops mirror the formulas.
@@ -73,7 +73,7 @@ b = 0.0
 "#;
 
 fn damper_deck() -> DamperDeck {
-    DamperDeck::from_toml_str(DAMPER_DECK, "FORMATS.md example").unwrap()
+    DamperDeck::from_toml_str(DAMPER_DECK, "docs/formats.md example").unwrap()
 }
 
 /// One converged step as seen by the element.

@@ -1,4 +1,4 @@
-//! Element and device tests against analytic results (issue #2 "must hold").
+//! Element and device tests against analytic results.
 use rotorsim::hydraulics::bench::{harmonic_run, IN_TO_M};
 use rotorsim::hydraulics::circuit::{IP0, IP1, IV0, IX0};
 use rotorsim::hydraulics::*;

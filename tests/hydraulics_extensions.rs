@@ -1,5 +1,5 @@
-//! The issue #7 extensions of the hydraulic library against analytic results, their analytic
-//! Jacobian against finite differences, and the deck keys (defaults off: bit-for-bit the same).
+//! The extensions of the hydraulic library (seal friction, free play, entrained air, ...) against
+//! analytic results, their analytic Jacobian against finite differences, and the deck keys (defaults off: bit-for-bit the same).
 use rotorsim::hydraulics::bench::{harmonic_run, replay, BenchTest};
 use rotorsim::hydraulics::circuit::{State, IP0, IP1, NS};
 use rotorsim::hydraulics::*;

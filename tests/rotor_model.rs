@@ -1,6 +1,6 @@
-//! UH-60A rotor forced response (issue #6): the model builds with each damper model, runs two
+//! UH-60A rotor forced response: the model builds with each damper model, runs two
 //! revolutions under the shipped flight record, and the damper coupling obeys its conventions
-//! (FORMATS: stroke positive in extension, force positive pushing the ends apart).
+//! (docs/formats.md: stroke positive in extension, force positive pushing the ends apart).
 //! Run: `cargo test --release --test rotor_model`.
 use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::DamperModel;
@@ -97,7 +97,7 @@ fn uh60a_linear_damper_two_revolutions() {
         .unwrap();
     let mut fmax: f64 = 0.0;
     for (ch, _) in &r.rows {
-        // F = -c d_dot (FORMATS: a damper resists the motion)
+        // F = -c d_dot (docs/formats.md: a damper resists the motion)
         assert!((ch[0] + c * ch[2]).abs() <= 1e-9 * (c * ch[2]).abs() + 1e-9);
         fmax = fmax.max(ch[0].abs());
     }

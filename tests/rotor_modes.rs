@@ -1,4 +1,4 @@
-//! UH-60A fan plot (issue #6) against the digitized reference (Bowen-Davies 2015, Hz versus
+//! UH-60A fan plot against the digitized reference (Bowen-Davies 2015, Hz versus
 //! Omega/Omega_nominal). Run: `cargo test --release --test rotor_modes`.
 //!
 //! What holds (docs/rotor_model.md, "Fan plot"): at 100% speed lag1, flap1 and flap2 within 5%;

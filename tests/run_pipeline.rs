@@ -1,4 +1,4 @@
-//! `rotorsim run` end to end (issue #6), with the lag-hinge test double (`--model sdof`) so the
+//! `rotorsim run` end to end, with the lag-hinge test double (`--model sdof`) so the
 //! pipeline is exercised in seconds: outputs, keys, units, periodicity, known-answer metrics,
 //! bad inputs.
 use rotorsim::flight::{DamperSample, FlightRecord};
@@ -346,7 +346,7 @@ fn periodicity_of_the_linear_model_decays_at_the_lag_mode_damping_rate() {
 
 #[test]
 fn a_damper_channel_too_coarse_to_compare_runs_without_metrics() {
-    // Flight records always carry a damper force (FORMATS: the column is required), but one
+    // Flight records always carry a damper force (docs/formats.md: the column is required), but one
     // with 8 azimuths per revolution cannot give harmonics 0-10/rev: the run goes on, the
     // metrics are absent with a note saying why.
     let out = tmp("coarse");
@@ -477,7 +477,7 @@ fn lag_hinge_double_matches_the_analytic_forced_response() {
         "{} vs {expect_deg}",
         hd[1].phase_deg
     );
-    // Damper force of the linear dashpot: -c times the stroke rate (FORMATS sign).
+    // Damper force of the linear dashpot: -c times the stroke rate (docs/formats.md sign).
     let f = run.channel("damper_force_N").unwrap();
     let hf = harmonics(&run.azimuth_deg, f, 2).unwrap();
     assert!((hf[1].amplitude - 68000.0 * w * amp).abs() < 1e-3 * hf[1].amplitude);

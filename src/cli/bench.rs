@@ -37,7 +37,7 @@ pub struct BenchArgs {
     /// Hydraulic sub-step scheme: rk4 or implicit.
     #[arg(long = "scheme", alias = "integrator", default_value = "rk4")]
     pub integrator: String,
-    /// Measured bench test(s) to replay instead of the harmonic sweep (bench CSV, FORMATS.md).
+    /// Measured bench test(s) to replay instead of the harmonic sweep (bench CSV, docs/formats.md).
     #[arg(long)]
     pub measured: Vec<PathBuf>,
     /// Output directory.

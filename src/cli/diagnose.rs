@@ -24,7 +24,7 @@ pub struct DiagnoseArgs {
     /// Damper deck of the baseline model (any TOML file with a [damper] table).
     #[arg(long = "damper-deck", alias = "deck")]
     pub deck: Option<PathBuf>,
-    /// Measured bench test(s) (bench CSV of FORMATS.md, with force).
+    /// Measured bench test(s) (bench CSV of docs/formats.md, with force).
     #[arg(long)]
     pub measured: Vec<PathBuf>,
     /// Rotor deck (flight-record diagnosis; its [damper] table is the baseline unless --damper-deck).
@@ -742,7 +742,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         }
         _ => None,
     };
-    // diagnosis.json: the FORMATS.md keys and the existing extras, plus new keys only.
+    // diagnosis.json: the docs/formats.md keys and the existing extras, plus new keys only.
     let mut json = serde_json::to_value(d)?;
     if let Some(obj) = json.as_object_mut() {
         if let Some(s) = &stroke_info {

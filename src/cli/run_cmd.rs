@@ -22,7 +22,7 @@ pub struct RunArgs {
     /// Rotor deck (docs/rotor_deck.md).
     #[arg(long, default_value = "rotors/uh60a.toml")]
     pub rotor: PathBuf,
-    /// Flight record: MCAP file or CSV stem (FORMATS.md).
+    /// Flight record: MCAP file or CSV stem (docs/formats.md).
     #[arg(long, default_value = "flightdata/c8534like")]
     pub flight: PathBuf,
     /// Damper model: linear, nonlinear, physical, or all (the three in parallel).

@@ -2,7 +2,7 @@
 //! re-calibration of uncertain nominal coefficients), with its fitted parameters and bounds.
 use crate::hydraulics::{DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction};
 
-/// Named causes (FORMATS.md `cause`).
+/// Named causes (docs/formats.md `cause`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Cause {
     None,

@@ -50,7 +50,7 @@ struct Window {
     to: usize,
 }
 
-/// `validation` of FORMATS.md.
+/// `validation` of docs/formats.md.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 #[allow(non_snake_case)]
 pub struct Validation {
@@ -59,7 +59,7 @@ pub struct Validation {
     pub extended_rms_N: f64,
 }
 
-/// One row of `candidates` (FORMATS.md, plus `held_out_rms_N`, `k`, `fit_evaluations`).
+/// One row of `candidates` (docs/formats.md, plus `held_out_rms_N`, `k`, `fit_evaluations`).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 #[allow(non_snake_case)]
 pub struct Candidate {
@@ -101,7 +101,7 @@ pub struct TestSummary {
     pub extended_rms_N: f64,
 }
 
-/// The diagnosis report (DIR/diagnosis.json; FORMATS.md keys first, then extra keys).
+/// The diagnosis report (DIR/diagnosis.json; docs/formats.md keys first, then extra keys).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 #[allow(non_snake_case)]
 pub struct Diagnosis {

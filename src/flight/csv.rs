@@ -1,4 +1,4 @@
-//! The CSV triple: `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (FORMATS.md).
+//! The CSV triple: `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (docs/formats.md).
 //!
 //! Reading converts alternate units to SI (units.rs); writing is always SI with shortest
 //! round-trip number formatting, so CSV -> MCAP -> CSV gives back every value bit for bit.

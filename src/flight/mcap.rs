@@ -1,4 +1,4 @@
-//! The MCAP form of a flight record (FORMATS.md): channels `/rotor/meta` (one message),
+//! The MCAP form of a flight record (docs/formats.md): channels `/rotor/meta` (one message),
 //! `/rotor/airloads` (one message per azimuth, arrays over stations), `/rotor/damper` (one message
 //! per sample); JSON message encoding, one JSON schema (encoding `jsonschema`) per channel;
 //! log time = (revolution * 360 + azimuth_deg) / Omega[deg/s], in nanoseconds.

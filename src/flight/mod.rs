@@ -1,7 +1,7 @@
 //! Flight records (CSV triple and MCAP), unit conversion at the edges, airload replay.
 //!
 //! A [`FlightRecord`] holds the metadata, the airloads per azimuth at radial stations (SI, section
-//! frame of FORMATS.md) and the measured damper channel. [`FlightRecord::read`] accepts either
+//! frame of docs/formats.md) and the measured damper channel. [`FlightRecord::read`] accepts either
 //! form; [`FlightRecord::write_csv`] and [`FlightRecord::write_mcap`] write them atomically.
 //! [`AirloadReplay`] turns a record into a load provider for the rotor run.
 //! Format details, interpolation and root/tip treatment: docs/flight_records.md.

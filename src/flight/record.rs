@@ -14,7 +14,7 @@ pub struct ControlsDeg {
 /// Metadata of a flight record (`NAME.meta.json` or the `/rotor/meta` MCAP message).
 ///
 /// The known keys are typed; every key, known or not, is kept in [`FlightMeta::raw`] and written
-/// back (FORMATS: extend, never break). On writing, the typed fields overwrite their raw keys.
+/// back (docs/formats.md: extend, never break). On writing, the typed fields overwrite their raw keys.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlightMeta {
     pub counter: Option<String>,
@@ -216,7 +216,7 @@ impl FlightMeta {
 pub struct DamperSample {
     pub revolution: u32,
     pub azimuth_deg: f64,
-    /// Damper force [N], FORMATS sign (positive pushes the end points apart).
+    /// Damper force [N], docs/formats.md sign (positive pushes the end points apart).
     pub force_N: f64,
     /// Damper stroke [m], positive in extension, where the record has it.
     pub stroke_m: Option<f64>,
@@ -231,7 +231,7 @@ pub struct DamperTrace {
     pub stroke_m: Option<Vec<f64>>,
 }
 
-/// A flight record (FORMATS.md "Flight record"), values in SI.
+/// A flight record (docs/formats.md "Flight record"), values in SI.
 ///
 /// Airloads are stored on a full grid: every listed revolution has the same azimuths, every
 /// azimuth the same stations (checked on construction). Revolutions may have gaps (a record of
@@ -710,7 +710,7 @@ impl FlightRecord {
         self.damper.first().is_some_and(|s| s.stroke_m.is_some())
     }
 
-    /// Time [s] of (revolution, azimuth): (rev * 360 + psi) / Omega [deg/s] (FORMATS).
+    /// Time [s] of (revolution, azimuth): (rev * 360 + psi) / Omega [deg/s] (docs/formats.md).
     pub fn time_s(&self, revolution: u32, azimuth_deg: f64) -> f64 {
         (revolution as f64 * 360.0 + azimuth_deg) / self.meta.rotor_speed_deg_s()
     }

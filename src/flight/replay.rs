@@ -1,7 +1,7 @@
 //! Replay of recorded airloads onto the blade: a load provider for the rotor run.
 //!
 //! For any time t (or azimuth) and radius, [`AirloadReplay`] gives the airloads per unit span in
-//! the deformed section frame (FORMATS.md): normal force along +z, chord force along -y (positive
+//! the deformed section frame (docs/formats.md): normal force along +z, chord force along -y (positive
 //! = drag), pitching moment about +x at the quarter chord (positive nose up).
 //!
 //! - Azimuth: periodic linear interpolation between the recorded azimuths (exact at them,
@@ -44,7 +44,7 @@ pub struct ReplayOptions {
     pub root_cutout_r_over_r: Option<f64>,
 }
 
-/// Airloads per unit span at one section (section frame of FORMATS.md).
+/// Airloads per unit span at one section (section frame of docs/formats.md).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 #[allow(non_snake_case)]
 pub struct SectionLoads {

@@ -1,6 +1,6 @@
 //! Units at the edges: CSV column names carry the unit; values are converted to SI on reading.
 //!
-//! Accepted units (FORMATS.md, plus the UH-60A airloads database's non-dimensional form):
+//! Accepted units (docs/formats.md, plus the UH-60A airloads database's non-dimensional form):
 //! - normal and chord force per span: `N_per_m`, `lb_per_in`, `M2Cn` / `M2Cc`
 //! - pitching moment per span: `N_m_per_m`, `in_lb_per_in`, `M2Cm`
 //! - damper force: `N`, `lb`; damper stroke: `m`, `in`

@@ -1,5 +1,5 @@
 //! Virtual test bench: harmonic stroking sweeps (paper Figs. 13-14) and replay of measured bench
-//! tests (bench CSV of FORMATS.md).
+//! tests (bench CSV of docs/formats.md).
 use super::{Device, HydraulicError};
 use std::path::Path;
 
@@ -231,7 +231,7 @@ const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
     ),
 ];
 
-/// Reads a bench CSV file (FORMATS.md): `time_s`, `stroke_m` required, `force_N`,
+/// Reads a bench CSV file (docs/formats.md): `time_s`, `stroke_m` required, `force_N`,
 /// `velocity_m_s` optional, alternates `stroke_in`, `force_lb`, `velocity_in_s`.
 pub fn read_bench_csv(path: &Path) -> Result<BenchTest, BenchCsvError> {
     let file = path.display().to_string();

@@ -1,4 +1,4 @@
-//! The damper deck of FORMATS.md: the `[damper]` table of any TOML file (other top-level tables
+//! The damper deck of docs/formats.md: the `[damper]` table of any TOML file (other top-level tables
 //! are ignored; unknown keys inside `[damper...]` tables are errors).
 use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
@@ -707,7 +707,7 @@ impl DamperDeck {
 }
 
 impl DamperDeck {
-    /// The deck as TOML (`[damper]` of FORMATS.md plus `[damper.physical.extensions]` where
+    /// The deck as TOML (`[damper]` of docs/formats.md plus `[damper.physical.extensions]` where
     /// any extension is on), readable by [`DamperDeck::from_toml_str`]; numbers use the shortest
     /// round-trip formatting, so the deck reads back to the same values.
     pub fn to_toml(&self) -> String {

@@ -60,7 +60,7 @@ pub struct BladeTable {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum AirloadFrame {
-    /// FORMATS: the deformed (follower) section frame of the model, elastic twist included.
+    /// docs/formats.md: the deformed (follower) section frame of the model, elastic twist included.
     #[default]
     Deformed,
     /// The deformed frame turned about the section axis to the rigid pitch, bearing pitch from

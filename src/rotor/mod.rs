@@ -24,7 +24,7 @@ pub struct Timing {
 }
 
 /// Names of the channels every [`ForcedResponse`] reports first, in this order. Sign
-/// conventions are those of ../shared/FORMATS.md (stroke positive in extension, force positive
+/// conventions are those of docs/formats.md (stroke positive in extension, force positive
 /// when the damper pushes its end points apart). Tip motion is in the hub (rotating) frame,
 /// relative to the undeformed blade: flap up positive, lag positive aft (against rotation),
 /// elastic twist nose-up positive.
@@ -75,7 +75,7 @@ pub trait ForcedResponse: Send {
     fn time_step_s(&self) -> f64;
     /// Current time [s]; starts at 0 (azimuth 0 of the reference blade).
     fn time_s(&self) -> f64;
-    /// Azimuth of the reference blade [deg] (FORMATS: 0 over the tail, increasing with
+    /// Azimuth of the reference blade [deg] (docs/formats.md: 0 over the tail, increasing with
     /// rotation), not wrapped.
     fn azimuth_deg(&self) -> f64 {
         self.time_s() / self.period_s() * 360.0

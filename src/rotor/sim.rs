@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// Airloads of the record on the blade: mean + ramp(t) (periodic part), follower section loads
-/// (FORMATS: normal along +z, chord force along -y, moment about +x; the beam reference line
+/// (docs/formats.md: normal along +z, chord force along -y, moment about +x; the beam reference line
 /// is taken as the quarter chord).
 pub struct BladeAirloads {
     full: AirloadReplay,

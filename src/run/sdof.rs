@@ -4,14 +4,14 @@
 //! rigid-blade reduction of a rotor deck with the airloads projected by the control pitch
 //! (`--model rigid`, docs/rotor_model.md).
 //!
-//! Equation of motion (lag angle `zeta`, positive aft, i.e. against the rotation, FORMATS):
+//! Equation of motion (lag angle `zeta`, positive aft, i.e. against the rotation, docs/formats.md):
 //!
 //! `I zeta'' + c zeta' + (e S Omega^2 + k) zeta = M(psi) + a F`
 //!
 //! with `I`, `S` the second and first mass moments of the blade about the hinge, `e` the hinge
 //! offset (centrifugal lag stiffness `e S Omega^2`), `k` and `c` the lag spring and damping
 //! (c = 0 in the test double), `a` the damper arm
-//! (stroke `d = a zeta`, so aft lag lengthens the damper) and `F` the damper force (FORMATS:
+//! (stroke `d = a zeta`, so aft lag lengthens the damper) and `F` the damper force (docs/formats.md:
 //! positive pushes the ends apart, so its generalized force on `zeta` is `a F`). `M(psi)` is the
 //! aerodynamic lag moment about the hinge, a sum of harmonics (0..2/rev in the test double,
 //! 0..16/rev in the reduction).

@@ -48,7 +48,7 @@ pub struct LimitCheck {
     /// `margin_n` relative to the larger limit magnitude.
     pub margin_rel: f64,
     /// Where the force is beyond a cracking force, is the relief valve of that side open at
-    /// every such sample (valve 0 for positive, valve 1 for negative force; FORMATS)? Then the
+    /// every such sample (valve 0 for positive, valve 1 for negative force; docs/formats.md)? Then the
     /// excess is the valve's own regulation (poppet spring and damping: the pressure rises as
     /// the valve opens, Eq. 5) and the valve is limiting the force. None without valve channels.
     pub excess_only_with_valve_open: Option<bool>,

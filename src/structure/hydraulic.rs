@@ -1,7 +1,7 @@
 //! Hydraulic device between two structural nodes (paper Eqs. 9-16): the coupling element.
 //!
 //! The device is attached by spherical joints, so only the translations of the two nodes enter.
-//! With `u = x_b - x_a` and `l = |u|`, the stroke is `d = l - L_ref` (FORMATS.md: positive in
+//! With `u = x_b - x_a` and `l = |u|`, the stroke is `d = l - L_ref` (docs/formats.md: positive in
 //! extension). Over a structural step from `t_i` to `t_f = t_i + dt` the device integrates its
 //! hydraulic states with the constant stroke rate `(d_f - d_i)/dt` and returns a step force `F_s`
 //! (the paper's step mean `F_m`, or the end-of-step force, see [`AppliedForce`]); the nodal

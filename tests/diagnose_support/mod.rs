@@ -134,7 +134,7 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
     }
 }
 
-/// Kinds drawn by [`draw`]: the six of issue #7 and three added while diagnosing the flight
+/// Kinds drawn by [`draw`]: the six named causes of docs/formats.md and three added while diagnosing the flight
 /// record.
 pub const KINDS: [Cause; 9] = [
     Cause::SealFriction,

@@ -24,7 +24,7 @@ pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("parsing {}: {e}", path.display()))
 }
 
-/// The top-level keys of diagnosis.json in ../shared/FORMATS.md.
+/// The top-level keys of diagnosis.json in docs/formats.md.
 pub const DIAGNOSIS_KEYS: [&str; 8] = [
     "cause",
     "parameters",
