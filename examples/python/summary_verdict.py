@@ -3,7 +3,7 @@
     python summary_verdict.py RUN_DIR
 
 Reads (docs/formats.md, "summary.json"): closest.statement, synthetic, and per model status,
-label, metrics.rms_error [N], metrics.correlation, periodic.converged, periodic.residual.
+label, metrics.rms_error_N, metrics.correlation, periodic.converged, periodic.residual.
 """
 import pandas as pd
 
@@ -19,7 +19,7 @@ for name, m in s["models"].items():
         "model": name,
         "label": m.get("label"),
         "status": m.get("status"),
-        "rms_error_N": metrics.get("rms_error"),
+        "rms_error_N": metrics.get("rms_error_N"),
         "correlation": metrics.get("correlation"),
         "periodic": periodic.get("converged"),
         "residual": periodic.get("residual"),

@@ -29,7 +29,7 @@ pub const LOG_TIME_TOLERANCE_NS: u64 = 1000;
 pub const META_SCHEMA_JSON: &str = r#"{
   "$schema": "https://json-schema.org/draft/2020-12/schema",
   "title": "rotorsim.FlightMeta",
-  "description": "Flight record metadata (FORMATS.md). Unknown keys are kept.",
+  "description": "Flight record metadata (docs/formats.md). Unknown keys are kept.",
   "type": "object",
   "required": ["synthetic", "rotor_speed_rad_s", "radius_m", "controls_deg"],
   "properties": {

@@ -18,7 +18,7 @@ fn schema_json(title: &str, names: &[&str]) -> String {
         let _ = write!(props, "\"{n}\": {{\"type\": \"number\"}}");
     }
     format!(
-        "{{\n  \"$schema\": \"https://json-schema.org/draft/2020-12/schema\",\n  \"title\": \"{title}\",\n  \"description\": \"One sample of the last revolution of a rotorsim run; units in the key names; FORMATS.md sign conventions.\",\n  \"type\": \"object\",\n  \"properties\": {{\n    {props}\n  }}\n}}"
+        "{{\n  \"$schema\": \"https://json-schema.org/draft/2020-12/schema\",\n  \"title\": \"{title}\",\n  \"description\": \"One sample of the last revolution of a rotorsim run; units in the key names; docs/formats.md sign conventions.\",\n  \"type\": \"object\",\n  \"properties\": {{\n    {props}\n  }}\n}}"
     )
 }
 
