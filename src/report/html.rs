@@ -17,6 +17,26 @@ pub fn escape(s: &str) -> String {
     o
 }
 
+/// The colour of a [`HtmlReport::banner`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Banner {
+    Ok,
+    Bad,
+    Synthetic,
+    Info,
+}
+
+impl Banner {
+    fn class(self) -> &'static str {
+        match self {
+            Banner::Ok => "ok",
+            Banner::Bad => "bad",
+            Banner::Synthetic => "synthetic",
+            Banner::Info => "info",
+        }
+    }
+}
+
 /// A report built section by section.
 #[derive(Debug, Clone)]
 pub struct HtmlReport {
@@ -46,6 +66,36 @@ impl HtmlReport {
     /// A highlighted notice (e.g. "synthetic data", "not converged").
     pub fn notice(&mut self, text: &str) -> &mut Self {
         let _ = writeln!(self.body, "<p class=\"notice\">{}</p>", escape(text));
+        self
+    }
+
+    /// A full-width banner: `kind` sets the colour (green "ok", red "bad", amber "synthetic",
+    /// grey "info").
+    pub fn banner(&mut self, kind: Banner, text: &str) -> &mut Self {
+        let _ = writeln!(
+            self.body,
+            "<div class=\"banner {}\">{}</div>",
+            kind.class(),
+            escape(text)
+        );
+        self
+    }
+
+    /// The boxed answer at the top of a report: a headline and supporting lines.
+    pub fn verdict(&mut self, headline: &str, lines: &[String]) -> &mut Self {
+        let _ = write!(
+            self.body,
+            "<div class=\"verdict\"><p class=\"headline\">{}</p>",
+            escape(headline)
+        );
+        if !lines.is_empty() {
+            self.body.push_str("<ul>");
+            for l in lines {
+                let _ = write!(self.body, "<li>{}</li>", escape(l));
+            }
+            self.body.push_str("</ul>");
+        }
+        self.body.push_str("</div>\n");
         self
     }
 
@@ -100,6 +150,14 @@ body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}\
 table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}\
 th{{background:#eee}}figure{{margin:1em 0}}figcaption{{font-size:90%;color:#555}}\
 .notice{{background:#fff3cd;border:1px solid #e0c060;padding:6px 10px}}pre{{background:#f6f6f6;padding:8px}}\
+.banner{{padding:8px 12px;margin:6px 0;font-weight:bold;border-radius:4px}}\
+.banner.ok{{background:#dff0d8;border:1px solid #3c763d;color:#2b542c}}\
+.banner.bad{{background:#c9302c;border:1px solid #8b1f1c;color:#fff;font-size:120%}}\
+.banner.synthetic{{background:#f0ad4e;border:1px solid #b06d0f;color:#222;font-size:120%}}\
+.banner.info{{background:#eef;border:1px solid #99b;color:#223}}\
+.verdict{{border:2px solid #333;border-radius:6px;padding:6px 14px;margin:10px 0 18px;background:#fafafa}}\
+.verdict .headline{{font-size:130%;font-weight:bold;margin:6px 0}}\
+figure svg{{max-width:100%;height:auto}}\
 </style></head><body>\n<h1>{t}</h1>\n{b}</body></html>\n",
             t = escape(&self.title),
             b = self.body

@@ -1,5 +1,18 @@
-//! SVG line plots (plotters, SVG backend). The DejaVu Sans font ships in `assets/fonts` and is
-//! registered before any text is drawn, so plots render the same on a machine with no fonts.
+//! SVG line and bar plots (plotters, SVG backend). The DejaVu Sans font ships in `assets/fonts`
+//! and is registered before any text is drawn, so plots render the same on a machine with no
+//! fonts.
+//!
+//! Conventions every figure rotorsim draws follows:
+//! - one fixed colour per damper model ([`MODEL_COLOURS`]: measured, linear, nonlinear,
+//!   physical), found from the series name, so a model has the same colour in the run report,
+//!   the bench and the diagnosis plots; other series take [`OTHER_COLOURS`] in turn;
+//! - ticks at "nice" steps (1, 2, 2.5, 5 x 10^k) or at a fixed step ([`Plot::x_step`], e.g. 90 deg
+//!   of azimuth), labelled with as many decimals as the step needs, never repeated;
+//! - data in SI, shown in engineering units through [`Plot::x_scale`] / [`Plot::y_scale`]
+//!   (e.g. N shown in kN with a scale of 1e-3 and an axis label "force [kN]");
+//! - the legend to the right of the data area, never over the data.
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -15,6 +28,41 @@ fn register_font() {
     });
 }
 
+/// The damper models' colours, the same in every plot: the measurement black, the linear
+/// dashpot blue, the nonlinear dashpot orange, the physical damper green.
+pub const MODEL_COLOURS: [(&str, RGBColor); 4] = [
+    ("measured", RGBColor(0, 0, 0)),
+    ("linear", RGBColor(31, 119, 180)),
+    ("nonlinear", RGBColor(255, 127, 14)),
+    ("physical", RGBColor(44, 160, 44)),
+];
+
+/// Colours of series that are not a damper model (limits, channels, amplitudes), in turn.
+pub const OTHER_COLOURS: [RGBColor; 6] = [
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(23, 190, 207),
+];
+
+/// The fixed colour of the damper model a series name refers to: the first word of the name
+/// that is a model name ("physical (sdof)", "SYNTHETIC measured (avg of 5 revs)",
+/// "linear p0"), or None.
+pub fn model_colour(name: &str) -> Option<RGBColor> {
+    name.split(|c: char| !c.is_ascii_alphanumeric())
+        .find_map(|w| {
+            let w = w.to_ascii_lowercase();
+            MODEL_COLOURS.iter().find(|m| m.0 == w).map(|m| m.1)
+        })
+}
+
+/// The colour as a CSS hex string (for HTML next to the plots).
+pub fn css(c: RGBColor) -> String {
+    format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2)
+}
+
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SeriesKind {
@@ -22,8 +70,12 @@ pub enum SeriesKind {
     Line,
     /// Dashed line (e.g. a reference or a model variant).
     Dashed,
+    /// Dotted line (a third channel of the same model).
+    Dotted,
     /// Markers only (e.g. measured or digitized data).
     Points,
+    /// Bars centred on each x, side by side with the plot's other bar series (harmonics).
+    Bars,
 }
 
 /// One named data series.
@@ -42,8 +94,14 @@ pub struct Plot {
     pub x_label: String,
     pub y_label: String,
     pub series: Vec<Series>,
+    /// Axis ranges in data units (SI), before scaling.
     pub x_range: Option<(f64, f64)>,
     pub y_range: Option<(f64, f64)>,
+    /// Fixed x tick step in displayed units (e.g. 90 for azimuth in deg).
+    pub x_step: Option<f64>,
+    /// Displayed value = data value * scale (e.g. 1e-3 for N shown in kN).
+    pub x_scale: f64,
+    pub y_scale: f64,
 }
 
 /// Errors while drawing.
@@ -60,16 +118,84 @@ pub enum PlotError {
 /// A closed interval (lo, hi).
 type Range = (f64, f64);
 
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(0, 0, 0),
-];
+/// A linear f64 axis with the ticks given (plotters' own picks its ticks itself).
+struct Ticked {
+    inner: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Ranged for Ticked {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
+fn ticked(lo: f64, hi: f64, ticks: Vec<f64>) -> Ticked {
+    Ticked {
+        inner: (lo..hi).into(),
+        ticks,
+    }
+}
+
+/// Ticks at a nice step (1, 2, 2.5, 5 x 10^k) with about `target` of them in [lo, hi], and the
+/// step.
+pub fn nice_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, f64) {
+    let span = hi - lo;
+    if span.is_nan() || span <= 0.0 || !span.is_finite() {
+        return (vec![lo], 1.0);
+    }
+    let raw = span / target.max(1) as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    (ticks_at(lo, hi, step), step)
+}
+
+/// Multiples of `step` in [lo, hi] (exact multiples, so 90 deg steps give 0, 90, 180, ...).
+pub fn ticks_at(lo: f64, hi: f64, step: f64) -> Vec<f64> {
+    let k0 = (lo / step - 1e-9).ceil() as i64;
+    let k1 = (hi / step + 1e-9).floor() as i64;
+    (k0..=k1.min(k0 + 1000)).map(|k| k as f64 * step).collect()
+}
+
+/// Decimals that label every multiple of `step` distinctly (0 for 90, 1 for 0.5, 2 for 0.25).
+pub fn decimals_for(step: f64) -> usize {
+    (0..8)
+        .find(|d| {
+            let s = step * 10f64.powi(*d as i32);
+            (s - s.round()).abs() < 1e-6 * s.abs().max(1.0)
+        })
+        .unwrap_or(8)
+}
+
+/// A tick label: `decimals` after the point, "-0" shown as "0"; beyond 1e5 in magnitude as a
+/// power of ten ("2.5e6") so no axis carries a label like "10000000.0".
+pub fn tick_label(v: f64, decimals: usize) -> String {
+    let v = if v.abs() < 1e-12 { 0.0 } else { v };
+    if v.abs() >= 1e5 {
+        let s = format!("{v:.3e}");
+        // 2.500e6 -> 2.5e6
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        return format!("{m}e{e}");
+    }
+    format!("{v:.decimals$}")
+}
 
 impl Plot {
     pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
@@ -80,6 +206,9 @@ impl Plot {
             series: Vec::new(),
             x_range: None,
             y_range: None,
+            x_step: None,
+            x_scale: 1.0,
+            y_scale: 1.0,
         }
     }
 
@@ -102,8 +231,21 @@ impl Plot {
         self.push(name, x, y, SeriesKind::Dashed)
     }
 
+    pub fn dotted(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::Dotted)
+    }
+
     pub fn points(self, name: &str, x: &[f64], y: &[f64]) -> Self {
         self.push(name, x, y, SeriesKind::Points)
+    }
+
+    pub fn bars(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::Bars)
+    }
+
+    /// A series of the given kind.
+    pub fn series(self, kind: SeriesKind, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, kind)
     }
 
     pub fn x_range(mut self, lo: f64, hi: f64) -> Self {
@@ -116,16 +258,58 @@ impl Plot {
         self
     }
 
+    /// x ticks every `step` displayed units.
+    pub fn x_step(mut self, step: f64) -> Self {
+        self.x_step = Some(step);
+        self
+    }
+
+    /// An azimuth axis: 0..360 deg, ticks every 90 deg.
+    pub fn azimuth(self) -> Self {
+        self.x_range(0.0, 360.0).x_step(90.0)
+    }
+
+    pub fn x_scale(mut self, s: f64) -> Self {
+        self.x_scale = s;
+        self
+    }
+
+    pub fn y_scale(mut self, s: f64) -> Self {
+        self.y_scale = s;
+        self
+    }
+
+    /// Colour of every series: the model's fixed colour, else the other colours in turn.
+    fn colours(&self) -> Vec<RGBColor> {
+        let mut k = 0;
+        self.series
+            .iter()
+            .map(|s| {
+                model_colour(&s.name).unwrap_or_else(|| {
+                    let c = OTHER_COLOURS[k % OTHER_COLOURS.len()];
+                    k += 1;
+                    c
+                })
+            })
+            .collect()
+    }
+
+    /// Displayed ranges (scaled).
     fn ranges(&self) -> Result<(Range, Range), PlotError> {
+        let (sx, sy) = (self.x_scale, self.y_scale);
         let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
         let mut yr = xr;
         for s in &self.series {
             for (&x, &y) in s.x.iter().zip(&s.y) {
                 if x.is_finite() && y.is_finite() {
-                    xr = (xr.0.min(x), xr.1.max(x));
-                    yr = (yr.0.min(y), yr.1.max(y));
+                    xr = (xr.0.min(x * sx), xr.1.max(x * sx));
+                    yr = (yr.0.min(y * sy), yr.1.max(y * sy));
                 }
             }
+        }
+        if self.series.iter().any(|s| s.kind == SeriesKind::Bars) && xr.0.is_finite() {
+            yr = (yr.0.min(0.0), yr.1.max(0.0));
+            xr = (xr.0 - 0.5 * sx.abs(), xr.1 + 0.5 * sx.abs());
         }
         if !xr.0.is_finite() {
             return Err(PlotError::NoData(self.title.clone()));
@@ -135,11 +319,30 @@ impl Plot {
             let span = if span > 0.0 { span } else { r.0.abs().max(1.0) };
             (r.0 - frac * span, r.1 + frac * span)
         };
-        let xr = self
-            .x_range
-            .unwrap_or(if xr.1 > xr.0 { xr } else { pad(xr, 0.5) });
-        let yr = self.y_range.unwrap_or(pad(yr, 0.05));
+        let sc = |r: (f64, f64), s: f64| {
+            let (a, b) = (r.0 * s, r.1 * s);
+            (a.min(b), a.max(b))
+        };
+        let xr =
+            self.x_range
+                .map(|r| sc(r, sx))
+                .unwrap_or(if xr.1 > xr.0 { xr } else { pad(xr, 0.5) });
+        let yr = self.y_range.map(|r| sc(r, sy)).unwrap_or(pad(yr, 0.05));
         Ok((xr, yr))
+    }
+
+    /// Width of the legend column [px] (0 without named series).
+    fn legend_width(&self, width: u32) -> u32 {
+        let longest = self
+            .series
+            .iter()
+            .map(|s| s.name.chars().count())
+            .max()
+            .unwrap_or(0);
+        if longest == 0 {
+            return 0;
+        }
+        ((longest as u32) * 8 + 44).min((width * 3 / 10).max(190).min(width / 2))
     }
 
     fn draw_on<DB: DrawingBackend>(
@@ -151,52 +354,138 @@ impl Plot {
             message: e.to_string(),
         };
         let ((x0, x1), (y0, y1)) = self.ranges()?;
-        let mut chart = ChartBuilder::on(area)
+        let (w, _) = area.dim_in_pixel();
+        let lw = self.legend_width(w);
+        let (plot_area, legend_area) = area.split_horizontally(w - lw);
+        let (xt, dx) = match self.x_step {
+            Some(s) => (ticks_at(x0, x1, s), decimals_for(s)),
+            None => {
+                let (t, s) = nice_ticks(x0, x1, 8);
+                (t, decimals_for(s))
+            }
+        };
+        let (yt, sy) = nice_ticks(y0, y1, 6);
+        let dy = decimals_for(sy);
+        let xfmt = move |v: &f64| tick_label(*v, dx);
+        let yfmt = move |v: &f64| tick_label(*v, dy);
+        let mut chart = ChartBuilder::on(&plot_area)
             .caption(&self.title, ("sans-serif", 18))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
+            .build_cartesian_2d(ticked(x0, x1, xt), ticked(y0, y1, yt))
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
             .label_style(("sans-serif", 13))
-            .light_line_style(RGBColor(235, 235, 235))
+            .x_label_formatter(&xfmt)
+            .y_label_formatter(&yfmt)
+            .bold_line_style(RGBColor(225, 225, 225))
+            .light_line_style(RGBColor(245, 245, 245))
             .draw()
             .map_err(|e| err(&e))?;
-        for (i, s) in self.series.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
+        let colours = self.colours();
+        let nbars = self
+            .series
+            .iter()
+            .filter(|s| s.kind == SeriesKind::Bars)
+            .count()
+            .max(1);
+        let mut jbar = 0usize;
+        let (sx, sy) = (self.x_scale, self.y_scale);
+        for (s, &color) in self.series.iter().zip(&colours) {
             let pts: Vec<(f64, f64)> =
                 s.x.iter()
                     .zip(&s.y)
                     .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    .map(|(&x, &y)| (x, y))
+                    .map(|(&x, &y)| (x * sx, y * sy))
                     .collect();
-            let anno = match s.kind {
-                SeriesKind::Line => chart
-                    .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                    .map_err(|e| err(&e))?,
-                SeriesKind::Dashed => chart
-                    .draw_series(DashedLineSeries::new(pts, 6, 4, color.stroke_width(2)))
-                    .map_err(|e| err(&e))?,
-                SeriesKind::Points => chart
-                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
-                    .map_err(|e| err(&e))?,
-            };
-            anno.label(s.name.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            match s.kind {
+                SeriesKind::Line => {
+                    chart
+                        .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Dashed => {
+                    chart
+                        .draw_series(DashedLineSeries::new(pts, 6, 4, color.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Dotted => {
+                    chart
+                        .draw_series(DashedLineSeries::new(pts, 2, 3, color.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Points => {
+                    chart
+                        .draw_series(pts.into_iter().map(|p| Circle::new(p, 2, color.filled())))
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Bars => {
+                    let bw = 0.8 * sx.abs() / nbars as f64;
+                    let off = -0.4 * sx.abs() + jbar as f64 * bw;
+                    jbar += 1;
+                    chart
+                        .draw_series(pts.into_iter().map(|(x, y)| {
+                            Rectangle::new([(x + off, 0.0), (x + off + bw, y)], color.filled())
+                        }))
+                        .map_err(|e| err(&e))?;
+                }
+            }
         }
-        if self.series.iter().any(|s| !s.name.is_empty()) {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 13))
-                .draw()
-                .map_err(|e| err(&e))?;
+        if lw > 0 {
+            let max_chars = ((lw.saturating_sub(44)) / 8).max(4) as usize;
+            let mut y = 40i32;
+            for (s, &color) in self.series.iter().zip(&colours) {
+                if s.name.is_empty() {
+                    continue;
+                }
+                let (x0, x1) = (6i32, 30i32);
+                let st = color.stroke_width(2);
+                let r = match s.kind {
+                    SeriesKind::Line => {
+                        legend_area.draw(&PathElement::new(vec![(x0, y), (x1, y)], st))
+                    }
+                    SeriesKind::Dashed | SeriesKind::Dotted => {
+                        let (on, off) = if s.kind == SeriesKind::Dashed {
+                            (6, 4)
+                        } else {
+                            (2, 3)
+                        };
+                        let mut xa = x0;
+                        let mut r = Ok(());
+                        while xa < x1 && r.is_ok() {
+                            r = legend_area
+                                .draw(&PathElement::new(vec![(xa, y), ((xa + on).min(x1), y)], st));
+                            xa += on + off;
+                        }
+                        r
+                    }
+                    SeriesKind::Points => {
+                        legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 3, color.filled()))
+                    }
+                    SeriesKind::Bars => legend_area.draw(&Rectangle::new(
+                        [(x0 + 4, y - 5), (x1 - 4, y + 5)],
+                        color.filled(),
+                    )),
+                };
+                r.map_err(|e| err(&e))?;
+                let mut name: String = s.name.chars().take(max_chars).collect();
+                if s.name.chars().count() > max_chars {
+                    name.pop();
+                    name.push('…');
+                }
+                legend_area
+                    .draw(&Text::new(
+                        name,
+                        (x1 + 6, y - 7),
+                        ("sans-serif", 13).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| err(&e))?;
+                y += 20;
+            }
         }
         Ok(())
     }
@@ -208,23 +497,35 @@ impl Plot {
 
     /// Renders and writes atomically.
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
-        crate::io::write_atomic(path, self.to_svg(800, 480)?.as_bytes())?;
+        crate::io::write_atomic(path, self.to_svg(900, 480)?.as_bytes())?;
         Ok(())
     }
 }
 
 /// Several plots stacked vertically in one SVG (e.g. the paper's Fig. 10: stroke over rate).
 pub fn stacked_svg(plots: &[Plot], width: u32, height_each: u32) -> Result<String, PlotError> {
+    grid_svg(plots, 1, width, height_each)
+}
+
+/// Plots in a grid of `cols` columns, row by row, in one SVG `width` wide.
+pub fn grid_svg(
+    plots: &[Plot],
+    cols: usize,
+    width: u32,
+    height_each: u32,
+) -> Result<String, PlotError> {
     register_font();
+    let cols = cols.max(1);
+    let rows = plots.len().max(1).div_ceil(cols);
     let mut buf = String::new();
     {
-        let total_h = height_each * plots.len().max(1) as u32;
+        let total_h = height_each * rows as u32;
         let root = SVGBackend::with_string(&mut buf, (width, total_h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| PlotError::Draw {
             title: "figure".into(),
             message: e.to_string(),
         })?;
-        let areas = root.split_evenly((plots.len().max(1), 1));
+        let areas = root.split_evenly((rows, cols));
         for (p, a) in plots.iter().zip(areas.iter()) {
             p.draw_on(a)?;
         }
@@ -252,6 +553,41 @@ mod tests {
         assert!(svg.starts_with("<svg"));
         assert!(svg.contains("time [s]") && svg.contains("measured"));
         assert!(svg.contains("<polyline") || svg.contains("<path"));
+    }
+
+    #[test]
+    fn ticks_are_nice_distinct_and_exact() {
+        assert_eq!(
+            ticks_at(0.0, 360.0, 90.0),
+            vec![0.0, 90.0, 180.0, 270.0, 360.0]
+        );
+        let (t, s) = nice_ticks(-3.2, 7.9, 6);
+        assert_eq!(s, 2.0);
+        assert_eq!(t, vec![-2.0, 0.0, 2.0, 4.0, 6.0]);
+        let (t, s) = nice_ticks(0.0, 0.013, 6);
+        let labels: Vec<String> = t.iter().map(|v| tick_label(*v, decimals_for(s))).collect();
+        let mut d = labels.clone();
+        d.dedup();
+        assert_eq!(d, labels, "no repeated tick labels: {labels:?}");
+        assert_eq!(tick_label(1.0e7, 1), "1e7");
+        assert_eq!(tick_label(-0.0, 0), "0");
+        assert_eq!(decimals_for(0.25), 2);
+    }
+
+    #[test]
+    fn a_model_has_one_colour_whatever_the_label() {
+        let lin = model_colour("linear").unwrap();
+        assert_eq!(model_colour("linear residual"), Some(lin));
+        assert_ne!(model_colour("nonlinear"), Some(lin));
+        assert_eq!(model_colour("physical (sdof)"), Some(MODEL_COLOURS[3].1));
+        assert_eq!(
+            model_colour("SYNTHETIC measured (avg of 5 revs)"),
+            Some(MODEL_COLOURS[0].1)
+        );
+        assert_eq!(model_colour("relief-valve limit (max)"), None);
+        for (_, c) in MODEL_COLOURS {
+            assert!(!OTHER_COLOURS.contains(&c));
+        }
     }
 
     #[test]

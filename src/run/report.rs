@@ -1,14 +1,357 @@
 //! DIR/report.html: the periodic solution as in the paper (Figs. 16-22), periodicity
 //! convergence, the metrics table and plain statements of which damper model comes closest and
 //! what none of them reproduces. Self-contained (inline SVG).
-use super::summary::{periodicity_statement, Measured, ModelFigures, Ranking, RunInfo};
+use super::summary::{periodicity_statement, Measured, ModelFigures, Ranking, RunInfo, Stats};
 use super::{ModelOutcome, ModelRun};
 use crate::analysis::compare::PeriodicInterp;
-use crate::report::html::HtmlReport;
-use crate::report::plot::{stacked_svg, Plot};
+use crate::report::html::{Banner, HtmlReport};
+use crate::report::plot::{stacked_svg, Plot, SeriesKind};
 
 const W: u32 = 900;
 const H: u32 = 380;
+
+/// Engineering units of a channel: (displayed unit, scale from SI).
+fn unit_of(channel: &str) -> (&'static str, f64) {
+    if channel.ends_with("_N") {
+        ("kN", 1e-3)
+    } else if channel.ends_with("_Nm") {
+        ("kN m", 1e-3)
+    } else if channel.ends_with("_Pa") {
+        ("MPa", 1e-6)
+    } else if channel.ends_with("_m3_s") {
+        ("L/s", 1e3)
+    } else if channel.ends_with("_m_s") {
+        ("mm/s", 1e3)
+    } else if channel.ends_with("_rad") {
+        ("deg", 180.0 / std::f64::consts::PI)
+    } else if channel.ends_with("_m") {
+        ("mm", 1e3)
+    } else {
+        ("", 1.0)
+    }
+}
+
+/// The measured stroke rate [m/s] from the averaged stroke (periodic central differences in
+/// azimuth, at the rotor speed of the run).
+fn measured_rate(m: &Measured, period_s: f64) -> Option<Vec<f64>> {
+    let s = m.stroke_m.as_ref()?;
+    let n = s.len();
+    if n < 3 || m.azimuth_deg.len() != n || period_s.is_nan() || period_s <= 0.0 {
+        return None;
+    }
+    let dpsi_dt = 360.0 / period_s;
+    Some(
+        (0..n)
+            .map(|i| {
+                let (a, b) = ((i + n - 1) % n, (i + 1) % n);
+                let mut dpsi = m.azimuth_deg[b] - m.azimuth_deg[a];
+                if dpsi <= 0.0 {
+                    dpsi += 360.0;
+                }
+                (s[b] - s[a]) / dpsi * dpsi_dt
+            })
+            .collect(),
+    )
+}
+
+/// Closes a loop (repeats the first sample at the end).
+fn closed(v: &[f64]) -> Vec<f64> {
+    let mut o = v.to_vec();
+    if let Some(f) = v.first() {
+        o.push(*f);
+    }
+    o
+}
+
+/// Banners and the verdict box; returns nothing, writes to `rep`.
+fn verdict(
+    rep: &mut HtmlReport,
+    info: &RunInfo,
+    runs: &[&ModelRun],
+    measured: &Result<Measured, String>,
+    rank: Option<&Ranking>,
+) {
+    if info.synthetic {
+        rep.banner(
+            Banner::Synthetic,
+            "SYNTHETIC flight record: the \"measured\" damper force is synthetic data (the record's metadata says synthetic), not a flight-test measurement.",
+        );
+    }
+    let not_periodic: Vec<String> = runs
+        .iter()
+        .filter(|r| !r.periodic.converged)
+        .map(|r| format!("{} (residual {:.1e})", r.label, r.periodic.residual))
+        .collect();
+    if runs.is_empty() {
+        rep.banner(Banner::Bad, "No model completed.");
+    } else if not_periodic.is_empty() {
+        rep.banner(
+            Banner::Ok,
+            &format!(
+                "periodic: every model's reported revolution repeats within the {:.0e} tolerance",
+                runs[0].periodic.tolerance
+            ),
+        );
+    } else {
+        rep.banner(
+            Banner::Bad,
+            &format!(
+                "NOT periodic: {} - the reported revolution is not a periodic solution; compare with care (--revs, or the rotor deck's transient damping)",
+                not_periodic.join(", ")
+            ),
+        );
+    }
+    let syn = if info.synthetic { "SYNTHETIC " } else { "" };
+    match (measured, rank) {
+        (Ok(m), Some(r)) => {
+            let best = &r.order[0];
+            let headline = match r.order.get(1) {
+                Some(next) => format!(
+                    "Closest to the {syn}measured damper force: {} - RMS error {:.2} kN, {:.2} kN ({:.0}%) below the next, {} ({:.2} kN)",
+                    best.0,
+                    best.1 * 1e-3,
+                    (next.1 - best.1) * 1e-3,
+                    100.0 * (1.0 - best.1 / next.1),
+                    next.0,
+                    next.1 * 1e-3
+                ),
+                None => format!(
+                    "Only {} was compared with the {syn}measured damper force: RMS error {:.2} kN",
+                    best.0,
+                    best.1 * 1e-3
+                ),
+            };
+            let ptp = Stats::of(&m.force_n).peak_to_peak;
+            let mut lines: Vec<String> = r
+                .order
+                .iter()
+                .enumerate()
+                .map(|(i, (name, rms, corr))| {
+                    format!(
+                        "{}. {name}: RMS error {:.2} kN ({:.0}% of the measured peak-to-peak {:.1} kN), correlation {corr:.3}",
+                        i + 1,
+                        rms * 1e-3,
+                        100.0 * rms / ptp,
+                        ptp * 1e-3
+                    )
+                })
+                .collect();
+            lines.push(format!(
+                "Measurement: the record's damper force averaged over {} revolutions, compared at its own {} azimuths.",
+                m.revolutions,
+                m.azimuth_deg.len()
+            ));
+            rep.verdict(&headline, &lines);
+        }
+        (Err(note), _) => {
+            rep.verdict(&format!("No comparison with a measurement: {note}."), &[]);
+        }
+        (Ok(_), None) => {
+            rep.verdict("No model completed, so there is no comparison.", &[]);
+        }
+    }
+}
+
+/// The figures right after the verdict: models over the measurement, loops, stroke, harmonics,
+/// periodicity, tip motion.
+fn top_figures(
+    rep: &mut HtmlReport,
+    info: &RunInfo,
+    runs: &[&ModelRun],
+    measured: Option<&Measured>,
+) {
+    let syn = if info.synthetic { "SYNTHETIC " } else { "" };
+    let mlabel = |_: &Measured| format!("{syn}measured");
+    // 1. Models over the measurement, and the residual.
+    if let Some(m) = measured {
+        rep.heading(2, "The damper models over the measurement (paper Fig. 22)");
+        let mut p = Plot::new(
+            &format!("Damper force: models and {syn}measurement"),
+            "azimuth [deg]",
+            "damper force [kN]",
+        )
+        .azimuth()
+        .y_scale(1e-3);
+        for r in runs {
+            if let Some(f) = r.channel("damper_force_N") {
+                p = p.line(&r.label, &r.azimuth_deg, f);
+            }
+        }
+        p = p.points(&mlabel(m), &m.azimuth_deg, &m.force_n);
+        let mut pr = Plot::new(
+            &format!("Residual: model - {syn}measured, at the measured azimuths"),
+            "azimuth [deg]",
+            "force error [kN]",
+        )
+        .azimuth()
+        .y_scale(1e-3);
+        for r in runs {
+            if let Some(f) = r.channel("damper_force_N") {
+                if let Ok(ip) = PeriodicInterp::new(crate::analysis::compare::Periodic {
+                    psi_deg: &r.azimuth_deg,
+                    value: f,
+                }) {
+                    let e: Vec<f64> = m
+                        .azimuth_deg
+                        .iter()
+                        .zip(&m.force_n)
+                        .map(|(p, y)| ip.at(*p) - y)
+                        .collect();
+                    pr = pr.line(&r.label, &m.azimuth_deg, &e);
+                }
+            }
+        }
+        svg(
+            rep,
+            &format!("Damper force of the models over the {syn}measured force (top); residual model - measured (bottom)."),
+            &[p, pr],
+        );
+    }
+    // 2. Loops.
+    let mut fs = Plot::new("Force-stroke loops", "stroke [mm]", "damper force [kN]")
+        .x_scale(1e3)
+        .y_scale(1e-3);
+    let mut fv = Plot::new(
+        "Force-velocity loops",
+        "stroke rate [mm/s]",
+        "damper force [kN]",
+    )
+    .x_scale(1e3)
+    .y_scale(1e-3);
+    for r in runs {
+        if let (Some(f), Some(s), Some(v)) = (
+            r.channel("damper_force_N"),
+            r.channel("damper_stroke_m"),
+            r.channel("damper_stroke_rate_m_s"),
+        ) {
+            fs = fs.line(&r.label, &closed(s), &closed(f));
+            fv = fv.line(&r.label, &closed(v), &closed(f));
+        }
+    }
+    let mut loop_note = String::new();
+    if let Some(m) = measured {
+        if let Some(s) = &m.stroke_m {
+            fs = fs.points(&mlabel(m), s, &m.force_n);
+            if let Some(v) = runs.first().and_then(|r| measured_rate(m, r.period_s)) {
+                fv = fv.points(&mlabel(m), &v, &m.force_n);
+                loop_note = " The measured stroke rate is the record's averaged stroke differentiated in azimuth at the rotor speed.".into();
+            }
+        } else {
+            loop_note =
+                " The record has no damper stroke, so only the models' loops are shown.".into();
+        }
+    }
+    if !fs.series.is_empty() {
+        rep.heading(2, "Force-stroke and force-velocity loops");
+        let svgs = crate::report::plot::grid_svg(&[fs, fv], 2, W, H);
+        match svgs {
+            Ok(s) => {
+                rep.svg(&format!("Damper force against stroke (left; the area is the energy dissipated per revolution) and against stroke rate (right), last revolution.{loop_note}"), &s);
+            }
+            Err(e) => {
+                rep.notice(&format!("loops could not be drawn: {e}"));
+            }
+        }
+    }
+    // 3. Stroke: the record's over the models'.
+    let mut ps = channel_plot(runs, "Damper stroke", &[("damper_stroke_m", "")]);
+    let mut pv = channel_plot(
+        runs,
+        "Damper stroke rate",
+        &[("damper_stroke_rate_m_s", "")],
+    );
+    if let Some(m) = measured {
+        if let Some(s) = &m.stroke_m {
+            ps = ps.points(&mlabel(m), &m.azimuth_deg, s);
+            if let Some(v) = runs.first().and_then(|r| measured_rate(m, r.period_s)) {
+                pv = pv.points(&mlabel(m), &m.azimuth_deg, &v);
+            }
+        }
+    }
+    rep.heading(2, "Damper stroke (paper Fig. 17)");
+    svg(
+        rep,
+        "Damper stroke (top) and stroke rate (bottom), last revolution, with the record's where it has a stroke.",
+        &[ps, pv],
+    );
+    // 4. Harmonics bar chart.
+    let nh = super::N_HARMONICS;
+    let ns: Vec<f64> = (0..=nh).map(|n| n as f64).collect();
+    let mut ph = Plot::new(
+        "Damper force harmonics",
+        "harmonic [/rev]",
+        "amplitude [kN]",
+    )
+    .x_step(1.0)
+    .y_scale(1e-3);
+    if let Some(m) = measured {
+        if let Ok(h) = crate::analysis::harmonics::harmonics(&m.azimuth_deg, &m.force_n, nh) {
+            let a: Vec<f64> = h.iter().map(|h| h.amplitude).collect();
+            ph = ph.bars(&format!("{syn}measured"), &ns, &a);
+        }
+    }
+    for r in runs {
+        if let Some(f) = r.channel("damper_force_N") {
+            if let Ok(h) = crate::analysis::harmonics::harmonics(&r.azimuth_deg, f, nh) {
+                let a: Vec<f64> = h.iter().map(|h| h.amplitude).collect();
+                ph = ph.bars(&r.label, &ns, &a);
+            }
+        }
+    }
+    if !ph.series.is_empty() {
+        rep.heading(2, "Harmonics");
+        svg(
+            rep,
+            &format!("Amplitude of the damper force harmonics 0-{nh}/rev (0/rev: the mean, shown as its magnitude)."),
+            &[ph],
+        );
+    }
+    // 5. Periodicity history.
+    rep.heading(2, "Periodicity");
+    let mut pc = Plot::new(
+        "Periodicity residual",
+        "iterate (shooting) or revolution (march)",
+        "log10(residual)",
+    );
+    let mut longest = 1usize;
+    for r in runs {
+        let h = r.measure_history();
+        longest = longest.max(h.len());
+        let x: Vec<f64> = (1..=h.len()).map(|k| k as f64).collect();
+        let y: Vec<f64> = h.iter().map(|m| m.max(1e-16).log10()).collect();
+        pc = pc.line(&r.label, &x, &y);
+    }
+    if let Some(r) = runs.first() {
+        let t = r.periodic.tolerance.log10();
+        pc = pc.dashed(
+            &format!("tolerance {:.0e}", r.periodic.tolerance),
+            &[1.0, longest as f64],
+            &[t, t],
+        );
+    }
+    svg(
+        rep,
+        "log10 of the periodicity residual after each shooting iterate (or marched revolution); the dashed line is the tolerance.",
+        &[pc],
+    );
+    let per: Vec<String> = runs
+        .iter()
+        .map(|r| format!("{}: {}", r.label, periodicity_statement(r)))
+        .collect();
+    rep.paragraph("The periodicity residual of the reported revolution is the largest change of the damper force and the blade tip flap, lag and twist over the revolution, end against start, relative to their peak-to-peak:");
+    rep.list(&per);
+    // 6. Tip motion.
+    rep.heading(2, "Blade tip motion");
+    svg(
+        rep,
+        "Blade tip flap (top), lag (middle) and elastic twist (bottom) over the last revolution.",
+        &[
+            channel_plot(runs, "Tip flap", &[("tip_flap_m", "")]),
+            channel_plot(runs, "Tip lag", &[("tip_lag_m", "")]),
+            channel_plot(runs, "Tip twist", &[("tip_twist_rad", "")]),
+        ],
+    );
+}
 
 fn svg(rep: &mut HtmlReport, caption: &str, plots: &[Plot]) {
     match stacked_svg(plots, W, H) {
@@ -21,20 +364,30 @@ fn svg(rep: &mut HtmlReport, caption: &str, plots: &[Plot]) {
     }
 }
 
-/// A plot of `channel` vs azimuth for every run that has it.
-fn channel_plot(runs: &[&ModelRun], title: &str, ylabel: &str, channels: &[(&str, &str)]) -> Plot {
-    let mut p = Plot::new(title, "azimuth [deg]", ylabel).x_range(0.0, 360.0);
+/// A plot of `channels` vs azimuth for every run that has them, in engineering units (from the
+/// first channel's SI suffix). Colour: the model; line style: the channel (solid, dashed, dotted).
+fn channel_plot(runs: &[&ModelRun], title: &str, channels: &[(&str, &str)]) -> Plot {
+    let (unit, scale) = channels.first().map_or(("", 1.0), |c| unit_of(c.0));
+    let ylabel = if unit.is_empty() {
+        title.to_lowercase()
+    } else {
+        format!("{} [{unit}]", title.to_lowercase())
+    };
+    let mut p = Plot::new(title, "azimuth [deg]", &ylabel)
+        .azimuth()
+        .y_scale(scale);
     let multi = runs.len() > 1;
     for r in runs {
-        for (ch, name) in channels {
+        for (k, (ch, name)) in channels.iter().enumerate() {
             if let Some(v) = r.channel(ch) {
                 let label = match (multi, name.is_empty()) {
                     (true, true) => r.label.clone(),
                     (true, false) => format!("{} {name}", r.label),
-                    (false, true) => ch.to_string(),
+                    (false, true) => r.label.clone(),
                     (false, false) => name.to_string(),
                 };
-                p = p.line(&label, &r.azimuth_deg, v);
+                let kind = [SeriesKind::Line, SeriesKind::Dashed, SeriesKind::Dotted][k % 3];
+                p = p.series(kind, &label, &r.azimuth_deg, v);
             }
         }
     }
@@ -118,29 +471,43 @@ pub fn unreproduced(items: &[(&ModelRun, &ModelFigures)], measured: &Measured) -
             "Peak asymmetry is reproduced within the models' spread (measured max/|min| {am:.2}, models {amin:.2} to {amax:.2})."
         ));
     }
-    // Dwell near zero.
+    // Dwell near zero: judged model by model (a model that dwells much longer than the record is
+    // as much a finding as one that dwells much shorter).
     let dm = res[0].1.dwell_measured;
-    let dmax = res
+    let longer: Vec<String> = res
         .iter()
-        .map(|r| r.1.dwell_model)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let dmin = res
+        .filter(|r| r.1.dwell_model > dm * 1.2 + 0.005)
+        .map(|r| format!("{} {:.1}%", r.0, 100.0 * r.1.dwell_model))
+        .collect();
+    let shorter: Vec<String> = res
         .iter()
-        .map(|r| r.1.dwell_model)
-        .fold(f64::INFINITY, f64::min);
-    if dm > dmax * 1.2 + 0.005 {
+        .filter(|r| r.1.dwell_model * 1.2 + 0.005 < dm)
+        .map(|r| format!("{} {:.1}%", r.0, 100.0 * r.1.dwell_model))
+        .collect();
+    let base = format!(
+        "Dwell near zero: the measured force stays within 5% of its peak of zero over {:.1}% of the revolution",
+        100.0 * dm
+    );
+    if longer.is_empty() && shorter.is_empty() {
+        let all: Vec<String> = res
+            .iter()
+            .map(|r| format!("{} {:.1}%", r.0, 100.0 * r.1.dwell_model))
+            .collect();
         out.push(format!(
-            "Dwell near zero: the measured force stays within 5% of its peak of zero over {:.1}% of the revolution, the models over {:.1}% to {:.1}% only.",
-            100.0 * dm,
-            100.0 * dmin,
-            100.0 * dmax
+            "{base}; every model dwells about as long ({}).",
+            all.join(", ")
         ));
     } else {
+        let mut parts = vec![];
+        if !longer.is_empty() {
+            parts.push(format!("much longer in {}", longer.join(", ")));
+        }
+        if !shorter.is_empty() {
+            parts.push(format!("much shorter in {}", shorter.join(", ")));
+        }
         out.push(format!(
-            "No excess dwell near zero: the measured force is within 5% of its peak of zero over {:.1}% of the revolution, the models {:.1}% to {:.1}%.",
-            100.0 * dm,
-            100.0 * dmin,
-            100.0 * dmax
+            "{base}; the force dwells there {}.",
+            parts.join("; ")
         ));
     }
     // Phase.
@@ -185,15 +552,15 @@ pub fn report_html(
         info.rotor_model, info.flight
     ));
     let syn = if info.synthetic { "SYNTHETIC " } else { "" };
-    if info.synthetic {
-        rep.notice("SYNTHETIC flight record: the measured damper force shown here is synthetic data (the record's `synthetic` flag is set), not a flight-test measurement.");
-    }
-    if info.rotor_model.contains("sdof") {
-        rep.notice("Rotor model: the lag-hinge single-degree-of-freedom TEST DOUBLE (--model sdof), not the UH-60A multibody rotor model.");
-    }
-    if info.rotor_model.contains("rigid-blade") {
-        rep.notice("Rotor model: the rigid-blade reduction of the rotor deck (--model rigid): the blade rigid on its lag hinge, no flap, no elastic bending or twist, airloads projected with the control pitch (docs/rotor_model.md). For damper comparisons on records of rigid-blade generators; blade loads need the multibody model.");
-    }
+    let ok_runs: Vec<&ModelRun> = outcomes
+        .iter()
+        .zip(figs)
+        .filter_map(|(o, f)| match (&o.result, f) {
+            (Ok(r), Some(Ok(_))) => Some(r),
+            _ => None,
+        })
+        .collect();
+    verdict(&mut rep, info, &ok_runs, measured, rank);
     rep.paragraph(&format!(
         "Rotor deck {}, damper deck {}, flight record {}{}; {} revolutions of {} steps, hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
         info.rotor,
@@ -223,9 +590,16 @@ pub fn report_html(
         }
     }
     let runs: Vec<&ModelRun> = ok.iter().map(|x| x.0).collect();
+    if info.rotor_model.contains("sdof") {
+        rep.banner(Banner::Info, "Rotor model: the lag-hinge single-degree-of-freedom TEST DOUBLE (--model sdof), not the UH-60A multibody rotor model.");
+    }
+    if info.rotor_model.contains("rigid-blade") {
+        rep.banner(Banner::Info, "Rotor model: the rigid-blade reduction of the rotor deck (--model rigid): the blade rigid on its lag hinge, no flap, no elastic bending or twist, airloads projected with the control pitch (docs/rotor_model.md). For damper comparisons on records of rigid-blade generators; blade loads need the multibody model.");
+    }
+    top_figures(&mut rep, info, &runs, measured.as_ref().ok());
 
-    // Conclusions first.
-    rep.heading(2, "Result");
+    // The findings in words.
+    rep.heading(2, "Findings");
     match (measured, rank) {
         (Ok(m), Some(r)) => {
             rep.paragraph(&format!(
@@ -256,12 +630,6 @@ pub fn report_html(
             rep.paragraph("No model completed, so there is no comparison.");
         }
     }
-    let per: Vec<String> = runs
-        .iter()
-        .map(|r| format!("{}: {}", r.label, periodicity_statement(r)))
-        .collect();
-    rep.paragraph("Periodicity (residual of the reported revolution: the largest change of the damper force and the blade tip flap, lag and twist over the revolution, end against start, relative to their peak-to-peak):");
-    rep.list(&per);
     let lim: Vec<String> = ok
         .iter()
         .filter_map(|(r, f)| {
@@ -351,36 +719,17 @@ pub fn report_html(
     }
 
     // Figures.
-    rep.heading(2, "Damper force and motion (paper Figs. 16-17)");
-    let mut pf = channel_plot(
-        &runs,
-        "Damper force (cf. Fig. 16)",
-        "force [N]",
-        &[("damper_force_N", "")],
-    );
+    rep.heading(2, "Damper force (paper Fig. 16)");
+    let mut pf = channel_plot(&runs, "Damper force", &[("damper_force_N", "")]);
     if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
         pf = pf
             .dashed("relief-valve limit (max)", &[0.0, 360.0], &[hi, hi])
             .dashed("relief-valve limit (min)", &[0.0, 360.0], &[lo, lo]);
     }
-    svg(&mut rep, "Damper force over the last revolution.", &[pf]);
     svg(
         &mut rep,
-        "Damper stroke (top) and stroke rate (bottom), last revolution (cf. Fig. 17).",
-        &[
-            channel_plot(
-                &runs,
-                "Damper stroke",
-                "stroke [m]",
-                &[("damper_stroke_m", "")],
-            ),
-            channel_plot(
-                &runs,
-                "Damper stroke rate",
-                "stroke rate [m/s]",
-                &[("damper_stroke_rate_m_s", "")],
-            ),
-        ],
+        "Damper force over the last revolution, with the relief-valve cracking forces.",
+        &[pf],
     );
     let phys: Vec<&ModelRun> = runs
         .iter()
@@ -399,7 +748,6 @@ pub fn report_html(
             &[channel_plot(
                 &phys,
                 "Chamber pressures",
-                "pressure [Pa]",
                 &[("p0_Pa", "p0"), ("p1_Pa", "p1")],
             )],
         );
@@ -409,21 +757,18 @@ pub fn report_html(
             &[channel_plot(
                 &phys,
                 "Orifice flow",
-                "flow [m^3/s]",
                 &[("q_orifice_m3_s", "")],
             )],
         );
         let mut valve = vec![channel_plot(
             &phys,
             "Relief valve displacements",
-            "displacement [m]",
             &[("x_valve0_m", "valve 0"), ("x_valve1_m", "valve 1")],
         )];
         if phys.iter().any(|r| r.channel("v_valve0_m_s").is_some()) {
             valve.push(channel_plot(
                 &phys,
                 "Relief valve velocities",
-                "velocity [m/s]",
                 &[("v_valve0_m_s", "valve 0"), ("v_valve1_m_s", "valve 1")],
             ));
         }
@@ -438,86 +783,12 @@ pub fn report_html(
             &[channel_plot(
                 &phys,
                 "Relief valve flows",
-                "flow [m^3/s]",
                 &[("q_valve0_m3_s", "valve 0"), ("q_valve1_m3_s", "valve 1")],
             )],
         );
     }
 
-    if let Ok(m) = measured {
-        rep.heading(2, "The damper models over the measurement (paper Fig. 22)");
-        let mut p = Plot::new(
-            &format!("Damper force: models and {syn}measurement (cf. Fig. 22)"),
-            "azimuth [deg]",
-            "force [N]",
-        )
-        .x_range(0.0, 360.0);
-        for r in &runs {
-            if let Some(f) = r.channel("damper_force_N") {
-                p = p.line(&r.label, &r.azimuth_deg, f);
-            }
-        }
-        p = p.points(
-            &format!("{syn}measured (avg of {} revs)", m.revolutions),
-            &m.azimuth_deg,
-            &m.force_n,
-        );
-        let mut pr = Plot::new(
-            &format!("Residual: model - {syn}measured, at the measured azimuths"),
-            "azimuth [deg]",
-            "force error [N]",
-        )
-        .x_range(0.0, 360.0);
-        for r in &runs {
-            if let Some(f) = r.channel("damper_force_N") {
-                if let Ok(ip) = PeriodicInterp::new(crate::analysis::compare::Periodic {
-                    psi_deg: &r.azimuth_deg,
-                    value: f,
-                }) {
-                    let e: Vec<f64> = m
-                        .azimuth_deg
-                        .iter()
-                        .zip(&m.force_n)
-                        .map(|(p, y)| ip.at(*p) - y)
-                        .collect();
-                    pr = pr.line(&r.label, &m.azimuth_deg, &e);
-                }
-            }
-        }
-        svg(
-            &mut rep,
-            &format!("Damper force of the three models over the {syn}measured force (top); residual (bottom)."),
-            &[p, pr],
-        );
-    }
-
     rep.heading(2, "Periodic solution");
-    let mut pc = Plot::new(
-        "Periodicity residual",
-        "iterate (shooting) or revolution (march)",
-        "log10(residual)",
-    );
-    let mut longest = 1usize;
-    for r in &runs {
-        let h = r.measure_history();
-        longest = longest.max(h.len());
-        let x: Vec<f64> = (1..=h.len()).map(|k| k as f64).collect();
-        let y: Vec<f64> = h.iter().map(|m| m.max(1e-16).log10()).collect();
-        pc = pc.line(&r.label, &x, &y);
-    }
-    if let Some(r) = runs.first() {
-        let t = r.periodic.tolerance.log10();
-        pc = pc.dashed(
-            &format!("tolerance {:.0e}", r.periodic.tolerance),
-            &[1.0, longest as f64],
-            &[t, t],
-        );
-    }
-    svg(
-        &mut rep,
-        "log10 of the periodicity residual after each shooting iterate (or marched revolution); the dashed line is the tolerance.",
-        &[pc],
-    );
     let per: Vec<Vec<String>> = runs
         .iter()
         .map(|r| {
@@ -652,7 +923,6 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
         &[channel_plot(
             runs,
             "Pitch-link load",
-            "force [N]",
             &[("pitch_link_force_N", "")],
         )],
     );
@@ -663,13 +933,11 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
             channel_plot(
                 &with,
                 "Root forces",
-                "force [N]",
                 &[("root_fx_N", "fx"), ("root_fy_N", "fy"), ("root_fz_N", "fz")],
             ),
             channel_plot(
                 &with,
                 "Root moments",
-                "moment [N m]",
                 &[("root_mx_Nm", "mx"), ("root_my_Nm", "my"), ("root_mz_Nm", "mz")],
             ),
         ],
