@@ -8,6 +8,12 @@ cd "$(dirname "$0")/.."
 root=$PWD
 if [ $# -ge 1 ]; then work=$1; mkdir -p "$work"; else work=$(mktemp -d); trap 'rm -rf "$work"' EXIT; fi
 python3 --version
+if ! python3 -c "import ensurepip, venv" 2>/dev/null; then
+    # Debian ships venv's pip bootstrap separately
+    sudo=""; [ "$(id -u)" = 0 ] || sudo="sudo -n"
+    $sudo apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q python3-venv
+fi
 python3 -m venv "$work/venv"
 "$work/venv/bin/python" -m pip install --quiet -r examples/python/requirements.txt
 py="$work/venv/bin/python"

@@ -306,7 +306,7 @@ const CASES: &[Case] = &[
     case("expand flight missing", R, &["expand", "--rotor", "{T}/r.toml", "--flight", "{T}/nothing"], &["nothing"]),
     case("diagnose max-substep negative", bench_csv!(BENCH_OK), &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--measured", "{T}/t.csv", "--max-substep=-1", "--out", "{T}/out"], &["--max-substep"]),
     case("diagnose fit-cycles zero", bench_csv!(BENCH_OK), &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--measured", "{T}/t.csv", "--fit-cycles", "0", "--out", "{T}/out"], &["--fit-cycles"]),
-    case("diagnose rotor model unknown", &[], &["diagnose", "--rotor", "{R}/rotors/uh60a.toml", "--flight", "{R}/flightdata/c8534like", "--rotor-model", "sdof", "--out", "{T}/out"], &["--rotor-model"]),
+    case("diagnose rotor model unknown", &[], &["diagnose", "--rotor", "{R}/rotors/uh60a.toml", "--flight", "{R}/flightdata/c8534like", "--model", "sdof", "--out", "{T}/out"], &["--model", "sdof"]),
     case("diagnose nothing to diagnose", &[], &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--out", "{T}/out"], &["--measured"]),
     case("unknown command", &[], &["simulate"], &["simulate"]),
 ];

@@ -856,7 +856,7 @@ pub fn report_html(
     }
     blade_loads(&mut rep, &runs);
     rep.heading(2, "Conventions");
-    rep.paragraph("Azimuth: FORMATS.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
+    rep.paragraph("Azimuth: docs/formats.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()
 }
 
