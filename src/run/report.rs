@@ -562,7 +562,7 @@ pub fn report_html(
         .collect();
     verdict(&mut rep, info, &ok_runs, measured, rank);
     rep.paragraph(&format!(
-        "Rotor deck {}, damper deck {}, flight record {}{}; {} revolutions of {} steps, hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
+        "Rotor deck {}, damper deck {}, flight record {}{}; at most {} revolutions of {} steps (each model stops once periodic), hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
         info.rotor,
         info.damper_deck,
         info.flight,
