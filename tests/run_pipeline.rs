@@ -649,7 +649,14 @@ fn a_run_that_is_not_periodic_says_so_and_fails_only_when_asked() {
         // the best revolution is kept: its state can start the next run
         assert!(out.join("linear/periodic_state.json").exists());
         let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-        assert!(html.contains("NOT periodic"), "{method}");
+        // the red banner heads the report, before the verdict box
+        let banner = html
+            .find("<div class=\"banner bad\">NOT periodic: linear")
+            .unwrap_or_else(|| panic!("{method}: no NOT periodic banner"));
+        assert!(
+            html.find("Closest to").is_none_or(|v| banner < v),
+            "{method}"
+        );
 
         let o = run_sdof(
             &example(),

@@ -180,3 +180,31 @@ fn completed_cases_are_skipped_and_failed_ones_kept_until_retried() {
     assert!(!o2.status.success());
     assert!(String::from_utf8_lossy(&o2.stderr).contains("another plan"));
 }
+
+#[test]
+fn a_case_that_must_be_periodic_and_is_not_is_kept_failed_until_retried() {
+    // require_periodic with 2 revolutions: no case reaches the tolerance. Each case folder is
+    // published complete (its best revolution), but the sweep fails, and a resume keeps the
+    // cases as failed, with the reason, until --retry-failed runs them again.
+    let d = tmp("sweep-not-periodic");
+    std::fs::create_dir_all(&d).unwrap();
+    let plan = d.join("np.toml");
+    std::fs::write(
+        &plan,
+        "[base]\nmodel = \"rigid\"\ndamper = \"linear\"\nrevs = 2\nrequire_periodic = true\n[vary]\nsubsteps = [5, 6]\n",
+    )
+    .unwrap();
+    let (p, out) = (plan.to_str().unwrap(), d.join("s"));
+    let o = out.to_str().unwrap();
+    let first = sweep(&[p, "--out", o], &[]);
+    assert!(!first.status.success());
+    let again = sweep(&[p, "--out", o], &[]);
+    assert!(!again.status.success());
+    let so = String::from_utf8_lossy(&again.stdout);
+    assert!(so.contains("0 run now"), "{so}");
+    assert!(so.contains("not periodic (require_periodic)"), "{so}");
+    let retried = sweep(&[p, "--out", o, "--retry-failed"], &[]);
+    let so = String::from_utf8_lossy(&retried.stdout);
+    assert!(so.contains("2 run now"), "{so}");
+    let _ = std::fs::remove_dir_all(&d);
+}

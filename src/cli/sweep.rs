@@ -261,7 +261,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     let failed = report.failed();
     if !failed.is_empty() {
         bail!(
-            "{} case(s) failed: {} (their folders are marked INCOMPLETE; rerun with --retry-failed)",
+            "{} case(s) failed: {} (a run that failed is marked INCOMPLETE, one that is not periodic under require_periodic is complete with its best revolution; rerun with --retry-failed)",
             failed.len(),
             failed.join(", ")
         );
