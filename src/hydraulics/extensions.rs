@@ -294,6 +294,61 @@ impl Device for ExtendedDamper {
     }
 }
 
+/// The [`Device`] methods of a device in series with an inner one through a hidden stroke
+/// `d_h` (fields `inner`, `d_h`, `fresh`, `trial`): commit, channels, reset and state are the
+/// same for every such link; only the trial step differs.
+macro_rules! series_link_methods {
+    ($what:literal) => {
+        fn commit(&mut self) {
+            if let Some(x) = self.trial.take() {
+                self.inner.commit();
+                self.d_h = x;
+                self.fresh = false;
+            }
+        }
+
+        fn channel_names(&self) -> &'static [&'static str] {
+            self.inner.channel_names()
+        }
+
+        fn channels(&self, out: &mut [f64]) {
+            self.inner.channels(out)
+        }
+
+        fn committed_force(&self) -> f64 {
+            self.inner.committed_force()
+        }
+
+        fn clone_device(&self) -> Box<dyn Device> {
+            Box::new(self.clone())
+        }
+
+        fn reset(&mut self) {
+            self.inner.reset();
+            self.d_h = 0.0;
+            self.fresh = true;
+            self.trial = None;
+        }
+
+        fn state_values(&self) -> Vec<f64> {
+            let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
+            v.extend(self.inner.state_values());
+            v
+        }
+
+        fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+            if v.len() < 2 {
+                return super::check_state_len($what, v, 2);
+            }
+            self.inner.set_state_values(&v[2..])?;
+            self.d_h = v[0];
+            self.fresh = v[1] != 0.0;
+            self.trial = None;
+            Ok(())
+        }
+    };
+}
+
 /// Elastic mounts (rod-end bearings, bushings, airframe attachment) in series with a damper:
 /// a spring of stiffness `k` between the attachment stroke `d` and the device stroke `d_h`.
 /// The link force is the device force `F(d_h)` and also the spring's, `F = k (d_h - d)`
@@ -462,53 +517,7 @@ impl Device for SeriesMount {
         })
     }
 
-    fn commit(&mut self) {
-        if let Some(x) = self.trial.take() {
-            self.inner.commit();
-            self.d_h = x;
-            self.fresh = false;
-        }
-    }
-
-    fn channel_names(&self) -> &'static [&'static str] {
-        self.inner.channel_names()
-    }
-
-    fn channels(&self, out: &mut [f64]) {
-        self.inner.channels(out)
-    }
-
-    fn committed_force(&self) -> f64 {
-        self.inner.committed_force()
-    }
-
-    fn clone_device(&self) -> Box<dyn Device> {
-        Box::new(self.clone())
-    }
-
-    fn reset(&mut self) {
-        self.inner.reset();
-        self.d_h = 0.0;
-        self.fresh = true;
-        self.trial = None;
-    }
-
-    fn state_values(&self) -> Vec<f64> {
-        let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
-        v.extend(self.inner.state_values());
-        v
-    }
-
-    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        if v.len() < 2 {
-            return super::check_state_len("series mount", v, 2);
-        }
-        self.inner.set_state_values(&v[2..])?;
-        self.d_h = v[0];
-        self.fresh = v[1] != 0.0;
-        self.trial = None;
-        Ok(())
-    }
+    series_link_methods!("series mount");
 }
 
 /// Free play as in hardware: a gap of total width `gap` in series with a contact stiffness `k`
@@ -689,53 +698,7 @@ impl Device for CompliantFreePlay {
         })
     }
 
-    fn commit(&mut self) {
-        if let Some(x) = self.trial.take() {
-            self.inner.commit();
-            self.d_h = x;
-            self.fresh = false;
-        }
-    }
-
-    fn channel_names(&self) -> &'static [&'static str] {
-        self.inner.channel_names()
-    }
-
-    fn channels(&self, out: &mut [f64]) {
-        self.inner.channels(out)
-    }
-
-    fn committed_force(&self) -> f64 {
-        self.inner.committed_force()
-    }
-
-    fn clone_device(&self) -> Box<dyn Device> {
-        Box::new(self.clone())
-    }
-
-    fn reset(&mut self) {
-        self.inner.reset();
-        self.d_h = 0.0;
-        self.fresh = true;
-        self.trial = None;
-    }
-
-    fn state_values(&self) -> Vec<f64> {
-        let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
-        v.extend(self.inner.state_values());
-        v
-    }
-
-    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        if v.len() < 2 {
-            return super::check_state_len("compliant free play", v, 2);
-        }
-        self.inner.set_state_values(&v[2..])?;
-        self.d_h = v[0];
-        self.fresh = v[1] != 0.0;
-        self.trial = None;
-        Ok(())
-    }
+    series_link_methods!("compliant free play");
 }
 
 #[cfg(test)]
