@@ -657,6 +657,12 @@ fn a_run_that_is_not_periodic_says_so_and_fails_only_when_asked() {
             html.find("Closest to").is_none_or(|v| banner < v),
             "{method}"
         );
+        // and the printed end of the run says so beside the verdict
+        assert!(
+            String::from_utf8_lossy(&o.stdout).contains("caution: NOT periodic: linear"),
+            "{method}: {}",
+            String::from_utf8_lossy(&o.stdout)
+        );
 
         let o = run_sdof(
             &example(),

@@ -619,6 +619,17 @@ fn print_verdict(out: &OutDir, verdict: &Option<String>, outcomes: &[ModelOutcom
     if let Some(v) = verdict {
         outln!("verdict: {v}");
     }
+    let not_periodic: Vec<&str> = outcomes
+        .iter()
+        .filter(|o| matches!(&o.result, Ok(r) if !r.converged()))
+        .map(|o| o.model.name())
+        .collect();
+    if !not_periodic.is_empty() {
+        outln!(
+            "caution: NOT periodic: {} (the verdict compares revolutions that are not a periodic solution)",
+            not_periodic.join(", ")
+        );
+    }
     let published = |name: &str| out.published_path(&out.file(name)).display().to_string();
     outln!(
         "open: {} (verdict, figures, tables)",
