@@ -121,7 +121,9 @@ impl HtmlReport {
     }
 
     pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) -> &mut Self {
-        self.body.push_str("<table>\n<tr>");
+        // A wide table scrolls in its own box, not the page.
+        self.body
+            .push_str("<div style=\"overflow-x:auto\"><table>\n<tr>");
         for h in header {
             let _ = write!(self.body, "<th>{}</th>", escape(h));
         }
@@ -133,7 +135,7 @@ impl HtmlReport {
             }
             self.body.push_str("</tr>\n");
         }
-        self.body.push_str("</table>\n");
+        self.body.push_str("</table></div>\n");
         self
     }
 

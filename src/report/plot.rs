@@ -323,10 +323,15 @@ impl Plot {
             let (a, b) = (r.0 * s, r.1 * s);
             (a.min(b), a.max(b))
         };
-        let xr =
-            self.x_range
-                .map(|r| sc(r, sx))
-                .unwrap_or(if xr.1 > xr.0 { xr } else { pad(xr, 0.5) });
+        // Lines run edge to edge; markers only (a sweep's cases) would sit on the frame.
+        let points_only = self.series.iter().all(|s| s.kind == SeriesKind::Points);
+        let xr = self.x_range.map(|r| sc(r, sx)).unwrap_or(if xr.1 <= xr.0 {
+            pad(xr, 0.5)
+        } else if points_only {
+            pad(xr, 0.05)
+        } else {
+            xr
+        });
         let yr = self.y_range.map(|r| sc(r, sy)).unwrap_or(pad(yr, 0.05));
         Ok((xr, yr))
     }

@@ -24,32 +24,38 @@ pub const METRICS: &[&str] = &[
     "root_mz_half_p2p_Nm",
 ];
 
-/// Metrics plotted in sweep.html (numeric ones), with their axis label.
-const PLOTTED: &[(&str, &str)] = &[
-    ("rms_error_N", "RMS error vs measured [N]"),
-    ("correlation", "correlation with measured [-]"),
+/// Metrics plotted in sweep.html (numeric ones): axis label (engineering units) and the scale
+/// from the CSV's SI value to it.
+const PLOTTED: &[(&str, &str, f64)] = &[
+    ("rms_error_N", "RMS error vs measured [kN]", 1e-3),
+    ("correlation", "correlation with measured [-]", 1.0),
     (
         "damper_force_peak_to_peak_N",
-        "damper force peak-to-peak [N]",
+        "damper force peak-to-peak [kN]",
+        1e-3,
     ),
-    ("periodic_residual", "periodicity residual [-]"),
-    ("revolutions", "revolutions integrated"),
-    ("wall_time_s", "wall time [s]"),
+    ("periodic_residual", "periodicity residual [-]", 1.0),
+    ("revolutions", "revolutions integrated", 1.0),
+    ("wall_time_s", "wall time [s]", 1.0),
     (
         "pitch_link_force_half_p2p_N",
-        "pitch-link force half peak-to-peak [N]",
+        "pitch-link force half peak-to-peak [kN]",
+        1e-3,
     ),
     (
         "root_mx_half_p2p_Nm",
-        "root moment mx half peak-to-peak [N m]",
+        "root moment mx half peak-to-peak [kN m]",
+        1e-3,
     ),
     (
         "root_my_half_p2p_Nm",
-        "root moment my half peak-to-peak [N m]",
+        "root moment my half peak-to-peak [kN m]",
+        1e-3,
     ),
     (
         "root_mz_half_p2p_Nm",
-        "root moment mz half peak-to-peak [N m]",
+        "root moment mz half peak-to-peak [kN m]",
+        1e-3,
     ),
 ];
 
@@ -183,7 +189,6 @@ pub fn counts(rows: &[Row]) -> (usize, usize, usize, usize) {
 /// model, and the table.
 pub fn html(plan: &Plan, rows: &[Row]) -> String {
     let mut h = HtmlReport::new("rotorsim sweep");
-    h.heading(1, "rotorsim sweep");
     let (ok, np, failed, not_run) = counts(rows);
     h.paragraph(&format!(
         "{} cases of {}; rows (case x damper model): {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run.",
@@ -207,9 +212,9 @@ pub fn html(plan: &Plan, rows: &[Row]) -> String {
             continue;
         }
         h.heading(2, &format!("against {key}"));
-        for (metric, label) in PLOTTED {
+        for (metric, label, scale) in PLOTTED {
             let mi = METRICS.iter().position(|m| m == metric).unwrap_or(0);
-            let mut p = Plot::new(&format!("{label} vs {key}"), key, label);
+            let mut p = Plot::new(&format!("{label} vs {key}"), key, label).y_scale(*scale);
             let mut any = false;
             for m in &models {
                 let (x, y): (Vec<f64>, Vec<f64>) = rows
