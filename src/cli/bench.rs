@@ -485,6 +485,11 @@ fn sweep_html(
     ];
     let mut rows = Vec::new();
     for (model, runs) in all {
+        let dir = if all.len() > 1 {
+            format!("{}/", model.name())
+        } else {
+            String::new()
+        };
         for x in runs {
             rows.push(vec![
                 model.name().to_string(),
@@ -495,7 +500,7 @@ fn sweep_html(
                 format!("{:.4e}", x.storage_stiffness_n_per_m),
                 format!("{:.4e}", x.loss_stiffness_n_per_m),
                 fmt_num(x.dissipated_last_cycle_j, 2),
-                history_name(x.peak_velocity_m_s),
+                format!("{dir}{}", history_name(x.peak_velocity_m_s)),
             ]);
         }
     }
@@ -779,18 +784,6 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
         .x_scale(1e3)
         .y_scale(1e-3);
         let first = test.time_s.partition_point(|&t| t < win.from_s);
-        if let Some(m) = &test.force_n {
-            tp = tp.points(
-                &format!("{syn}measured"),
-                &thin(&test.time_s, 3000),
-                &thin(m, 3000),
-            );
-            lp = lp.points(
-                &format!("{syn}measured"),
-                &thin(&test.stroke_m[first..], 3000),
-                &thin(&m[first..], 3000),
-            );
-        }
         for (model, dev) in devices {
             let r = bench::replay(dev.as_ref(), test).map_err(|e| {
                 let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
@@ -887,6 +880,19 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
                     model.name()
                 ),
             }
+        }
+        // the measurement last, drawn over the models
+        if let Some(m) = &test.force_n {
+            tp = tp.points(
+                &format!("{syn}measured"),
+                &thin(&test.time_s, 3000),
+                &thin(m, 3000),
+            );
+            lp = lp.points(
+                &format!("{syn}measured"),
+                &thin(&test.stroke_m[first..], 3000),
+                &thin(&m[first..], 3000),
+            );
         }
         if args.skip_cycles > 0 {
             let (lo, hi) = test
