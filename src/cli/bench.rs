@@ -441,7 +441,23 @@ fn fig13_plot(
             &neg,
         );
     }
-    p.dashed("paper cap 3200 lb (Fig. 16)", &[0.0, vmax], &[cap, cap])
+    from_zero(p.dashed("paper cap 3200 lb (Fig. 16)", &[0.0, vmax], &[cap, cap]))
+}
+
+/// The y axis from zero to a little above the largest value (peaks, K'', energy are >= 0 and
+/// read against zero, as in the paper's Fig. 13).
+fn from_zero(p: Plot) -> Plot {
+    let top = p
+        .series
+        .iter()
+        .flat_map(|s| s.y.iter())
+        .filter(|y| y.is_finite())
+        .fold(0.0f64, |a, &y| a.max(y));
+    if top > 0.0 {
+        p.y_range(0.0, 1.08 * top)
+    } else {
+        p
+    }
 }
 
 fn fmt_num(v: f64, d: usize) -> String {
@@ -554,13 +570,24 @@ fn sweep_html(
     }
     r.heading(2, "Dynamic stiffness and energy per cycle vs amplitude");
     r.paragraph("K' and K'' are the first harmonic of the reaction -F over the last cycle, in phase with the stroke and with the stroke rate, per metre of amplitude: -F ~ K' d + (K''/omega) d'. The energy per cycle is the work of the damper force over the last cycle (Eq. 11), all harmonics included; for the first harmonic alone it is pi A^2 K''.");
+    let has_lin = all.iter().any(|(m, _)| *m == DamperModel::Linear) && lin_c.is_some();
+    let dashed_note = |what: &str| {
+        if has_lin {
+            format!(" (dashed: the linear model's analytic {what})")
+        } else {
+            String::new()
+        }
+    };
     r.svg(
-        "K' (storage, in phase with the stroke) and K'' (loss, in phase with the stroke rate); a pure dashpot c has K' = 0 and K'' = c omega (dashed: the linear model's analytic c omega).",
-        &grid_svg(&[ks, kl], 2, 1100, 380)?,
+        &format!("K' (storage, in phase with the stroke) and K'' (loss, in phase with the stroke rate); a pure dashpot c has K' = 0 and K'' = c omega{}.", dashed_note("c omega")),
+        &grid_svg(&[ks, from_zero(kl)], 2, 1100, 380)?,
     );
     r.svg(
-        "Energy dissipated per cycle; a dashpot c dissipates pi c omega A^2 (dashed: the linear model's analytic value).",
-        &en.to_svg(1000, 420)?,
+        &format!(
+            "Energy dissipated per cycle; a dashpot c dissipates pi c omega A^2{}.",
+            dashed_note("value")
+        ),
+        &from_zero(en).to_svg(1000, 420)?,
     );
 
     // Loops per amplitude, every model in its colour.
