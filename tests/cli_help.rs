@@ -45,6 +45,23 @@ fn every_help_says_what_the_command_writes_and_the_exit_status() {
 }
 
 #[test]
+fn bench_help_lists_its_files_and_options() {
+    let o = rotorsim(&["bench", "--help"]);
+    let h = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "bench.html",
+        "bench_summary.csv",
+        "history_v<v>m_s.csv",
+        "peaks.csv",
+        "replay_summary.csv",
+        "--output-rate <HZ>",
+        "--skip-cycles <N>",
+    ] {
+        assert!(h.contains(want), "bench --help lacks {want}\n{h}");
+    }
+}
+
+#[test]
 fn one_name_per_concept_with_the_old_spellings_kept() {
     // --damper-deck, --scheme and --model mean the same in run, bench and diagnose; the old
     // spellings (--deck, --integrator, --rotor-model) parse to the same options: each call

@@ -56,6 +56,8 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
         substeps: 25,
         integrator: "rk4".into(),
         measured: vec![],
+        output_rate: None,
+        skip_cycles: 0,
         out: dir.join("bench"),
     })
     .unwrap();

@@ -216,7 +216,8 @@ fn cli_sweep_writes_the_contracted_files_and_bad_input_leaves_nothing() {
     );
     let peaks = std::fs::read_to_string(out.join("physical/peaks.csv")).unwrap();
     assert!(peaks.starts_with("peak_velocity_m_s,peak_force_pos_N,peak_force_neg_N\n"));
-    let h = std::fs::read_to_string(out.join("physical/history_1.csv")).unwrap();
+    // histories are named by peak velocity in m/s (4 in/s = 0.1016 m/s)
+    let h = std::fs::read_to_string(out.join("physical/history_v0.101600m_s.csv")).unwrap();
     assert!(h.starts_with("time_s,stroke_m,velocity_m_s,force_N,p0_Pa,p1_Pa,q_orifice_m3_s,x_valve0_m,x_valve1_m,q_valve0_m3_s,q_valve1_m3_s"));
     assert!(
         out.join("peak_force_vs_velocity.svg").exists()

@@ -116,9 +116,14 @@ pub struct Cli {
 pub enum Command {
     /// Virtual damper test bench: harmonic sweeps or replay of measured bench tests.
     #[command(after_long_help = writes!(
-        "Writes DIR/: peaks.csv (peak force per amplitude and model), history CSVs (time \
-histories), peak_force_vs_velocity.svg (paper Fig. 13), time_history.svg; with --measured: \
-replay_<test>.csv, loop_<test>.svg and replay_summary.csv."
+        "Writes DIR/: bench.html (paper Fig. 13 peak force vs velocity, force-stroke and \
+force-velocity loops per amplitude, K' and K'' and energy per cycle vs amplitude), \
+bench_summary.csv (per model and amplitude: peaks, K_storage_N_per_m, K_loss_N_per_m, \
+energy_per_cycle_J, ...), peaks.csv, history_v<v>m_s.csv (one time history per peak velocity v \
+in m/s, sampled at --output-rate), peak_force_vs_velocity.svg, time_history.svg; with --damper \
+all the per-model files in DIR/<model>/. With --measured: bench.html (measured vs model over \
+time and loops, error metrics), replay_<test>_<model>.csv, loop_<test>_<model>.svg and \
+replay_summary.csv (errors over the samples after --skip-cycles)."
     ))]
     Bench(bench::BenchArgs),
     /// Nonlinear static analysis of a model deck.

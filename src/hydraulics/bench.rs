@@ -75,12 +75,22 @@ impl History {
 #[derive(Debug, Clone, PartialEq)]
 pub struct HarmonicRun {
     pub peak_velocity_m_s: f64,
-    /// Largest force over the last cycle [N].
+    /// Stroke amplitude `A = v/omega` [m].
+    pub amplitude_m: f64,
+    /// Largest force over the last cycle [N] (at every output sample).
     pub peak_force_pos_n: f64,
     /// Smallest (most negative) force over the last cycle [N].
     pub peak_force_neg_n: f64,
     /// Energy dissipated in the last cycle, `-int F d_dot dt` [J] (positive for a damper).
     pub dissipated_last_cycle_j: f64,
+    /// Storage stiffness K' [N/m]: in-phase first harmonic of the reaction `-F` over the last
+    /// cycle, divided by the amplitude.
+    pub storage_stiffness_n_per_m: f64,
+    /// Loss stiffness K'' [N/m]: quadrature (velocity-phase) first harmonic of `-F` over the last
+    /// cycle, divided by the amplitude; `pi A^2 K''` is the first harmonic's energy per cycle.
+    pub loss_stiffness_n_per_m: f64,
+    /// Output samples per step (1: one sample at every step end).
+    pub samples_per_step: usize,
     pub history: History,
 }
 
@@ -94,26 +104,54 @@ pub fn harmonic_run(
     steps_per_cycle: usize,
     keep_history: bool,
 ) -> Result<HarmonicRun, HydraulicError> {
+    harmonic_run_sampled(
+        device,
+        omega,
+        peak_velocity,
+        cycles,
+        steps_per_cycle,
+        1,
+        keep_history,
+    )
+}
+
+/// As [`harmonic_run`], with `samples_per_step` output samples in every step: each step's
+/// stroke (linear from `d_i` to `d_f`, as the coupled analysis hands it over) is fed to the
+/// device in that many equal pieces, one sample at the end of each. The stroke the device sees
+/// is the same; a device built with `substeps / samples_per_step` sub-steps integrates with the
+/// same sub-step, so only the sampling changes (peaks between step ends are seen).
+pub fn harmonic_run_sampled(
+    device: &dyn Device,
+    omega: f64,
+    peak_velocity: f64,
+    cycles: usize,
+    steps_per_cycle: usize,
+    samples_per_step: usize,
+    keep_history: bool,
+) -> Result<HarmonicRun, HydraulicError> {
     if cycles == 0
         || steps_per_cycle == 0
+        || samples_per_step == 0
         || !(omega > 0.0 && omega.is_finite())
         || !peak_velocity.is_finite()
     {
         return Err(HydraulicError::BadStep {
             t: 0.0,
             reason: format!(
-                "harmonic run needs cycles >= 1 ({cycles}), steps per cycle >= 1 ({steps_per_cycle}), omega > 0 ({omega} rad/s) and a finite peak velocity ({peak_velocity} m/s)"
+                "harmonic run needs cycles >= 1 ({cycles}), steps per cycle >= 1 ({steps_per_cycle}), samples per step >= 1 ({samples_per_step}), omega > 0 ({omega} rad/s) and a finite peak velocity ({peak_velocity} m/s)"
             ),
         });
     }
     let mut dev = device.clone_device();
     dev.reset();
     let period = 2.0 * std::f64::consts::PI / omega;
+    let m = samples_per_step;
     let n = cycles * steps_per_cycle;
     let dt = period / steps_per_cycle as f64;
+    let dts = dt / m as f64;
     let amp = peak_velocity / omega;
     let stroke = |k: usize| amp * (omega * k as f64 * dt).sin();
-    let mut hist = History::new(dev.as_ref(), if keep_history { n + 1 } else { 0 });
+    let mut hist = History::new(dev.as_ref(), if keep_history { n * m + 1 } else { 0 });
     let mut buf = vec![0.0; hist.channel_names.len()];
     let f0 = dev.committed_force();
     if keep_history {
@@ -128,36 +166,64 @@ pub fn harmonic_run(
         );
     }
     let (mut fmax, mut fmin, mut work) = (f64::NEG_INFINITY, f64::INFINITY, 0.0);
+    // First-harmonic integrals of the reaction -F over the last cycle.
+    let (mut in_phase, mut quadrature) = (0.0, 0.0);
     let last_start = n - steps_per_cycle;
     for k in 0..n {
         let (d_i, d_f) = (stroke(k), stroke(k + 1));
-        let t_i = k as f64 * dt;
-        let sf = dev.trial_step(t_i, dt, d_i, d_f)?;
-        dev.commit();
-        if k >= last_start {
-            fmax = fmax.max(sf.force_end);
-            fmin = fmin.min(sf.force_end);
-            // Exact work of the step-averaged force over the step (Eq. 11).
-            work += sf.force_mean * (d_f - d_i);
-        }
-        if keep_history {
-            let t = t_i + dt;
-            hist.push(
-                dev.as_ref(),
-                &mut buf,
-                t,
-                d_f,
-                peak_velocity * (omega * t).cos(),
-                sf.force_end,
-                sf.force_mean,
-            );
+        let t_k = k as f64 * dt;
+        for j in 0..m {
+            // The step's linear stroke at the piece ends (exact ends at j = 0 and j = m).
+            let at = |j: usize| {
+                if j == m {
+                    d_f
+                } else {
+                    d_i + (d_f - d_i) * (j as f64 / m as f64)
+                }
+            };
+            let (p_i, p_f) = (at(j), at(j + 1));
+            let t_i = t_k + j as f64 * dts;
+            let t_f = t_i + dts;
+            let sf = dev.trial_step(t_i, dts, p_i, p_f)?;
+            dev.commit();
+            if k >= last_start {
+                fmax = fmax.max(sf.force_end);
+                fmin = fmin.min(sf.force_end);
+                // Exact work of the piece-averaged force over the piece (Eq. 11).
+                work += sf.force_mean * (p_f - p_i);
+                // int sin and int cos over the piece, exact; the force is its piece mean.
+                let (wi, wf) = (omega * t_i, omega * t_f);
+                in_phase -= sf.force_mean * (wi.cos() - wf.cos()) / omega;
+                quadrature -= sf.force_mean * (wf.sin() - wi.sin()) / omega;
+            }
+            if keep_history {
+                hist.push(
+                    dev.as_ref(),
+                    &mut buf,
+                    t_f,
+                    p_f,
+                    peak_velocity * (omega * t_f).cos(),
+                    sf.force_end,
+                    sf.force_mean,
+                );
+            }
         }
     }
+    // Fourier coefficients of -F against sin and cos, over one period, per unit amplitude.
+    let scale = if amp != 0.0 {
+        2.0 / (period * amp)
+    } else {
+        f64::NAN
+    };
     Ok(HarmonicRun {
         peak_velocity_m_s: peak_velocity,
+        amplitude_m: amp,
         peak_force_pos_n: fmax,
         peak_force_neg_n: fmin,
         dissipated_last_cycle_j: -work,
+        storage_stiffness_n_per_m: in_phase * scale,
+        loss_stiffness_n_per_m: quadrature * scale,
+        samples_per_step: m,
         history: hist,
     })
 }
@@ -411,6 +477,92 @@ pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, Hydraulic
         force_model_n: force,
         rms_error_n: rms,
         history: hist,
+    })
+}
+
+/// The stroke's period [s]: the median interval between upward crossings of the stroke's
+/// mid-range `(max + min)/2`, a crossing counting only after the stroke was below the mid-range
+/// by a tenth of the half-range (so measurement noise near the mid-range does not count twice).
+/// Crossing instants are interpolated linearly between samples. None with fewer than two
+/// crossings (not a periodic stroke, or less than one cycle of it).
+pub fn stroke_period(time_s: &[f64], stroke_m: &[f64]) -> Option<f64> {
+    let (lo, hi) = stroke_m
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if hi <= lo {
+        return None;
+    }
+    let mid = 0.5 * (lo + hi);
+    let arm = mid - 0.1 * 0.5 * (hi - lo);
+    let mut armed = false;
+    let mut ups = Vec::new();
+    for i in 1..stroke_m.len().min(time_s.len()) {
+        let (a, b) = (stroke_m[i - 1], stroke_m[i]);
+        if a < arm || b < arm {
+            armed = true;
+        }
+        if armed && a < mid && b >= mid {
+            let f = (mid - a) / (b - a);
+            ups.push(time_s[i - 1] + f * (time_s[i] - time_s[i - 1]));
+            armed = b < arm;
+        }
+    }
+    let mut d: Vec<f64> = ups.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return None;
+    }
+    d.sort_by(f64::total_cmp);
+    Some(d[d.len() / 2])
+}
+
+/// Error of a replay's model force against the measured force, over the samples from a given
+/// instant on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayMetrics {
+    /// Samples the metrics use (those at or after `from_s`).
+    pub samples_used: usize,
+    /// First instant used [s].
+    pub from_s: f64,
+    /// RMS of model - measured [N].
+    pub rms_error_n: f64,
+    /// RMS error over the RMS of the measured force about its mean.
+    pub rms_error_rel: f64,
+    /// Largest |model - measured| [N].
+    pub max_abs_error_n: f64,
+}
+
+/// The replay's error over the samples at or after `from_s` (None without a measured force or
+/// without a sample from `from_s` on).
+pub fn replay_metrics(
+    test: &BenchTest,
+    force_model_n: &[f64],
+    from_s: f64,
+) -> Option<ReplayMetrics> {
+    let m = test.force_n.as_ref()?;
+    let idx: Vec<usize> = (0..m.len().min(force_model_n.len()))
+        .filter(|&i| test.time_s[i] >= from_s)
+        .collect();
+    if idx.is_empty() {
+        return None;
+    }
+    let n = idx.len() as f64;
+    let mean = idx.iter().map(|&i| m[i]).sum::<f64>() / n;
+    let (mut se, mut sm, mut mx) = (0.0, 0.0, 0.0f64);
+    for &i in &idx {
+        let e = force_model_n[i] - m[i];
+        se += e * e;
+        sm += (m[i] - mean) * (m[i] - mean);
+        mx = mx.max(e.abs());
+    }
+    let rms = (se / n).sqrt();
+    Some(ReplayMetrics {
+        samples_used: idx.len(),
+        from_s: test.time_s[idx[0]],
+        rms_error_n: rms,
+        rms_error_rel: rms / (sm / n).sqrt(),
+        max_abs_error_n: mx,
     })
 }
 

@@ -279,19 +279,24 @@ impl Plot {
         self
     }
 
-    /// Colour of every series: the model's fixed colour, else the other colours in turn.
+    /// Colour of every series: the model's fixed colour, else the other colours in turn; a
+    /// series with no name continues the one before it (same colour, no legend entry), e.g. the
+    /// markers on a model's line.
     fn colours(&self) -> Vec<RGBColor> {
         let mut k = 0;
-        self.series
-            .iter()
-            .map(|s| {
-                model_colour(&s.name).unwrap_or_else(|| {
+        let mut out: Vec<RGBColor> = Vec::with_capacity(self.series.len());
+        for s in &self.series {
+            let c = match (s.name.is_empty(), out.last()) {
+                (true, Some(&prev)) => prev,
+                _ => model_colour(&s.name).unwrap_or_else(|| {
                     let c = OTHER_COLOURS[k % OTHER_COLOURS.len()];
                     k += 1;
                     c
-                })
-            })
-            .collect()
+                }),
+            };
+            out.push(c);
+        }
+        out
     }
 
     /// Displayed ranges (scaled).
@@ -593,6 +598,11 @@ mod tests {
         for (_, c) in MODEL_COLOURS {
             assert!(!OTHER_COLOURS.contains(&c));
         }
+        // an unnamed series (markers on a line) keeps the colour of the series before it
+        let p = Plot::new("t", "x", "y")
+            .line("nonlinear", &[0.0, 1.0], &[0.0, 1.0])
+            .points("", &[0.0, 1.0], &[0.0, 1.0]);
+        assert_eq!(p.colours()[1], MODEL_COLOURS[2].1);
     }
 
     #[test]
