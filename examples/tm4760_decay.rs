@@ -1,6 +1,6 @@
 //! Free decay of the TM-4760 blade's lag hinge (rotors/tm4760.toml, docs/validation_tm4760.md):
-//! `cargo run --release --example tm4760_decay -- [STEP_S] [frame|inertial] [modified|full] [END_S] [RTOL]`
-//! (defaults 0.005 frame modified 6 1e-8). Prints the linearised rigid lag mode, the decay's damped
+//! `cargo run --release --example tm4760_decay -- [STEP_S] [frame|inertial] [modified|full] [END_S] [RTOL] [RHO_INF]`
+//! (defaults 0.005 frame modified 6 1e-8 0.9). Prints the linearised rigid lag mode, the decay's damped
 //! frequency and damping ratio (linear-prediction fit and log decrement over t >= 1 s), the
 //! Newton iterations and factorizations per step and the CPU cost per step of this thread, and
 //! writes the lag angle history to `tm4760_decay.csv` in the current folder.
@@ -43,6 +43,7 @@ fn main() -> anyhow::Result<()> {
     };
     let end: f64 = a.get(4).map_or(Ok(6.0), |v| v.parse())?;
     let rtol: f64 = a.get(5).map_or(Ok(1e-8), |v| v.parse())?;
+    let rho: f64 = a.get(6).map_or(Ok(0.9), |v| v.parse())?;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors/tm4760.toml");
     let spec = HingedSpec::from_file(&path)?;
     let om = spec.rotor.omega_rad_s;
@@ -59,14 +60,14 @@ fn main() -> anyhow::Result<()> {
             omega_rad_s: om,
             release_moment_nm: 4.5,
             time_step_s: h,
-            rho_inf: 0.9,
+            rho_inf: rho,
             newton,
             newton_rtol: rtol,
             rotating_frame: frame,
         },
     )?;
     println!(
-        "h = {h} s, {} frame, {} Newton, rtol {rtol:e}; initial lag {:.4} deg",
+        "h = {h} s, {} frame, {} Newton, rtol {rtol:e}, rho_inf {rho}; initial lag {:.4} deg",
         if frame { "turning" } else { "inertial" },
         newton.name(),
         sim.lag_angle_rad().to_degrees()
@@ -75,8 +76,16 @@ fn main() -> anyhow::Result<()> {
     let mut x = Vec::with_capacity(n);
     let c0 = cpu_seconds();
     let t0 = std::time::Instant::now();
-    for _ in 0..n {
+    for k in 0..n {
+        let f0 = sim.solver.factorizations;
         sim.step()?;
+        if std::env::var("TM_DEBUG").is_ok() && (200..215).contains(&k) {
+            eprintln!(
+                "step {k}: refactor {} residuals {:?}",
+                sim.solver.factorizations - f0,
+                sim.solver.last_residuals
+            );
+        }
         x.push(sim.lag_angle_rad());
     }
     let wall = t0.elapsed().as_secs_f64();
