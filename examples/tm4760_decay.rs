@@ -59,6 +59,7 @@ fn main() -> anyhow::Result<()> {
         &DecayOptions {
             omega_rad_s: om,
             release_moment_nm: 4.5,
+            release_time_s: 0.01,
             time_step_s: h,
             rho_inf: rho,
             newton,

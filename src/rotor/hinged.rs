@@ -7,8 +7,8 @@
 //! What this module gives: the expansion into a model deck (docs/model_deck.md), the fan plot
 //! (rotating equilibrium + linearisation at each speed, as src/rotor/fan.rs) with the rigid and
 //! elastic modes told apart by the nodes of their shapes, and the free-decay run (lag displaced
-//! by a static moment on the blade root and released) with its damped frequency and damping
-//! ratio from a linear-prediction fit.
+//! by a static moment on the blade root, then ramped off) with its damped frequency and damping
+//! ratio from a least-squares fit of a damped sine.
 use super::deck::RotorTable;
 use crate::solver::modal::{modes, ModalOptions, Mode, ModeKind};
 use crate::solver::statics::{static_solve, StaticOptions};
@@ -359,8 +359,9 @@ pub struct HingedExpand {
     /// Shaft speed of the prescribed hub rotation and of `[static]` [rad/s] (None: nominal).
     pub omega_rad_s: Option<f64>,
     /// Static moment about the lag hinge axis on the blade root [N m] (positive aft), removed
-    /// at t = 0+ (free-decay release); 0: none.
+    /// over `lag_release_time_s` (free-decay release, linear ramp to zero); 0: none.
     pub lag_release_moment_nm: f64,
+    pub lag_release_time_s: f64,
     /// `[dynamic]` time step and end time [s] (None: 256 steps per revolution, one revolution).
     pub time_step_s: Option<f64>,
     pub end_time_s: Option<f64>,
@@ -522,9 +523,10 @@ pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
             let mz = opts.lag_release_moment_nm;
             let _ = writeln!(
                 s,
-                "# Free decay: static lag moment at t = 0, released at t = 0+\n[[load]]\nname = \"lag_release\"\nnode = \"{}\"\nforce_N = [0.0, 0.0, 0.0]\nmoment_Nm = {}\ntime_table = [[0.0, 1.0], [1e-9, 0.0]]\n",
+                "# Free decay: static lag moment at t = 0, ramped to zero\n[[load]]\nname = \"lag_release\"\nnode = \"{}\"\nforce_N = [0.0, 0.0, 0.0]\nmoment_Nm = {}\ntime_table = [[0.0, 1.0], [{}, 0.0]]\n",
                 spec.root_node(),
-                v3([mz * axis[0], mz * axis[1], mz * axis[2]])
+                v3([mz * axis[0], mz * axis[1], mz * axis[2]]),
+                f(opts.lag_release_time_s.max(1e-9))
             );
         }
     }
@@ -785,6 +787,9 @@ pub struct DecayOptions {
     pub omega_rad_s: f64,
     /// Static lag moment [N m] (positive aft) that displaces the blade before the release.
     pub release_moment_nm: f64,
+    /// Release: the moment ramps linearly to zero over this time [s] (a step release would
+    /// depend on the integrator's convention for the initial acceleration).
+    pub release_time_s: f64,
     pub time_step_s: f64,
     pub rho_inf: f64,
     pub newton: NewtonMethod,
@@ -795,7 +800,7 @@ pub struct DecayOptions {
 }
 
 /// Free decay of the lag hinge: the blade in rotating equilibrium under a static lag moment,
-/// released at t = 0 and marched by the generalized-alpha solver (full nonlinear model, the
+/// ramped off (`release_time_s`) and marched by the generalized-alpha solver (full nonlinear model, the
 /// shaft driven at Omega).
 pub struct DecaySim {
     pub solver: DynamicSolver,
@@ -845,6 +850,7 @@ impl DecaySim {
             &HingedExpand {
                 omega_rad_s: Some(om),
                 lag_release_moment_nm: opts.release_moment_nm,
+                lag_release_time_s: opts.release_time_s,
                 time_step_s: Some(opts.time_step_s),
                 hub_clamped: rf,
                 ..Default::default()
