@@ -800,8 +800,8 @@ pub struct DecayOptions {
 }
 
 /// Free decay of the lag hinge: the blade in rotating equilibrium under a static lag moment,
-/// ramped off (`release_time_s`) and marched by the generalized-alpha solver (full nonlinear model, the
-/// shaft driven at Omega).
+/// ramped off (`release_time_s`) and marched by the generalized-alpha solver (full nonlinear
+/// model; inertial frame with the shaft driven at Omega, or the frame turning with it).
 pub struct DecaySim {
     pub solver: DynamicSolver,
     lag: usize,
