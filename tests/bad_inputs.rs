@@ -128,6 +128,11 @@ macro_rules! rotor {
         &[("r.toml", Repo(UH60A), &[($from, $to)])]
     };
 }
+macro_rules! tm4760 {
+    ($from:expr, $to:expr) => {
+        &[("r.toml", Repo("rotors/tm4760.toml"), &[($from, $to)])]
+    };
+}
 macro_rules! damper {
     ($from:expr, $to:expr) => {
         &[("d.toml", Repo(DAMPER), &[($from, $to)])]
@@ -157,6 +162,13 @@ macro_rules! record {
 #[rustfmt::skip]
 const CASES: &[Case] = &[
     // ---- rotor decks (run, expand, modes --rotor) ----
+    case("hinged deck hinges out of order", tm4760!("r_m = 0.0762                          # 3.00 in; free", "r_m = 0.05 #"), MODES_R, &["r.toml", "hinge[1].r_m"]),
+    case("hinged deck unknown hinge axis", tm4760!("axis = \"flap\"", "axis = \"twist\""), MODES_R, &["r.toml", "twist"]),
+    case("hinged deck negative hinge damping", tm4760!("damping_Nms_per_rad = 0.2867869", "damping_Nms_per_rad = -0.2867869"), MODES_R, &["r.toml", "hinge[0].damping_Nms_per_rad"]),
+    case("hinged deck segment without elements", tm4760!("elements = 1", "elements = 0"), MODES_R, &["r.toml", "blade.segment[0].elements"]),
+    case("hinged deck radius off the tip", tm4760!("radius_m = 1.397", "radius_m = 1.5"), MODES_R, &["r.toml", "rotor.radius_m"]),
+    case("hinged deck segment EI zero", tm4760!("EI2_Nm2 = 14353.98", "EI2_Nm2 = 0.0"), MODES_R, &["r.toml", "blade.segment[0].section.EI2_Nm2"]),
+    case("hinged deck given to run", tm4760!("blades = 4", "blades = 4"), RUN_R, &["r.toml", "hinged-blade"]),
     case("rotor omega NaN", rotor!("omega_rad_s = 27.0", "omega_rad_s = nan"), RUN_R, &["r.toml", "rotor.omega_rad_s"]),
     case("rotor radius negative", rotor!("radius_m = 8.1786", "radius_m = -8.1786"), EXPAND_R, &["r.toml", "radius_m"]),
     case("rotor blades zero", rotor!("blades = 4 ", "blades = 0 "), MODES_R, &["r.toml", "rotor.blades"]),
@@ -331,6 +343,10 @@ fn absolutize(text: String) -> String {
     text.replace(
         "sections_csv = \"data/",
         &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
+    )
+    .replace(
+        "csv = \"data/",
+        &format!("csv = \"{}/", r.join("rotors/data").display()),
     )
     .replace(
         "deck = \"../../rotors/",

@@ -108,6 +108,7 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
             &ModalOptions {
                 n_modes: md.count,
                 omega: rot,
+                shift_rad_s: 0.0,
             },
         ) {
             Ok(m) => m,
@@ -235,6 +236,9 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     use crate::rotor::fan::{fan, read_reference, TRACKED};
     if args.count == 0 {
         anyhow::bail!("--count 0: expected at least 1 mode per speed");
+    }
+    if std::fs::read_to_string(path).is_ok_and(|t| crate::rotor::hinged::is_hinged(&t)) {
+        return run_hinged(path, args);
     }
     let deck = crate::rotor::RotorDeck::from_file(path)?;
     let fractions = parse_speeds(&args.speeds)?;
@@ -389,6 +393,171 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
         let yy = [0.0, n as f64 * xmax * om_n / (2.0 * std::f64::consts::PI)];
         plot = plot.dashed(&format!("{n}/rev"), &xx, &yy);
     }
+    out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
+    out.finish()?;
+    outln!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Fan plot of a hinged-blade deck (docs/rotor_deck.md, "Hinged-blade decks"): rigid and
+/// elastic modes, damped frequencies, the deck's reference table over it; the reference's
+/// speeds are added to `--speeds` so that every reference row is compared.
+fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
+    use crate::rotor::hinged::{fan, read_reference, HingedSpec, TRACKED};
+    let spec = HingedSpec::from_file(path)?;
+    let mut fractions = parse_speeds(&args.speeds)?;
+    let om_n = spec.rotor.omega_rad_s;
+    let rpm_n = spec.rpm();
+    let mut inputs = vec![path.to_path_buf()];
+    let ref_path = args.reference.clone().or_else(|| spec.reference_path(path));
+    let label = spec
+        .fan_reference
+        .as_ref()
+        .map_or("reference".to_string(), |r| r.label.clone());
+    let reference = match &ref_path {
+        Some(p) => {
+            inputs.push(p.clone());
+            Some(read_reference(p)?)
+        }
+        None => None,
+    };
+    if let Some(rf) = &reference {
+        fractions.extend(rf.iter().map(|r| r.rpm / rpm_n));
+    }
+    fractions.sort_by(f64::total_cmp);
+    fractions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let out = OutDir::create(&args.out, &inputs)?;
+    let pts = match fan(&spec, path, &fractions, args.count.max(TRACKED.len())) {
+        Ok(p) => p,
+        Err(e) => {
+            out.mark_incomplete(&e.to_string())?;
+            return Err(e);
+        }
+    };
+    let rpm = |x: f64| x * rpm_n;
+    let mut h: Vec<String> = vec!["speed_fraction".into(), "omega_rad_s".into(), "rpm".into()];
+    h.extend(TRACKED.iter().map(|t| format!("{t}_Hz")));
+    h.extend(TRACKED.iter().map(|t| format!("{t}_damping_ratio")));
+    let hs: Vec<&str> = h.iter().map(|s| s.as_str()).collect();
+    let rows: Vec<Vec<f64>> = pts
+        .iter()
+        .map(|p| {
+            let mut r = vec![p.fraction, p.omega_rad_s, rpm(p.fraction)];
+            r.extend(p.tracked_hz);
+            r.extend(p.tracked_zeta);
+            r
+        })
+        .collect();
+    let mut text = csv_string(&hs, &rows);
+    text.push_str("# *_Hz: damped frequency Im(s)/2pi; NaN: no oscillatory mode of that kind (a free hinge at rest)\n");
+    out.write("fan.csv", text.as_bytes())?;
+    let mh = [
+        "speed_fraction",
+        "mode",
+        "freq_Hz",
+        "damped_freq_Hz",
+        "damping_ratio",
+        "flap_fraction",
+        "lag_fraction",
+        "torsion_fraction",
+        "axial_fraction",
+    ];
+    let mut mrows = vec![];
+    for p in &pts {
+        for (i, m) in p.modes.iter().enumerate() {
+            mrows.push(vec![
+                p.fraction,
+                (i + 1) as f64,
+                m.freq_hz,
+                crate::rotor::hinged::damped_hz(m),
+                m.damping_ratio,
+                m.fractions[0],
+                m.fractions[1],
+                m.fractions[2],
+                m.fractions[3],
+            ]);
+        }
+    }
+    out.write("modes.csv", csv_string(&mh, &mrows).as_bytes())?;
+    outln!(
+        "hinged-blade rotor {}: {} rpm nominal",
+        path.display(),
+        rpm_n
+    );
+    if let Some(rf) = &reference {
+        outln!(
+            "{:>6} {:>10} {:>10} {:>10} {:>8}",
+            "rpm",
+            "mode",
+            "model_Hz",
+            "ref_Hz",
+            "err_%"
+        );
+        let mut crow = vec![];
+        for r in rf {
+            let Some(p) = pts
+                .iter()
+                .find(|p| (rpm(p.fraction) - r.rpm).abs() < 1e-6 * rpm_n)
+            else {
+                continue;
+            };
+            for (k, name) in TRACKED.iter().enumerate() {
+                let (m, re) = (p.tracked_hz[k], r.hz[k]);
+                let err = if re != 0.0 {
+                    100.0 * (m - re) / re
+                } else {
+                    f64::NAN
+                };
+                crow.push(vec![r.rpm, k as f64, m, re, err]);
+                outln!(
+                    "{:>6.0} {:>10} {:>10.4} {:>10.2} {:>8.2}",
+                    r.rpm,
+                    name,
+                    m,
+                    re,
+                    err
+                );
+            }
+        }
+        let ch = ["rpm", "mode_index", "model_Hz", "reference_Hz", "error_pct"];
+        let mut text = csv_string(&ch, &crow);
+        let names: Vec<String> = TRACKED
+            .iter()
+            .enumerate()
+            .map(|(k, t)| format!("{k} {t}"))
+            .collect();
+        text.push_str(&format!("# mode_index: {}\n", names.join(", ")));
+        out.write("fan_comparison.csv", text.as_bytes())?;
+    }
+    let x: Vec<f64> = pts.iter().map(|p| rpm(p.fraction)).collect();
+    let mut plot = crate::report::plot::Plot::new(
+        &format!("Fan plot: model (lines) and {label} (points)"),
+        "rotor speed [rpm]",
+        "frequency [Hz]",
+    );
+    for (k, t) in TRACKED.iter().enumerate() {
+        let (xs, ys): (Vec<f64>, Vec<f64>) = pts
+            .iter()
+            .zip(&x)
+            .filter(|(p, _)| p.tracked_hz[k].is_finite())
+            .map(|(p, x)| (*x, p.tracked_hz[k]))
+            .unzip();
+        plot = plot.line(&format!("model {t}"), &xs, &ys);
+    }
+    if let Some(rf) = &reference {
+        let rx: Vec<f64> = rf.iter().map(|r| r.rpm).collect();
+        for (k, t) in TRACKED.iter().enumerate() {
+            let ry: Vec<f64> = rf.iter().map(|r| r.hz[k]).collect();
+            plot = plot.points(&format!("{label}: {t}"), &rx, &ry);
+        }
+    }
+    let xmax = x.iter().cloned().fold(0.0, f64::max).max(1e-3);
+    for n in 1..=6 {
+        let xx = [0.0, xmax];
+        let yy = [0.0, n as f64 * xmax / 60.0];
+        plot = plot.dashed(&format!("{n}/rev"), &xx, &yy);
+    }
+    let _ = om_n;
     out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
     out.finish()?;
     outln!("wrote {}", args.out.display());

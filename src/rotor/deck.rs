@@ -222,6 +222,11 @@ impl RotorSpec {
 
     /// Parse deck text; `file` names it in errors (toml reports line and column).
     pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
+        if super::hinged::is_hinged(text) {
+            anyhow::bail!(
+                "rotor deck {file}: a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it"
+            );
+        }
         let spec: RotorSpec = toml::from_str(text)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.to_string().trim_end()))?;
         spec.validate(file)?;

@@ -145,6 +145,7 @@ pub fn fan_with(
                 &ModalOptions {
                     n_modes: count,
                     omega: rot,
+                    shift_rad_s: 0.0,
                 },
             )?)
         };

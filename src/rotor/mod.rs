@@ -151,6 +151,7 @@ pub struct SimState {
 pub mod deck;
 pub mod expand;
 pub mod fan;
+pub mod hinged;
 pub mod loads;
 pub mod sim;
 pub mod transient;

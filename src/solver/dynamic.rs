@@ -159,6 +159,39 @@ pub struct DynamicSolver {
     /// angle at which it was made.
     have_factor: bool,
     factor_angle: f64,
+    /// Steady rotation of the frame the state is given in [rad/s] (None: inertial). With it the
+    /// positions, velocities and accelerations of the state are relative to a frame turning at
+    /// `omega` about the origin (as MBDyn's rigid-body kinematics), and every element sees the
+    /// absolute kinematics `v + omega x x`, `w + omega`, `a + 2 omega x v + omega x (omega x x)`,
+    /// `al + omega x w` in that frame's components (the elements are objective); the iteration
+    /// matrix carries the same terms through the seeds ([`frame_seed`]).
+    pub frame_omega: Option<[f64; 3]>,
+}
+
+/// Absolute kinematics of relative ones in a frame turning steadily at `om` (see
+/// [`DynamicSolver::frame_omega`]).
+pub fn to_frame(k: &mut NodeKin<f64>, om: [f64; 3]) {
+    let wv = cross(om, k.v);
+    k.a = add(add(k.a, fmul(2.0, wv)), cross(om, cross(om, k.x)));
+    k.al = add(k.al, cross(om, k.w));
+    k.v = add(k.v, cross(om, k.x));
+    k.w = add(k.w, om);
+}
+
+/// The seed of a relative dof seen through [`to_frame`]: chain rule of the absolute
+/// kinematics in the relative position and velocities.
+pub fn frame_seed(s: Seed, om: [f64; 3]) -> Seed {
+    Seed {
+        dx: s.dx,
+        dth: s.dth,
+        dv: add(s.dv, cross(om, s.dx)),
+        dw: s.dw,
+        da: add(
+            add(s.da, fmul(2.0, cross(om, s.dv))),
+            cross(om, cross(om, s.dx)),
+        ),
+        dal: add(s.dal, cross(om, s.dw)),
+    }
 }
 
 impl DynamicSolver {
@@ -210,6 +243,7 @@ impl DynamicSolver {
             corot,
             have_factor: false,
             factor_angle: 0.0,
+            frame_omega: None,
             ws_a: vec![],
             ws_vd: vec![],
             ws_v: vec![],
@@ -285,7 +319,14 @@ impl DynamicSolver {
         let (cv, ca) = self.coeffs();
         let h = self.h;
         let tl = &self.tl;
-        let seed = |node: usize, comp: usize| Seed::generalized_alpha(comp, h, cv, ca, &tl[node]);
+        let fo = self.frame_omega;
+        let seed = |node: usize, comp: usize| {
+            let s = Seed::generalized_alpha(comp, h, cv, ca, &tl[node]);
+            match fo {
+                None => s,
+                Some(om) => frame_seed(s, om),
+            }
+        };
         self.asm
             .assemble(
                 &mut self.model,
@@ -436,6 +477,11 @@ impl DynamicSolver {
                     a: [vd_new[i][0], vd_new[i][1], vd_new[i][2]],
                     al: [vd_new[i][3], vd_new[i][4], vd_new[i][5]],
                 });
+            }
+            if let Some(om) = self.frame_omega {
+                for k in self.kin.iter_mut() {
+                    to_frame(k, om);
+                }
             }
             self.model.update_distributed_loads(t, &self.kin);
             // A matrix is assembled only where it is factored: modified Newton without a

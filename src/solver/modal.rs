@@ -58,6 +58,11 @@ pub struct ModalOptions {
     pub n_modes: usize,
     /// Steady rotation (rad/s) about the origin; `None` = non-rotating.
     pub omega: Option<[f64; 3]>,
+    /// Real spectral shift sigma [1/s] of the shift-invert form (0: none, the form about s = 0).
+    /// A model with a free rigid-body rotation (a hinge without spring at rest) has a singular
+    /// `K`; about `s = sigma > 0` the form is regular: `K + sigma G + sigma^2 M` replaces `K`,
+    /// `G + 2 sigma M` replaces `G`, and `s = sigma + mu`.
+    pub shift_rad_s: f64,
 }
 
 fn dense_block(asm: &Assembler, n: usize, rows: std::ops::Range<usize>) -> DMatrix<f64> {
@@ -189,14 +194,20 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     // Shift-invert form when K is regular: eigenvalues 1/s of
     // A^-1 = [-K^-1 G, -K^-1 M; I, 0] resolve the lowest modes to full relative precision even
     // with very stiff axial/shear modes; otherwise the direct form [0 I; -M^-1 K, -M^-1 G].
-    let klu = kr.clone().lu();
+    let sig = opts.shift_rad_s;
+    let (kr_s, gr_s) = if sig != 0.0 {
+        (&kr + &gr * sig + &mr * (sig * sig), &gr + &mr * (2.0 * sig))
+    } else {
+        (kr.clone(), gr.clone())
+    };
+    let klu = kr_s.clone().lu();
     let kinv = klu
         .solve(&DMatrix::<f64>::identity(nr, nr))
         .filter(|ki| ki.iter().all(|v| v.is_finite()));
     let mut a = faer::Mat::<f64>::zeros(2 * nr, 2 * nr);
     let inverted = kinv.is_some();
     if let Some(ki) = kinv {
-        let kig = &ki * &gr;
+        let kig = &ki * &gr_s;
         let kim = &ki * &mr;
         for i in 0..nr {
             a[(nr + i, i)] = 1.0;
@@ -233,7 +244,7 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
                 if z.norm() == 0.0 {
                     faer::c64::new(f64::INFINITY, 0.0)
                 } else {
-                    z.conj() / (z.norm() * z.norm())
+                    z.conj() / (z.norm() * z.norm()) + faer::c64::new(sig, 0.0)
                 }
             } else {
                 z

@@ -253,6 +253,7 @@ pub fn rotating_cantilever(n_elem: usize, lambdas: &[f64]) -> Result<Vec<Check>,
             &ModalOptions {
                 n_modes: 12,
                 omega: Some(omega),
+                shift_rad_s: 0.0,
             },
         )
         .map_err(|e| e.to_string())?;

@@ -1,0 +1,998 @@
+//! Hinged-blade rotor decks (docs/rotor_deck.md, "Hinged-blade decks"): a blade on a chain of
+//! hinges (lag, flap, pitch revolute joints at given radii, each with an optional spring and
+//! dashpot; rotations without a hinge are locked), a blade of uniform-section segments and
+//! concentrated masses, no pitch link or hydraulic damper. Example: rotors/tm4760.toml (the
+//! NASA TM-4760 model blade, docs/validation_tm4760.md).
+//!
+//! What this module gives: the expansion into a model deck (docs/model_deck.md), the fan plot
+//! (rotating equilibrium + linearisation at each speed, as src/rotor/fan.rs) with the rigid and
+//! elastic modes told apart by the nodes of their shapes, and the free-decay run (lag displaced
+//! by a static moment on the blade root, then ramped off) with its damped frequency and damping
+//! ratio from a least-squares fit of a damped sine.
+use super::deck::RotorTable;
+use crate::solver::modal::{modes, ModalOptions, Mode, ModeKind};
+use crate::solver::statics::{static_solve, StaticOptions};
+use crate::solver::{DynamicSolver, NewtonMethod, State};
+use crate::structure::deck::parse_deck;
+use crate::structure::model::{Element, Model};
+use crate::structure::section::SectionProps;
+use serde::Deserialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Whether a rotor deck text is of the hinged-blade form (it has `[[hinge]]` tables).
+pub fn is_hinged(text: &str) -> bool {
+    toml::from_str::<toml::Table>(text)
+        .map(|t| t.contains_key("hinge"))
+        .unwrap_or(false)
+}
+
+/// Rotation a hinge frees (hub frame; angle signs as the bearing of docs/rotor_deck.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HingeAxis {
+    /// About -z: positive aft (against rotation).
+    Lag,
+    /// About -y: positive up.
+    Flap,
+    /// About +x: positive nose up.
+    Pitch,
+}
+
+impl HingeAxis {
+    pub fn name(self) -> &'static str {
+        match self {
+            HingeAxis::Lag => "lag",
+            HingeAxis::Flap => "flap",
+            HingeAxis::Pitch => "pitch",
+        }
+    }
+    /// Joint axis and x-direction hint (global, undeformed).
+    fn axes(self) -> ([f64; 3], [f64; 3]) {
+        match self {
+            HingeAxis::Lag => ([0.0, 0.0, -1.0], [1.0, 0.0, 0.0]),
+            HingeAxis::Flap => ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0]),
+            HingeAxis::Pitch => ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hinge {
+    pub axis: HingeAxis,
+    /// Radius of the hinge point [m].
+    pub r_m: f64,
+    #[serde(rename = "stiffness_Nm_per_rad", default)]
+    pub k: f64,
+    #[serde(rename = "damping_Nms_per_rad", default)]
+    pub c: f64,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BladeSegment {
+    /// Outer end of the segment [m] (the first starts at `blade.root_r_m`).
+    pub r_end_m: f64,
+    pub elements: usize,
+    pub section: SectionProps,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SegmentedBlade {
+    /// Start of the blade beam [m] (at or outboard of the last hinge; rigid in between).
+    pub root_r_m: f64,
+    /// Stiffness-proportional structural damping mu [s] (default 0).
+    #[serde(default)]
+    pub damping_mu_s: f64,
+    #[serde(rename = "segment")]
+    pub segments: Vec<BladeSegment>,
+}
+
+/// A concentrated mass on the blade, attached rigidly to the nearest blade node.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointMass {
+    pub name: String,
+    /// Radius of its centre of mass [m].
+    pub r_m: f64,
+    pub mass_kg: f64,
+    /// Centre-of-mass offset from the blade axis, [y (toward the leading edge), z (up)] [m].
+    #[serde(default)]
+    pub offset_m: [f64; 2],
+    /// Principal inertias about its centre of mass, blade axes [x, y, z] [kg m^2].
+    #[serde(default)]
+    pub inertia_kgm2: [f64; 3],
+}
+
+/// Reference frequencies drawn over the fan plot and compared in `fan_comparison.csv`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FanReference {
+    /// CSV (relative to the deck): `rpm` then columns named as [`TRACKED`] with `_Hz`.
+    pub csv: String,
+    /// Legend label of the points.
+    pub label: String,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HingedSpec {
+    pub rotor: RotorTable,
+    #[serde(rename = "hinge")]
+    pub hinges: Vec<Hinge>,
+    pub blade: SegmentedBlade,
+    #[serde(rename = "mass", default)]
+    pub masses: Vec<PointMass>,
+    #[serde(default)]
+    pub fan_reference: Option<FanReference>,
+}
+
+/// The modes followed in the fan plot of a hinged blade, in this order.
+pub const TRACKED: [&str; 7] = [
+    "rigid_lag",
+    "rigid_flap",
+    "flap1",
+    "flap2",
+    "lag1",
+    "flap3",
+    "torsion1",
+];
+
+impl HingedSpec {
+    pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
+        let spec: HingedSpec = toml::from_str(text).map_err(|e| {
+            anyhow::anyhow!(
+                "rotor deck {file} (hinged blade): {}",
+                e.to_string().trim_end()
+            )
+        })?;
+        spec.validate(file)?;
+        Ok(spec)
+    }
+
+    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+        Self::parse(&text, &file)
+    }
+
+    /// Nominal rotor speed [rpm].
+    pub fn rpm(&self) -> f64 {
+        self.rotor.omega_rad_s * 60.0 / (2.0 * std::f64::consts::PI)
+    }
+
+    fn validate(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: String| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
+        let fin = |v: f64| v.is_finite();
+        if !(fin(self.rotor.omega_rad_s) && self.rotor.omega_rad_s > 0.0) {
+            return Err(bad(
+                "rotor.omega_rad_s",
+                format!(
+                    "expected a positive number, found {}",
+                    self.rotor.omega_rad_s
+                ),
+            ));
+        }
+        if self.rotor.blades == 0 {
+            return Err(bad("rotor.blades", "expected at least 1 blade".into()));
+        }
+        if self.hinges.is_empty() {
+            return Err(bad("hinge", "expected at least one [[hinge]]".into()));
+        }
+        let mut r_prev = 0.0;
+        let mut seen = vec![];
+        for (i, h) in self.hinges.iter().enumerate() {
+            let key = |k: &str| format!("hinge[{i}].{k}");
+            if !(fin(h.r_m) && h.r_m >= r_prev) {
+                return Err(bad(
+                    &key("r_m"),
+                    format!(
+                        "expected a finite radius >= {r_prev} (hinges listed from the hub outward), found {}",
+                        h.r_m
+                    ),
+                ));
+            }
+            r_prev = h.r_m;
+            for (k, v) in [("stiffness_Nm_per_rad", h.k), ("damping_Nms_per_rad", h.c)] {
+                if !(fin(v) && v >= 0.0) {
+                    return Err(bad(
+                        &key(k),
+                        format!("expected a non-negative number, found {v}"),
+                    ));
+                }
+            }
+            if seen.contains(&h.axis) {
+                return Err(bad(
+                    &key("axis"),
+                    format!("a second `{}` hinge (one per axis)", h.axis.name()),
+                ));
+            }
+            seen.push(h.axis);
+        }
+        let b = &self.blade;
+        if !(fin(b.root_r_m) && b.root_r_m >= r_prev) {
+            return Err(bad(
+                "blade.root_r_m",
+                format!(
+                    "expected a radius at or outboard of the last hinge ({r_prev} m), found {}",
+                    b.root_r_m
+                ),
+            ));
+        }
+        if !(fin(b.damping_mu_s) && b.damping_mu_s >= 0.0) {
+            return Err(bad(
+                "blade.damping_mu_s",
+                format!("expected a non-negative number, found {}", b.damping_mu_s),
+            ));
+        }
+        if b.segments.is_empty() {
+            return Err(bad(
+                "blade.segment",
+                "expected at least one [[blade.segment]]".into(),
+            ));
+        }
+        let mut r0 = b.root_r_m;
+        for (i, s) in b.segments.iter().enumerate() {
+            let key = |k: &str| format!("blade.segment[{i}].{k}");
+            if !(fin(s.r_end_m) && s.r_end_m > r0) {
+                return Err(bad(
+                    &key("r_end_m"),
+                    format!(
+                        "expected a radius beyond the segment's start {r0} m, found {}",
+                        s.r_end_m
+                    ),
+                ));
+            }
+            r0 = s.r_end_m;
+            if s.elements == 0 {
+                return Err(bad(
+                    &key("elements"),
+                    "expected at least one element".into(),
+                ));
+            }
+            s.section.check().map_err(|(k, what)| {
+                let v = toml::Value::try_from(s.section)
+                    .ok()
+                    .and_then(|t| t.get(k).cloned())
+                    .map_or("?".to_string(), |v| v.to_string());
+                bad(
+                    &key(&format!("section.{k}")),
+                    format!("expected {what}, found {v}"),
+                )
+            })?;
+        }
+        let tip = r0;
+        let rr = self.rotor.radius_m;
+        if !(fin(rr) && (rr - tip).abs() <= 1e-9 * rr.abs().max(1.0)) {
+            return Err(bad(
+                "rotor.radius_m",
+                format!("expected the outer end of the last blade segment ({tip} m), found {rr}"),
+            ));
+        }
+        let mut names: Vec<&str> = vec![];
+        for (i, m) in self.masses.iter().enumerate() {
+            let key = |k: &str| format!("mass[{i}].{k}");
+            if m.name.is_empty() || names.contains(&m.name.as_str()) {
+                return Err(bad(
+                    &key("name"),
+                    format!("expected a unique non-empty name, found `{}`", m.name),
+                ));
+            }
+            names.push(&m.name);
+            if !(fin(m.r_m) && m.r_m >= b.root_r_m && m.r_m <= tip) {
+                return Err(bad(
+                    &key("r_m"),
+                    format!(
+                        "expected a radius on the blade ({} to {tip} m), found {}",
+                        b.root_r_m, m.r_m
+                    ),
+                ));
+            }
+            if !(fin(m.mass_kg) && m.mass_kg > 0.0) {
+                return Err(bad(
+                    &key("mass_kg"),
+                    format!("expected a positive mass, found {}", m.mass_kg),
+                ));
+            }
+            if m.offset_m.iter().any(|v| !fin(*v)) {
+                return Err(bad(
+                    &key("offset_m"),
+                    format!("expected two finite numbers, found {:?}", m.offset_m),
+                ));
+            }
+            if m.inertia_kgm2.iter().any(|v| !(fin(*v) && *v >= 0.0)) {
+                return Err(bad(
+                    &key("inertia_kgm2"),
+                    format!(
+                        "expected three non-negative numbers, found {:?}",
+                        m.inertia_kgm2
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Radii of the blade nodes with their names, root to tip.
+    pub fn blade_nodes(&self) -> Vec<(String, f64)> {
+        let mut v = vec![];
+        let mut r0 = self.blade.root_r_m;
+        for (k, s) in self.blade.segments.iter().enumerate() {
+            let n = 3 * s.elements;
+            if k == 0 {
+                v.push((self.root_node(), r0));
+            }
+            for j in 1..=n {
+                v.push((
+                    format!("blade_s{k}.n{j}"),
+                    r0 + (s.r_end_m - r0) * j as f64 / n as f64,
+                ));
+            }
+            r0 = s.r_end_m;
+        }
+        v
+    }
+
+    /// Name of the blade's first node: the last hinge's node when the blade starts there.
+    pub fn root_node(&self) -> String {
+        let n = self.hinges.len();
+        if self.blade.root_r_m == self.hinges[n - 1].r_m {
+            format!("hinge{}", n - 1)
+        } else {
+            "blade_s0.n0".to_string()
+        }
+    }
+
+    /// Name of the tip node.
+    pub fn tip_node(&self) -> String {
+        let k = self.blade.segments.len() - 1;
+        format!("blade_s{k}.n{}", 3 * self.blade.segments[k].elements)
+    }
+}
+
+/// Options of the expansion.
+#[derive(Clone, Debug, Default)]
+pub struct HingedExpand {
+    /// Shaft speed of the prescribed hub rotation and of `[static]` [rad/s] (None: nominal).
+    pub omega_rad_s: Option<f64>,
+    /// Static moment about the lag hinge axis on the blade root [N m] (positive aft), removed
+    /// over `lag_release_time_s` (free-decay release, linear ramp to zero); 0: none.
+    pub lag_release_moment_nm: f64,
+    pub lag_release_time_s: f64,
+    /// `[dynamic]` time step and end time [s] (None: 256 steps per revolution, one revolution).
+    pub time_step_s: Option<f64>,
+    pub end_time_s: Option<f64>,
+    /// Hub clamped instead of driven (the model of a solver working in the frame that turns
+    /// with the shaft, [`crate::solver::DynamicSolver::frame_omega`]).
+    pub hub_clamped: bool,
+}
+
+fn f(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn v3(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2]))
+}
+
+fn section(p: &SectionProps) -> String {
+    let mut s = format!(
+        "{{ EA_N = {}, GA2_N = {}, GA3_N = {}, GJ_Nm2 = {}, EI2_Nm2 = {}, EI3_Nm2 = {}, m_kg_per_m = {}, I1_kgm = {}, I2_kgm = {}, I3_kgm = {}",
+        f(p.ea), f(p.ga2), f(p.ga3), f(p.gj), f(p.ei2), f(p.ei3), f(p.m), f(p.i1), f(p.i2), f(p.i3)
+    );
+    for (k, v) in [
+        ("cm2_m", p.cm2),
+        ("cm3_m", p.cm3),
+        ("sc2_m", p.sc2),
+        ("sc3_m", p.sc3),
+        ("ca2_m", p.ca2),
+        ("ca3_m", p.ca3),
+    ] {
+        if v != 0.0 {
+            let _ = write!(s, ", {k} = {}", f(v));
+        }
+    }
+    s.push_str(" }");
+    s
+}
+
+/// The model deck text (docs/model_deck.md): hub node driven at Omega (`shaft`), the hinges as
+/// revolute joints `lag`/`flap`/`pitch` through the nodes `hinge0`, `hinge1`, ... (a hinge
+/// outboard of the previous one hangs on a rigid offset, `*_base` clamped to its parent), the
+/// blade segments `blade_s0`, `blade_s1`, ... sharing their end nodes, the masses as rigid
+/// bodies on the nearest blade node.
+pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
+    let mut s = String::new();
+    let om = opts.omega_rad_s.unwrap_or(spec.rotor.omega_rad_s);
+    let _ = writeln!(
+        s,
+        "# Multibody model deck generated from a hinged-blade rotor deck (docs/rotor_deck.md).\n\
+         title = \"rotor: single hinged blade\"\n"
+    );
+    let node = |s: &mut String, name: &str, p: [f64; 3]| {
+        let _ = writeln!(s, "[[node]]\nname = \"{name}\"\nposition_m = {}\n", v3(p));
+    };
+    let clamp = |s: &mut String, name: &str, a: &str, b: &str| {
+        let _ = writeln!(
+            s,
+            "[[joint]]\nname = \"{name}\"\ntype = \"clamp\"\nnode_a = \"{a}\"\nnode_b = \"{b}\"\n"
+        );
+    };
+    node(&mut s, "hub", [0.0; 3]);
+    if opts.hub_clamped {
+        let _ = writeln!(
+            s,
+            "# hub fixed: the state is relative to the frame turning with the shaft\n[[joint]]\nname = \"shaft\"\ntype = \"clamp\"\nnode_b = \"hub\"\n"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "[[joint]]\nname = \"shaft\"\ntype = \"revolute\"\nnode_b = \"hub\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
+            f(om)
+        );
+    }
+    let mut parent = ("hub".to_string(), 0.0);
+    for (i, h) in spec.hinges.iter().enumerate() {
+        let p = [h.r_m, 0.0, 0.0];
+        let a = if h.r_m != parent.1 {
+            let base = format!("hinge{i}_base");
+            node(&mut s, &base, p);
+            clamp(&mut s, &format!("{base}_mount"), &parent.0, &base);
+            base
+        } else {
+            parent.0.clone()
+        };
+        let b = format!("hinge{i}");
+        node(&mut s, &b, p);
+        let (axis, xd) = h.axis.axes();
+        let _ = writeln!(
+            s,
+            "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_a = \"{a}\"\nnode_b = \"{b}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}\n",
+            h.axis.name(),
+            v3(axis),
+            v3(xd),
+            f(h.k),
+            f(h.c)
+        );
+        parent = (b, h.r_m);
+    }
+    let b = &spec.blade;
+    let root_start = if b.root_r_m == parent.1 {
+        Some(parent.0.clone())
+    } else {
+        None
+    };
+    let mut r0 = b.root_r_m;
+    for (k, seg) in b.segments.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "[[beam]]\nname = \"blade_s{k}\"\nelements = {}",
+            seg.elements
+        );
+        let start = if k == 0 {
+            root_start.clone()
+        } else {
+            Some(format!(
+                "blade_s{}.n{}",
+                k - 1,
+                3 * b.segments[k - 1].elements
+            ))
+        };
+        if let Some(n) = start {
+            let _ = writeln!(s, "start_node = \"{n}\"");
+        }
+        let _ = writeln!(
+            s,
+            "start_m = {}\nend_m = {}\nsection = {}\ndamping_mu_s = {}\n",
+            v3([r0, 0.0, 0.0]),
+            v3([seg.r_end_m, 0.0, 0.0]),
+            section(&seg.section),
+            f(b.damping_mu_s)
+        );
+        r0 = seg.r_end_m;
+    }
+    if root_start.is_none() {
+        clamp(&mut s, "blade_root", &parent.0, "blade_s0.n0");
+    }
+    let nodes = spec.blade_nodes();
+    for m in &spec.masses {
+        let (name, rn) = nodes
+            .iter()
+            .min_by(|a, b| (a.1 - m.r_m).abs().total_cmp(&(b.1 - m.r_m).abs()))
+            .cloned()
+            .unwrap_or_else(|| (spec.root_node(), b.root_r_m));
+        let i = m.inertia_kgm2;
+        let _ = writeln!(
+            s,
+            "[[rigid_body]]\nname = \"{}\"\nnode = \"{name}\"\nmass_kg = {}\ncm_offset_m = {}\ninertia_kgm2 = [[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]\n",
+            m.name,
+            f(m.mass_kg),
+            v3([m.r_m - rn, m.offset_m[0], m.offset_m[1]]),
+            f(i[0]),
+            f(i[1]),
+            f(i[2])
+        );
+    }
+    if opts.lag_release_moment_nm != 0.0 {
+        let lag = spec.hinges.iter().any(|h| h.axis == HingeAxis::Lag);
+        if lag {
+            let (axis, _) = HingeAxis::Lag.axes();
+            let mz = opts.lag_release_moment_nm;
+            let _ = writeln!(
+                s,
+                "# Free decay: static lag moment at t = 0, ramped to zero\n[[load]]\nname = \"lag_release\"\nnode = \"{}\"\nforce_N = [0.0, 0.0, 0.0]\nmoment_Nm = {}\ntime_table = [[0.0, 1.0], [{}, 0.0]]\n",
+                spec.root_node(),
+                v3([mz * axis[0], mz * axis[1], mz * axis[2]]),
+                f(opts.lag_release_time_s.max(1e-9))
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "[[sensor]]\nname = \"tip\"\nnode = \"{}\"\n",
+        spec.tip_node()
+    );
+    for h in &spec.hinges {
+        let _ = writeln!(
+            s,
+            "[[sensor]]\nname = \"{0}\"\njoint = \"{0}\"\n",
+            h.axis.name()
+        );
+    }
+    let period = 2.0 * std::f64::consts::PI / om;
+    let _ = writeln!(
+        s,
+        "[static]\nload_steps = 1\nomega_rad_s = [0.0, 0.0, {}]\n\n[dynamic]\ntime_step_s = {}\nend_time_s = {}\ninitial_omega_rad_s = [0.0, 0.0, {}]\nstart_from_static = true\n\n[modes]\ncount = 14\naxis = [0.0, 0.0, 1.0]\n",
+        f(om),
+        f(opts.time_step_s.unwrap_or(period / 256.0)),
+        f(opts.end_time_s.unwrap_or(period)),
+        f(om)
+    );
+    s
+}
+
+/// Parse the expanded deck into a model (relative paths against the deck's folder).
+pub fn expanded_model(
+    spec: &HingedSpec,
+    opts: &HingedExpand,
+    file: &Path,
+) -> anyhow::Result<Model> {
+    let text = expand(spec, opts);
+    let base = file.parent().map(Path::to_path_buf).unwrap_or_default();
+    let name = format!("{} (expanded)", file.display());
+    let (_, model) = parse_deck(&text, &name, &base)?;
+    Ok(model)
+}
+
+/// Modes at one rotor speed.
+#[derive(Clone, Debug)]
+pub struct HingedFanPoint {
+    pub fraction: f64,
+    pub omega_rad_s: f64,
+    pub modes: Vec<Mode>,
+    /// Damped frequencies `Im(s) / 2 pi` [Hz] of [`TRACKED`] (NaN when not found: e.g. a free
+    /// hinge without rotation has a zero eigenvalue, no oscillation).
+    pub tracked_hz: [f64; 7],
+    /// Damping ratios of [`TRACKED`].
+    pub tracked_zeta: [f64; 7],
+}
+
+/// Damped frequency `Im(s) / 2 pi` of a mode [Hz] (`freq_hz` is `|s| / 2 pi`).
+pub fn damped_hz(m: &Mode) -> f64 {
+    m.freq_hz * (1.0 - m.damping_ratio * m.damping_ratio).max(0.0).sqrt()
+}
+
+/// Sign changes of a shape component along the blade (values below 1e-3 of the largest are
+/// skipped): 0 for a rigid hinge mode, n for the n-th elastic mode.
+fn crossings(v: &[f64]) -> usize {
+    let mx = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut last = 0.0f64;
+    let mut n = 0;
+    for &x in v {
+        if x.abs() <= 1e-3 * mx {
+            continue;
+        }
+        if last != 0.0 && x.signum() != last.signum() {
+            n += 1;
+        }
+        last = x;
+    }
+    n
+}
+
+/// Assign the modes (sorted by frequency) to [`TRACKED`]: by kind (dominant mass-weighted
+/// fraction) and, for flap and lag, by the number of nodes of the out-of-plane (z) or in-plane
+/// (y) displacement along the blade (0 rigid, 1 first elastic, ...); the first torsion mode.
+pub fn track(ms: &[Mode], blade_nodes: &[usize]) -> ([f64; 7], [f64; 7]) {
+    let mut hz = [f64::NAN; 7];
+    let mut zeta = [f64::NAN; 7];
+    for m in ms {
+        let comp = |c: usize| -> Vec<f64> { blade_nodes.iter().map(|&i| m.shape[i][c]).collect() };
+        let slot = match m.kind {
+            ModeKind::Lag => match crossings(&comp(1)) {
+                0 => Some(0),
+                1 => Some(4),
+                _ => None,
+            },
+            ModeKind::Flap => match crossings(&comp(2)) {
+                0 => Some(1),
+                1 => Some(2),
+                2 => Some(3),
+                3 => Some(5),
+                _ => None,
+            },
+            ModeKind::Torsion => Some(6),
+            ModeKind::Axial => None,
+        };
+        if let Some(k) = slot {
+            if hz[k].is_nan() {
+                hz[k] = damped_hz(m);
+                zeta[k] = m.damping_ratio;
+            }
+        }
+    }
+    (hz, zeta)
+}
+
+/// Spectral shift of the modal analysis [1/s]: a hinge without spring at rest has a zero
+/// eigenvalue (singular K), about which the unshifted shift-invert form loses the rest of the
+/// spectrum (measured: flap 2 at rest 7% low, 0.0003 Hz for the free flap hinge).
+pub const MODAL_SHIFT_RAD_S: f64 = 1.0;
+
+/// Rotating equilibrium at `omega` and the modes about it.
+pub fn modes_at(
+    spec: &HingedSpec,
+    file: &Path,
+    omega: f64,
+    count: usize,
+) -> anyhow::Result<(Model, Vec<Mode>)> {
+    let mut model = expanded_model(spec, &HingedExpand::default(), file)?;
+    let mut st = State::from_model(&model);
+    let rot = if omega > 0.0 {
+        Some([0.0, 0.0, omega])
+    } else {
+        None
+    };
+    static_solve(
+        &mut model,
+        &mut st,
+        &StaticOptions {
+            load_steps: 1,
+            omega: rot,
+            ..Default::default()
+        },
+        |_, _, _, _| {},
+    )
+    .map_err(|e| anyhow::anyhow!("equilibrium at {omega} rad/s: {e}"))?;
+    let ms = modes(
+        &mut model,
+        &st,
+        &ModalOptions {
+            n_modes: count,
+            omega: rot,
+            // a free hinge at rest leaves K singular: shift-invert about s = 1/s (docs/rotor_deck.md)
+            shift_rad_s: MODAL_SHIFT_RAD_S,
+        },
+    )?;
+    Ok((model, ms))
+}
+
+/// Model node ids of the blade nodes, root to tip.
+pub fn blade_node_ids(spec: &HingedSpec, model: &Model) -> anyhow::Result<Vec<usize>> {
+    spec.blade_nodes()
+        .iter()
+        .map(|(n, _)| Ok(model.node_id(n)?))
+        .collect()
+}
+
+/// Fan plot at the speed fractions of the nominal Omega.
+pub fn fan(
+    spec: &HingedSpec,
+    file: &Path,
+    fractions: &[f64],
+    count: usize,
+) -> anyhow::Result<Vec<HingedFanPoint>> {
+    let mut out = vec![];
+    for &x in fractions {
+        if !(x.is_finite() && x >= 0.0) {
+            anyhow::bail!("speed fraction {x} must be finite and non-negative");
+        }
+        let om = x * spec.rotor.omega_rad_s;
+        let (model, ms) = modes_at(spec, file, om, count)
+            .map_err(|e| anyhow::anyhow!("{} at {x} x Omega: {e}", file.display()))?;
+        let ids = blade_node_ids(spec, &model)?;
+        let (hz, zeta) = track(&ms, &ids);
+        out.push(HingedFanPoint {
+            fraction: x,
+            omega_rad_s: om,
+            modes: ms,
+            tracked_hz: hz,
+            tracked_zeta: zeta,
+        });
+    }
+    Ok(out)
+}
+
+/// One reference row: rotor speed [rpm] and the frequencies of [`TRACKED`] [Hz] (NaN: blank).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceRow {
+    pub rpm: f64,
+    pub hz: [f64; 7],
+}
+
+/// Read a reference table: `#` lines are comments; header `rpm` and `NAME_Hz` for the names of
+/// [`TRACKED`] (any order, all required).
+pub fn read_reference(path: &Path) -> anyhow::Result<Vec<ReferenceRow>> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow::anyhow!("reference table {file}: cannot read: {e}"))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (_, head) = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("reference table {file}: no header"))?;
+    let head: Vec<&str> = head.split(',').map(str::trim).collect();
+    let col = |n: &str| {
+        head.iter().position(|h| *h == n).ok_or_else(|| {
+            anyhow::anyhow!("reference table {file}: no column `{n}` (header {head:?})")
+        })
+    };
+    let c_rpm = col("rpm")?;
+    let cols: Vec<usize> = TRACKED
+        .iter()
+        .map(|t| col(&format!("{t}_Hz")))
+        .collect::<Result<_, _>>()?;
+    let mut rows = vec![];
+    for (i, l) in lines {
+        let v: Vec<&str> = l.split(',').map(str::trim).collect();
+        let get = |c: usize| -> anyhow::Result<f64> {
+            v.get(c).and_then(|s| s.parse::<f64>().ok()).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "reference table {file}, line {}: expected a number in column {}",
+                    i + 1,
+                    head[c]
+                )
+            })
+        };
+        let mut hz = [f64::NAN; 7];
+        for (k, &c) in cols.iter().enumerate() {
+            hz[k] = get(c)?;
+        }
+        rows.push(ReferenceRow {
+            rpm: get(c_rpm)?,
+            hz,
+        });
+    }
+    Ok(rows)
+}
+
+impl HingedSpec {
+    /// The deck's reference table path (relative to the deck's folder), if any.
+    pub fn reference_path(&self, deck: &Path) -> Option<PathBuf> {
+        self.fan_reference
+            .as_ref()
+            .map(|r| deck.parent().unwrap_or(Path::new("")).join(&r.csv))
+    }
+}
+
+/// Options of the free-decay run.
+#[derive(Clone, Copy, Debug)]
+pub struct DecayOptions {
+    /// Rotor speed [rad/s].
+    pub omega_rad_s: f64,
+    /// Static lag moment [N m] (positive aft) that displaces the blade before the release.
+    pub release_moment_nm: f64,
+    /// Release: the moment ramps linearly to zero over this time [s] (a step release would
+    /// depend on the integrator's convention for the initial acceleration).
+    pub release_time_s: f64,
+    pub time_step_s: f64,
+    pub rho_inf: f64,
+    pub newton: NewtonMethod,
+    pub newton_rtol: f64,
+    /// March in the frame turning with the shaft (hub clamped, centrifugal and Coriolis terms
+    /// in the kinematics) instead of the inertial frame with the hub driven.
+    pub rotating_frame: bool,
+}
+
+/// Free decay of the lag hinge: the blade in rotating equilibrium under a static lag moment,
+/// ramped off (`release_time_s`) and marched by the generalized-alpha solver (full nonlinear
+/// model; inertial frame with the shaft driven at Omega, or the frame turning with it).
+pub struct DecaySim {
+    pub solver: DynamicSolver,
+    lag: usize,
+    /// Lag angle at the unloaded rotating equilibrium [rad].
+    pub lag_eq_rad: f64,
+}
+
+fn joint_angle(m: &Model, id: usize) -> f64 {
+    match &m.elements[id] {
+        Element::Joint(j) => j.angle_prev,
+        _ => f64::NAN,
+    }
+}
+
+impl DecaySim {
+    /// The initial lag angle is the displaced equilibrium's ([`DecaySim::lag_angle_rad`]
+    /// before the first step).
+    pub fn new(spec: &HingedSpec, file: &Path, opts: &DecayOptions) -> anyhow::Result<Self> {
+        let om = opts.omega_rad_s;
+        let rot = Some([0.0, 0.0, om]);
+        let sopts = StaticOptions {
+            load_steps: 1,
+            omega: rot,
+            ..Default::default()
+        };
+        // unloaded equilibrium: the lag angle the decay settles to
+        let rf = opts.rotating_frame;
+        let mut m0 = expanded_model(
+            spec,
+            &HingedExpand {
+                omega_rad_s: Some(om),
+                hub_clamped: rf,
+                ..Default::default()
+            },
+            file,
+        )?;
+        let mut s0 = State::from_model(&m0);
+        static_solve(&mut m0, &mut s0, &sopts, |_, _, _, _| {})
+            .map_err(|e| anyhow::anyhow!("unloaded equilibrium at {om} rad/s: {e}"))?;
+        let lag0 = m0
+            .element_id("lag")
+            .ok_or_else(|| anyhow::anyhow!("{}: no lag hinge", file.display()))?;
+        let lag_eq_rad = joint_angle(&m0, lag0);
+        let mut model = expanded_model(
+            spec,
+            &HingedExpand {
+                omega_rad_s: Some(om),
+                lag_release_moment_nm: opts.release_moment_nm,
+                lag_release_time_s: opts.release_time_s,
+                time_step_s: Some(opts.time_step_s),
+                hub_clamped: rf,
+                ..Default::default()
+            },
+            file,
+        )?;
+        let lag = model
+            .element_id("lag")
+            .ok_or_else(|| anyhow::anyhow!("{}: no lag hinge", file.display()))?;
+        let mut st = State::from_model(&model);
+        static_solve(&mut model, &mut st, &sopts, |_, _, _, _| {})
+            .map_err(|e| anyhow::anyhow!("displaced equilibrium at {om} rad/s: {e}"))?;
+        if rf {
+            // at rest in the turning frame: relative velocities and accelerations zero (the
+            // static equilibrium holds at t = 0, so these are the consistent initial values)
+            for v in [&mut st.v, &mut st.w, &mut st.a, &mut st.al] {
+                v.iter_mut().for_each(|x| *x = [0.0; 3]);
+            }
+        }
+        let mut solver = DynamicSolver::new(model, st, opts.time_step_s, opts.rho_inf)?;
+        solver.newton.method = opts.newton;
+        solver.newton.rtol = opts.newton_rtol;
+        if rf {
+            solver.frame_omega = Some([0.0, 0.0, om]);
+        } else {
+            solver.init_accelerations()?;
+        }
+        Ok(DecaySim {
+            solver,
+            lag,
+            lag_eq_rad,
+        })
+    }
+
+    /// Lag hinge angle [rad] (positive aft) at the last converged step.
+    pub fn lag_angle_rad(&self) -> f64 {
+        joint_angle(&self.solver.model, self.lag)
+    }
+
+    pub fn step(&mut self) -> anyhow::Result<()> {
+        self.solver
+            .step()
+            .map_err(|e| anyhow::anyhow!("free decay: {e}"))?;
+        Ok(())
+    }
+}
+
+/// Damped frequency [Hz] and damping ratio of a uniformly sampled decay `x` (time step `h`):
+/// Levenberg-Marquardt least-squares fit of `x(t) = c + exp(-sigma t) (a cos(w t) + b sin(w t))`
+/// (5 parameters, analytic Jacobian) started from `guess = (Hz, zeta)` (e.g. the log
+/// decrement's); `zeta = sigma / sqrt(sigma^2 + w^2)`. Faster components (elastic modes still
+/// ringing) are residuals, not bias. None when the fit fails.
+pub fn fit_damped_sine(x: &[f64], h: f64, guess: (f64, f64)) -> Option<(f64, f64)> {
+    use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+    use nalgebra::{DMatrix, DVector, Dyn, Owned};
+    struct P<'a> {
+        x: &'a [f64],
+        h: f64,
+        p: DVector<f64>,
+    }
+    impl LeastSquaresProblem<f64, Dyn, Dyn> for P<'_> {
+        type ResidualStorage = Owned<f64, Dyn>;
+        type JacobianStorage = Owned<f64, Dyn, Dyn>;
+        type ParameterStorage = Owned<f64, Dyn>;
+        fn set_params(&mut self, p: &DVector<f64>) {
+            self.p.copy_from(p);
+        }
+        fn params(&self) -> DVector<f64> {
+            self.p.clone()
+        }
+        fn residuals(&self) -> Option<DVector<f64>> {
+            let [c, a, b, sg, w] = [self.p[0], self.p[1], self.p[2], self.p[3], self.p[4]];
+            Some(DVector::from_iterator(
+                self.x.len(),
+                self.x.iter().enumerate().map(|(k, &v)| {
+                    let t = k as f64 * self.h;
+                    let (sn, cs) = (w * t).sin_cos();
+                    c + (-sg * t).exp() * (a * cs + b * sn) - v
+                }),
+            ))
+        }
+        fn jacobian(&self) -> Option<DMatrix<f64>> {
+            let [_, a, b, sg, w] = [self.p[0], self.p[1], self.p[2], self.p[3], self.p[4]];
+            let mut j = DMatrix::zeros(self.x.len(), 5);
+            for k in 0..self.x.len() {
+                let t = k as f64 * self.h;
+                let (sn, cs) = (w * t).sin_cos();
+                let e = (-sg * t).exp();
+                j[(k, 0)] = 1.0;
+                j[(k, 1)] = e * cs;
+                j[(k, 2)] = e * sn;
+                j[(k, 3)] = -t * e * (a * cs + b * sn);
+                j[(k, 4)] = t * e * (-a * sn + b * cs);
+            }
+            Some(j)
+        }
+    }
+    if x.len() < 8 || guess.0.is_nan() || guess.0 <= 0.0 {
+        return None;
+    }
+    let w0 = 2.0 * std::f64::consts::PI * guess.0;
+    let sg0 = guess.1 * w0 / (1.0 - guess.1 * guess.1).max(1e-12).sqrt();
+    let c0 = x.iter().sum::<f64>() / x.len() as f64;
+    let p0 = DVector::from_vec(vec![c0, x[0] - c0, 0.0, sg0, w0]);
+    let (pb, report) = LevenbergMarquardt::new()
+        .with_xtol(1e-12)
+        .with_ftol(1e-14)
+        .minimize(P { x, h, p: p0 });
+    if !report.termination.was_successful() {
+        return None;
+    }
+    let (sg, w) = (pb.p[3], pb.p[4]);
+    Some((
+        w / (2.0 * std::f64::consts::PI),
+        sg / (sg * sg + w * w).sqrt(),
+    ))
+}
+
+/// Damped frequency [Hz] and damping ratio from the peaks of `x - x_eq` (logarithmic
+/// decrement over the peaks found, parabolic interpolation of each peak): the cross-check of
+/// [`fit_damped_sine`]. None with fewer than three peaks.
+pub fn log_decrement(x: &[f64], x_eq: f64, h: f64) -> Option<(f64, f64)> {
+    let mut peaks = vec![];
+    for k in 1..x.len().saturating_sub(1) {
+        let (a, b, c) = (x[k - 1] - x_eq, x[k] - x_eq, x[k + 1] - x_eq);
+        if b > 0.0 && b >= a && b > c {
+            // parabola through the three samples
+            let den = a - 2.0 * b + c;
+            let d = if den != 0.0 { 0.5 * (a - c) / den } else { 0.0 };
+            let t = (k as f64 + d) * h;
+            let v = b - 0.25 * (a - c) * d;
+            peaks.push((t, v));
+        }
+    }
+    if peaks.len() < 3 {
+        return None;
+    }
+    let n = peaks.len() - 1;
+    let (t0, v0) = peaks[0];
+    let (tn, vn) = peaks[n];
+    let period = (tn - t0) / n as f64;
+    let delta = (v0 / vn).ln() / n as f64;
+    let zeta = delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt();
+    Some((1.0 / period, zeta))
+}
