@@ -372,27 +372,21 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     // fan.svg
     let x: Vec<f64> = pts.iter().map(|p| p.fraction).collect();
     let mut plot = crate::report::plot::Plot::new(
-        "UH-60A fan plot: model (lines) and digitized reference (points, Bowen-Davies 2015)",
+        "UH-60A fan plot: model (lines) and digitized reference (points in the colour of their mode, Bowen-Davies 2015)",
         "rotor speed Omega / Omega_nominal [-]",
         "frequency [Hz]",
     );
     for (k, t) in TRACKED.iter().enumerate() {
         let y: Vec<f64> = pts.iter().map(|p| p.tracked_hz[k]).collect();
-        plot = plot.line(&format!("model {t}"), &x, &y);
-    }
-    if let Some(rf) = &reference {
-        let rx: Vec<f64> = rf.iter().map(|r| r.0).collect();
-        for (k, t) in TRACKED.iter().enumerate() {
+        plot = plot.line(t, &x, &y);
+        if let Some(rf) = &reference {
+            let rx: Vec<f64> = rf.iter().map(|r| r.0).collect();
             let ry: Vec<f64> = rf.iter().map(|r| r.1[k]).collect();
-            plot = plot.points(&format!("reference {t}"), &rx, &ry);
+            plot = plot.points("", &rx, &ry);
         }
     }
     let xmax = x.iter().cloned().fold(0.0, f64::max).max(1e-3);
-    for n in 1..=6 {
-        let xx = [0.0, xmax];
-        let yy = [0.0, n as f64 * xmax * om_n / (2.0 * std::f64::consts::PI)];
-        plot = plot.dashed(&format!("{n}/rev"), &xx, &yy);
-    }
+    plot = per_rev_lines(plot, xmax, xmax * om_n / (2.0 * std::f64::consts::PI));
     out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
     out.finish()?;
     outln!("wrote {}", args.out.display());
@@ -406,7 +400,6 @@ fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     use crate::rotor::hinged::{fan, read_reference, HingedSpec, TRACKED};
     let spec = HingedSpec::from_file(path)?;
     let mut fractions = parse_speeds(&args.speeds)?;
-    let om_n = spec.rotor.omega_rad_s;
     let rpm_n = spec.rpm();
     let mut inputs = vec![path.to_path_buf()];
     let ref_path = args.reference.clone().or_else(|| spec.reference_path(path));
@@ -531,10 +524,11 @@ fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     }
     let x: Vec<f64> = pts.iter().map(|p| rpm(p.fraction)).collect();
     let mut plot = crate::report::plot::Plot::new(
-        &format!("Fan plot: model (lines) and {label} (points)"),
+        &format!("Fan plot: model (lines) and {label} (points, in the colour of their mode)"),
         "rotor speed [rpm]",
         "frequency [Hz]",
     );
+    let xmax = x.iter().cloned().fold(0.0, f64::max).max(1e-3);
     for (k, t) in TRACKED.iter().enumerate() {
         let (xs, ys): (Vec<f64>, Vec<f64>) = pts
             .iter()
@@ -542,24 +536,31 @@ fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
             .filter(|(p, _)| p.tracked_hz[k].is_finite())
             .map(|(p, x)| (*x, p.tracked_hz[k]))
             .unzip();
-        plot = plot.line(&format!("model {t}"), &xs, &ys);
-    }
-    if let Some(rf) = &reference {
-        let rx: Vec<f64> = rf.iter().map(|r| r.rpm).collect();
-        for (k, t) in TRACKED.iter().enumerate() {
+        plot = plot.line(t, &xs, &ys);
+        if let Some(rf) = &reference {
+            let rx: Vec<f64> = rf.iter().map(|r| r.rpm).collect();
             let ry: Vec<f64> = rf.iter().map(|r| r.hz[k]).collect();
-            plot = plot.points(&format!("{label}: {t}"), &rx, &ry);
+            // unnamed: drawn in its mode's colour, no legend entry of its own
+            plot = plot.points("", &rx, &ry);
         }
     }
-    let xmax = x.iter().cloned().fold(0.0, f64::max).max(1e-3);
-    for n in 1..=6 {
-        let xx = [0.0, xmax];
-        let yy = [0.0, n as f64 * xmax / 60.0];
-        plot = plot.dashed(&format!("{n}/rev"), &xx, &yy);
-    }
-    let _ = om_n;
+    plot = per_rev_lines(plot, xmax, xmax / 60.0);
     out.write("fan.svg", plot.to_svg(1000, 700)?.as_bytes())?;
     out.finish()?;
     outln!("wrote {}", args.out.display());
     Ok(())
+}
+
+/// The 1/rev..6/rev lines of a fan plot, from the origin to (`xmax`, n `f1`), `f1` the 1/rev
+/// frequency [Hz] at `xmax`: one grey legend entry, the lines read by their slope.
+fn per_rev_lines(
+    mut plot: crate::report::plot::Plot,
+    xmax: f64,
+    f1: f64,
+) -> crate::report::plot::Plot {
+    for n in 1..=6 {
+        let name = if n == 1 { "1/rev to 6/rev" } else { "" };
+        plot = plot.dashed(name, &[0.0, xmax], &[0.0, n as f64 * f1]);
+    }
+    plot
 }

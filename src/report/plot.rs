@@ -38,13 +38,15 @@ pub const MODEL_COLOURS: [(&str, RGBColor); 4] = [
 ];
 
 /// Colours of series that are not a damper model (limits, channels, amplitudes), in turn.
-pub const OTHER_COLOURS: [RGBColor; 6] = [
+pub const OTHER_COLOURS: [RGBColor; 8] = [
     RGBColor(214, 39, 40),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
     RGBColor(23, 190, 207),
+    RGBColor(188, 189, 34),
+    RGBColor(0, 0, 128),
 ];
 
 /// The fixed colour of the damper model a series name refers to: the first word of the name
@@ -288,6 +290,8 @@ impl Plot {
         for s in &self.series {
             let c = match (s.name.is_empty(), out.last()) {
                 (true, Some(&prev)) => prev,
+                // per-rev reference lines of a fan plot: background grey
+                _ if s.name.ends_with("/rev") => RGBColor(170, 170, 170),
                 _ => model_colour(&s.name).unwrap_or_else(|| {
                     let c = OTHER_COLOURS[k % OTHER_COLOURS.len()];
                     k += 1;
