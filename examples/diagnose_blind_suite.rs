@@ -2,6 +2,7 @@
 //! independent truth model, diagnosed, scored; one CSV row per campaign as it finishes, then the
 //! rates.
 //! `cargo run --release --example diagnose_blind_suite -- [OUT.csv] [CYCLES] [RATE_HZ] [ID_PREFIX...]`
+//! `cargo run --release --example diagnose_blind_suite -- --effect-size` (effect vs noise only)
 //! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns).
 #[path = "../tests/blind_support/mod.rs"]
 mod blind;
@@ -15,6 +16,15 @@ use std::time::Instant;
 
 fn main() -> anyhow::Result<()> {
     let a: Vec<String> = std::env::args().collect();
+    if a.get(1).map(String::as_str) == Some("--effect-size") {
+        // Effect size only (no diagnosis): RMS of the effect, noise sigma, best reachable gain.
+        println!("id,hidden,effect_rms_N,noise_sigma_N,best_gain");
+        for cp in blind::suite() {
+            let (r, s, g) = blind::effect_size(&cp, 4, 2000.0).map_err(anyhow::Error::msg)?;
+            println!("{},{},{r:.1},{s:.1},{g:.3}", cp.id, cp.hidden());
+        }
+        return Ok(());
+    }
     let out = PathBuf::from(
         a.get(1)
             .cloned()

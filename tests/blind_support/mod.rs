@@ -801,3 +801,41 @@ pub fn rates(rows: &[(Campaign, Score)]) -> String {
         Rates::of(&flight)
     )
 }
+
+/// Size of the hidden effect against the noise: the RMS difference of the noise-free truth
+/// with and without the effect over every test after its first cycle, the noise sigma (1% of
+/// the peak), and the held-out gain a perfect model could reach, `1 - sigma/sqrt(sigma^2 + r^2)`
+/// (the baseline's residual is effect plus noise, a perfect model's the noise alone).
+pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f64, f64), String> {
+    let with = cp.truth();
+    let without = Truth::new(Sheet::nominal());
+    let mut tests = Vec::new();
+    if cp.flight {
+        let stroke = flight_stroke();
+        let period = stroke.period();
+        let t: Vec<f64> = (0..FLIGHT_REVS * FLIGHT_AZIMUTHS)
+            .map(|i| 2.0 * period + period * i as f64 / FLIGHT_AZIMUTHS as f64)
+            .collect();
+        tests.push((stroke, t, FLIGHT_AZIMUTHS));
+    } else {
+        for (_, stroke, cyc) in bench_tests(cycles) {
+            let period = stroke.period();
+            let n = (cyc as f64 * period * rate_hz).round() as usize + 1;
+            let t: Vec<f64> = (0..n).map(|k| k as f64 / rate_hz).collect();
+            tests.push((stroke, t, (period * rate_hz).round() as usize));
+        }
+    }
+    let (mut ss, mut count, mut peak) = (0.0, 0usize, 0.0f64);
+    for (stroke, t, per_cycle) in &tests {
+        let a = force_at(&with, stroke, t, Tolerance::default())?;
+        let b = force_at(&without, stroke, t, Tolerance::default())?;
+        peak = a.iter().fold(peak, |p, f| p.max(f.abs()));
+        for (x, y) in a.iter().zip(&b).skip(*per_cycle) {
+            ss += (x - y).powi(2);
+            count += 1;
+        }
+    }
+    let r = (ss / count.max(1) as f64).sqrt();
+    let sigma = 0.01 * peak;
+    Ok((r, sigma, 1.0 - sigma / (sigma * sigma + r * r).sqrt()))
+}
