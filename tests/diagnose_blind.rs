@@ -1,0 +1,338 @@
+//! Blind suite, CI part: the independent truth model against analytic limits and against
+//! rotorsim's nominal damper, and a small subset of the blind campaigns diagnosed with the rates
+//! the full suite is judged by (docs/diagnosis.md "Blind suite"; the full suite is
+//! `cargo run --release --example diagnose_blind_suite`).
+mod blind_support;
+use blind_support::truth::{force_at, Integrator, Sheet, Stroke, Tolerance, Truth};
+use blind_support::*;
+use rotorsim::diagnose::fit::simulate;
+use rotorsim::diagnose::rotor::flight_measurement;
+use rotorsim::diagnose::{diagnose, DiagnoseOptions, Measurement};
+use rotorsim::flight::FlightRecord;
+use rotorsim::hydraulics::DamperDeck;
+use std::path::Path;
+
+fn nominal_deck() -> DamperDeck {
+    DamperDeck::from_file(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/flightdata/damper_nominal.toml"
+    )))
+    .unwrap()
+}
+
+/// Pressure of a sealed chamber whose volume went from `v0` to `v`, mixture with air fraction
+/// `x` at `p_ref`: `(1-x) v0 c(p_ref)/c(p) + x v0 p_ref/p = v`, solved by bisection.
+fn sealed_pressure(s: &Sheet, x: f64, p_ref: f64, v0: f64, v: f64) -> f64 {
+    let c = |p: f64| 1.0 + s.alpha * p + s.beta * p * p;
+    let vol = |p: f64| (1.0 - x) * v0 * c(p_ref) / c(p) + x * v0 * p_ref / p;
+    let (mut lo, mut hi) = (1.0e5, 1.0e9);
+    for _ in 0..200 {
+        let m = 0.5 * (lo + hi);
+        if vol(m) > v {
+            lo = m
+        } else {
+            hi = m
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+fn sealed(mut s: Sheet) -> Sheet {
+    s.a_orf = 0.0;
+    s.a_check = 0.0;
+    for r in &mut s.relief {
+        r.f_p = 1e9;
+    }
+    s
+}
+
+#[test]
+fn truth_sealed_chambers_follow_the_bulk_law_with_and_without_air() {
+    for (beta, air) in [(0.0, 0.0), (2.0e-19, 0.0), (0.0, 0.02)] {
+        let mut s = sealed(Sheet::nominal());
+        s.p_s = 3.0e7; // high enough that neither chamber nears cavitation
+        s.beta = beta;
+        let mut t = Truth::new(s.clone());
+        t.air = [air, air];
+        let amp = 2.0e-4;
+        let stroke = Stroke::harmonic(27.02, amp);
+        let t_end = stroke.period() / 4.0; // d = amp
+        let mut it = Integrator::new(&t, &stroke, Tolerance::default());
+        it.advance(t_end).unwrap();
+        let p0 = sealed_pressure(&s, air, s.p_s, s.volume[0], s.volume[0] + s.area[0] * amp);
+        let p1 = sealed_pressure(&s, air, s.p_s, s.volume[1], s.volume[1] - s.area[1] * amp);
+        let e0 = (it.y[0] - p0).abs() / p0;
+        let e1 = (it.y[1] - p1).abs() / p1;
+        assert!(
+            e0 < 1e-6 && e1 < 1e-6,
+            "beta {beta} air {air}: p0 {} vs {p0}, p1 {} vs {p1}",
+            it.y[0],
+            it.y[1]
+        );
+    }
+}
+
+#[test]
+fn truth_orifice_gives_the_incompressible_law_at_low_frequency() {
+    // Relief valves shut (preload 1e9 N): the force at peak velocity is A (rho/2)(A v/(Cd A_orf))^2.
+    let mut s = Sheet::nominal();
+    for r in &mut s.relief {
+        r.f_p = 1e9;
+    }
+    let t = Truth::new(s.clone());
+    let (w, amp) = (5.0, 0.01);
+    let stroke = Stroke::harmonic(w, amp);
+    let period = stroke.period();
+    let times: Vec<f64> = (0..3).map(|k| (1.0 + k as f64 * 0.5) * period).collect();
+    let f = force_at(&t, &stroke, &times, Tolerance::default()).unwrap();
+    let v = w * amp;
+    let q = s.area[0] * v;
+    let dp = 0.5 * s.rho * (q / (s.cd * s.a_orf)).powi(2);
+    let expect = s.area[0] * dp;
+    for (k, fk) in f.iter().enumerate() {
+        // at t = n T/2 the velocity is +-v: the force opposes it
+        let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+        let rel = (fk - sign * expect).abs() / expect;
+        assert!(
+            rel < 5e-3,
+            "sample {k}: {fk} N vs {} N ({rel:.2e})",
+            sign * expect
+        );
+    }
+}
+
+#[test]
+fn truth_leakage_of_a_sealed_pair_decays_exponentially() {
+    let s = sealed(Sheet::nominal());
+    let mut t = Truth::new(s.clone());
+    let k = 1.0e-11;
+    t.leak = Some(blind_support::truth::Leak { k, couette: 0.0 });
+    let stroke = Stroke::harmonic(27.02, 0.0);
+    let mut it = Integrator::new(&t, &stroke, Tolerance::default());
+    let dp0 = 1.0e5;
+    it.y[0] = s.p_s + dp0;
+    // B at the mean pressure (Eq. 3, beta = 0)
+    let pm = s.p_s + 0.5 * dp0;
+    let b = (1.0 + s.alpha * pm) / s.alpha;
+    let tau = 1.0 / (k * b * (1.0 / s.volume[0] + 1.0 / s.volume[1]));
+    it.advance(tau).unwrap();
+    let dp = it.y[0] - it.y[1];
+    let expect = dp0 * (-1.0f64).exp();
+    assert!((dp - expect).abs() / expect < 2e-3, "{dp} vs {expect}");
+}
+
+#[test]
+fn truth_integrator_converges_with_its_tolerance() {
+    // 8 in/s harmonic with relief valves opening, a compliant gap and friction: every
+    // nonsmooth part of the truth model.
+    let cp = Campaign {
+        id: "conv".into(),
+        effects: vec![
+            Effect::CompliantFreePlay(0.1e-3, 2e8),
+            Effect::SealFriction(400.0),
+        ],
+        seed: 1,
+        flight: false,
+    };
+    let t = cp.truth();
+    let stroke = Stroke::harmonic(27.02, 8.0 * 0.0254 / 27.02);
+    let times: Vec<f64> = (0..930).map(|k| k as f64 * 5e-4).collect();
+    let run = |rtol: f64, atol: f64| {
+        force_at(
+            &t,
+            &stroke,
+            &times,
+            Tolerance {
+                rtol,
+                atol_pa: atol,
+            },
+        )
+        .unwrap()
+    };
+    let reference = run(1e-10, 0.01);
+    let diff = |a: &[f64]| {
+        a.iter()
+            .zip(&reference)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    let loose = diff(&run(1e-5, 1000.0));
+    let default = diff(&run(1e-7, 10.0));
+    let peak = reference.iter().fold(0.0f64, |a, f| a.max(f.abs()));
+    eprintln!("peak {peak:.0} N, max difference to rtol 1e-10: rtol 1e-5 {loose:.3} N, default {default:.4} N");
+    assert!(default < loose, "tighter tolerance must be closer");
+    // The truth must be exact far below the 1% noise: within 0.1% of the peak.
+    assert!(
+        default < 1e-3 * peak,
+        "default tolerance within 1e-3 of the peak: {default} N"
+    );
+}
+
+/// Peak forces over the last cycle of a harmonic test: (min, max).
+fn last_cycle_peaks(f: &[f64], per_cycle: usize) -> (f64, f64) {
+    let last = &f[f.len() - per_cycle..];
+    last.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        })
+}
+
+#[test]
+fn truth_agrees_with_rotorsims_nominal_damper_in_physics() {
+    // The two models share the data sheet, not code: peak forces on the bench's harmonic tests
+    // agree within a few percent, the histories within a few percent of the peak.
+    let deck = nominal_deck();
+    let t = Truth::new(Sheet::nominal());
+    let rate = 4000.0;
+    let mut worst_peak: f64 = 0.0;
+    let mut worst_rms: f64 = 0.0;
+    for &v in &HARMONIC_IN_S {
+        let stroke = Stroke::harmonic(OMEGA, v * 0.0254 / OMEGA);
+        let period = stroke.period();
+        let n = (5.0 * period * rate).round() as usize + 1;
+        let time_s: Vec<f64> = (0..n).map(|k| k as f64 / rate).collect();
+        let (d, vel): (Vec<f64>, Vec<f64>) = time_s.iter().map(|&t| stroke.at(t)).unzip();
+        let truth = force_at(&t, &stroke, &time_s, Tolerance::default()).unwrap();
+        let m = Measurement {
+            name: "h".into(),
+            time_s: time_s.clone(),
+            stroke_m: d,
+            force_n: vec![0.0; n],
+            velocity_m_s: vel,
+            period_s: period,
+        };
+        let mut model = Vec::new();
+        simulate(&deck, &m, n, 1e-5, &mut model).unwrap();
+        let pc = (period * rate).round() as usize;
+        let (a0, b0) = last_cycle_peaks(&truth, pc);
+        let (a1, b1) = last_cycle_peaks(&model, pc);
+        let pk = b1.max(-a1);
+        let dpk = ((a0 - a1).abs().max((b0 - b1).abs())) / pk;
+        let rms = (truth[n - pc..]
+            .iter()
+            .zip(&model[n - pc..])
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            / pc as f64)
+            .sqrt()
+            / pk;
+        eprintln!("{v} in/s: truth [{a0:.0}, {b0:.0}] N, rotorsim [{a1:.0}, {b1:.0}] N; peak difference {:.2}%, RMS difference {:.2}% of peak", 100.0 * dpk, 100.0 * rms);
+        worst_peak = worst_peak.max(dpk);
+        worst_rms = worst_rms.max(rms);
+    }
+    assert!(
+        worst_peak < 0.03,
+        "peak forces differ by {:.2}%",
+        100.0 * worst_peak
+    );
+    assert!(
+        worst_rms < 0.05,
+        "histories differ by {:.2}% RMS",
+        100.0 * worst_rms
+    );
+}
+
+fn run_campaign(cp: &Campaign, cycles: usize, rate: f64) -> Score {
+    let data = if cp.flight {
+        let dir = std::env::temp_dir().join(format!("rotorsim_blind_ci_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let stem = dir.join(&cp.id);
+        write_flight_record(cp, &stem).unwrap();
+        let rec = FlightRecord::read(&stem).unwrap();
+        let m = flight_measurement(&rec, &stem, None).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        vec![m]
+    } else {
+        bench_campaign(cp, cycles, rate).unwrap()
+    };
+    let o = diagnose(&nominal_deck(), &data, &DiagnoseOptions::default()).unwrap();
+    score(cp, &o.diagnosis)
+}
+
+/// The CI subset, diagnosed once per test binary.
+fn subset_rows() -> &'static [(Campaign, Score)] {
+    static ROWS: std::sync::OnceLock<Vec<(Campaign, Score)>> = std::sync::OnceLock::new();
+    ROWS.get_or_init(|| {
+        let t0 = std::time::Instant::now();
+        let mut rows = Vec::new();
+        for cp in ci_subset() {
+            let s = run_campaign(&cp, 4, 2000.0);
+            eprintln!("{}", csv_row(&cp, &s, t0.elapsed().as_secs_f64()));
+            rows.push((cp, s));
+        }
+        eprintln!("{}", rates(&rows));
+        rows
+    })
+}
+
+#[test]
+fn blind_subset_names_the_hidden_effect_with_the_required_gain() {
+    let r = Rates::of(subset_rows());
+    assert!(r.exact_rate() >= 0.95, "{r}");
+    assert!(r.among_rate() >= 0.98, "{r}");
+    assert_eq!(r.none_on_no_effect, r.no_effect, "{r}");
+    assert!(r.min_gain_named >= 0.3, "{r}");
+}
+
+#[test]
+#[ignore = "fails with the diagnosis as it is: the 95% intervals cover 3 of 7 true parameters of the subset (docs/diagnosis.md, Blind suite); run with --ignored"]
+fn blind_subset_intervals_cover_the_truth() {
+    let r = Rates::of(subset_rows());
+    assert!(r.coverage() >= 0.9, "{r}");
+}
+
+#[test]
+fn truth_link_tends_to_the_librarys_quasi_static_gap_as_mass_and_damping_vanish() {
+    // The truth's free play (gap, contact stiffness, moving mass, contact damping) against the
+    // library's quasi-static compliant free play: they agree as the mass and the damping go to
+    // zero; the hardware values (1.5 kg, 5% of critical) are the model-form difference the
+    // blind suite measures.
+    use rotorsim::diagnose::Cause;
+    let (g, k) = (0.15e-3, 2.2e8);
+    let deck = Cause::CompliantFreePlay.apply(&nominal_deck(), &[g, k]);
+    let rate = 4000.0;
+    let stroke = Stroke::harmonic(OMEGA, 2.0 * 0.0254 / OMEGA);
+    let period = stroke.period();
+    let n = (4.0 * period * rate).round() as usize + 1;
+    let time_s: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+    let (d, vel): (Vec<f64>, Vec<f64>) = time_s.iter().map(|&t| stroke.at(t)).unzip();
+    let m = Measurement {
+        name: "h".into(),
+        time_s: time_s.clone(),
+        stroke_m: d,
+        force_n: vec![0.0; n],
+        velocity_m_s: vel,
+        period_s: period,
+    };
+    let mut lib = Vec::new();
+    simulate(&deck, &m, n, 1e-5, &mut lib).unwrap();
+    let pc = (period * rate).round() as usize;
+    let peak = lib[n - pc..].iter().fold(0.0f64, |a, f| a.max(f.abs()));
+    let rms_diff = |mass: f64, zeta: f64| {
+        let mut t = Truth::new(Sheet::nominal());
+        t.link = Some(blind_support::truth::Link {
+            gap: g,
+            k,
+            c: 2.0 * zeta * (k * mass).sqrt(),
+            mass,
+        });
+        let f = force_at(&t, &stroke, &time_s, Tolerance::default()).unwrap();
+        (f[n - pc..]
+            .iter()
+            .zip(&lib[n - pc..])
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            / pc as f64)
+            .sqrt()
+            / peak
+    };
+    let hardware = rms_diff(blind_support::truth::LINK_MASS_KG, 0.05);
+    let light = rms_diff(0.01, 0.0);
+    eprintln!(
+        "RMS difference to the library's element, % of peak: hardware link {:.2}%, 10 g and undamped {:.2}%",
+        100.0 * hardware,
+        100.0 * light
+    );
+    assert!(light < hardware, "the limit must be closer");
+    assert!(light < 0.01, "light link within 1% of the peak: {light}");
+}
