@@ -829,8 +829,17 @@ pub fn diagnose(
                         });
                         continue;
                     }
-                    for (p, x) in spec.iter_mut().zip(x1.iter().chain(&e.3)) {
-                        p.starts = vec![*x];
+                    // The best single at its fitted value; the companion from its own
+                    // single-cause fit and its starting grid (scouted like a single cause's).
+                    let k1 = x1.len();
+                    for (i, p) in spec.iter_mut().enumerate() {
+                        if i < k1 {
+                            p.starts = vec![x1[i]];
+                        } else if let Some(&x) = e.3.get(i - k1) {
+                            if !p.starts.iter().any(|s| (s / x - 1.0).abs() < 1e-3) {
+                                p.starts.insert(0, x);
+                            }
+                        }
                     }
                     pairs.push((vec![c1, c2], spec));
                 }
