@@ -563,3 +563,75 @@ fn compliant_free_play_balances_the_link_force() {
     assert!(worst <= 1.0, "largest force mismatch {worst} N");
     assert!(open > 10, "{open} steps with the gap open");
 }
+
+/// Checks a device's analytic tangent `dF_m/dd_f` against a central difference of `F_m` (trial
+/// steps restart from the committed state) at every 4th step of two harmonic cycles; steps
+/// whose `d_f +- h` straddle a kink (gap closing, tangent changing) are skipped. The link solves
+/// stop at a force mismatch of 0.1 N, which bounds the difference's error by 0.2 N / (2 h).
+/// The relative 1e-4 is the central difference's truncation on the dashpot tables (h^2 terms).
+/// Returns (steps checked in contact, steps checked inside the gap).
+fn check_tangent(dev: &mut dyn Device, label: &str) -> (usize, usize) {
+    let (a, w, n) = (2.0e-3, 27.02, 512);
+    let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+    let h = 1.0e-6;
+    let (mut contact, mut open) = (0, 0);
+    for i in 0..2 * n {
+        let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+        let (d0, d1) = (a * (w * t0).sin(), a * (w * t1).sin());
+        if i % 4 == 0 && i > n / 4 {
+            let p = dev.trial_step(t0, dt, d0, d1 + h).unwrap();
+            let m = dev.trial_step(t0, dt, d0, d1 - h).unwrap();
+            let s = dev.trial_step(t0, dt, d0, d1).unwrap();
+            let an = s.dforce_dstroke;
+            // Same piece on both sides: the gap open (tangent exactly 0) or closed on all three.
+            let same = |x: f64| (x == 0.0) == (an == 0.0) && (x - an).abs() <= 0.01 * an.abs();
+            if same(p.dforce_dstroke) && same(m.dforce_dstroke) {
+                let fd = (p.force_mean - m.force_mean) / (2.0 * h);
+                assert!(
+                    (fd - an).abs() <= 1e-4 * an.abs() + 0.2 / (2.0 * h),
+                    "{label}, step {i}: analytic {an:e} vs FD {fd:e} N/m"
+                );
+                if an == 0.0 {
+                    open += 1;
+                } else {
+                    contact += 1;
+                }
+            }
+        }
+        dev.trial_step(t0, dt, d0, d1).unwrap();
+        dev.commit();
+    }
+    (contact, open)
+}
+
+/// The compliant free play's analytic tangent (contact spring k in series with the device's
+/// tangent, `-k k_d/(k + k_d)`; zero while the gap is open) against finite differences, on
+/// devices whose own tangent is exact and whose mean and end forces coincide (dashpots); the
+/// series mount's alike.
+#[test]
+fn compliant_free_play_tangent_matches_finite_differences() {
+    let table = || {
+        rotorsim::hydraulics::dashpot::MonotoneTable::new(
+            vec![0.0, 0.05, 0.2, 0.4],
+            vec![0.0, 5000.0, 12000.0, 14500.0],
+        )
+        .unwrap()
+    };
+    for k in [5.0e7, 1.0e9] {
+        let mut lin = CompliantFreePlay::new(Box::new(LinearDashpot::new(1.0e5)), 0.3e-3, k);
+        let (c, o) = check_tangent(&mut lin, &format!("linear dashpot, k {k:e}"));
+        assert!(
+            c > 50 && o > 10,
+            "linear: {c} steps in contact, {o} in the gap"
+        );
+        let mut nl = CompliantFreePlay::new(Box::new(NonlinearDashpot::new(table())), 0.3e-3, k);
+        let (c, o) = check_tangent(&mut nl, &format!("nonlinear dashpot, k {k:e}"));
+        assert!(
+            c > 50 && o > 10,
+            "nonlinear: {c} steps in contact, {o} in the gap"
+        );
+        let mut mount = SeriesMount::new(Box::new(NonlinearDashpot::new(table())), k);
+        let (c, o) = check_tangent(&mut mount, &format!("series mount, k {k:e}"));
+        assert!(c > 50 && o == 0, "mount: {c} steps checked");
+    }
+}

@@ -802,6 +802,16 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     for l in &d.limitations {
         outln!("limitation: {l}");
     }
+    for i in &d.identifiability {
+        outln!(
+            "not separable: {} ({}){}",
+            i.candidates.join(" vs "),
+            i.why,
+            i.deciding_test
+                .as_ref()
+                .map_or(String::new(), |t| format!("; to decide: {}", t.statement))
+        );
+    }
     if let Some(s) = &stroke_info {
         if s["kind"] == "simulated" {
             outln!("stroke: {}", s["statement"].as_str().unwrap_or_default());

@@ -247,3 +247,75 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
         _ => "no candidate beats the baseline by more than the noise-level threshold".to_string(),
     }
 }
+
+/// The residual signatures of one force series (measured, baseline or a candidate's
+/// prediction), each measured the same way so that a candidate's predicted signature stands
+/// beside the measured one (extra key `signatures`).
+#[derive(Debug, Clone, serde::Serialize, PartialEq)]
+#[allow(non_snake_case)]
+pub struct Signature {
+    /// `measured`, `baseline` or the candidate's cause.
+    pub source: String,
+    /// Time per force zero crossing within the dwell band, smallest-amplitude test [ms].
+    pub dwell_ms: f64,
+    /// Step of (force - baseline) across the velocity sign: compressing mean minus extending
+    /// mean, |v| above 20% of the peak velocity, all tests [N].
+    pub reversal_step_N: f64,
+    /// Lag of the force behind the baseline model that best aligns them (loop tilt),
+    /// smallest-amplitude test [ms].
+    pub lag_ms: f64,
+    /// |negative peak| / positive peak, largest-amplitude test.
+    pub peak_ratio: f64,
+    /// Mean force above 90% of the positive / below 90% of the negative peak (the relief-valve
+    /// plateaus), largest-amplitude test [N].
+    pub plateau_pos_N: f64,
+    pub plateau_neg_N: f64,
+}
+
+/// Signature of `force[test]` (same sample grid as `curves`).
+pub fn signature(curves: &[Curves], force: &[Vec<f64>], source: &str, band: f64) -> Signature {
+    let small = (0..curves.len()).min_by(|&a, &b| amp(&curves[a]).total_cmp(&amp(&curves[b])));
+    let large = (0..curves.len()).max_by(|&a, &b| amp(&curves[a]).total_cmp(&amp(&curves[b])));
+    let view = |i: usize| Curves {
+        measured_n: force[i].clone(),
+        ..curves[i].clone()
+    };
+    let (mut dwell_ms, mut lag_ms) = (f64::NAN, f64::NAN);
+    if let Some(i) = small {
+        let c = view(i);
+        let period = period_of(&c);
+        dwell_ms = 1e3 * dwell(&c, band, period).0;
+        let n = c.time_s.len();
+        let dt = (c.time_s[n - 1] - c.time_s[0]) / (n - 1) as f64;
+        lag_ms = best_lag(&c).map_or(f64::NAN, |(s, _, _)| 1e3 * s * dt);
+    }
+    let views: Vec<Curves> = (0..curves.len()).map(view).collect();
+    let (rp, rn) = velocity_sign_step(&views);
+    let (mut peak_ratio, mut plateau_pos, mut plateau_neg) = (f64::NAN, f64::NAN, f64::NAN);
+    if let Some(i) = large {
+        let f = &force[i][curves[i].from..];
+        let (mp, mn) = peaks(f);
+        peak_ratio = -mn / mp;
+        let mean = |it: Vec<f64>| it.iter().sum::<f64>() / it.len().max(1) as f64;
+        plateau_pos = mean(f.iter().copied().filter(|&x| x > 0.9 * mp).collect());
+        plateau_neg = mean(f.iter().copied().filter(|&x| x < 0.9 * mn).collect());
+    }
+    Signature {
+        source: source.to_string(),
+        dwell_ms,
+        reversal_step_N: rn - rp,
+        lag_ms,
+        peak_ratio,
+        plateau_pos_N: plateau_pos,
+        plateau_neg_N: plateau_neg,
+    }
+}
+
+/// Dwell band of the signatures: 3 noise sigma, at least 2% of the peak force (as the evidence).
+pub fn dwell_band(curves: &[Curves], sigma: f64) -> f64 {
+    let peak = curves
+        .iter()
+        .flat_map(|c| c.measured_n.iter())
+        .fold(0.0f64, |a, f| a.max(f.abs()));
+    (3.0 * sigma).max(0.02 * peak)
+}

@@ -128,6 +128,11 @@ pub struct Diagnosis {
     pub baseline_bic: f64,
     pub criterion: String,
     pub limitations: Vec<String>,
+    /// Residual signatures of the measured force, the baseline and every candidate's
+    /// prediction, measured alike.
+    pub signatures: Vec<super::evidence::Signature>,
+    /// Candidates the data cannot tell apart, why, and the test that would decide.
+    pub identifiability: Vec<super::identify::Identifiability>,
     pub tests: Vec<TestSummary>,
 }
 
@@ -387,9 +392,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 /// A fitted and evaluated candidate: row, full replays, deck, fitted parameters.
 type Evaluated = (Candidate, Option<Vec<Vec<f64>>>, DamperDeck, Vec<f64>);
 
-/// Result of one multi-start fit of one candidate.
+/// Result of one Levenberg-Marquardt run of one candidate from one start.
 struct Fit {
     x: Vec<f64>,
+    /// Where it stopped, in the transformed parameters (a start for a longer run).
+    z: Vec<f64>,
     rss: f64,
     evals: usize,
 }
@@ -404,6 +411,7 @@ fn fit_one(
     data: &[Measurement],
     windows: &[Window],
     opts: &DiagnoseOptions,
+    patience: usize,
     scale: f64,
 ) -> Option<Fit> {
     let mut pb = Problem {
@@ -424,7 +432,7 @@ fn fit_one(
     let (pb, _report) = LevenbergMarquardt::new()
         .with_xtol(1e-4)
         .with_ftol(1e-6)
-        .with_patience(opts.patience)
+        .with_patience(patience)
         .minimize(pb);
     // The crate leaves the best point set; re-evaluate where it stopped without residuals.
     let r = match &pb.r {
@@ -433,9 +441,22 @@ fn fit_one(
     };
     Some(Fit {
         x: to_x(spec, pb.z.as_slice()),
+        z: pb.z.as_slice().to_vec(),
         rss: r.norm_squared() * scale * scale,
         evals: pb.evals.get(),
     })
+}
+
+/// RMS of the difference of two replays over `windows`.
+fn diff_rms(windows: &[Window], a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for w in windows {
+        for (x, y) in a[w.test][w.from..w.to].iter().zip(&b[w.test][w.from..w.to]) {
+            s += (x - y) * (x - y);
+            n += 1;
+        }
+    }
+    (s / n.max(1) as f64).sqrt()
 }
 
 fn rms_over(windows: &[Window], model: &[Vec<f64>], data: &[Measurement]) -> f64 {
@@ -602,13 +623,37 @@ pub fn diagnose(
                 jobs.push((ci, z0));
             }
         }
+        // Several starts: each is scouted with a short run, and only the best one is run on
+        // to convergence (the starts pick the basin; the descent inside it is the same).
+        let mut n_starts = vec![0usize; cands.len()];
+        for (ci, _) in &jobs {
+            n_starts[*ci] += 1;
+        }
+        let patience = |ci: usize| {
+            if n_starts[ci] > 1 {
+                SCOUT_PATIENCE.min(opts.patience)
+            } else {
+                opts.patience
+            }
+        };
         let fits: Vec<(usize, Option<Fit>)> = jobs
             .into_par_iter()
             .map(|(ci, z0)| {
                 let (c, spec) = &cands[ci];
                 (
                     ci,
-                    fit_one(c, scales, base, spec, z0, data, &fit_w, opts, scale),
+                    fit_one(
+                        c,
+                        scales,
+                        base,
+                        spec,
+                        z0,
+                        data,
+                        &fit_w,
+                        opts,
+                        patience(ci),
+                        scale,
+                    ),
                 )
             })
             .collect();
@@ -622,6 +667,47 @@ pub fn diagnose(
                 }
             }
         }
+        // Continuation of the best scouted start (its evaluations count for the candidate).
+        let best: Vec<(Option<Fit>, usize)> = best
+            .into_par_iter()
+            .enumerate()
+            .map(|(ci, f)| {
+                let Some(f) = f else {
+                    return (None, 0);
+                };
+                if patience(ci) == opts.patience {
+                    return (Some(f), 0);
+                }
+                let (c, spec) = &cands[ci];
+                match fit_one(
+                    c,
+                    scales,
+                    base,
+                    spec,
+                    f.z.clone(),
+                    data,
+                    &fit_w,
+                    opts,
+                    opts.patience,
+                    scale,
+                ) {
+                    Some(g) if g.rss <= f.rss => {
+                        let e = g.evals;
+                        (Some(g), e)
+                    }
+                    Some(g) => (Some(f), g.evals),
+                    None => (Some(f), 0),
+                }
+            })
+            .collect();
+        let best: Vec<Option<Fit>> = best
+            .into_iter()
+            .zip(evals.iter_mut())
+            .map(|((f, e), ev)| {
+                *ev += e;
+                f
+            })
+            .collect();
         cands
             .par_iter()
             .zip(best.par_iter())
@@ -712,25 +798,51 @@ pub fn diagnose(
                 .find(|(c, _)| combined_name(c) == row.cause)
                 .map(|(c, _)| c[0]);
             if let Some(c1) = c1 {
-                let pairs: Vec<(Vec<Cause>, Vec<ParamSpec>)> = evaluated
-                    .iter()
-                    .skip(1)
-                    .filter(|e| e.1.is_some())
-                    .filter_map(|e| {
-                        let c2 = singles
-                            .iter()
-                            .find(|(c, _)| combined_name(c) == e.0.cause)?
-                            .0[0];
-                        if nested(c1, c2) {
-                            return None;
+                // Each pair starts from the two single-cause fits (the best single's value
+                // and the companion's own); a companion that alone does not lower the
+                // baseline's BIC explains nothing the fit can build on and is not tried.
+                let mut pairs: Vec<(Vec<Cause>, Vec<ParamSpec>)> = Vec::new();
+                for e in evaluated.iter().skip(1).filter(|e| e.1.is_some()) {
+                    let Some(c2) = singles
+                        .iter()
+                        .find(|(c, _)| combined_name(c) == e.0.cause)
+                        .map(|(c, _)| c[0])
+                    else {
+                        continue;
+                    };
+                    if nested(c1, c2) {
+                        continue;
+                    }
+                    let Some(mut spec) = combined_params(&[c1, c2], base, scales) else {
+                        continue;
+                    };
+                    if e.0.bic >= base_bic {
+                        companions.push(Companion {
+                            pair: combined_name(&[c1, c2]),
+                            companion: c2.name().to_string(),
+                            passes: false,
+                            kept: false,
+                            reason: format!(
+                                "not tried: alone its BIC ({:.1}) is not below the baseline's ({:.1}), it explains nothing of the residual",
+                                e.0.bic, base_bic
+                            ),
+                        });
+                        continue;
+                    }
+                    // The best single at its fitted value; the companion from its own
+                    // single-cause fit and its starting grid (scouted like a single cause's).
+                    let k1 = x1.len();
+                    for (i, p) in spec.iter_mut().enumerate() {
+                        if i < k1 {
+                            p.starts = vec![x1[i]];
+                        } else if let Some(&x) = e.3.get(i - k1) {
+                            if !p.starts.iter().any(|s| (s / x - 1.0).abs() < 1e-3) {
+                                p.starts.insert(0, x);
+                            }
                         }
-                        let mut spec = combined_params(&[c1, c2], base, scales)?;
-                        for (p, x) in spec.iter_mut().zip(x1) {
-                            p.starts = vec![*x];
-                        }
-                        Some((vec![c1, c2], spec))
-                    })
-                    .collect();
+                    }
+                    pairs.push((vec![c1, c2], spec));
+                }
                 pair_ref = Some((row.bic, row.held_out_rms_N));
                 let ev = stage(&pairs);
                 for e in &ev {
@@ -829,6 +941,29 @@ pub fn diagnose(
             }
         }
     }
+    let identifiability = identifiability(
+        chosen,
+        &evaluated,
+        data,
+        &all_w,
+        IdContext {
+            base_bic,
+            base_held,
+            // Several amplitudes: the held-out tests check how an effect scales, so the
+            // noise-level threshold of the choice separates; one amplitude: held-out cycles
+            // of the same test do not, and the near-tie margin of the limitations applies.
+            margin: if one_amp {
+                threshold.max(0.05 * base_held)
+            } else {
+                threshold
+            },
+            sigma,
+            one_amp,
+            scales,
+            base,
+            max_h: opts.max_substep_s,
+        },
+    );
     let curves: Vec<Curves> = data
         .iter()
         .enumerate()
@@ -868,6 +1003,17 @@ pub fn diagnose(
     let evidence = super::evidence::evidence(
         &curves, sigma, &cause, &params, &cand_rows, base_held, ext_held,
     );
+    let band = super::evidence::dwell_band(&curves, sigma);
+    let measured: Vec<Vec<f64>> = data.iter().map(|m| m.force_n.clone()).collect();
+    let mut signatures = vec![
+        super::evidence::signature(&curves, &measured, "measured", band),
+        super::evidence::signature(&curves, &baseline, "baseline", band),
+    ];
+    for e in &evaluated {
+        if let Some(sim) = &e.1 {
+            signatures.push(super::evidence::signature(&curves, sim, &e.0.cause, band));
+        }
+    }
     let diagnosis = Diagnosis {
         gain: 1.0 - ext_held / base_held,
         cause,
@@ -890,6 +1036,8 @@ pub fn diagnose(
         baseline_bic: base_bic,
         criterion: "BIC = n ln(RSS/n) + k ln n on the fit samples (n samples, k fitted parameters); the lowest BIC is chosen if it is below the baseline's and improves the held-out RMS by more than 0.05 sigma + 3 sigma/sqrt(2 n_held) (sigma: noise from second differences); else none".into(),
         limitations,
+        signatures,
+        identifiability,
         tests,
     };
     Ok(Outcome {
@@ -947,6 +1095,9 @@ fn demote_behind(evaluated: &mut [Evaluated], name: &str) {
     }
 }
 
+/// Levenberg-Marquardt patience of a scouting run from one of several starts.
+const SCOUT_PATIENCE: usize = 1;
+
 /// Strong evidence on the BIC scale (a difference of 10: odds of ~150 to 1).
 const BIC_STRONG: f64 = 10.0;
 
@@ -992,4 +1143,131 @@ fn free_play_limit(cause: &str, evaluated: &[Evaluated]) -> Option<String> {
         "the data support the rigid-gap limit (contact stiffness not resolved: free_play)"
     };
     Some(format!("{verdict}: {fitted}"))
+}
+
+/// What the identifiability analysis needs of the diagnosis.
+struct IdContext<'a> {
+    base_bic: f64,
+    base_held: f64,
+    /// Held-out RMS difference below which two candidates count as tied.
+    margin: f64,
+    sigma: f64,
+    one_amp: bool,
+    scales: Scales,
+    base: &'a DamperDeck,
+    max_h: f64,
+}
+
+/// Most ties reported (the closest by held-out RMS).
+const MAX_TIES: usize = 3;
+
+/// Causes of a candidate's name (`a` or `a+b`).
+fn causes_of(name: &str) -> Option<Vec<Cause>> {
+    name.split('+')
+        .map(|n| Cause::CANDIDATES.iter().copied().find(|c| c.name() == n))
+        .collect()
+}
+
+/// Candidates the data cannot separate from the chosen cause: the same number of causes,
+/// passing against the baseline too, held-out RMS within `margin` of the chosen one's; and the
+/// chosen cause's parameters whose 95% interval is unbounded. Each with the proposed test where
+/// the two fitted models differ most.
+fn identifiability(
+    chosen: Option<&Evaluated>,
+    evaluated: &[Evaluated],
+    data: &[Measurement],
+    all_w: &[Window],
+    cx: IdContext,
+) -> Vec<super::identify::Identifiability> {
+    use super::identify::{deciding_test, Conditions, Identifiability};
+    let Some((lead, Some(lead_sim), lead_deck, lead_x)) = chosen else {
+        return vec![];
+    };
+    let cond = Conditions::of(data);
+    let pair = lead.cause.contains('+');
+    let mut ties: Vec<&Evaluated> = evaluated
+        .iter()
+        .filter(|e| {
+            e.0.cause != lead.cause
+                && e.1.is_some()
+                && e.0.cause.contains('+') == pair
+                && e.0.bic < cx.base_bic
+                && cx.base_held - e.0.held_out_rms_N > 0.0
+                && (e.0.held_out_rms_N - lead.held_out_rms_N).abs() < cx.margin
+        })
+        .collect();
+    ties.sort_by(|a, b| a.0.held_out_rms_N.total_cmp(&b.0.held_out_rms_N));
+    ties.truncate(MAX_TIES);
+    let mut out = Vec::new();
+    for e in ties {
+        let sim = e.1.as_ref().expect("filtered on a replay");
+        let camp = diff_rms(all_w, lead_sim, sim);
+        let why = format!(
+            "held-out RMS {:.1} vs {:.1} N: a difference of {:.1} N, below the margin of {:.1} N ({}); BIC {:.1} vs {:.1}; their fitted forces differ by {:.1} N RMS on the campaign (noise sigma {:.1} N){}",
+            lead.held_out_rms_N,
+            e.0.held_out_rms_N,
+            (e.0.held_out_rms_N - lead.held_out_rms_N).abs(),
+            cx.margin,
+            if cx.one_amp {
+                "one amplitude: the larger of the threshold and 5% of the baseline's held-out RMS"
+            } else {
+                "the threshold of the choice"
+            },
+            lead.bic,
+            e.0.bic,
+            camp,
+            cx.sigma,
+            if cx.one_amp {
+                "; the campaign has one stroke amplitude and frequency, where effects that scale differently with amplitude or frequency can look alike"
+            } else {
+                ""
+            }
+        );
+        out.push(Identifiability {
+            candidates: vec![lead.cause.clone(), e.0.cause.clone()],
+            why,
+            deciding_test: deciding_test(lead_deck, &e.2, &cond, cx.max_h, camp, cx.sigma),
+        });
+    }
+    // Parameters the data do not bound: the cause with the parameter doubled (or halved at the
+    // upper bound) against the fit.
+    if let Some(causes) = causes_of(&lead.cause) {
+        if let Some(spec) = combined_params(&causes, cx.base, cx.scales) {
+            for (i, p) in spec.iter().enumerate() {
+                let Some(&[lo, hi]) = lead.intervals.get(p.name) else {
+                    continue;
+                };
+                if hi.is_finite() && lo > 0.0 {
+                    continue;
+                }
+                let mut x = lead_x.clone();
+                x[i] = if 2.0 * x[i] <= p.hi {
+                    2.0 * x[i]
+                } else {
+                    0.5 * x[i]
+                };
+                let other = apply_all(&causes, cx.base, cx.scales, &x);
+                let camp = match data
+                    .iter()
+                    .map(|m| {
+                        let mut f = Vec::new();
+                        simulate(&other, m, m.time_s.len(), cx.max_h, &mut f).map(|_| f)
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+                {
+                    Ok(sim) => diff_rms(all_w, lead_sim, &sim),
+                    Err(_) => f64::NAN,
+                };
+                out.push(Identifiability {
+                    candidates: vec![lead.cause.clone()],
+                    why: format!(
+                        "{} = {:.4e} is not bounded by the data (95% interval {:.3e} - {:.3e}): the fit's residual hardly changes with it; compared with the same cause at {:.4e}",
+                        p.name, lead_x[i], lo, hi, x[i]
+                    ),
+                    deciding_test: deciding_test(lead_deck, &other, &cond, cx.max_h, camp, cx.sigma),
+                });
+            }
+        }
+    }
+    out
 }

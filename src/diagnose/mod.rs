@@ -6,6 +6,7 @@ pub mod candidates;
 pub mod data;
 pub mod evidence;
 pub mod fit;
+pub mod identify;
 pub mod report;
 pub mod rotor;
 

@@ -48,6 +48,55 @@ pub fn html_with(
     extra(&mut r)?;
     r.heading(2, "Evidence");
     r.list(&d.evidence);
+    r.heading(2, "Signatures: measured beside each candidate's prediction");
+    let rows: Vec<Vec<String>> = d
+        .signatures
+        .iter()
+        .map(|g| {
+            vec![
+                g.source.clone(),
+                format!("{:.1}", g.dwell_ms),
+                format!("{:+.1}", g.reversal_step_N),
+                format!("{:+.2}", g.lag_ms),
+                format!("{:.3}", g.peak_ratio),
+                format!("{:.0}", g.plateau_pos_N),
+                format!("{:.0}", g.plateau_neg_N),
+            ]
+        })
+        .collect();
+    r.table(
+        &[
+            "force",
+            "dwell near zero [ms] (smallest amplitude)",
+            "step at reversal vs baseline [N]",
+            "lag behind baseline (loop tilt) [ms]",
+            "|neg|/pos peak (largest amplitude)",
+            "plateau + [N]",
+            "plateau - [N]",
+        ],
+        &rows,
+    );
+    r.heading(2, "Identifiability");
+    if d.identifiability.is_empty() {
+        r.paragraph("No candidate is within the margin of the cause on held-out data and every parameter of the cause is bounded by the data.");
+    } else {
+        let rows: Vec<Vec<String>> = d
+            .identifiability
+            .iter()
+            .map(|i| {
+                vec![
+                    i.candidates.join(" vs "),
+                    i.why.clone(),
+                    i.deciding_test
+                        .as_ref()
+                        .map_or("no proposed test can be simulated".into(), |t| {
+                            t.statement.clone()
+                        }),
+                ]
+            })
+            .collect();
+        r.table(&["not separable", "why", "test that would decide"], &rows);
+    }
     r.heading(2, "Candidates (ranked by BIC)");
     let rows: Vec<Vec<String>> = d
         .candidates
