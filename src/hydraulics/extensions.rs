@@ -613,6 +613,7 @@ impl Device for CompliantFreePlay {
         let mut x = d_f + (dh_i - d_i);
         let mut prev = f64::INFINITY;
         let mut step = 1e-6_f64.max(tol / self.k);
+        let mut collapsed = false;
         for _ in 0..PLAY_MAX_ITER {
             let (h, contact, sf) = eval(self, x)?;
             if h.abs() <= tol {
@@ -669,13 +670,16 @@ impl Device for CompliantFreePlay {
             };
             if let (Some((a, _)), Some((b, _))) = (lo, hi) {
                 if (b - a).abs() <= 4.0 * f64::EPSILON * a.abs().max(1e-3) {
+                    collapsed = true;
                     break;
                 }
             }
             prev = h.abs();
         }
-        // A stall within 1 N of force balance (a valve switching inside the step) is accepted.
-        if best.1 <= 1.0 {
+        // A bracket closed to round-off holds no root: the device force jumps there (a valve
+        // switching inside the step) and the jump is the force balance's best (as the series
+        // mount's bracket accepts). Otherwise a stall within 1 N of force balance is accepted.
+        if collapsed || best.1 <= 1.0 {
             let (_, contact, sf) = eval(self, best.0)?;
             self.trial = Some(best.0);
             let kd = -sf.dforce_dstroke;
