@@ -41,7 +41,10 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
     assert!(dir.join("out/diagnosis.html").exists());
     assert!(!dir.join("out/INCOMPLETE").exists());
     let html = std::fs::read_to_string(dir.join("out/diagnosis.html")).unwrap();
-    assert!(html.contains("SYNTHETIC"));
+    // the SYNTHETIC banner heads the report, before the first section, under one title
+    let banner = html.find("class=\"banner synthetic\"").expect("SYNTHETIC banner");
+    assert!(banner < html.find("<h2>").unwrap());
+    assert_eq!(html.matches("<h1>").count(), 1);
     // The written deck is a damper deck `bench` accepts.
     let text = std::fs::read_to_string(&deck).unwrap();
     assert!(text.contains("[damper.physical.extensions]"));

@@ -670,14 +670,20 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
                     Ok(m)
                 })
                 .collect::<anyhow::Result<Vec<_>>>()?;
+            // Bench files carry no metadata: a file named synthetic is labelled so (as bench does).
+            let synthetic = args.measured.iter().any(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().to_ascii_lowercase().contains("synthetic"))
+            });
             let src = format!(
-                "Bench tests {} (stroke-driven replay), baseline deck {}.",
+                "Bench tests {} (stroke-driven replay), baseline deck {}.{}",
                 args.measured
                     .iter()
                     .map(|p| p.display().to_string())
                     .collect::<Vec<_>>()
                     .join(", "),
-                deck_path.display()
+                deck_path.display(),
+                if synthetic { " SYNTHETIC tests (named synthetic)." } else { "" }
             );
             (deck, data, src)
         }

@@ -4,7 +4,8 @@ use super::fit::{Curves, Diagnosis};
 use crate::report::html::HtmlReport;
 use crate::report::plot::{Plot, PlotError};
 
-/// HTML report of a diagnosis; `source` describes the data (and says synthetic where it is).
+/// HTML report of a diagnosis; `source` describes the data and says SYNTHETIC where it is, which
+/// puts the SYNTHETIC banner at the head of the report.
 pub fn html(d: &Diagnosis, curves: &[Curves], source: &str) -> Result<String, PlotError> {
     html_with(d, curves, source, |_| Ok(()))
 }
@@ -17,8 +18,13 @@ pub fn html_with(
     source: &str,
     extra: impl FnOnce(&mut HtmlReport) -> Result<(), PlotError>,
 ) -> Result<String, PlotError> {
-    let mut r = HtmlReport::new("rotorsim diagnosis");
-    r.heading(1, &format!("Diagnosis: {}", d.cause));
+    let mut r = HtmlReport::new(&format!("rotorsim diagnosis: {}", d.cause));
+    if source.contains("SYNTHETIC") {
+        r.banner(
+            crate::report::html::Banner::Synthetic,
+            "SYNTHETIC data: the \"measured\" force diagnosed here is synthetic, not a test measurement.",
+        );
+    }
     r.paragraph(source);
     let params: Vec<String> = d
         .parameters
