@@ -42,7 +42,9 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
     assert!(!dir.join("out/INCOMPLETE").exists());
     let html = std::fs::read_to_string(dir.join("out/diagnosis.html")).unwrap();
     // the SYNTHETIC banner heads the report, before the first section, under one title
-    let banner = html.find("class=\"banner synthetic\"").expect("SYNTHETIC banner");
+    let banner = html
+        .find("class=\"banner synthetic\"")
+        .expect("SYNTHETIC banner");
     assert!(banner < html.find("<h2>").unwrap());
     assert_eq!(html.matches("<h1>").count(), 1);
     // The written deck is a damper deck `bench` accepts.
