@@ -97,15 +97,17 @@ impl RotorSpec {
     }
 }
 
-fn f(v: f64) -> String {
+/// A value as TOML writes it back exactly (shortest round-trip form).
+pub(crate) fn f(v: f64) -> String {
     format!("{v:?}")
 }
 
-fn v3(v: [f64; 3]) -> String {
+pub(crate) fn v3(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2]))
 }
 
-fn section(p: &SectionProps) -> String {
+/// A model-deck section table (inline TOML), offsets only where non-zero.
+pub(crate) fn section(p: &SectionProps) -> String {
     let mut s = format!(
         "{{ EA_N = {}, GA2_N = {}, GA3_N = {}, GJ_Nm2 = {}, EI2_Nm2 = {}, EI3_Nm2 = {}, m_kg_per_m = {}, I1_kgm = {}, I2_kgm = {}, I3_kgm = {}",
         f(p.ea), f(p.ga2), f(p.ga3), f(p.gj), f(p.ei2), f(p.ei3), f(p.m), f(p.i1), f(p.i2), f(p.i3)

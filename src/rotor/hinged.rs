@@ -13,7 +13,6 @@ use super::deck::RotorTable;
 use crate::solver::modal::{modes, ModalOptions, Mode, ModeKind};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonMethod, State};
-use crate::structure::deck::parse_deck;
 use crate::structure::model::{Element, Model};
 use crate::structure::section::SectionProps;
 use serde::Deserialize;
@@ -370,34 +369,7 @@ pub struct HingedExpand {
     pub hub_clamped: bool,
 }
 
-fn f(v: f64) -> String {
-    format!("{v:?}")
-}
-
-fn v3(v: [f64; 3]) -> String {
-    format!("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2]))
-}
-
-fn section(p: &SectionProps) -> String {
-    let mut s = format!(
-        "{{ EA_N = {}, GA2_N = {}, GA3_N = {}, GJ_Nm2 = {}, EI2_Nm2 = {}, EI3_Nm2 = {}, m_kg_per_m = {}, I1_kgm = {}, I2_kgm = {}, I3_kgm = {}",
-        f(p.ea), f(p.ga2), f(p.ga3), f(p.gj), f(p.ei2), f(p.ei3), f(p.m), f(p.i1), f(p.i2), f(p.i3)
-    );
-    for (k, v) in [
-        ("cm2_m", p.cm2),
-        ("cm3_m", p.cm3),
-        ("sc2_m", p.sc2),
-        ("sc3_m", p.sc3),
-        ("ca2_m", p.ca2),
-        ("ca3_m", p.ca3),
-    ] {
-        if v != 0.0 {
-            let _ = write!(s, ", {k} = {}", f(v));
-        }
-    }
-    s.push_str(" }");
-    s
-}
+use super::expand::{f, section, v3};
 
 /// The model deck text (docs/model_deck.md): hub node driven at Omega (`shaft`), the hinges as
 /// revolute joints `lag`/`flap`/`pitch` through the nodes `hinge0`, `hinge1`, ... (a hinge
@@ -560,11 +532,7 @@ pub fn expanded_model(
     opts: &HingedExpand,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    let text = expand(spec, opts);
-    let base = file.parent().map(Path::to_path_buf).unwrap_or_default();
-    let name = format!("{} (expanded)", file.display());
-    let (_, model) = parse_deck(&text, &name, &base)?;
-    Ok(model)
+    super::sim::parse_expanded(&expand(spec, opts), file)
 }
 
 /// Modes at one rotor speed.

@@ -151,10 +151,15 @@ pub fn expanded_model(
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    let text = expand(spec, opts);
+    parse_expanded(&expand(spec, opts), file)
+}
+
+/// A model deck expanded from the rotor deck `file`, parsed into a model (relative paths against
+/// the deck's folder, errors naming the deck as expanded).
+pub(crate) fn parse_expanded(text: &str, file: &Path) -> anyhow::Result<Model> {
     let base = file.parent().map(Path::to_path_buf).unwrap_or_default();
     let name = format!("{} (expanded)", file.display());
-    let (_, model) = parse_deck(&text, &name, &base)?;
+    let (_, model) = parse_deck(text, &name, &base)?;
     Ok(model)
 }
 
