@@ -3,7 +3,8 @@
 //! rates.
 //! `cargo run --release --example diagnose_blind_suite -- [OUT.csv] [CYCLES] [RATE_HZ] [ID_PREFIX...]`
 //! `cargo run --release --example diagnose_blind_suite -- --effect-size` (effect vs noise only)
-//! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns).
+//! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns;
+//! with BLIND_JSON_DIR set, every diagnosis.json is written there as `<id>.json`).
 #[path = "../tests/blind_support/mod.rs"]
 mod blind;
 use rotorsim::diagnose::rotor::flight_measurement;
@@ -71,6 +72,12 @@ fn main() -> anyhow::Result<()> {
             blind::bench_campaign(&cp, cycles, rate).map_err(anyhow::Error::msg)?
         };
         let o = diagnose(&base, &data, &DiagnoseOptions::default())?;
+        if let Some(dir) = std::env::var_os("BLIND_JSON_DIR") {
+            // Every diagnosis in full, for study (optional).
+            std::fs::create_dir_all(&dir)?;
+            let path = Path::new(&dir).join(format!("{}.json", cp.id));
+            std::fs::write(path, serde_json::to_string_pretty(&o.diagnosis)?)?;
+        }
         let s = blind::score(&cp, &o.diagnosis);
         let wall = t0.elapsed().as_secs_f64();
         let row = blind::csv_row(&cp, &s, wall);

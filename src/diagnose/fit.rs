@@ -72,6 +72,9 @@ pub struct Candidate {
     pub intervals: BTreeMap<String, [f64; 2]>,
     pub k: usize,
     pub fit_evaluations: usize,
+    /// How the fit was cut short, if it was (a screened pair).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     /// Fit failure (model failure at every start), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
@@ -282,12 +285,17 @@ fn residuals_x(
 /// Normal quantile of a two-sided 95% interval.
 const Z95: f64 = 1.959_963_984_540_054;
 
-/// 95% intervals of fitted parameters from the Jacobian of the fit residuals: the covariance
-/// of `ln x` is `s^2 (J^T J)^-1`, J by central differences in `ln x` (step 1%, the residual is
-/// only piecewise smooth), `s` the measured noise sigma or, where the fit leaves a larger
-/// residual (model-form error), the residual's own RMS (so that an imperfect fit widens its
-/// intervals rather than claiming the noise's precision). Returns `[lo, hi]` per parameter
-/// (`[0, inf]` where the data do not constrain it).
+/// 95% intervals of fitted parameters: the noise's scatter plus a bound on the bias that
+/// model-form error puts on them. J is the Jacobian of the fit residuals by central differences
+/// in `ln x` (step 1%, the residual is only piecewise smooth) and `C = (J^T J)^-1`.
+/// - Noise: `ln x` has the covariance `sigma^2 C` (sigma the measured noise).
+/// - Model form: what the noise does not explain, `r_sys = n ms - (n - k) sigma^2`, is error of
+///   the model's form (`ms` the larger mean square residual of the fit and held-out data). The part of it along the columns of J has been absorbed by the fit and
+///   biases `ln x_c` by at most `sqrt(r_par C_cc)` (Cauchy-Schwarz), r_par its squared norm. It
+///   cannot be seen in the residual; it is taken as large as the part that can, `r_sys`.
+///
+/// The half-width is `1.96 sqrt(sigma^2 C_cc) + sqrt(r_sys C_cc)`. Returns `[lo, hi]` per
+/// parameter (`[0, inf]` where the data do not constrain it).
 #[allow(clippy::too_many_arguments)]
 fn intervals(
     cause: &[Cause],
@@ -298,7 +306,7 @@ fn intervals(
     windows: &[Window],
     max_h: f64,
     sigma: f64,
-    rss: f64,
+    ms: f64,
 ) -> Vec<[f64; 2]> {
     let k = x.len();
     let unbounded = vec![[0.0, f64::INFINITY]; k];
@@ -321,17 +329,18 @@ fn intervals(
         };
         j.set_column(c, &((rp - rm) / (2.0 * h)));
     }
-    let s2 = sigma.powi(2).max(rss / (n - k) as f64);
+    let s2 = sigma.powi(2);
+    let r_sys = (n as f64 * ms - (n - k) as f64 * s2).max(0.0);
     let Some(cov) = (j.transpose() * &j).try_inverse() else {
         return unbounded;
     };
     (0..k)
         .map(|c| {
-            let v = s2 * cov[(c, c)];
+            let v = cov[(c, c)];
             if v.is_finite() && v >= 0.0 {
-                let sd = v.sqrt();
+                let half = Z95 * (s2 * v).sqrt() + (r_sys * v).sqrt();
                 // exp overflows to inf for an unconstrained parameter: reported as such.
-                [x[c] * (-Z95 * sd).exp(), x[c] * (Z95 * sd).exp()]
+                [x[c] * (-half).exp(), x[c] * half.exp()]
             } else {
                 [0.0, f64::INFINITY]
             }
@@ -602,7 +611,9 @@ pub fn diagnose(
         .iter()
         .filter_map(|&c| c.params(base, scales).map(|s| (vec![c], s)))
         .collect();
-    let stage = |cands: &[(Vec<Cause>, Vec<ParamSpec>)]| -> Vec<Evaluated> {
+    // `keep`: when fewer than the candidates, every candidate is scouted and only the `keep`
+    // best after scouting are run to convergence (the others keep their scouted fit).
+    let stage = |cands: &[(Vec<Cause>, Vec<ParamSpec>)], keep: usize| -> Vec<Evaluated> {
         let mut jobs = Vec::new();
         for (ci, (_, spec)) in cands.iter().enumerate() {
             // Grid of starts: the product of each parameter's starting values.
@@ -629,8 +640,9 @@ pub fn diagnose(
         for (ci, _) in &jobs {
             n_starts[*ci] += 1;
         }
+        let screen = keep < cands.len();
         let patience = |ci: usize| {
-            if n_starts[ci] > 1 {
+            if n_starts[ci] > 1 || screen {
                 SCOUT_PATIENCE.min(opts.patience)
             } else {
                 opts.patience
@@ -667,6 +679,15 @@ pub fn diagnose(
                 }
             }
         }
+        let mut rank: Vec<usize> = (0..cands.len()).filter(|&ci| best[ci].is_some()).collect();
+        rank.sort_by(|&a, &b| {
+            let rss = |ci: usize| best[ci].as_ref().map_or(f64::INFINITY, |f| f.rss);
+            rss(a).total_cmp(&rss(b))
+        });
+        let mut continued = vec![false; cands.len()];
+        for &ci in rank.iter().take(keep) {
+            continued[ci] = true;
+        }
         // Continuation of the best scouted start (its evaluations count for the candidate).
         let best: Vec<(Option<Fit>, usize)> = best
             .into_par_iter()
@@ -675,7 +696,7 @@ pub fn diagnose(
                 let Some(f) = f else {
                     return (None, 0);
                 };
-                if patience(ci) == opts.patience {
+                if patience(ci) == opts.patience || !continued[ci] {
                     return (Some(f), 0);
                 }
                 let (c, spec) = &cands[ci];
@@ -712,7 +733,8 @@ pub fn diagnose(
             .par_iter()
             .zip(best.par_iter())
             .zip(evals.par_iter())
-            .map(|(((c, spec), f), &ev)| {
+            .enumerate()
+            .map(|(ci, (((c, spec), f), &ev))| {
                 let mut row = Candidate {
                     cause: combined_name(c),
                     rms_N: f64::NAN,
@@ -723,12 +745,23 @@ pub fn diagnose(
                     k: spec.len(),
                     fit_evaluations: ev,
                     failure: None,
+                    note: (!continued[ci]).then(|| {
+                        format!("screened: after a short run its fit ranked below the best {keep} of {} tried together; not run to convergence", cands.len())
+                    }),
                 };
                 let Some(f) = f else {
                     row.failure = Some("model failed at every starting point".into());
                     return (row, None, base.clone(), vec![]);
                 };
                 let deck = apply_all(c, base, scales, &f.x);
+                let sim = sim_all(&deck);
+                // The model-form error is measured where the model predicts as well as where
+                // it was fitted: the larger mean square of the two.
+                let ms_fit = f.rss / n_fit.max(1) as f64;
+                let ms = match &sim {
+                    Ok(sim) => ms_fit.max(rms_over(&held_w, sim, data).powi(2)),
+                    Err(_) => ms_fit,
+                };
                 let iv = intervals(
                     c,
                     scales,
@@ -738,13 +771,13 @@ pub fn diagnose(
                     &fit_w,
                     opts.max_substep_s,
                     sigma,
-                    f.rss,
+                    ms,
                 );
                 for ((p, x), i) in spec.iter().zip(&f.x).zip(iv) {
                     row.parameters.insert(p.name.into(), *x);
                     row.intervals.insert(p.name.into(), i);
                 }
-                match sim_all(&deck) {
+                match sim {
                     Ok(sim) => {
                         row.rms_N = rms_over(&all_w, &sim, data);
                         row.held_out_rms_N = rms_over(&held_w, &sim, data);
@@ -759,7 +792,7 @@ pub fn diagnose(
             })
             .collect()
     };
-    let mut evaluated = stage(&singles);
+    let mut evaluated = stage(&singles, usize::MAX);
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
     // A compliant free play that is not decisively better than one of its limits gives way to
     // that limit (one parameter fewer): it moves behind the limit and may not be chosen.
@@ -771,7 +804,12 @@ pub fn diagnose(
     let mut pair_ref: Option<(f64, f64)> = None;
     let mut companions: Vec<Companion> = Vec::new();
     let mut pair_stage = String::from("no single cause passes: no companion is tried");
-    if let Some((row, Some(_), _, x1)) = evaluated.first() {
+    let first = evaluated
+        .first()
+        .filter(|e| e.1.is_some())
+        .map(|e| (e.0.clone(), e.3.clone()));
+    let mut refit_single: Option<Evaluated> = None;
+    if let Some((row, x1)) = first {
         let first_ok = row.bic < base_bic && base_held - row.held_out_rms_N > threshold;
         let systematic = row.held_out_rms_N > 1.5 * sigma;
         pair_stage = if !first_ok {
@@ -799,9 +837,12 @@ pub fn diagnose(
                 .map(|(c, _)| c[0]);
             if let Some(c1) = c1 {
                 // Each pair starts from the two single-cause fits (the best single's value
-                // and the companion's own); a companion that alone does not lower the
-                // baseline's BIC explains nothing the fit can build on and is not tried.
+                // and the companion's own). A companion that alone does not lower the
+                // baseline's BIC may still be masked by the larger effect: it is tried when,
+                // added at one of its starting values to the best single's fit, it earns its
+                // parameters without any fitting (BIC below the single's).
                 let mut pairs: Vec<(Vec<Cause>, Vec<ParamSpec>)> = Vec::new();
+                let mut probe: Vec<(Cause, Vec<ParamSpec>, f64)> = Vec::new();
                 for e in evaluated.iter().skip(1).filter(|e| e.1.is_some()) {
                     let Some(c2) = singles
                         .iter()
@@ -817,16 +858,7 @@ pub fn diagnose(
                         continue;
                     };
                     if e.0.bic >= base_bic {
-                        companions.push(Companion {
-                            pair: combined_name(&[c1, c2]),
-                            companion: c2.name().to_string(),
-                            passes: false,
-                            kept: false,
-                            reason: format!(
-                                "not tried: alone its BIC ({:.1}) is not below the baseline's ({:.1}), it explains nothing of the residual",
-                                e.0.bic, base_bic
-                            ),
-                        });
+                        probe.push((c2, spec, e.0.bic));
                         continue;
                     }
                     // The best single at its fitted value; the companion from its own
@@ -843,12 +875,111 @@ pub fn diagnose(
                     }
                     pairs.push((vec![c1, c2], spec));
                 }
-                pair_ref = Some((row.bic, row.held_out_rms_N));
-                let ev = stage(&pairs);
-                for e in &ev {
+                let k1 = x1.len();
+                let points: Vec<(usize, Vec<f64>)> = probe
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(pi, (_, spec, _))| {
+                        let mut grid: Vec<Vec<f64>> = vec![x1.clone()];
+                        for p in &spec[k1..] {
+                            grid = grid
+                                .into_iter()
+                                .flat_map(|g| {
+                                    p.starts.iter().map(move |&v| {
+                                        let mut t = g.clone();
+                                        t.push(v);
+                                        t
+                                    })
+                                })
+                                .collect();
+                        }
+                        grid.into_iter().map(move |g| (pi, g))
+                    })
+                    .collect();
+                let probed: Vec<(usize, f64)> = points
+                    .par_iter()
+                    .filter_map(|(pi, x)| {
+                        let r = residuals_x(
+                            &[c1, probe[*pi].0],
+                            scales,
+                            base,
+                            x,
+                            data,
+                            &fit_w,
+                            opts.max_substep_s,
+                            1.0,
+                        )?;
+                        Some((*pi, bic(r.norm_squared(), n_fit, x.len())))
+                    })
+                    .collect();
+                for (pi, (c2, mut spec, alone)) in probe.into_iter().enumerate() {
+                    let best = probed
+                        .iter()
+                        .filter(|(i, _)| *i == pi)
+                        .map(|(_, b)| *b)
+                        .fold(f64::INFINITY, f64::min);
+                    if best < row.bic {
+                        for p in spec.iter_mut().take(k1).zip(&x1) {
+                            p.0.starts = vec![*p.1];
+                        }
+                        pairs.push((vec![c1, c2], spec));
+                        continue;
+                    }
+                    companions.push(Companion {
+                        pair: combined_name(&[c1, c2]),
+                        companion: c2.name().to_string(),
+                        passes: false,
+                        kept: false,
+                        reason: format!(
+                            "not tried: alone its BIC ({alone:.1}) is not below the baseline's ({base_bic:.1}), and added at its starting values to {} it lowers no BIC (best {best:.1} against {:.1})",
+                            row.cause, row.bic
+                        ),
+                    });
+                }
+                let mut ev = stage(&pairs, PAIRS_CONVERGED);
+                // A pair may beat the single only because its joint fit found a better
+                // optimum of the single cause, its companion idle: the single is refitted
+                // from the two best pairs' values of its own parameters, and the pairs are
+                // judged against the best single found.
+                let mut reference = (row.bic, row.held_out_rms_N);
+                if let Some((_, spec1)) = singles.iter().find(|(c, _)| c[..] == [c1]) {
+                    let mut better: Vec<&Evaluated> = ev
+                        .iter()
+                        .filter(|e| e.1.is_some() && e.0.bic < row.bic)
+                        .collect();
+                    better.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+                    let restarts: Vec<(Vec<Cause>, Vec<ParamSpec>)> = better
+                        .into_iter()
+                        .take(2)
+                        .map(|e| {
+                            let mut s = spec1.clone();
+                            for (p, &x) in s.iter_mut().zip(&e.3) {
+                                p.starts = vec![x];
+                            }
+                            (vec![c1], s)
+                        })
+                        .collect();
+                    if !restarts.is_empty() {
+                        let best = stage(&restarts, usize::MAX)
+                            .into_iter()
+                            .filter(|e| e.1.is_some())
+                            .min_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+                        if let Some(mut b) = best.filter(|b| b.0.bic < row.bic) {
+                            b.0.fit_evaluations += row.fit_evaluations;
+                            pair_stage.push_str(&format!(
+                                "; refitted from a pair's values, {} reaches BIC {:.1} (was {:.1}) and held-out RMS {:.1} N (was {:.1} N), the reference of every pair",
+                                row.cause, b.0.bic, row.bic, b.0.held_out_rms_N, row.held_out_rms_N
+                            ));
+                            reference = (b.0.bic, b.0.held_out_rms_N);
+                            refit_single = Some(b);
+                        }
+                    }
+                }
+                pair_ref = Some(reference);
+                let judge = |e: &Evaluated| -> (bool, String) {
                     let r = &e.0;
-                    let d_bic = row.bic - r.bic;
-                    let d_held = row.held_out_rms_N - r.held_out_rms_N;
+                    let d_bic = reference.0 - r.bic;
+                    let d_held = reference.1 - r.held_out_rms_N;
                     let by_bic = d_bic > 0.0;
                     let by_held = d_held > threshold;
                     let reason = format!(
@@ -861,16 +992,76 @@ pub fn diagnose(
                         threshold,
                         if by_held { "improves held-out data" } else { "no held-out improvement" },
                     );
+                    (e.1.is_some() && by_bic && by_held, reason)
+                };
+                for e in &ev {
+                    let (passes, reason) = judge(e);
                     companions.push(Companion {
-                        pair: r.cause.clone(),
-                        companion: r.cause.split('+').nth(1).unwrap_or_default().to_string(),
-                        passes: e.1.is_some() && by_bic && by_held,
+                        pair: e.0.cause.clone(),
+                        companion: e.0.cause.split('+').nth(1).unwrap_or_default().to_string(),
+                        passes,
                         kept: false,
                         reason,
                     });
                 }
+                // The best single need not be one of the pair's causes (a bleed can stand in
+                // for a leakage until the air beside it is found): the winning pair's
+                // companion is also paired with the next two single causes (a beam of width
+                // three over the first cause), each from the two fits' values.
+                let winner = ev
+                    .iter()
+                    .filter(|e| judge(e).0)
+                    .min_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+                let c2 = winner.and_then(|w| {
+                    let name = w.0.cause.split('+').nth(1)?;
+                    let c2 = singles.iter().find(|(c, _)| c[0].name() == name)?.0[0];
+                    Some((c2, w.3[k1..].to_vec()))
+                });
+                if let Some((c2, x2)) = c2 {
+                    let swaps: Vec<(Vec<Cause>, Vec<ParamSpec>)> = evaluated
+                        .iter()
+                        .filter(|e| e.1.is_some() && e.0.bic < base_bic && e.0.cause != row.cause)
+                        .filter_map(|e| {
+                            let c = singles
+                                .iter()
+                                .find(|(c, _)| combined_name(c) == e.0.cause)?
+                                .0[0];
+                            // Another form of the first cause is not another mechanism.
+                            (c != c2 && !nested(c, c2) && !nested(c, c1)).then(|| (c, e.3.clone()))
+                        })
+                        .take(2)
+                        .filter_map(|(c, xc)| {
+                            let mut spec = combined_params(&[c, c2], base, scales)?;
+                            for (p, &v) in spec.iter_mut().zip(xc.iter().chain(&x2)) {
+                                p.starts = vec![v];
+                            }
+                            Some((vec![c, c2], spec))
+                        })
+                        .collect();
+                    let swapped = stage(&swaps, usize::MAX);
+                    for e in &swapped {
+                        let (passes, reason) = judge(e);
+                        companions.push(Companion {
+                            pair: e.0.cause.clone(),
+                            companion: c2.name().to_string(),
+                            passes,
+                            kept: false,
+                            reason: format!(
+                                "{} in place of {}: {reason}",
+                                e.0.cause.split('+').next().unwrap_or_default(),
+                                row.cause
+                            ),
+                        });
+                    }
+                    ev.extend(swapped);
+                }
                 evaluated.extend(ev);
             }
+        }
+    }
+    if let Some(b) = refit_single {
+        if let Some(slot) = evaluated.iter_mut().find(|e| e.0.cause == b.0.cause) {
+            *slot = b;
         }
     }
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
@@ -1097,6 +1288,8 @@ fn demote_behind(evaluated: &mut [Evaluated], name: &str) {
 
 /// Levenberg-Marquardt patience of a scouting run from one of several starts.
 const SCOUT_PATIENCE: usize = 1;
+/// Pairs run to convergence after all of them are scouted.
+const PAIRS_CONVERGED: usize = 3;
 
 /// Strong evidence on the BIC scale (a difference of 10: odds of ~150 to 1).
 const BIC_STRONG: f64 = 10.0;

@@ -397,8 +397,12 @@ pub fn suite() -> Vec<Campaign> {
 /// records (no effect, compliant free play, friction, air in one chamber, mount) and one bench
 /// campaign from the middle of the compliant free-play grid.
 pub fn ci_subset() -> Vec<Campaign> {
+    // Flight records, a compliant free play, and three campaigns that need the pair stage's
+    // safeguards: a single cause fitted into a poor optimum (recal_1), a companion masked by
+    // the larger effect (pair_5) and a best single that is not one of the pair (pair_1).
     let ids = [
-        "flight_0", "flight_1", "flight_2", "flight_3", "flight_4", "cfp_11",
+        "flight_0", "flight_1", "flight_2", "flight_3", "flight_4", "cfp_11", "recal_1", "pair_5",
+        "pair_1",
     ];
     let all = suite();
     ids.iter()
