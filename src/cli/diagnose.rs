@@ -749,8 +749,10 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         _ => None,
     };
     // diagnosis.json: the docs/formats.md keys and the existing extras, plus new keys only.
+    let noise = diagnose::report::noise_of(d, &outcome.curves);
     let mut json = serde_json::to_value(d)?;
     if let Some(obj) = json.as_object_mut() {
+        obj.insert("signature_noise".into(), serde_json::to_value(&noise)?);
         if let Some(s) = &stroke_info {
             obj.insert("stroke_source".into(), s.clone());
         }
@@ -763,7 +765,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
     let synthetic = record.as_ref().is_some_and(|(r, _)| r.meta.synthetic);
-    let html = diagnose::report::html_with(d, &outcome.curves, &source, |r| {
+    let html = diagnose::report::html_with(d, &outcome.curves, &source, Some(&noise), |r| {
         if let Some(w) = stroke_info.as_ref().and_then(|s| s.get("warning")) {
             r.notice(w.as_str().unwrap_or_default());
         }
