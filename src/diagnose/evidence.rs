@@ -319,3 +319,49 @@ pub fn dwell_band(curves: &[Curves], sigma: f64) -> f64 {
         .fold(0.0f64, |a, f| a.max(f.abs()));
     (3.0 * sigma).max(0.02 * peak)
 }
+
+/// Realizations of the noise spread of the signatures ([`signature_noise`]).
+pub const NOISE_REALIZATIONS: usize = 32;
+
+/// Spread of the signature that the measurement noise alone gives: the standard deviation of
+/// each signature quantity over [`NOISE_REALIZATIONS`] copies of `reference` (a noise-free
+/// force on the grid of `curves`, e.g. the extended model's) with white Gaussian noise of
+/// `sigma` added (a parametric bootstrap; seeded, so a diagnosis is reproducible). Source
+/// `noise_sd`.
+pub fn signature_noise(
+    curves: &[Curves],
+    reference: &[Vec<f64>],
+    sigma: f64,
+    band: f64,
+) -> Signature {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5167_0a7e);
+    let normal = Normal::new(0.0, sigma.max(0.0)).unwrap_or(Normal::new(0.0, 0.0).unwrap());
+    let sigs: Vec<Signature> = (0..NOISE_REALIZATIONS)
+        .map(|_| {
+            let noisy: Vec<Vec<f64>> = reference
+                .iter()
+                .map(|f| f.iter().map(|v| v + normal.sample(&mut rng)).collect())
+                .collect();
+            signature(curves, &noisy, "noise", band)
+        })
+        .collect();
+    let sd = |f: fn(&Signature) -> f64| {
+        let v: Vec<f64> = sigs.iter().map(f).filter(|x| x.is_finite()).collect();
+        if v.len() < 2 {
+            return f64::NAN;
+        }
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+    };
+    Signature {
+        source: "noise_sd".into(),
+        dwell_ms: sd(|s| s.dwell_ms),
+        reversal_step_N: sd(|s| s.reversal_step_N),
+        lag_ms: sd(|s| s.lag_ms),
+        peak_ratio: sd(|s| s.peak_ratio),
+        plateau_pos_N: sd(|s| s.plateau_pos_N),
+        plateau_neg_N: sd(|s| s.plateau_neg_N),
+    }
+}

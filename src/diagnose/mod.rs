@@ -7,6 +7,7 @@ pub mod data;
 pub mod evidence;
 pub mod fit;
 pub mod identify;
+pub mod pipeline;
 pub mod report;
 pub mod rotor;
 

@@ -1,21 +1,157 @@
 //! DIR/diagnosis.html: residuals vs time, stroke and velocity; force-stroke and force-velocity
-//! loops (measured, baseline, extended); the candidates table.
+//! loops (measured, baseline, extended); the signatures (table and dot plots); the candidates
+//! table.
+use super::evidence::Signature;
 use super::fit::{Curves, Diagnosis};
 use crate::report::html::HtmlReport;
-use crate::report::plot::{Plot, PlotError};
+use crate::report::plot::{grid_svg, Plot, PlotError, OTHER_COLOURS};
+use plotters::style::RGBColor;
+
+/// The quantities of a [`Signature`] in the figure: JSON key, panel title, x axis label, value.
+type Quantity = (
+    &'static str,
+    &'static str,
+    &'static str,
+    fn(&Signature) -> f64,
+);
+pub const SIGNATURE_QUANTITIES: [Quantity; 6] = [
+    (
+        "dwell_ms",
+        "dwell near zero force",
+        "time per zero crossing, smallest amplitude [ms]",
+        |s| s.dwell_ms,
+    ),
+    (
+        "reversal_step_N",
+        "force step at reversal",
+        "compressing - extending, vs baseline [N]",
+        |s| s.reversal_step_N,
+    ),
+    (
+        "lag_ms",
+        "lag behind baseline (loop tilt)",
+        "lag, smallest amplitude [ms]",
+        |s| s.lag_ms,
+    ),
+    (
+        "peak_ratio",
+        "peak ratio",
+        "|negative| / positive peak, largest amplitude [-]",
+        |s| s.peak_ratio,
+    ),
+    (
+        "plateau_pos_N",
+        "positive plateau",
+        "mean force above 90% of the peak [N]",
+        |s| s.plateau_pos_N,
+    ),
+    (
+        "plateau_neg_N",
+        "negative plateau",
+        "mean force below 90% of the negative peak [N]",
+        |s| s.plateau_neg_N,
+    ),
+];
+
+/// Colour of the candidates that are not the cause (grey: they stand back).
+const ALSO_RAN: RGBColor = RGBColor(150, 150, 150);
+
+/// Half-width of the measured noise band in noise standard deviations (about 95%).
+pub const NOISE_BAND_SD: f64 = 2.0;
+
+/// One dot plot per signature quantity: a row per source (measured, baseline, the chosen cause,
+/// the other candidates), one dot series per source named by it; the measured value as a
+/// dashed vertical line through every row, over the band measured +- 2 noise sd (`noise`, where
+/// finite); the chosen cause ringed.
+pub fn signature_plots(d: &Diagnosis, noise: Option<&Signature>, synthetic: bool) -> Vec<Plot> {
+    let mut order: Vec<&Signature> = Vec::with_capacity(d.signatures.len());
+    let is = |g: &&Signature, s: &str| g.source == s;
+    order.extend(d.signatures.iter().filter(|g| is(g, "measured")));
+    order.extend(d.signatures.iter().filter(|g| is(g, "baseline")));
+    order.extend(d.signatures.iter().filter(|g| is(g, &d.cause)));
+    order.extend(
+        d.signatures
+            .iter()
+            .filter(|g| !is(g, "measured") && !is(g, "baseline") && !is(g, &d.cause)),
+    );
+    let rows: Vec<String> = order
+        .iter()
+        .map(|g| match g.source.as_str() {
+            "measured" if synthetic => "measured (SYNTHETIC)".to_string(),
+            s if s == d.cause => format!("{s} (chosen)"),
+            s => s.to_string(),
+        })
+        .collect();
+    let n = order.len() as f64;
+    let measured = order.iter().find(|g| is(g, "measured"));
+    SIGNATURE_QUANTITIES
+        .iter()
+        .map(|&(_, title, x_label, f)| {
+            let m = measured.map_or(f64::NAN, |g| f(g));
+            let sd = noise.map_or(f64::NAN, f);
+            let mut p = Plot::new(title, x_label, "")
+                .y_categories(&rows)
+                .no_legend();
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut widen = |v: f64| {
+                if v.is_finite() {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            };
+            if m.is_finite() && sd.is_finite() && sd > 0.0 {
+                let (a, b) = (m - NOISE_BAND_SD * sd, m + NOISE_BAND_SD * sd);
+                widen(a);
+                widen(b);
+                p = p.band("measured noise band", &[a, b], &[-0.5, n - 0.5]);
+            }
+            if m.is_finite() {
+                p = p.dashed("measured value", &[m, m], &[-0.5, n - 0.5]);
+            }
+            for (i, g) in order.iter().enumerate() {
+                let v = f(g);
+                widen(v);
+                p = p.dots(&g.source, &[v], &[i as f64]);
+                p = match g.source.as_str() {
+                    "measured" => p,
+                    "baseline" => p.colour(OTHER_COLOURS[0]),
+                    s if s == d.cause => p.colour(OTHER_COLOURS[1]),
+                    _ => p.colour(ALSO_RAN),
+                };
+                if g.source == d.cause {
+                    p = p.rings("", &[v], &[i as f64]).colour(OTHER_COLOURS[1]);
+                }
+            }
+            if lo.is_finite() {
+                let span = if hi > lo { hi - lo } else { lo.abs().max(1e-3) };
+                p = p.x_range(lo - 0.08 * span, hi + 0.08 * span);
+            }
+            p
+        })
+        .collect()
+}
+
+/// The measured noise spread of the signatures ([`super::evidence::signature_noise`]) about the
+/// chosen model's force (the baseline's for `none`).
+pub fn noise_of(d: &Diagnosis, curves: &[Curves]) -> Signature {
+    let reference: Vec<Vec<f64>> = curves.iter().map(|c| c.extended_n.clone()).collect();
+    let band = super::evidence::dwell_band(curves, d.noise_sigma_N);
+    super::evidence::signature_noise(curves, &reference, d.noise_sigma_N, band)
+}
 
 /// HTML report of a diagnosis; `source` describes the data and says SYNTHETIC where it is, which
 /// puts the SYNTHETIC banner at the head of the report.
 pub fn html(d: &Diagnosis, curves: &[Curves], source: &str) -> Result<String, PlotError> {
-    html_with(d, curves, source, |_| Ok(()))
+    html_with(d, curves, source, Some(&noise_of(d, curves)), |_| Ok(()))
 }
 
-/// As [`html`], with extra sections (e.g. the rotor-level check) after the headline and the
-/// limitations.
+/// As [`html`], with the signatures' noise spread given ([`noise_of`]) and extra sections (e.g.
+/// the rotor-level check) after the headline and the limitations.
 pub fn html_with(
     d: &Diagnosis,
     curves: &[Curves],
     source: &str,
+    noise: Option<&Signature>,
     extra: impl FnOnce(&mut HtmlReport) -> Result<(), PlotError>,
 ) -> Result<String, PlotError> {
     let mut r = HtmlReport::new(&format!("rotorsim diagnosis: {}", d.cause));
@@ -81,6 +217,17 @@ pub fn html_with(
             "plateau - [N]",
         ],
         &rows,
+    );
+    let synthetic = source.contains("SYNTHETIC");
+    let plots = signature_plots(d, noise, synthetic);
+    r.svg(
+        &format!(
+            "Signatures{}: each row one force, its dot the value of the quantity; black dashed line: the measured value, grey band: measured +- {NOISE_BAND_SD} sd of the spread the measurement noise alone gives (sigma {:.1} N, {} noisy copies of the chosen model's force); ringed: the chosen cause; grey dots: the other candidates. A cause that explains the data puts its dots on the measured line.",
+            if synthetic { " (SYNTHETIC data)" } else { "" },
+            d.noise_sigma_N,
+            super::evidence::NOISE_REALIZATIONS
+        ),
+        &grid_svg(&plots, 2, 1100, 380)?,
     );
     r.heading(2, "Identifiability");
     if d.identifiability.is_empty() {

@@ -78,6 +78,12 @@ pub enum SeriesKind {
     Points,
     /// Bars centred on each x, side by side with the plot's other bar series (harmonics).
     Bars,
+    /// Large filled dots (a dot plot's values).
+    Dots,
+    /// Open rings around points (highlights a dot, e.g. the chosen cause).
+    Rings,
+    /// A shaded rectangle over the bounding box of the series' points (a band, e.g. noise).
+    Band,
 }
 
 /// One named data series.
@@ -87,6 +93,8 @@ pub struct Series {
     pub x: Vec<f64>,
     pub y: Vec<f64>,
     pub kind: SeriesKind,
+    /// Colour overriding the plot's convention (e.g. grey for the also-rans of a dot plot).
+    pub colour: Option<RGBColor>,
 }
 
 /// A 2-D plot with any number of series.
@@ -104,6 +112,11 @@ pub struct Plot {
     /// Displayed value = data value * scale (e.g. 1e-3 for N shown in kN).
     pub x_scale: f64,
     pub y_scale: f64,
+    /// A categorical y axis: category i is the i-th row from the top, at y = i in the series'
+    /// data (a dot plot's rows); `y_scale` and `y_range` do not apply.
+    pub y_categories: Option<Vec<String>>,
+    /// Draw the legend column (off when the rows already name the series).
+    pub legend: bool,
 }
 
 /// Errors while drawing.
@@ -211,6 +224,8 @@ impl Plot {
             x_step: None,
             x_scale: 1.0,
             y_scale: 1.0,
+            y_categories: None,
+            legend: true,
         }
     }
 
@@ -221,6 +236,7 @@ impl Plot {
             x: x[..n].to_vec(),
             y: y[..n].to_vec(),
             kind,
+            colour: None,
         });
         self
     }
@@ -243,6 +259,39 @@ impl Plot {
 
     pub fn bars(self, name: &str, x: &[f64], y: &[f64]) -> Self {
         self.push(name, x, y, SeriesKind::Bars)
+    }
+
+    pub fn dots(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::Dots)
+    }
+
+    pub fn rings(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::Rings)
+    }
+
+    /// A shaded band over the bounding box of the points given.
+    pub fn band(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::Band)
+    }
+
+    /// Colour of the last series added (overrides the model colours).
+    pub fn colour(mut self, c: RGBColor) -> Self {
+        if let Some(s) = self.series.last_mut() {
+            s.colour = Some(c);
+        }
+        self
+    }
+
+    /// A categorical y axis, rows named from the top (series' y = row index).
+    pub fn y_categories(mut self, names: &[String]) -> Self {
+        self.y_categories = Some(names.to_vec());
+        self
+    }
+
+    /// No legend column.
+    pub fn no_legend(mut self) -> Self {
+        self.legend = false;
+        self
     }
 
     /// A series of the given kind.
@@ -288,8 +337,9 @@ impl Plot {
         let mut k = 0;
         let mut out: Vec<RGBColor> = Vec::with_capacity(self.series.len());
         for s in &self.series {
-            let c = match (s.name.is_empty(), out.last()) {
-                (true, Some(&prev)) => prev,
+            let c = match (s.colour, s.name.is_empty(), out.last()) {
+                (Some(c), _, _) => c,
+                (None, true, Some(&prev)) => prev,
                 // per-rev reference lines of a fan plot: background grey
                 _ if s.name.ends_with("/rev") => RGBColor(170, 170, 170),
                 _ => model_colour(&s.name).unwrap_or_else(|| {
@@ -333,7 +383,12 @@ impl Plot {
             (a.min(b), a.max(b))
         };
         // Lines run edge to edge; markers only (a sweep's cases) would sit on the frame.
-        let points_only = self.series.iter().all(|s| s.kind == SeriesKind::Points);
+        let points_only = self.series.iter().all(|s| {
+            matches!(
+                s.kind,
+                SeriesKind::Points | SeriesKind::Dots | SeriesKind::Rings | SeriesKind::Band
+            )
+        });
         let xr = self.x_range.map(|r| sc(r, sx)).unwrap_or(if xr.1 <= xr.0 {
             pad(xr, 0.5)
         } else if points_only {
@@ -341,12 +396,18 @@ impl Plot {
         } else {
             xr
         });
-        let yr = self.y_range.map(|r| sc(r, sy)).unwrap_or(pad(yr, 0.05));
+        let yr = match &self.y_categories {
+            Some(c) => (-0.6, c.len() as f64 - 0.4),
+            None => self.y_range.map(|r| sc(r, sy)).unwrap_or(pad(yr, 0.05)),
+        };
         Ok((xr, yr))
     }
 
     /// Width of the legend column [px] (0 without named series).
     fn legend_width(&self, width: u32) -> u32 {
+        if !self.legend {
+            return 0;
+        }
         let longest = self
             .series
             .iter()
@@ -378,15 +439,41 @@ impl Plot {
                 (t, decimals_for(s))
             }
         };
-        let (yt, sy) = nice_ticks(y0, y1, 6);
-        let dy = decimals_for(sy);
+        let cats = self.y_categories.clone();
+        let ncat = cats.as_ref().map_or(0, Vec::len);
+        let (yt, dy) = match &cats {
+            // row i from the top sits at y = ncat - 1 - i
+            Some(_) => ((0..ncat).map(|k| k as f64).collect(), 0),
+            None => {
+                let (t, s) = nice_ticks(y0, y1, 6);
+                (t, decimals_for(s))
+            }
+        };
         let xfmt = move |v: &f64| tick_label(*v, dx);
-        let yfmt = move |v: &f64| tick_label(*v, dy);
+        let yfmt = move |v: &f64| match &cats {
+            Some(c) => {
+                let k = v.round();
+                if k >= 0.0 && (k as usize) < c.len() {
+                    c[c.len() - 1 - k as usize].clone()
+                } else {
+                    String::new()
+                }
+            }
+            None => tick_label(*v, dy),
+        };
+        // Row names need room (13 px DejaVu Sans: about 7.5 px a character).
+        let y_area = match &self.y_categories {
+            Some(c) => {
+                let longest = c.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+                ((longest as f64 * 7.5) as u32 + 16).clamp(70, w / 2)
+            }
+            None => 70,
+        };
         let mut chart = ChartBuilder::on(&plot_area)
             .caption(&self.title, ("sans-serif", 18))
             .margin(10)
             .x_label_area_size(40)
-            .y_label_area_size(70)
+            .y_label_area_size(y_area)
             .build_cartesian_2d(ticked(x0, x1, xt), ticked(y0, y1, yt))
             .map_err(|e| err(&e))?;
         chart
@@ -409,12 +496,19 @@ impl Plot {
             .max(1);
         let mut jbar = 0usize;
         let (sx, sy) = (self.x_scale, self.y_scale);
+        let fy = |y: f64| {
+            if ncat > 0 {
+                (ncat - 1) as f64 - y
+            } else {
+                y * sy
+            }
+        };
         for (s, &color) in self.series.iter().zip(&colours) {
             let pts: Vec<(f64, f64)> =
                 s.x.iter()
                     .zip(&s.y)
                     .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    .map(|(&x, &y)| (x * sx, y * sy))
+                    .map(|(&x, &y)| (x * sx, fy(y)))
                     .collect();
             match s.kind {
                 SeriesKind::Line => {
@@ -436,6 +530,38 @@ impl Plot {
                     chart
                         .draw_series(pts.into_iter().map(|p| Circle::new(p, 2, color.filled())))
                         .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Dots => {
+                    chart
+                        .draw_series(pts.into_iter().map(|p| Circle::new(p, 5, color.filled())))
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Rings => {
+                    chart
+                        .draw_series(
+                            pts.into_iter()
+                                .map(|p| Circle::new(p, 9, color.stroke_width(2))),
+                        )
+                        .map_err(|e| err(&e))?;
+                }
+                SeriesKind::Band => {
+                    let bb = pts.iter().fold(
+                        (
+                            f64::INFINITY,
+                            f64::INFINITY,
+                            f64::NEG_INFINITY,
+                            f64::NEG_INFINITY,
+                        ),
+                        |b, &(x, y)| (b.0.min(x), b.1.min(y), b.2.max(x), b.3.max(y)),
+                    );
+                    if bb.0 <= bb.2 {
+                        chart
+                            .draw_series(std::iter::once(Rectangle::new(
+                                [(bb.0, bb.1), (bb.2, bb.3)],
+                                color.mix(0.12).filled(),
+                            )))
+                            .map_err(|e| err(&e))?;
+                    }
                 }
                 SeriesKind::Bars => {
                     let bw = 0.8 * sx.abs() / nbars as f64;
@@ -477,9 +603,16 @@ impl Plot {
                         }
                         r
                     }
-                    SeriesKind::Points => {
+                    SeriesKind::Points | SeriesKind::Dots => {
                         legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 3, color.filled()))
                     }
+                    SeriesKind::Rings => {
+                        legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 5, color.stroke_width(2)))
+                    }
+                    SeriesKind::Band => legend_area.draw(&Rectangle::new(
+                        [(x0, y - 5), (x1, y + 5)],
+                        color.mix(0.12).filled(),
+                    )),
                     SeriesKind::Bars => legend_area.draw(&Rectangle::new(
                         [(x0 + 4, y - 5), (x1 - 4, y + 5)],
                         color.filled(),
@@ -607,6 +740,31 @@ mod tests {
             .line("nonlinear", &[0.0, 1.0], &[0.0, 1.0])
             .points("", &[0.0, 1.0], &[0.0, 1.0]);
         assert_eq!(p.colours()[1], MODEL_COLOURS[2].1);
+    }
+
+    #[test]
+    fn categorical_rows_are_named_top_down() {
+        let rows = vec!["first row".to_string(), "second row".to_string()];
+        let p = Plot::new("dots", "value [N]", "")
+            .y_categories(&rows)
+            .no_legend()
+            .band("noise", &[0.5, 1.5], &[-0.5, 1.5])
+            .dots("a", &[1.0], &[0.0])
+            .dots("b", &[2.0], &[1.0])
+            .colour(RGBColor(1, 2, 3));
+        assert_eq!(p.legend_width(600), 0);
+        assert_eq!(p.ranges().unwrap().1, (-0.6, 1.6));
+        assert_eq!(p.colours()[2], RGBColor(1, 2, 3));
+        let svg = p.to_svg(600, 300).unwrap();
+        // the y attribute of the <text> element holding `label`
+        let y_of = |label: &str| -> f64 {
+            let at = svg.find(label).unwrap();
+            let start = svg[..at].rfind("<text").unwrap();
+            let tag = &svg[start..at];
+            let y = tag.split(" y=\"").nth(1).unwrap();
+            y[..y.find('"').unwrap()].parse().unwrap()
+        };
+        assert!(y_of("first row") < y_of("second row"), "rows top-down");
     }
 
     #[test]

@@ -10,6 +10,7 @@
 //! (result.mcap). Conventions and alignment: docs/run.md.
 pub mod loads;
 pub mod mcap_out;
+pub mod outputs;
 pub mod periodic;
 pub mod report;
 pub mod sdof;
