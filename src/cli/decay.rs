@@ -80,7 +80,7 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
     out.finish()?;
     let n = r.lag_rad.len();
     outln!(
-        "{} rpm, h = {} s, {} steps ({} frame, {} Newton): {:.3} iterations and {:.4} \
+        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton): {:.3} iterations and {:.4} \
          factorizations per step",
         r.omega_rad_s * 30.0 / std::f64::consts::PI,
         opts.time_step_s,
