@@ -4,10 +4,8 @@
 //! frequency and damping ratio (linear-prediction fit and log decrement over t >= 1 s), the
 //! Newton iterations and factorizations per step and the CPU cost per step of this thread, and
 //! writes the lag angle history to `tm4760_decay.csv` in the current folder.
-use rotorsim::rotor::hinged::{
-    blade_node_ids, fit_damped_sine, log_decrement, modes_at, track, DecayOptions, DecaySim,
-    HingedSpec,
-};
+use rotorsim::rotor::hinged::HingedSpec;
+use rotorsim::run::decay::{analyse, decay_sim, modal_lag, steps, DecayRun, DecayRunOptions};
 use rotorsim::solver::NewtonMethod;
 use std::path::Path;
 
@@ -47,33 +45,29 @@ fn main() -> anyhow::Result<()> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors/tm4760.toml");
     let spec = HingedSpec::from_file(&path)?;
     let om = spec.rotor.omega_rad_s;
-    let (model, ms) = modes_at(&spec, &path, om, 14)?;
-    let (hz, zeta) = track(&ms, &blade_node_ids(&spec, &model)?);
+    let opts = DecayRunOptions {
+        omega_rad_s: Some(om),
+        time_step_s: h,
+        duration_s: end,
+        rotating_frame: frame,
+        newton,
+        newton_rtol: rtol,
+        rho_inf: rho,
+        ..Default::default()
+    };
+    let modal = modal_lag(&spec, &path, om)?;
     println!(
         "modal rigid lag: {:.6} Hz (damped), zeta {:.6}",
-        hz[0], zeta[0]
+        modal.0, modal.1
     );
-    let mut sim = DecaySim::new(
-        &spec,
-        &path,
-        &DecayOptions {
-            omega_rad_s: om,
-            release_moment_nm: 4.5,
-            release_time_s: 0.01,
-            time_step_s: h,
-            rho_inf: rho,
-            newton,
-            newton_rtol: rtol,
-            rotating_frame: frame,
-        },
-    )?;
+    let mut sim = decay_sim(&spec, &path, &opts)?;
     println!(
         "h = {h} s, {} frame, {} Newton, rtol {rtol:e}, rho_inf {rho}; initial lag {:.4} deg",
         if frame { "turning" } else { "inertial" },
         newton.name(),
         sim.lag_angle_rad().to_degrees()
     );
-    let n = (end / h).round() as usize;
+    let n = steps(&opts);
     let mut x = Vec::with_capacity(n);
     let c0 = cpu_seconds();
     let t0 = std::time::Instant::now();
@@ -91,15 +85,13 @@ fn main() -> anyhow::Result<()> {
     }
     let wall = t0.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - c0;
-    let w = &x[((1.0 / h).round() as usize).min(x.len())..];
-    let ld = log_decrement(w, sim.lag_eq_rad, h);
-    let fit = ld.and_then(|g| fit_damped_sine(w, h, g));
+    let (fit, ld) = analyse(&x, sim.lag_eq_rad, &opts);
     println!("fit: {fit:?} (Hz, zeta); log decrement: {ld:?}");
     if let Some((f, z)) = fit {
         println!(
             "fit vs modal: frequency {:+.3}%, damping ratio {:+.3}%",
-            100.0 * (f - hz[0]) / hz[0],
-            100.0 * (z - zeta[0]) / zeta[0]
+            100.0 * (f - modal.0) / modal.0,
+            100.0 * (z - modal.1) / modal.1
         );
     }
     let s = &sim.solver;
@@ -110,10 +102,17 @@ fn main() -> anyhow::Result<()> {
         1e3 * cpu / n as f64,
         1e3 * wall / n as f64
     );
-    let mut csv = String::from("time_s,lag_rad\n");
-    for (k, v) in x.iter().enumerate() {
-        csv.push_str(&format!("{},{}\n", (k + 1) as f64 * h, v));
-    }
-    std::fs::write("tm4760_decay.csv", csv)?;
+    let run = DecayRun {
+        options: opts,
+        omega_rad_s: om,
+        lag_eq_rad: sim.lag_eq_rad,
+        lag_rad: x,
+        modal,
+        fit,
+        log_decrement: ld,
+        newton_iterations: s.total_iterations,
+        factorizations: s.factorizations,
+    };
+    std::fs::write("tm4760_decay.csv", run.history_csv())?;
     Ok(())
 }

@@ -60,6 +60,7 @@ macro_rules! errout {
 
 pub mod bench;
 pub mod convert;
+pub mod decay;
 pub mod diagnose;
 pub mod dynamic;
 pub mod expand;
@@ -145,6 +146,13 @@ paper figure 9-12 of each device."
 reference table, fan_comparison.csv (rotor deck)."
     ))]
     Modes(modes::ModesArgs),
+    /// Free decay of a hinged blade's lag hinge beside its linearised mode.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: decay.csv (lag angle history: time_s, lag_angle_rad, lag_angle_deg) and \
+decay_summary.csv (frequency_Hz and damping_ratio of the linearised mode, of a damped-sine fit \
+and of the log decrement over t >= 1 s)."
+    ))]
+    Decay(decay::DecayArgs),
     /// Run the verification suite and write verify.json.
     #[command(after_long_help = writes!("Writes DIR/verify.json: every check with its \
 reference, value, tolerance and pass/fail."))]
@@ -224,6 +232,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Static(a) => static_cmd::run(a),
         Command::Dynamic(a) => dynamic::run(a),
         Command::Modes(a) => modes::run(a),
+        Command::Decay(a) => decay::run(a),
         Command::Verify(a) => verify::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Inspect(a) => inspect::run(a),

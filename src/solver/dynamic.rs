@@ -391,19 +391,17 @@ impl DynamicSolver {
         }
     }
 
-    /// Advance one step of size `h`. On error the state is left at the last converged step.
-    pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
+    /// Zero-acceleration predictor of the step from the converged state: `dq`, `v_new`,
+    /// `vd_new` (`a_new`: the algorithmic accelerations it implies) and `x_prev`.
+    fn predict(
+        &mut self,
+        a_new: &mut Vec<[f64; 6]>,
+        v_new: &mut Vec<[f64; 6]>,
+        vd_new: &mut Vec<[f64; 6]>,
+    ) {
         let p = self.params;
         let h = self.h;
         let n = self.model.nodes.len();
-        let nn = 6 * n;
-        let t_n = self.state.t;
-        let t = t_n + h;
-        let (cv, ca) = self.coeffs();
-        // predictor (vd_{n+1} = 0)
-        let mut a_new = std::mem::take(&mut self.ws_a);
-        let mut vd_new = std::mem::take(&mut self.ws_vd);
-        let mut v_new = std::mem::take(&mut self.ws_v);
         a_new.resize(n, [0.0; 6]);
         vd_new.resize(n, [0.0; 6]);
         v_new.resize(n, [0.0; 6]);
@@ -420,6 +418,119 @@ impl DynamicSolver {
             }
         }
         self.x_prev.clone_from(&self.state.x);
+    }
+
+    /// Node kinematics `self.kin` of the iterate: configuration from `dq`
+    /// (`x = x_n + h dq_x`, `R = exp(h dq_th) R_n`), velocities and accelerations `v_new`,
+    /// `vd_new`, made absolute ([`to_frame`]) in a turning frame; `tl` the rotation tangents.
+    fn set_iterate(
+        &mut self,
+        x_new: &mut [[f64; 3]],
+        q_new: &mut [nalgebra::UnitQuaternion<f64>],
+        q_prev: &[nalgebra::UnitQuaternion<f64>],
+        v_new: &[[f64; 6]],
+        vd_new: &[[f64; 6]],
+    ) {
+        let h = self.h;
+        let n = self.model.nodes.len();
+        for i in 0..n {
+            let th = [h * self.dq[i][3], h * self.dq[i][4], h * self.dq[i][5]];
+            for k in 0..3 {
+                x_new[i][k] = self.x_prev[i][k] + h * self.dq[i][k];
+            }
+            q_new[i] = update_left(&q_prev[i], th);
+            self.tl[i] = tangent_left(th);
+        }
+        self.kin.clear();
+        for i in 0..n {
+            self.kin.push(NodeKin {
+                x: x_new[i],
+                r: quat_to_arr(&q_new[i]),
+                v: [v_new[i][0], v_new[i][1], v_new[i][2]],
+                w: [v_new[i][3], v_new[i][4], v_new[i][5]],
+                a: [vd_new[i][0], vd_new[i][1], vd_new[i][2]],
+                al: [vd_new[i][3], vd_new[i][4], vd_new[i][5]],
+            });
+        }
+        if let Some(om) = self.frame_omega {
+            for k in self.kin.iter_mut() {
+                to_frame(k, om);
+            }
+        }
+    }
+
+    /// Test hook for finite-difference checks of the iteration matrix: the residual and the
+    /// dense iteration matrix of the next step's Newton system at the zero-acceleration
+    /// predictor moved by the Newton correction `d` (node dofs, then scaled multipliers; the
+    /// update of [`DynamicSolver::step`]). With `frame_terms = false` the matrix is assembled
+    /// from seeds without the turning-frame terms of [`frame_seed`] (the residual is the
+    /// same): the matrix of a solver that ignored them. The converged state is unchanged.
+    #[doc(hidden)]
+    pub fn iteration_system(
+        &mut self,
+        d: &[f64],
+        frame_terms: bool,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), NewtonError> {
+        let n = self.model.nodes.len();
+        let nn = 6 * n;
+        assert_eq!(d.len(), self.asm.ndof, "correction length");
+        let t_n = self.state.t;
+        let t = t_n + self.h;
+        let (cv, ca) = self.coeffs();
+        let (mut a_new, mut v_new, mut vd_new) = (vec![], vec![], vec![]);
+        self.predict(&mut a_new, &mut v_new, &mut vd_new);
+        for i in 0..n {
+            for k in 0..6 {
+                let di = d[6 * i + k];
+                self.dq[i][k] += di;
+                v_new[i][k] += cv * di;
+                vd_new[i][k] += ca * di;
+            }
+        }
+        let lam_hat: Vec<f64> = self
+            .lam_hat
+            .iter()
+            .zip(&d[nn..])
+            .map(|(l, di)| l + di)
+            .collect();
+        let q_prev = self.state.q.clone();
+        let mut x_new = self.state.x.clone();
+        let mut q_new = q_prev.clone();
+        self.set_iterate(&mut x_new, &mut q_new, &q_prev, &v_new, &vd_new);
+        self.model.update_distributed_loads(t, &self.kin);
+        let ctx = EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: self.cscale,
+            inertia: true,
+        };
+        let fo = self.frame_omega;
+        if !frame_terms {
+            self.frame_omega = None;
+        }
+        let r = self.assemble_at(t, t_n, &lam_hat, &ctx, true, (0, f64::NAN));
+        self.frame_omega = fo;
+        r?;
+        // the factorization (if any) no longer matches the assembled values
+        self.have_factor = false;
+        Ok((self.res.clone(), self.asm.to_dense()))
+    }
+
+    /// Advance one step of size `h`. On error the state is left at the last converged step.
+    pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
+        let p = self.params;
+        let h = self.h;
+        let n = self.model.nodes.len();
+        let nn = 6 * n;
+        let t_n = self.state.t;
+        let t = t_n + h;
+        let (cv, ca) = self.coeffs();
+        // predictor (vd_{n+1} = 0)
+        let mut a_new = std::mem::take(&mut self.ws_a);
+        let mut vd_new = std::mem::take(&mut self.ws_vd);
+        let mut v_new = std::mem::take(&mut self.ws_v);
+        self.predict(&mut a_new, &mut v_new, &mut vd_new);
         let mut q_prev = std::mem::take(&mut self.ws_q);
         q_prev.clone_from(&self.state.q);
         let mut lam_hat = std::mem::take(&mut self.ws_lam);
@@ -458,31 +569,7 @@ impl DynamicSolver {
         let mut tiny = false;
         let mut r_last = f64::NAN;
         loop {
-            // configuration from dq
-            for i in 0..n {
-                let th = [h * self.dq[i][3], h * self.dq[i][4], h * self.dq[i][5]];
-                for k in 0..3 {
-                    x_new[i][k] = self.x_prev[i][k] + h * self.dq[i][k];
-                }
-                q_new[i] = update_left(&q_prev[i], th);
-                self.tl[i] = tangent_left(th);
-            }
-            self.kin.clear();
-            for i in 0..n {
-                self.kin.push(NodeKin {
-                    x: x_new[i],
-                    r: quat_to_arr(&q_new[i]),
-                    v: [v_new[i][0], v_new[i][1], v_new[i][2]],
-                    w: [v_new[i][3], v_new[i][4], v_new[i][5]],
-                    a: [vd_new[i][0], vd_new[i][1], vd_new[i][2]],
-                    al: [vd_new[i][3], vd_new[i][4], vd_new[i][5]],
-                });
-            }
-            if let Some(om) = self.frame_omega {
-                for k in self.kin.iter_mut() {
-                    to_frame(k, om);
-                }
-            }
+            self.set_iterate(&mut x_new, &mut q_new, &q_prev, &v_new, &vd_new);
             self.model.update_distributed_loads(t, &self.kin);
             // A matrix is assembled only where it is factored: modified Newton without a
             // stored factorization assembles it with the residual; otherwise the residual

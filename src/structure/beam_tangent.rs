@@ -437,8 +437,11 @@ impl Beam {
     }
 }
 
-#[cfg(test)]
-mod tests {
+/// Fixture shared by the tangent tests and the tangent cost benchmark
+/// (benches/structure_tangent.rs): a curved, pre-twisted element with coupled sections and
+/// loads, random configurations and solver-shaped seeds, and the 24-lane dual reference.
+#[doc(hidden)]
+pub mod fixture {
     use super::*;
     use crate::structure::beam::{BeamLoad, SectionLoad};
     use crate::structure::kin::TimeTable;
@@ -446,10 +449,10 @@ mod tests {
     use crate::structure::section::{SectionProps, SectionTable};
 
     /// xorshift64: deterministic, no dependency.
-    struct Rng(u64);
+    pub struct Rng(pub u64);
     impl Rng {
         /// Uniform in [-1, 1).
-        fn next(&mut self) -> f64 {
+        pub fn sym(&mut self) -> f64 {
             let mut x = self.0;
             x ^= x << 13;
             x ^= x >> 7;
@@ -457,18 +460,18 @@ mod tests {
             self.0 = x;
             (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         }
-        fn vec(&mut self, s: f64) -> V {
-            [s * self.next(), s * self.next(), s * self.next()]
+        pub fn vec(&mut self, s: f64) -> V {
+            [s * self.sym(), s * self.sym(), s * self.sym()]
         }
         /// Random direction, norm uniform in [0, max].
-        fn rotvec(&mut self, max: f64) -> V {
+        pub fn rotvec(&mut self, max: f64) -> V {
             let d = self.vec(1.0);
             let n = dot(d, d).sqrt().max(1e-12);
-            fmul(max * 0.5 * (1.0 + self.next()) / n, d)
+            fmul(max * 0.5 * (1.0 + self.sym()) / n, d)
         }
     }
 
-    fn section(s: f64, f: f64) -> SectionProps {
+    pub fn section(s: f64, f: f64) -> SectionProps {
         SectionProps {
             s_m: s,
             ea: 5e5 * f,
@@ -493,7 +496,7 @@ mod tests {
     /// Curved (arc of radius 3 m, 0.4 rad, with a rise), pre-twisted (0.6 rad) element, or a
     /// straight untwisted one, with coupled, spanwise-varying sections, cm offset, damping,
     /// follower and fixed loads.
-    fn test_beam(rng: &mut Rng, mu: f64, curved: bool) -> (Beam, [V; 4], [M; 4]) {
+    pub fn test_beam(rng: &mut Rng, mu: f64, curved: bool) -> (Beam, [V; 4], [M; 4]) {
         let mut x0 = [[0.0; 3]; 4];
         let mut r0 = [IM; 4];
         for i in 0..4 {
@@ -534,7 +537,7 @@ mod tests {
 
     /// Rigid rotation up to 0.9 pi of the reference, node rotations up to `dev` rad on top
     /// (relative rotations between nodes up to `2 dev` beyond the reference ones), random rates.
-    fn config(rng: &mut Rng, x0: &[V; 4], r0: &[M; 4], dev: f64) -> [NodeKin<f64>; 4] {
+    pub fn config(rng: &mut Rng, x0: &[V; 4], r0: &[M; 4], dev: f64) -> [NodeKin<f64>; 4] {
         let rb = exp_map(rng.rotvec(0.9 * std::f64::consts::PI));
         let off = rng.vec(2.0);
         std::array::from_fn(|i| NodeKin {
@@ -549,7 +552,7 @@ mod tests {
 
     /// Seeds shaped like the dynamic solver's: `dx = h e`, `dth = h T e`, `dv = dw = cv e`,
     /// `da = dal = ca e`; `mask` keeps only some of the six parts (to test each separately).
-    fn seeds(rng: &mut Rng, h: f64, cv: f64, ca: f64, mask: [bool; 6]) -> [[Seed; 6]; 4] {
+    pub fn seeds(rng: &mut Rng, h: f64, cv: f64, ca: f64, mask: [bool; 6]) -> [[Seed; 6]; 4] {
         std::array::from_fn(|_| {
             let t = tangent_left(rng.rotvec(0.3));
             std::array::from_fn(|c| {
@@ -576,7 +579,7 @@ mod tests {
     }
 
     /// Reference: one 24-lane dual evaluation of the residual (as the assembly's dual path).
-    fn dual_tangent(
+    pub fn dual_tangent(
         b: &Beam,
         k: &[NodeKin<f64>; 4],
         ctx: &EvalCtx,
@@ -587,6 +590,12 @@ mod tests {
         b.residual(&k24, ctx, &mut o24);
         (0..576).map(|i| o24[i / 24].d[i % 24]).collect()
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixture::*;
+    use super::*;
 
     fn perturbed(k: &NodeKin<f64>, s: &Seed, eps: f64) -> NodeKin<f64> {
         let p = |a: V, d: V| add(a, fmul(eps, d));
@@ -742,42 +751,6 @@ mod tests {
         println!(
             "analytic vs central differences, worst relative error (x th v w a al all): {:?}",
             worst.map(|x| format!("{x:.1e}"))
-        );
-    }
-
-    /// Cost per call of the analytic and the 24-lane dual tangent and of the f64 residual
-    /// (best of 20 batches of 500 calls, so that other load on the machine matters less):
-    /// `cargo test --release --lib beam_tangent::tests::timing -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn timing() {
-        let mut rng = Rng(7);
-        let (b, x0, r0) = test_beam(&mut rng, 0.01, true);
-        let k = config(&mut rng, &x0, &r0, 0.25);
-        let cx = ctx(true);
-        let s = seeds(&mut rng, 2e-3, 1e3, 7e5, [true; 6]);
-        let best = |f: &mut dyn FnMut()| {
-            let n = 500;
-            (0..20)
-                .map(|_| {
-                    let t0 = std::time::Instant::now();
-                    for _ in 0..n {
-                        f();
-                    }
-                    t0.elapsed().as_secs_f64() / n as f64 * 1e9
-                })
-                .fold(f64::INFINITY, f64::min)
-        };
-        let mut t = [0.0; 576];
-        let ta = best(&mut || b.tangent(std::hint::black_box(&k), &cx, &s, &mut t));
-        let mut d = vec![];
-        let td = best(&mut || d = dual_tangent(&b, std::hint::black_box(&k), &cx, &s));
-        let mut r = [0.0; 24];
-        let tr = best(&mut || b.residual(std::hint::black_box(&k), &cx, &mut r));
-        println!(
-            "beam tangent: closed form {ta:.0} ns, DualN<24> {td:.0} ns, f64 residual {tr:.0} ns \
-             per call ({:.1e})",
-            t[17] + d[17] + r[3]
         );
     }
 }

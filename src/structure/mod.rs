@@ -14,6 +14,9 @@ pub mod rotation;
 pub mod section;
 
 pub use beam::{Beam, BeamLoad, SectionLoad};
+/// Fixture of the beam tangent tests, for the tangent cost benchmark.
+#[doc(hidden)]
+pub use beam_tangent::fixture as beam_tangent_fixture;
 pub use hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
 pub use joint::{AngleLaw, Joint, JointKind};
 pub use kin::{EvalCtx, NodeKin, Seed, TimeTable};

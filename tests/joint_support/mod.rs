@@ -1,0 +1,161 @@
+//! Random joint cases (frames, offsets, prescribed motion, spring and damper, evaluation
+//! point and generalized-alpha seeds) shared by the joint tangent tests and the joint cost
+//! benchmark (benches/structure_tangent.rs).
+#![allow(dead_code)]
+use rotorsim::structure::rotation::*;
+use rotorsim::structure::*;
+
+/// xorshift64*: deterministic, no dependency.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let u = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+        u as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [lo, hi).
+    pub fn uni(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+    pub fn v3(&mut self, s: f64) -> [f64; 3] {
+        std::array::from_fn(|_| self.uni(-s, s))
+    }
+    /// Rotation by an angle up to `max` about a random axis.
+    pub fn rot(&mut self, max: f64) -> [[f64; 3]; 3] {
+        let ax = loop {
+            let v = self.v3(1.0);
+            let n = dot(v, v).sqrt();
+            if n > 0.1 && n <= 1.0 {
+                break fmul(1.0 / n, v);
+            }
+        };
+        exp_map(fmul(self.uni(0.0, max), ax))
+    }
+    pub fn kin(&mut self) -> NodeKin<f64> {
+        NodeKin {
+            x: self.v3(2.0),
+            r: self.rot(0.9 * std::f64::consts::PI),
+            v: self.v3(3.0),
+            w: self.v3(5.0),
+            a: self.v3(10.0),
+            al: self.v3(10.0),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Extra {
+    None,
+    Angle,
+    Disp,
+    SpringDamper,
+    DispSpring,
+}
+
+pub const KINDS: [JointKind; 4] = [
+    JointKind::Clamp,
+    JointKind::Revolute,
+    JointKind::Universal,
+    JointKind::Spherical,
+];
+
+pub fn table() -> TimeTable {
+    TimeTable {
+        points: vec![(0.0, 0.0), (0.5, 0.7), (1.0, -0.3)],
+    }
+}
+
+/// A joint with random frames and offsets, and its evaluation point.
+pub struct Case {
+    pub j: Joint,
+    pub a: NodeKin<f64>,
+    pub b: NodeKin<f64>,
+    pub lam: Vec<f64>,
+    pub ctx: EvalCtx,
+    pub seeds: Vec<[Seed; 6]>,
+}
+
+pub fn case(rng: &mut Rng, kind: JointKind, grounded: bool, extra: Extra, dyn_seeds: bool) -> Case {
+    let mut j = Joint::new(
+        "j",
+        kind,
+        (!grounded).then_some((0, [0.0; 3], ident())),
+        (1, [0.0; 3], ident()),
+        [0.0; 3],
+        ident(),
+    );
+    j.qa = rng.rot(3.0);
+    j.qb = rng.rot(3.0);
+    j.da = rng.v3(1.5);
+    j.db = rng.v3(1.5);
+    match extra {
+        Extra::None => {}
+        Extra::Angle => {
+            j.prescribed_angle = Some(AngleLaw {
+                omega_rad_s: rng.uni(-30.0, 30.0),
+                table: Some(table()),
+            })
+        }
+        Extra::Disp => j.displacement_m = Some((rng.v3(0.2), table())),
+        Extra::SpringDamper | Extra::DispSpring => {
+            j.spring_nm_per_rad = rng.uni(1e3, 1e5);
+            j.damper_nms_per_rad = rng.uni(10.0, 1e3);
+            if matches!(extra, Extra::DispSpring) {
+                j.displacement_m = Some((rng.v3(0.2), table()));
+            }
+        }
+    }
+    j.angle_prev = rng.uni(-20.0, 20.0);
+    let a = if grounded {
+        NodeKin::ground()
+    } else {
+        rng.kin()
+    };
+    let b = rng.kin();
+    let lam = (0..j.n_lambda()).map(|_| rng.uni(-1e3, 1e3)).collect();
+    let ctx = EvalCtx {
+        t: rng.uni(0.0, 1.0),
+        cscale: rng.uni(0.5, 50.0),
+        ..Default::default()
+    };
+    let nnodes = 1 + !grounded as usize;
+    let seeds = (0..nnodes)
+        .map(|_| {
+            if dyn_seeds {
+                // generalized-alpha seeds: dx = h e, dth = h T_L(h dq) e, dv = dw = cv e,
+                // da = dal = ca e
+                let h = rng.uni(1e-4, 1e-2);
+                let tl = tangent_left(fmul(h, rng.v3(50.0)));
+                let cv = rng.uni(0.5, 2.0) / h;
+                let ca = cv / (0.3 * h);
+                std::array::from_fn(|comp| Seed::generalized_alpha(comp, h, cv, ca, &tl))
+            } else {
+                // every part of every seed non-zero
+                std::array::from_fn(|_| Seed {
+                    dx: rng.v3(1.0),
+                    dth: rng.v3(1.0),
+                    dv: rng.v3(1.0),
+                    dw: rng.v3(1.0),
+                    da: rng.v3(1.0),
+                    dal: rng.v3(1.0),
+                })
+            }
+        })
+        .collect();
+    Case {
+        j,
+        a,
+        b,
+        lam,
+        ctx,
+        seeds,
+    }
+}
+
+pub fn sizes(c: &Case) -> (usize, usize) {
+    let nn = if c.j.node_a.is_some() { 12 } else { 6 };
+    (nn, nn + c.j.n_lambda())
+}
