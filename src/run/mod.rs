@@ -8,6 +8,7 @@
 //! ([`drive_periodic`]: shooting or marching), keeps the reported revolution, and hands the results to
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
+pub mod bench;
 pub mod decay;
 pub mod loads;
 pub mod mcap_out;

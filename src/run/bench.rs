@@ -1,0 +1,807 @@
+//! The outputs of `rotorsim bench`: the harmonic sweep of a damper deck (paper Figs. 13-14:
+//! peaks.csv, history_v<v>m_s.csv, time_history.svg, bench_summary.csv,
+//! peak_force_vs_velocity.svg, bench.html) and the replay of measured bench tests
+//! (replay_*.csv, loop_*.svg, replay_summary.csv, bench.html). The devices come built from
+//! the deck; nothing here prints (the command reports through the callbacks).
+use crate::hydraulics::bench::{
+    self, BenchTest, HarmonicRun, History, ReplayMetrics, SweepOptions, IN_TO_M, LB_TO_N,
+};
+use crate::hydraulics::{DamperDeck, DamperModel, Device, IntegratorOptions};
+use crate::io::{csv_from_columns, OutDir};
+use crate::report::html::{Banner, HtmlReport};
+use crate::report::plot::{grid_svg, stacked_svg, Plot};
+use anyhow::{bail, Context};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// What a bench run needs, checked by the command (units as on its command line).
+#[derive(Debug, Clone)]
+pub struct Config {
+    /// The damper deck file (for the output manifest).
+    pub deck: PathBuf,
+    pub out: PathBuf,
+    /// Circular frequency of the harmonic stroking [rad/s].
+    pub omega: f64,
+    /// Peak velocities in `velocity_unit`.
+    pub peak_velocity: Vec<f64>,
+    /// Unit of `peak_velocity` ("in/s", "m/s", "ft/s") and metres per second in it.
+    pub velocity_unit: String,
+    pub factor: f64,
+    pub cycles: usize,
+    pub steps_per_cycle: usize,
+    /// Output samples per step of the harmonic sweep.
+    pub per_step: usize,
+    /// Hydraulic sub-stepping of each output sample.
+    pub opts: IntegratorOptions,
+    /// Measured tests to replay, and the cycles their metrics leave out.
+    pub measured: Vec<PathBuf>,
+    pub skip_cycles: usize,
+}
+
+/// Runs the harmonic sweep of every device and writes its outputs into `cfg.out`;
+/// `on_model` gets each model's runs once its files are written.
+pub fn sweep(
+    cfg: &Config,
+    deck: &DamperDeck,
+    devices: &[(DamperModel, Box<dyn Device>)],
+    on_model: &mut dyn FnMut(DamperModel, &[HarmonicRun]),
+) -> anyhow::Result<()> {
+    let (factor, per_step, opts) = (cfg.factor, cfg.per_step, cfg.opts);
+    let step_rate = cfg.omega * cfg.steps_per_cycle as f64 / (2.0 * PI);
+    let sweep = SweepOptions {
+        omega_rad_s: cfg.omega,
+        peak_velocities_m_s: cfg.peak_velocity.iter().map(|v| v * factor).collect(),
+        cycles: cfg.cycles,
+        steps_per_cycle: cfg.steps_per_cycle,
+    };
+    let out = OutDir::create(&cfg.out, std::slice::from_ref(&cfg.deck))?;
+    let mut all = Vec::new();
+    let mut time_histories = Vec::new();
+    for (model, dev) in devices {
+        let mut runs = Vec::with_capacity(sweep.peak_velocities_m_s.len());
+        for &v in &sweep.peak_velocities_m_s {
+            let r = bench::harmonic_run_sampled(
+                dev.as_ref(),
+                sweep.omega_rad_s,
+                v,
+                sweep.cycles,
+                sweep.steps_per_cycle,
+                per_step,
+                true,
+            );
+            runs.push(r.map_err(|e| {
+                let msg = format!(
+                    "{} model at peak velocity {} {} ({v} m/s): {e}",
+                    model.name(),
+                    v / factor,
+                    cfg.velocity_unit
+                );
+                let _ = out.mark_incomplete(&msg);
+                anyhow::anyhow!(msg)
+            })?);
+        }
+        let sub = if devices.len() > 1 {
+            format!("{}/", model.name())
+        } else {
+            String::new()
+        };
+        let th = write_sweep(&out, &sub, deck, *model, &runs, cfg, factor)?;
+        time_histories.push(th);
+        on_model(*model, &runs);
+        all.push((*model, runs));
+    }
+    let rate = step_rate * per_step as f64;
+    out.write(
+        "bench_summary.csv",
+        summary_csv(&all, cfg, rate, devices.len() > 1).as_bytes(),
+    )?;
+    let fig13 = fig13_plot(&all, cfg, factor, deck);
+    out.write(
+        "peak_force_vs_velocity.svg",
+        fig13.to_svg(900, 480)?.as_bytes(),
+    )?;
+    let html = sweep_html(
+        &all,
+        cfg,
+        factor,
+        deck,
+        rate,
+        per_step,
+        opts,
+        &time_histories,
+    )?;
+    out.write("bench.html", html.as_bytes())?;
+    out.finish()?;
+    Ok(())
+}
+
+/// The history file of a peak velocity: `history_v<v>m_s.csv` with v in m/s to 1 um/s and at
+/// least one integer digit, so names sort as the velocities do below 10 m/s.
+pub fn history_name(v_m_s: f64) -> String {
+    format!("history_v{v_m_s:08.6}m_s.csv")
+}
+
+fn history_csv(h: &History) -> String {
+    let mut header = vec!["time_s", "stroke_m", "velocity_m_s", "force_N"];
+    let mut cols: Vec<&[f64]> = vec![&h.time_s, &h.stroke_m, &h.velocity_m_s, &h.force_n];
+    push_device_channels(h, &mut header, &mut cols);
+    csv_from_columns(&header, &cols)
+}
+
+/// The device's channels after the bench's own, except those the bench already wrote (a
+/// dashpot's only channel is the stroke rate, `velocity_m_s`): no column twice.
+fn push_device_channels<'a>(h: &'a History, header: &mut Vec<&'a str>, cols: &mut Vec<&'a [f64]>) {
+    for (n, c) in h.channel_names.iter().zip(&h.channels) {
+        if !header.contains(n) {
+            header.push(n);
+            cols.push(c);
+        }
+    }
+}
+
+fn channel<'a>(h: &'a History, name: &str) -> Option<&'a [f64]> {
+    h.channel_names
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| h.channels[i].as_slice())
+}
+
+/// Index of the first sample of the last cycle.
+fn last_cycle_start(r: &HarmonicRun, steps_per_cycle: usize) -> usize {
+    r.history
+        .time_s
+        .len()
+        .saturating_sub(steps_per_cycle * r.samples_per_step + 1)
+}
+
+/// Writes one model's peaks.csv, histories and time_history.svg; returns the time-history SVG.
+fn write_sweep(
+    out: &OutDir,
+    sub: &str,
+    deck: &DamperDeck,
+    model: DamperModel,
+    runs: &[HarmonicRun],
+    cfg: &Config,
+    factor: f64,
+) -> anyhow::Result<String> {
+    let rows: Vec<[f64; 3]> = runs
+        .iter()
+        .map(|r| [r.peak_velocity_m_s, r.peak_force_pos_n, r.peak_force_neg_n])
+        .collect();
+    out.write(
+        &format!("{sub}peaks.csv"),
+        crate::io::csv_string(
+            &["peak_velocity_m_s", "peak_force_pos_N", "peak_force_neg_N"],
+            &rows,
+        )
+        .as_bytes(),
+    )?;
+    for r in runs {
+        out.write(
+            &format!("{sub}{}", history_name(r.peak_velocity_m_s)),
+            history_csv(&r.history).as_bytes(),
+        )?;
+    }
+    // Time history at the amplitude closest to 2 in/s (paper Fig. 14), last two cycles.
+    let target = 2.0 * IN_TO_M;
+    let r = runs
+        .iter()
+        .min_by(|a, b| {
+            (a.peak_velocity_m_s - target)
+                .abs()
+                .total_cmp(&(b.peak_velocity_m_s - target).abs())
+        })
+        .context("no runs")?;
+    let h = &r.history;
+    let from = h
+        .time_s
+        .len()
+        .saturating_sub(2 * cfg.steps_per_cycle * r.samples_per_step + 1);
+    let t = &h.time_s[from..];
+    let title = format!(
+        "{} model, peak velocity {} {} (cf. paper Fig. 14; {}), {}",
+        model.name(),
+        r.peak_velocity_m_s / factor,
+        cfg.velocity_unit,
+        history_name(r.peak_velocity_m_s),
+        deck.source
+    );
+    let mut plots = vec![Plot::new(&title, "time [s]", "force [kN]")
+        .y_scale(1e-3)
+        .line(model.name(), t, &h.force_n[from..])];
+    if let (Some(p0), Some(p1)) = (channel(h, "p0_Pa"), channel(h, "p1_Pa")) {
+        plots.push(
+            Plot::new("chamber pressures", "time [s]", "pressure [MPa]")
+                .y_scale(1e-6)
+                .line("p0", t, &p0[from..])
+                .line("p1", t, &p1[from..]),
+        );
+    }
+    if let (Some(x0), Some(x1)) = (channel(h, "x_valve0_m"), channel(h, "x_valve1_m")) {
+        plots.push(
+            Plot::new("relief valve lifts", "time [s]", "lift [mm]")
+                .y_scale(1e3)
+                .line("valve 0", t, &x0[from..])
+                .line("valve 1", t, &x1[from..]),
+        );
+    }
+    let sv: Vec<f64> = h.stroke_m[from..].to_vec();
+    plots.push(
+        Plot::new("stroke", "time [s]", "stroke [mm]")
+            .y_scale(1e3)
+            .line("stroke", t, &sv),
+    );
+    // One legend width for the stack, so the time axes line up (trailing spaces do not show).
+    let w = plots
+        .iter()
+        .flat_map(|p| p.series.iter().map(|s| s.name.chars().count()))
+        .max()
+        .unwrap_or(0);
+    for p in &mut plots {
+        for s in &mut p.series {
+            s.name = format!("{:<w$}", s.name);
+        }
+    }
+    let svg = stacked_svg(&plots, 900, 260)?;
+    out.write(&format!("{sub}time_history.svg"), svg.as_bytes())?;
+    Ok(svg)
+}
+
+/// bench_summary.csv: one row per model and amplitude.
+fn summary_csv(
+    all: &[(DamperModel, Vec<HarmonicRun>)],
+    cfg: &Config,
+    rate: f64,
+    sub_dirs: bool,
+) -> String {
+    let mut s = String::from(
+        "model,peak_velocity_m_s,peak_velocity_in_s,amplitude_m,omega_rad_s,output_rate_Hz,\
+peak_force_pos_N,peak_force_neg_N,K_storage_N_per_m,K_loss_N_per_m,energy_per_cycle_J,\
+equivalent_damping_N_s_per_m,history_file\n",
+    );
+    for (model, runs) in all {
+        for r in runs {
+            let a = r.amplitude_m;
+            let c_eq = r.dissipated_last_cycle_j / (PI * cfg.omega * a * a);
+            let dir = if sub_dirs {
+                format!("{}/", model.name())
+            } else {
+                String::new()
+            };
+            s.push_str(&format!(
+                "{},{},{},{},{},{},{},{},{},{},{},{},{}{}\n",
+                model.name(),
+                r.peak_velocity_m_s,
+                // to 1e-9 in/s, so 6 in/s reads 6 and not 5.999999999999999
+                (r.peak_velocity_m_s / IN_TO_M * 1e9).round() / 1e9,
+                a,
+                cfg.omega,
+                rate,
+                r.peak_force_pos_n,
+                r.peak_force_neg_n,
+                r.storage_stiffness_n_per_m,
+                r.loss_stiffness_n_per_m,
+                r.dissipated_last_cycle_j,
+                c_eq,
+                dir,
+                history_name(r.peak_velocity_m_s)
+            ));
+        }
+    }
+    s
+}
+
+/// Peak force vs peak velocity (paper Fig. 13), every model, with the paper's relief cap.
+fn fig13_plot(
+    all: &[(DamperModel, Vec<HarmonicRun>)],
+    cfg: &Config,
+    factor: f64,
+    deck: &DamperDeck,
+) -> Plot {
+    let cap = 3200.0 * LB_TO_N;
+    let vmax = cfg.peak_velocity.iter().cloned().fold(0.0, f64::max) * factor;
+    let mut p = Plot::new(
+        &format!(
+            "Peak force vs peak velocity (cf. paper Fig. 13), omega = {} rad/s ({})",
+            cfg.omega, deck.source
+        ),
+        &format!("peak velocity [{}]", cfg.velocity_unit),
+        "peak force [kN]",
+    )
+    .x_scale(1.0 / factor)
+    .y_scale(1e-3);
+    for (model, runs) in all {
+        let x: Vec<f64> = runs.iter().map(|r| r.peak_velocity_m_s).collect();
+        let pos: Vec<f64> = runs.iter().map(|r| r.peak_force_pos_n).collect();
+        let neg: Vec<f64> = runs.iter().map(|r| -r.peak_force_neg_n).collect();
+        p = p.line(&format!("{} +peak", model.name()), &x, &pos).dashed(
+            &format!("{} |-peak|", model.name()),
+            &x,
+            &neg,
+        );
+    }
+    from_zero(p.dashed("paper cap 3200 lb (Fig. 16)", &[0.0, vmax], &[cap, cap]))
+}
+
+/// The y axis from zero to a little above the largest value (peaks, K'', energy are >= 0 and
+/// read against zero, as in the paper's Fig. 13).
+fn from_zero(p: Plot) -> Plot {
+    let top = p
+        .series
+        .iter()
+        .flat_map(|s| s.y.iter())
+        .filter(|y| y.is_finite())
+        .fold(0.0f64, |a, &y| a.max(y));
+    if top > 0.0 {
+        p.y_range(0.0, 1.08 * top)
+    } else {
+        p
+    }
+}
+
+fn fmt_num(v: f64, d: usize) -> String {
+    format!("{v:.d$}")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep_html(
+    all: &[(DamperModel, Vec<HarmonicRun>)],
+    cfg: &Config,
+    factor: f64,
+    deck: &DamperDeck,
+    rate: f64,
+    per_step: usize,
+    opts: IntegratorOptions,
+    time_histories: &[String],
+) -> anyhow::Result<String> {
+    let unit = &cfg.velocity_unit;
+    let mut r = HtmlReport::new("rotorsim bench: harmonic sweep");
+    r.banner(
+        Banner::Info,
+        &format!(
+            "Virtual bench: every curve is computed by rotorsim's damper models from the deck {} (no measurement is shown). The dashed 3200 lb line is the paper's relief cap.",
+            deck.source
+        ),
+    );
+    r.paragraph(&format!(
+        "Stroke d(t) = A sin(omega t), A = v/omega, omega = {} rad/s; {} cycles per amplitude from a fresh damper, {} steps per cycle, {} sample(s) per step ({:.1} samples/s), {:?} with {} sub-step(s) per sample. Peaks, loops, K', K'' and the energy are over the last cycle.",
+        cfg.omega, cfg.cycles, cfg.steps_per_cycle, per_step, rate, opts.scheme, opts.substeps
+    ));
+    let header = [
+        "model",
+        &format!("v [{unit}]"),
+        "A [mm]",
+        "F+ [kN]",
+        "F- [kN]",
+        "K' [N/m]",
+        "K'' [N/m]",
+        "energy/cycle [J]",
+        "history",
+    ];
+    let mut rows = Vec::new();
+    for (model, runs) in all {
+        let dir = if all.len() > 1 {
+            format!("{}/", model.name())
+        } else {
+            String::new()
+        };
+        for x in runs {
+            rows.push(vec![
+                model.name().to_string(),
+                fmt_num(x.peak_velocity_m_s / factor, 3),
+                fmt_num(x.amplitude_m * 1e3, 3),
+                fmt_num(x.peak_force_pos_n * 1e-3, 3),
+                fmt_num(x.peak_force_neg_n * 1e-3, 3),
+                format!("{:.4e}", x.storage_stiffness_n_per_m),
+                format!("{:.4e}", x.loss_stiffness_n_per_m),
+                fmt_num(x.dissipated_last_cycle_j, 2),
+                format!("{dir}{}", history_name(x.peak_velocity_m_s)),
+            ]);
+        }
+    }
+    let hdr: Vec<&str> = header.iter().map(|s| s.as_ref()).collect();
+    r.heading(2, "Summary (bench_summary.csv)");
+    r.table(&hdr, &rows);
+
+    r.heading(2, "Peak force vs peak velocity (paper Fig. 13)");
+    r.svg(
+        "Peak force over the last cycle against peak stroke velocity; solid: largest force, dashed: magnitude of the most negative force. Paper's Fig. 13 is this plot for the physical damper.",
+        &fig13_plot(all, cfg, factor, deck).to_svg(1000, 460)?,
+    );
+
+    // Dynamic stiffness and energy vs amplitude.
+    let lin_c = deck.linear_c_n_s_per_m;
+    let mut ks = Plot::new(
+        "Storage stiffness K' vs stroke amplitude",
+        "stroke amplitude [mm]",
+        "K' [MN/m]",
+    )
+    .x_scale(1e3)
+    .y_scale(1e-6);
+    let mut kl = Plot::new(
+        "Loss stiffness K'' vs stroke amplitude",
+        "stroke amplitude [mm]",
+        "K'' [MN/m]",
+    )
+    .x_scale(1e3)
+    .y_scale(1e-6);
+    let mut en = Plot::new(
+        "Energy dissipated per cycle vs stroke amplitude",
+        "stroke amplitude [mm]",
+        "energy per cycle [J]",
+    )
+    .x_scale(1e3);
+    for (model, runs) in all {
+        let a: Vec<f64> = runs.iter().map(|x| x.amplitude_m).collect();
+        let k1: Vec<f64> = runs.iter().map(|x| x.storage_stiffness_n_per_m).collect();
+        let k2: Vec<f64> = runs.iter().map(|x| x.loss_stiffness_n_per_m).collect();
+        let e: Vec<f64> = runs.iter().map(|x| x.dissipated_last_cycle_j).collect();
+        ks = ks.line(model.name(), &a, &k1).points("", &a, &k1);
+        kl = kl.line(model.name(), &a, &k2).points("", &a, &k2);
+        en = en.line(model.name(), &a, &e).points("", &a, &e);
+        if let (DamperModel::Linear, Some(c)) = (model, lin_c) {
+            let w = cfg.omega;
+            let ca: Vec<f64> = a.iter().map(|_| c * w).collect();
+            let ea: Vec<f64> = a.iter().map(|x| PI * c * w * x * x).collect();
+            kl = kl.dashed("linear analytic", &a, &ca);
+            en = en.dashed("linear analytic", &a, &ea);
+        }
+    }
+    r.heading(2, "Dynamic stiffness and energy per cycle vs amplitude");
+    r.paragraph("K' and K'' are the first harmonic of the reaction -F over the last cycle, in phase with the stroke and with the stroke rate, per metre of amplitude: -F ~ K' d + (K''/omega) d'. The energy per cycle is the work of the damper force over the last cycle (Eq. 11), all harmonics included; for the first harmonic alone it is pi A^2 K''.");
+    let has_lin = all.iter().any(|(m, _)| *m == DamperModel::Linear) && lin_c.is_some();
+    let dashed_note = |what: &str| {
+        if has_lin {
+            format!(" (dashed: the linear model's analytic {what})")
+        } else {
+            String::new()
+        }
+    };
+    r.svg(
+        &format!("K' (storage, in phase with the stroke) and K'' (loss, in phase with the stroke rate); a pure dashpot c has K' = 0 and K'' = c omega{}.", dashed_note("c omega")),
+        &grid_svg(&[ks, from_zero(kl)], 2, 1100, 380)?,
+    );
+    r.svg(
+        &format!(
+            "Energy dissipated per cycle; a dashpot c dissipates pi c omega A^2{}.",
+            dashed_note("value")
+        ),
+        &from_zero(en).to_svg(1000, 420)?,
+    );
+
+    // Loops per amplitude, every model in its colour.
+    r.heading(2, "Hysteresis loops per amplitude (last cycle)");
+    let n_amp = all.first().map_or(0, |(_, runs)| runs.len());
+    let mut loops = Vec::new();
+    for k in 0..n_amp {
+        let v0 = all[0].1[k].peak_velocity_m_s;
+        let a0 = all[0].1[k].amplitude_m;
+        let mut fs = Plot::new(
+            &format!(
+                "v = {:.3} {unit}, A = {:.2} mm: force vs stroke",
+                v0 / factor,
+                a0 * 1e3
+            ),
+            "stroke [mm]",
+            "force [kN]",
+        )
+        .x_scale(1e3)
+        .y_scale(1e-3);
+        let mut fv = Plot::new(
+            &format!("v = {:.3} {unit}: force vs velocity", v0 / factor),
+            &format!("stroke velocity [{unit}]"),
+            "force [kN]",
+        )
+        .x_scale(1.0 / factor)
+        .y_scale(1e-3);
+        for (model, runs) in all {
+            let x = &runs[k];
+            let h = &x.history;
+            let from = last_cycle_start(x, cfg.steps_per_cycle);
+            fs = fs.line(model.name(), &h.stroke_m[from..], &h.force_n[from..]);
+            fv = fv.line(model.name(), &h.velocity_m_s[from..], &h.force_n[from..]);
+        }
+        loops.push(fs);
+        loops.push(fv);
+    }
+    r.svg(
+        "Left: force against stroke; right: force against stroke velocity; last cycle of each amplitude. Force F as in docs/formats.md: positive when the damper pushes its ends apart, so a damper's F falls with the stroke velocity (F ~ -c d').",
+        &grid_svg(&loops, 2, 1100, 330)?,
+    );
+
+    r.heading(2, "Time history (paper Fig. 14)");
+    for (svg, (model, _)) in time_histories.iter().zip(all) {
+        r.svg(
+            &format!(
+                "{} model, amplitude closest to 2 in/s, last two cycles (time_history.svg).",
+                model.name()
+            ),
+            svg,
+        );
+    }
+    r.paragraph("Files: bench_summary.csv (this table, SI), peaks.csv, history_v<v>m_s.csv (every sample; v = peak velocity in m/s), peak_force_vs_velocity.svg, time_history.svg; columns and units in docs/formats.md.");
+    Ok(r.finish())
+}
+
+/// Where a test's metrics start: the first instant plus `--skip-cycles` stroke periods.
+pub struct Window {
+    pub period_s: Option<f64>,
+    pub from_s: f64,
+}
+
+pub fn window(cfg: &Config, test: &BenchTest, path: &std::path::Path) -> anyhow::Result<Window> {
+    let period = bench::stroke_period(&test.time_s, &test.stroke_m);
+    let t0 = test.time_s[0];
+    let t1 = test.time_s[test.time_s.len() - 1];
+    if cfg.skip_cycles == 0 {
+        return Ok(Window {
+            period_s: period,
+            from_s: t0,
+        });
+    }
+    let Some(p) = period else {
+        bail!(
+            "--skip-cycles {}: {} has no cycle to count (its stroke crosses its mid-range upward fewer than twice; a cycle is the stroke's period)",
+            cfg.skip_cycles,
+            path.display()
+        );
+    };
+    let from = t0 + cfg.skip_cycles as f64 * p;
+    if from > t1 {
+        bail!(
+            "--skip-cycles {} leaves no sample of {}: it holds {:.2} cycles of the stroke's period {:.6} s",
+            cfg.skip_cycles,
+            path.display(),
+            (t1 - t0) / p,
+            p
+        );
+    }
+    Ok(Window {
+        period_s: Some(p),
+        from_s: from,
+    })
+}
+
+/// Every n-th point so a plot holds at most about `max` points.
+fn thin(x: &[f64], max: usize) -> Vec<f64> {
+    let s = x.len().div_ceil(max.max(1)).max(1);
+    x.iter().step_by(s).copied().collect()
+}
+
+fn is_synthetic(path: &std::path::Path) -> bool {
+    path.file_name().is_some_and(|n| {
+        n.to_string_lossy()
+            .to_ascii_lowercase()
+            .contains("synthetic")
+    })
+}
+
+/// Replays every measured test (`cfg.measured`) through every device and writes
+/// replay_*.csv, loop_*.svg, replay_summary.csv and bench.html into `cfg.out`; `note` gets one
+/// line per test and model (its error metrics).
+pub fn replay(
+    cfg: &Config,
+    deck: &DamperDeck,
+    devices: &[(DamperModel, Box<dyn Device>)],
+    note: &mut dyn FnMut(&str),
+) -> anyhow::Result<()> {
+    // Read every test and find its cycles before creating any output.
+    let tests = cfg
+        .measured
+        .iter()
+        .map(|p| bench::read_bench_csv(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let windows = tests
+        .iter()
+        .zip(&cfg.measured)
+        .map(|(t, p)| window(cfg, t, p))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let inputs: Vec<PathBuf> = std::iter::once(cfg.deck.clone())
+        .chain(cfg.measured.iter().cloned())
+        .collect();
+    let out = OutDir::create(&cfg.out, &inputs)?;
+    let mut summary = String::from(
+        "test,model,samples,rms_error_N,samples_used,skip_cycles,cycle_period_s,from_time_s,\
+rms_error_rel,max_abs_error_N,rms_error_all_N\n",
+    );
+    let mut html = HtmlReport::new("rotorsim bench: replay of bench tests");
+    let synthetic: Vec<&PathBuf> = cfg.measured.iter().filter(|p| is_synthetic(p)).collect();
+    if !synthetic.is_empty() {
+        html.banner(
+            Banner::Synthetic,
+            &format!(
+                "SYNTHETIC bench data: {} (named synthetic), not a measurement of a real damper.",
+                synthetic
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    }
+    html.banner(
+        Banner::Info,
+        &format!(
+            "Each model (deck {}) is driven by the measured stroke, one step per sample interval, from rest; its force is compared with the measured force.",
+            deck.source
+        ),
+    );
+    html.paragraph(&format!(
+        "--skip-cycles {}: the error metrics leave out the samples before the first instant plus {} cycle(s); a cycle is the stroke's period, the median interval between upward crossings of the stroke's mid-range.",
+        cfg.skip_cycles, cfg.skip_cycles
+    ));
+    let mut rows = Vec::new();
+    let mut figures = Vec::new();
+    for ((test, path), win) in tests.iter().zip(&cfg.measured).zip(&windows) {
+        let syn = if is_synthetic(path) { "SYNTHETIC " } else { "" };
+        let mut tp = Plot::new(
+            &format!("{}: force over time", test.name),
+            "time [s]",
+            "force [kN]",
+        )
+        .y_scale(1e-3);
+        let mut lp = Plot::new(
+            &format!("{}: force vs stroke (metric window)", test.name),
+            "stroke [mm]",
+            "force [kN]",
+        )
+        .x_scale(1e3)
+        .y_scale(1e-3);
+        let first = test.time_s.partition_point(|&t| t < win.from_s);
+        for (model, dev) in devices {
+            let r = bench::replay(dev.as_ref(), test).map_err(|e| {
+                let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
+                anyhow::anyhow!(
+                    "replay of {} with the {} model: {e}",
+                    test.name,
+                    model.name()
+                )
+            })?;
+            let h = &r.history;
+            let stem = format!("{}_{}", test.name, model.name());
+            let mut header = vec!["time_s", "stroke_m", "velocity_m_s", "force_model_N"];
+            let mut cols: Vec<&[f64]> = vec![&h.time_s, &h.stroke_m, &h.velocity_m_s, &h.force_n];
+            if let Some(m) = &test.force_n {
+                header.push("force_measured_N");
+                cols.push(m);
+            }
+            push_device_channels(h, &mut header, &mut cols);
+            out.write(
+                &format!("replay_{stem}.csv"),
+                csv_from_columns(&header, &cols).as_bytes(),
+            )?;
+            let mut p = Plot::new(
+                &format!(
+                    "{}: force vs stroke, {} model over measurement",
+                    test.name,
+                    model.name()
+                ),
+                "stroke [mm]",
+                "force [kN]",
+            )
+            .x_scale(1e3)
+            .y_scale(1e-3);
+            if let Some(m) = &test.force_n {
+                p = p.points(&format!("{syn}measured"), &test.stroke_m, m);
+            }
+            p = p.line(&format!("{} model", model.name()), &h.stroke_m, &h.force_n);
+            out.write(&format!("loop_{stem}.svg"), p.to_svg(900, 480)?.as_bytes())?;
+            tp = tp.line(
+                model.name(),
+                &thin(&h.time_s, 3000),
+                &thin(&h.force_n, 3000),
+            );
+            lp = lp.line(
+                model.name(),
+                &thin(&h.stroke_m[first..], 3000),
+                &thin(&h.force_n[first..], 3000),
+            );
+            let met: Option<ReplayMetrics> =
+                bench::replay_metrics(test, &r.force_model_n, win.from_s);
+            let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+            summary.push_str(&format!(
+                "{},{},{},{},{},{},{},{},{},{},{}\n",
+                test.name,
+                model.name(),
+                test.time_s.len(),
+                opt(met.as_ref().map(|m| m.rms_error_n)),
+                met.as_ref()
+                    .map_or(String::new(), |m| m.samples_used.to_string()),
+                cfg.skip_cycles,
+                opt(win.period_s),
+                win.from_s,
+                opt(met.as_ref().map(|m| m.rms_error_rel)),
+                opt(met.as_ref().map(|m| m.max_abs_error_n)),
+                opt(r.rms_error_n),
+            ));
+            match &met {
+                Some(m) => {
+                    note(&format!(
+                        "{} ({} model): RMS error {:.1} N over {} of {} samples (from t = {:.4} s, {} cycle(s) skipped)",
+                        test.name,
+                        model.name(),
+                        m.rms_error_n,
+                        m.samples_used,
+                        test.time_s.len(),
+                        m.from_s,
+                        cfg.skip_cycles
+                    ));
+                    rows.push(vec![
+                        format!("{syn}{}", test.name),
+                        model.name().to_string(),
+                        format!("{} of {}", m.samples_used, test.time_s.len()),
+                        cfg.skip_cycles.to_string(),
+                        win.period_s.map_or("-".into(), |p| format!("{p:.5}")),
+                        format!("{:.1}", m.rms_error_n),
+                        format!("{:.3}", m.rms_error_rel),
+                        format!("{:.1}", m.max_abs_error_n),
+                        r.rms_error_n.map_or("-".into(), |v| format!("{v:.1}")),
+                    ]);
+                }
+                None => note(&format!(
+                    "{} ({} model): no measured force, model force written",
+                    test.name,
+                    model.name()
+                )),
+            }
+        }
+        // the measurement last, drawn over the models
+        if let Some(m) = &test.force_n {
+            tp = tp.points(
+                &format!("{syn}measured"),
+                &thin(&test.time_s, 3000),
+                &thin(m, 3000),
+            );
+            lp = lp.points(
+                &format!("{syn}measured"),
+                &thin(&test.stroke_m[first..], 3000),
+                &thin(&m[first..], 3000),
+            );
+        }
+        if cfg.skip_cycles > 0 {
+            let (lo, hi) = test
+                .force_n
+                .iter()
+                .flatten()
+                .fold((0.0f64, 0.0f64), |(a, b), &f| (a.min(f), b.max(f)));
+            tp = tp.dashed(
+                &format!("end of {} skipped cycle(s)", cfg.skip_cycles),
+                &[win.from_s, win.from_s],
+                &[lo, hi],
+            );
+        }
+        figures.push((test.name.clone(), tp, lp));
+    }
+    if !rows.is_empty() {
+        html.heading(2, "Error metrics (replay_summary.csv)");
+        html.table(
+            &[
+                "test",
+                "model",
+                "samples used",
+                "cycles skipped",
+                "period [s]",
+                "RMS error [N]",
+                "RMS error / RMS measured",
+                "max |error| [N]",
+                "RMS error, all samples [N]",
+            ],
+            &rows,
+        );
+    }
+    for (name, tp, lp) in figures {
+        html.heading(2, &format!("Test {name}"));
+        html.svg(
+            "Measured force (points) and each model's force over time; the dashed line ends the skipped cycles.",
+            &tp.to_svg(1000, 420)?,
+        );
+        html.svg(
+            "Force against stroke over the samples the metrics use.",
+            &lp.to_svg(1000, 460)?,
+        );
+    }
+    out.write("replay_summary.csv", summary.as_bytes())?;
+    out.write("bench.html", html.finish().as_bytes())?;
+    out.finish()?;
+    Ok(())
+}
