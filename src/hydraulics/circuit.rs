@@ -250,6 +250,55 @@ impl CircuitParams {
         y: &State,
         contact: Option<[bool; 2]>,
     ) -> Result<(State, Jacobian, Flows), HydraulicError> {
+        let FlowPart {
+            mut f,
+            mut j,
+            fl,
+            qn,
+            vol,
+            dq,
+        } = self.flow_part::<JAC>(t, d, y, contact)?;
+        for (k, ip) in [(0, IP0), (1, IP1)] {
+            let (rate, drate_dp, b_over_v) = self.pressure_rate(k, y[ip], vol[k], qn[k], d_dot);
+            f[ip] = rate;
+            if JAC {
+                for (c, dqc) in dq[k].iter().enumerate() {
+                    j[(ip, c)] = b_over_v * dqc;
+                }
+                j[(ip, ip)] += drate_dp;
+            }
+        }
+        Ok((f, j, fl))
+    }
+
+    /// Eq. (1) for chamber k at pressure p, volume v, net inflow `qn` and stroke rate `d_dot`:
+    /// `(p_dot, dp_dot/dp, dp_dot/dQ)`, with the bulk modulus of the chamber's contents.
+    #[inline]
+    pub fn pressure_rate(&self, k: usize, p: f64, v: f64, qn: f64, d_dot: f64) -> (f64, f64, f64) {
+        match self.ext.air_of(k) {
+            None => self.chambers[k].pressure_rate(&self.fluid, p, v, qn, d_dot),
+            Some(a) => self.chambers[k].pressure_rate_with_bulk(
+                &self.fluid,
+                a.bulk(&self.fluid, p),
+                p,
+                v,
+                qn,
+                d_dot,
+            ),
+        }
+    }
+
+    /// Everything of [`CircuitParams::evaluate`] but the chamber pressure rates: the poppet
+    /// rates, the impulse rate (Eq. 8), the flows and the net inflow into each chamber, which
+    /// with the stroke rate give the pressure rates (Eq. 1).
+    #[inline]
+    pub fn flow_part<const JAC: bool>(
+        &self,
+        t: f64,
+        d: f64,
+        y: &State,
+        contact: Option<[bool; 2]>,
+    ) -> Result<FlowPart, HydraulicError> {
         let law = self.law();
         let (p0, p1) = (y[IP0], y[IP1]);
         let mut vol = [0.0; 2];
@@ -346,33 +395,36 @@ impl CircuitParams {
             fl.orifice + fl.leakage + fl.relief[0] - fl.relief[1] + fl.check[1] + fl.entrance[1]
                 - fl.bleed[1],
         ];
-        for (k, ip) in [(0, IP0), (1, IP1)] {
-            let (rate, drate_dp, b_over_v) = match self.ext.air_of(k) {
-                None => self.chambers[k].pressure_rate(&self.fluid, y[ip], vol[k], qn[k], d_dot),
-                Some(a) => self.chambers[k].pressure_rate_with_bulk(
-                    &self.fluid,
-                    a.bulk(&self.fluid, y[ip]),
-                    y[ip],
-                    vol[k],
-                    qn[k],
-                    d_dot,
-                ),
-            };
-            f[ip] = rate;
-            if JAC {
-                for (c, dqc) in dq[k].iter().enumerate() {
-                    j[(ip, c)] = b_over_v * dqc;
-                }
-                j[(ip, ip)] += drate_dp;
-            }
-        }
         f[IIMP] = self.force(y);
         if JAC {
             j[(IIMP, IP0)] = self.chambers[0].area;
             j[(IIMP, IP1)] = -self.chambers[1].area;
         }
-        Ok((f, j, fl))
+        Ok(FlowPart {
+            f,
+            j,
+            fl,
+            qn,
+            vol,
+            dq,
+        })
     }
+}
+
+/// The circuit's right-hand side without the chamber pressure rates ([`CircuitParams::flow_part`]).
+#[derive(Debug, Clone, Copy)]
+pub struct FlowPart {
+    /// Rates of the poppets and the impulse; zero in the pressure rows.
+    pub f: State,
+    /// Jacobian rows of the poppets and the impulse (when asked for).
+    pub j: Jacobian,
+    pub fl: Flows,
+    /// Net inflow into each chamber from its flow paths [m^3/s].
+    pub qn: [f64; 2],
+    /// Chamber volumes [m^3].
+    pub vol: [f64; 2],
+    /// dQn_k/dy of the net inflows (when asked for).
+    pub dq: [[f64; NS]; 2],
 }
 
 /// The circuit over one step: stroke linear in time from `d_i` at `t_i`.

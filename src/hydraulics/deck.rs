@@ -8,7 +8,8 @@ use super::extensions::{
     SealFriction, SeriesMount,
 };
 use super::fluid::Fluid;
-use super::integrators::IntegratorOptions;
+use super::integrators::{IntegratorOptions, Scheme};
+use super::link::LinkedCircuit;
 use super::Device;
 use std::path::Path;
 use toml::{Table, Value};
@@ -658,6 +659,21 @@ impl DamperDeck {
                 let rigid_play = e
                     .free_play
                     .filter(|_| e.free_play_contact_stiffness_n_per_m.is_none());
+                // One link (compliant free play or mount) on the bare circuit, explicit scheme:
+                // integrated with the circuit as one ODE, one integration per step.
+                let link = match (
+                    e.free_play_contact_stiffness_n_per_m,
+                    e.mount_stiffness_n_per_m,
+                ) {
+                    (Some(k), None) => Some((e.free_play.map_or(0.0, |p| p.gap), k)),
+                    (None, Some(k)) => Some((0.0, k)),
+                    _ => None,
+                };
+                if let Some((gap, k)) = link.filter(|_| {
+                    e.friction.is_none() && rigid_play.is_none() && opts.scheme == Scheme::Rk4
+                }) {
+                    return Ok(Box::new(LinkedCircuit::new(dev, gap, k)));
+                }
                 let dev: Box<dyn Device> = if e.friction.is_some() || rigid_play.is_some() {
                     Box::new(ExtendedDamper::new(dev, e.friction, rigid_play))
                 } else {

@@ -13,6 +13,7 @@ pub mod elements;
 pub mod extensions;
 pub mod fluid;
 pub mod integrators;
+pub mod link;
 
 pub use circuit::{
     ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear, Tangent,
@@ -26,6 +27,7 @@ pub use extensions::{
 };
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
+pub use link::LinkedCircuit;
 
 /// Result of one trial step of a device.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,6 +8,10 @@
 //! ([`drive_periodic`]: shooting or marching), keeps the reported revolution, and hands the results to
 //! [`summary`] (summary.json, last_rev.csv), [`report`] (report.html) and [`mcap_out`]
 //! (result.mcap). Conventions and alignment: docs/run.md.
+//!
+//! Beside it, the pipelines of the other commands that write result folders: [`bench`] (the
+//! damper bench's sweep and replay outputs), [`decay`] (a hinged blade's lag free decay) and
+//! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check).
 pub mod bench;
 pub mod decay;
 pub mod loads;
