@@ -112,6 +112,9 @@ pub struct Diagnosis {
     pub parameters: BTreeMap<String, f64>,
     /// 95% interval of every parameter of the cause.
     pub parameter_intervals: BTreeMap<String, [f64; 2]>,
+    /// Every parameter of the cause fitted to each test alone, and its spread across tests
+    /// (three tests or more; empty otherwise).
+    pub parameter_spread: BTreeMap<String, ParameterSpread>,
     /// Which limit of free play behind a contact stiffness the data support, when a compliant
     /// or gap cause is in play.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -314,21 +317,9 @@ fn intervals(
     if k == 0 || n <= k {
         return unbounded;
     }
-    let h: f64 = 0.01;
-    let mut j = nalgebra::DMatrix::zeros(n, k);
-    for c in 0..k {
-        let mut xp = x.to_vec();
-        let mut xm = x.to_vec();
-        xp[c] *= h.exp();
-        xm[c] *= (-h).exp();
-        let (Some(rp), Some(rm)) = (
-            residuals_x(cause, scales, base, &xp, data, windows, max_h, 1.0),
-            residuals_x(cause, scales, base, &xm, data, windows, max_h, 1.0),
-        ) else {
-            return unbounded;
-        };
-        j.set_column(c, &((rp - rm) / (2.0 * h)));
-    }
+    let Some(j) = jacobian_ln(cause, scales, base, x, data, windows, max_h) else {
+        return unbounded;
+    };
     let s2 = sigma.powi(2);
     let r_sys = (n as f64 * ms - (n - k) as f64 * s2).max(0.0);
     let Some(cov) = (j.transpose() * &j).try_inverse() else {
@@ -343,6 +334,128 @@ fn intervals(
                 [x[c] * (-half).exp(), x[c] * half.exp()]
             } else {
                 [0.0, f64::INFINITY]
+            }
+        })
+        .collect()
+}
+
+/// Jacobian of the residuals (in N) over `windows` in `ln x`, by central differences (step 1%:
+/// the residual is only piecewise smooth); None where a replay fails.
+#[allow(clippy::too_many_arguments)]
+fn jacobian_ln(
+    cause: &[Cause],
+    scales: Scales,
+    base: &DamperDeck,
+    x: &[f64],
+    data: &[Measurement],
+    windows: &[Window],
+    max_h: f64,
+) -> Option<nalgebra::DMatrix<f64>> {
+    let n: usize = windows.iter().map(|w| w.to - w.from).sum();
+    let h: f64 = 0.01;
+    let mut j = nalgebra::DMatrix::zeros(n, x.len());
+    for c in 0..x.len() {
+        let mut xp = x.to_vec();
+        let mut xm = x.to_vec();
+        xp[c] *= h.exp();
+        xm[c] *= (-h).exp();
+        let rp = residuals_x(cause, scales, base, &xp, data, windows, max_h, 1.0)?;
+        let rm = residuals_x(cause, scales, base, &xm, data, windows, max_h, 1.0)?;
+        j.set_column(c, &((rp - rm) / (2.0 * h)));
+    }
+    Some(j)
+}
+
+/// `parameter_spread` of diagnosis.json: a parameter of the cause fitted to each test alone.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ParameterSpread {
+    /// Fitted to each test alone (from its second cycle), by test name; `null` where that test
+    /// does not bound the parameter (its noise interval is unbounded).
+    pub per_test: BTreeMap<String, Option<f64>>,
+    /// Standard deviation of `ln x` across the tests beyond what the noise explains
+    /// (DerSimonian-Laird); 0 when the tests agree within their noise.
+    pub spread_ln: f64,
+    /// Cochran's heterogeneity statistic Q of the per-test values (about `tests - 1` when they
+    /// differ by noise alone).
+    pub heterogeneity_q: f64,
+    /// Tests that bound the parameter (fewer than three: no spread is estimated).
+    pub tests: usize,
+}
+
+/// The cause's parameters fitted to each test alone (warm started at the joint fit `x`), and
+/// per parameter the spread of `ln x` across tests beyond the noise: each test's value has the
+/// noise variance `sigma^2 (J^T J)^-1` of its own fit, and the spread is DerSimonian and
+/// Laird's between-test variance `tau^2 = max(0, (Q - (m - 1)) / (S1 - S2/S1))`, Q Cochran's
+/// statistic, `S1 = sum w`, `S2 = sum w^2`, `w` the inverse noise variances, m the tests. A
+/// model of the right form gives every test the same parameter up to noise (tau ~ 0); a
+/// parameter that moves with amplitude or frequency is standing in for something the model
+/// does not have, and no single value is known better than that spread.
+#[allow(clippy::too_many_arguments)]
+fn parameter_spread(
+    cause: &[Cause],
+    scales: Scales,
+    base: &DamperDeck,
+    spec: &[ParamSpec],
+    x: &[f64],
+    data: &[Measurement],
+    windows: &[Window],
+    opts: &DiagnoseOptions,
+    sigma: f64,
+    scale: f64,
+) -> Vec<ParameterSpread> {
+    let z0: Vec<f64> = spec.iter().zip(x).map(|(p, &v)| to_z(p, v)).collect();
+    let per_test: Vec<Option<(Vec<f64>, Vec<f64>)>> = windows
+        .par_iter()
+        .map(|w| {
+            let one = std::slice::from_ref(w);
+            let f = fit_one(
+                cause,
+                scales,
+                base,
+                spec,
+                z0.clone(),
+                data,
+                one,
+                opts,
+                opts.patience,
+                scale,
+            )?;
+            let j = jacobian_ln(cause, scales, base, &f.x, data, one, opts.max_substep_s)?;
+            let cov = (j.transpose() * &j).try_inverse()?;
+            let var: Vec<f64> = (0..x.len()).map(|c| sigma * sigma * cov[(c, c)]).collect();
+            Some((f.x, var))
+        })
+        .collect();
+    (0..x.len())
+        .map(|c| {
+            let mut values = BTreeMap::new();
+            let mut pts: Vec<(f64, f64)> = Vec::new();
+            for (w, r) in windows.iter().zip(&per_test) {
+                let v = r.as_ref().and_then(|(xi, var)| {
+                    (var[c].is_finite() && var[c] > 0.0 && xi[c] > 0.0).then_some((xi[c], var[c]))
+                });
+                values.insert(data[w.test].name.clone(), v.map(|v| v.0));
+                if let Some((xi, var)) = v {
+                    pts.push((xi.ln(), 1.0 / var));
+                }
+            }
+            let m = pts.len();
+            let (mut tau2, mut q) = (0.0, 0.0);
+            if m >= 3 {
+                let s1: f64 = pts.iter().map(|p| p.1).sum();
+                let s2: f64 = pts.iter().map(|p| p.1 * p.1).sum();
+                let mean = pts.iter().map(|p| p.0 * p.1).sum::<f64>() / s1;
+                q = pts.iter().map(|p| p.1 * (p.0 - mean).powi(2)).sum();
+                let den = s1 - s2 / s1;
+                if den > 0.0 {
+                    tau2 = ((q - (m - 1) as f64) / den).max(0.0);
+                }
+            }
+            ParameterSpread {
+                per_test: values,
+                spread_ln: tau2.sqrt(),
+                heterogeneity_q: q,
+                tests: m,
             }
         })
         .collect()
@@ -1111,6 +1224,29 @@ pub fn diagnose(
             BTreeMap::new(),
         ),
     };
+    // The cause's parameters test by test: their spread beyond the noise widens the intervals
+    // (in ln x, in quadrature with the noise and model-form half-width).
+    let mut param_iv = param_iv;
+    let mut spreads = BTreeMap::new();
+    if let (Some((row, Some(_), _, x)), true) = (chosen, data.len() >= 3) {
+        if let Some(causes) = causes_of(&row.cause) {
+            if let Some(spec) = combined_params(&causes, base, scales) {
+                let spread = parameter_spread(
+                    &causes, scales, base, &spec, x, data, &all_w, opts, sigma, scale,
+                );
+                for ((p, xc), sp) in spec.iter().zip(x).zip(spread) {
+                    if let Some(iv) = param_iv.get_mut(p.name) {
+                        if iv[1].is_finite() && iv[0] > 0.0 && sp.spread_ln > 0.0 {
+                            let half = (iv[1] / xc).ln().max((xc / iv[0]).ln());
+                            let half = half.hypot(Z95 * sp.spread_ln);
+                            *iv = [xc * (-half).exp(), xc * half.exp()];
+                        }
+                    }
+                    spreads.insert(p.name.to_string(), sp);
+                }
+            }
+        }
+    }
     let free_play_limit = free_play_limit(&cause, &evaluated);
     for c in &mut companions {
         c.kept = c.pair == cause;
@@ -1190,7 +1326,10 @@ pub fn diagnose(
             }
         })
         .collect();
-    let cand_rows: Vec<Candidate> = evaluated.iter().map(|e| e.0.clone()).collect();
+    let mut cand_rows: Vec<Candidate> = evaluated.iter().map(|e| e.0.clone()).collect();
+    if let Some(r) = cand_rows.iter_mut().find(|r| r.cause == cause) {
+        r.intervals = param_iv.clone();
+    }
     let evidence = super::evidence::evidence(
         &curves, sigma, &cause, &params, &cand_rows, base_held, ext_held,
     );
@@ -1210,6 +1349,7 @@ pub fn diagnose(
         cause,
         parameters: params,
         parameter_intervals: param_iv,
+        parameter_spread: spreads,
         free_play_limit,
         pair_stage,
         companions,

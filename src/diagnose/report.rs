@@ -250,6 +250,51 @@ pub fn html_with(
             .collect();
         r.table(&["not separable", "why", "test that would decide"], &rows);
     }
+    if !d.parameter_spread.is_empty() {
+        r.heading(2, "The cause's parameters test by test");
+        r.paragraph("Each parameter of the cause fitted to each test alone. A model of the right form gives every test the same value up to noise; a value that moves with amplitude or frequency stands in for something the model does not have. The spread is the standard deviation of ln x across tests beyond the noise (DerSimonian-Laird); the 95% interval above includes it.");
+        let names: Vec<&String> = d.parameter_spread.keys().collect();
+        let tests: Vec<&String> = d
+            .parameter_spread
+            .values()
+            .next()
+            .map(|s| s.per_test.keys().collect())
+            .unwrap_or_default();
+        let mut rows: Vec<Vec<String>> = tests
+            .iter()
+            .map(|t| {
+                let mut row = vec![(*t).clone()];
+                for n in &names {
+                    row.push(match d.parameter_spread[*n].per_test.get(*t) {
+                        Some(Some(v)) => format!("{v:.4e}"),
+                        _ => "not bounded".into(),
+                    });
+                }
+                row
+            })
+            .collect();
+        let mut joint = vec!["all tests (joint fit)".to_string()];
+        let mut spread = vec!["spread (sd of ln x beyond noise; Q, tests)".to_string()];
+        for n in &names {
+            joint.push(
+                d.parameters
+                    .get(*n)
+                    .map_or(String::new(), |v| format!("{v:.4e}")),
+            );
+            let sp = &d.parameter_spread[*n];
+            spread.push(format!(
+                "{:.1}% (Q {:.1}, {})",
+                100.0 * sp.spread_ln,
+                sp.heterogeneity_q,
+                sp.tests
+            ));
+        }
+        rows.push(joint);
+        rows.push(spread);
+        let mut head = vec!["test"];
+        head.extend(names.iter().map(|n| n.as_str()));
+        r.table(&head, &rows);
+    }
     r.heading(2, "Candidates (ranked by BIC)");
     let rows: Vec<Vec<String>> = d
         .candidates
