@@ -68,6 +68,28 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
     .unwrap();
 }
 
+/// `--write-deck` inside `--out` (the README's command): the deck is in the published folder,
+/// also when an earlier result is replaced.
+#[test]
+fn a_deck_written_inside_the_result_folder_is_kept() {
+    let dir = tmp("deck_inside");
+    let out = dir.join("out");
+    let deck = out.join("extended.toml");
+    for _ in 0..2 {
+        diagnose(DiagnoseArgs {
+            write_deck: Some(deck.clone()),
+            ..args(out.clone())
+        })
+        .unwrap();
+        let text = std::fs::read_to_string(&deck).expect("the written deck");
+        assert!(text.contains("[damper.physical.extensions]"));
+        assert_eq!(
+            text,
+            std::fs::read_to_string(out.join("extended_deck.toml")).unwrap()
+        );
+    }
+}
+
 #[test]
 fn flight_record_without_stroke_needs_a_rotor_deck_for_the_rotor_run() {
     let dir = tmp("nostroke");

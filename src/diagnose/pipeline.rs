@@ -739,6 +739,13 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
     })?;
     out.write("diagnosis.html", html.as_bytes())?;
     out.finish()?;
+    // A deck asked for inside the result folder went with the folder it replaced: written again
+    // into the published one.
+    if let Some(p) = &args.write_deck {
+        if !p.exists() {
+            write_atomic(p, deck_text.as_bytes())?;
+        }
+    }
     Ok(Report {
         outcome,
         stroke_info,
