@@ -307,45 +307,7 @@ macro_rules! series_link_methods {
             }
         }
 
-        fn channel_names(&self) -> &'static [&'static str] {
-            self.inner.channel_names()
-        }
-
-        fn channels(&self, out: &mut [f64]) {
-            self.inner.channels(out)
-        }
-
-        fn committed_force(&self) -> f64 {
-            self.inner.committed_force()
-        }
-
-        fn clone_device(&self) -> Box<dyn Device> {
-            Box::new(self.clone())
-        }
-
-        fn reset(&mut self) {
-            self.inner.reset();
-            self.d_h = 0.0;
-            self.fresh = true;
-            self.trial = None;
-        }
-
-        fn state_values(&self) -> Vec<f64> {
-            let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
-            v.extend(self.inner.state_values());
-            v
-        }
-
-        fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-            if v.len() < 2 {
-                return super::check_state_len($what, v, 2);
-            }
-            self.inner.set_state_values(&v[2..])?;
-            self.d_h = v[0];
-            self.fresh = v[1] != 0.0;
-            self.trial = None;
-            Ok(())
-        }
+        series_link_state_methods!($what);
     };
 }
 

@@ -223,7 +223,6 @@ pub struct LinkedCircuit {
     d_h: f64,
     fresh: bool,
     trial: Option<(State, f64, f64)>,
-    what: &'static str,
 }
 
 impl LinkedCircuit {
@@ -239,11 +238,6 @@ impl LinkedCircuit {
             d_h: 0.0,
             fresh: true,
             trial: None,
-            what: if gap_m > 0.0 {
-                "compliant free play"
-            } else {
-                "series mount"
-            },
         }
     }
 
@@ -330,45 +324,5 @@ impl Device for LinkedCircuit {
         }
     }
 
-    fn channel_names(&self) -> &'static [&'static str] {
-        self.inner.channel_names()
-    }
-
-    fn channels(&self, out: &mut [f64]) {
-        self.inner.channels(out)
-    }
-
-    fn committed_force(&self) -> f64 {
-        self.inner.committed_force()
-    }
-
-    fn clone_device(&self) -> Box<dyn Device> {
-        Box::new(self.clone())
-    }
-
-    fn reset(&mut self) {
-        self.inner.reset();
-        self.d_h = 0.0;
-        self.fresh = true;
-        self.trial = None;
-    }
-
-    /// `[d_h, fresh, circuit state..., t, d_h]`: the layout of the compliant free play and the
-    /// series mount around a circuit, so saved states carry over between them.
-    fn state_values(&self) -> Vec<f64> {
-        let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
-        v.extend(self.inner.state_values());
-        v
-    }
-
-    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        if v.len() < 2 {
-            return super::check_state_len(self.what, v, 2);
-        }
-        self.inner.set_state_values(&v[2..])?;
-        self.d_h = v[0];
-        self.fresh = v[1] != 0.0;
-        self.trial = None;
-        Ok(())
-    }
+    series_link_state_methods!("linked circuit");
 }

@@ -5,6 +5,53 @@
 //! Every device implements [`Device`]: the structure hands it the strokes at the ends of a
 //! structural step, the device integrates its internal (hydraulic) state over the step with
 //! `N` sub-steps and returns the step-averaged force `F_m` of Eq. (13) and its derivative.
+/// The [`Device`] methods other than the trial step and the commit of a device in series with
+/// an inner one through a hidden stroke `d_h` (fields `inner`, `d_h`, `fresh`, `trial`):
+/// channels and force are the inner device's, the state is `[d_h, fresh, inner state...]`.
+macro_rules! series_link_state_methods {
+    ($what:literal) => {
+        fn channel_names(&self) -> &'static [&'static str] {
+            self.inner.channel_names()
+        }
+
+        fn channels(&self, out: &mut [f64]) {
+            self.inner.channels(out)
+        }
+
+        fn committed_force(&self) -> f64 {
+            self.inner.committed_force()
+        }
+
+        fn clone_device(&self) -> Box<dyn Device> {
+            Box::new(self.clone())
+        }
+
+        fn reset(&mut self) {
+            self.inner.reset();
+            self.d_h = 0.0;
+            self.fresh = true;
+            self.trial = None;
+        }
+
+        fn state_values(&self) -> Vec<f64> {
+            let mut v = vec![self.d_h, f64::from(u8::from(self.fresh))];
+            v.extend(self.inner.state_values());
+            v
+        }
+
+        fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+            if v.len() < 2 {
+                return super::check_state_len($what, v, 2);
+            }
+            self.inner.set_state_values(&v[2..])?;
+            self.d_h = v[0];
+            self.fresh = v[1] != 0.0;
+            self.trial = None;
+            Ok(())
+        }
+    };
+}
+
 pub mod bench;
 pub mod circuit;
 pub mod dashpot;
