@@ -15,6 +15,7 @@
 //! existing elements. [`ExtendedDamper`] composes a [`CircuitDevice`] with friction and free play.
 use super::circuit::CircuitDevice;
 use super::fluid::Fluid;
+use super::link::Link;
 use super::{check_step, Device, HydraulicError, StepForce};
 
 /// Seal friction: `F = -[F_c + (F_s - F_c) exp(-(v/v_s)^2)] tanh(v/v_eps)` with v the piston
@@ -499,8 +500,7 @@ impl Device for SeriesMount {
 #[derive(Debug, Clone)]
 pub struct CompliantFreePlay {
     inner: Box<dyn Device>,
-    half_gap: f64,
-    k: f64,
+    link: Link,
     d_h: f64,
     fresh: bool,
     trial: Option<f64>,
@@ -513,8 +513,10 @@ impl CompliantFreePlay {
     pub fn new(inner: Box<dyn Device>, gap_m: f64, k_n_per_m: f64) -> Self {
         Self {
             inner,
-            half_gap: 0.5 * gap_m,
-            k: k_n_per_m,
+            link: Link {
+                half_gap: 0.5 * gap_m,
+                k: k_n_per_m,
+            },
             d_h: 0.0,
             fresh: true,
             trial: None,
@@ -529,13 +531,7 @@ impl CompliantFreePlay {
     /// Link force of a link deflection `e = d_h - d` [N] and whether the gap is closed.
     #[inline]
     pub fn link_force(&self, e: f64) -> (f64, bool) {
-        if e > self.half_gap {
-            (self.k * (e - self.half_gap), true)
-        } else if e < -self.half_gap {
-            (self.k * (e + self.half_gap), true)
-        } else {
-            (0.0, false)
-        }
+        self.link.force(e)
     }
 }
 
@@ -549,16 +545,7 @@ impl Device for CompliantFreePlay {
     ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
         if self.fresh {
-            // Link deflection carrying the device's initial force (centred when it is zero).
-            let f = self.inner.committed_force();
-            let e = if f > 0.0 {
-                self.half_gap + f / self.k
-            } else if f < 0.0 {
-                -self.half_gap + f / self.k
-            } else {
-                0.0
-            };
-            self.d_h = d_i + e;
+            self.d_h = d_i + self.link.deflection_of(self.inner.committed_force());
         }
         let dh_i = self.d_h;
         let tol = 0.1;
@@ -574,7 +561,7 @@ impl Device for CompliantFreePlay {
         // Start: the link keeps its deflection.
         let mut x = d_f + (dh_i - d_i);
         let mut prev = f64::INFINITY;
-        let mut step = 1e-6_f64.max(tol / self.k);
+        let mut step = 1e-6_f64.max(tol / self.link.k);
         let mut collapsed = false;
         for _ in 0..PLAY_MAX_ITER {
             let (h, contact, sf) = eval(self, x)?;
@@ -582,7 +569,7 @@ impl Device for CompliantFreePlay {
                 self.trial = Some(x);
                 let kd = -sf.dforce_dstroke;
                 let dl = if contact {
-                    -(kd * self.k) / (kd + self.k)
+                    -(kd * self.link.k) / (kd + self.link.k)
                 } else {
                     0.0
                 };
@@ -599,7 +586,7 @@ impl Device for CompliantFreePlay {
             } else {
                 hi = Some((x, h));
             }
-            let slope = if contact { self.k } else { 0.0 } - sf.dforce_dstroke;
+            let slope = if contact { self.link.k } else { 0.0 } - sf.dforce_dstroke;
             let newton = x - h / slope;
             x = match (lo, hi) {
                 (Some((a, ga)), Some((b, gb))) => {
@@ -646,7 +633,7 @@ impl Device for CompliantFreePlay {
             self.trial = Some(best.0);
             let kd = -sf.dforce_dstroke;
             let dl = if contact {
-                -(kd * self.k) / (kd + self.k)
+                -(kd * self.link.k) / (kd + self.link.k)
             } else {
                 0.0
             };

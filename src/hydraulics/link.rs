@@ -47,6 +47,19 @@ impl Link {
             (0.0, false)
         }
     }
+
+    /// The deflection carrying a force `f` (centred in the gap when it is zero): where a link
+    /// starts from a device's initial force.
+    #[inline]
+    pub fn deflection_of(&self, f: f64) -> f64 {
+        if f > 0.0 {
+            self.half_gap + f / self.k
+        } else if f < 0.0 {
+            -self.half_gap + f / self.k
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The circuit and link over one step, the end's stroke linear in time from `d_i` at `t_i`.
@@ -262,17 +275,7 @@ impl Device for LinkedCircuit {
     ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
         if self.fresh {
-            // Link deflection carrying the circuit's initial force (centred when it is zero).
-            let f = self.inner.committed_force();
-            let g = self.link.half_gap;
-            let e = if f > 0.0 {
-                g + f / self.link.k
-            } else if f < 0.0 {
-                -g + f / self.link.k
-            } else {
-                0.0
-            };
-            self.d_h = d_i + e;
+            self.d_h = d_i + self.link.deflection_of(self.inner.committed_force());
         }
         let opts: IntegratorOptions = self.inner.options();
         let params = self.inner.params();
