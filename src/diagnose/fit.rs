@@ -370,7 +370,7 @@ fn jacobian_ln(
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ParameterSpread {
     /// Fitted to each test alone (from its second cycle), by test name; `null` where that test
-    /// does not bound the parameter (its noise interval is unbounded).
+    /// does not bound the parameter (its own 95% noise interval wider than a factor of 10).
     pub per_test: BTreeMap<String, Option<f64>>,
     /// Standard deviation of `ln x` across the tests beyond what the noise explains
     /// (DerSimonian-Laird); 0 when the tests agree within their noise.
@@ -431,8 +431,10 @@ fn parameter_spread(
             let mut values = BTreeMap::new();
             let mut pts: Vec<(f64, f64)> = Vec::new();
             for (w, r) in windows.iter().zip(&per_test) {
+                // A test bounds the parameter when its own 95% interval is within a factor of 10.
                 let v = r.as_ref().and_then(|(xi, var)| {
-                    (var[c].is_finite() && var[c] > 0.0 && xi[c] > 0.0).then_some((xi[c], var[c]))
+                    (var[c] > 0.0 && Z95 * var[c].sqrt() < 10f64.ln() && xi[c] > 0.0)
+                        .then_some((xi[c], var[c]))
                 });
                 values.insert(data[w.test].name.clone(), v.map(|v| v.0));
                 if let Some((xi, var)) = v {
