@@ -37,6 +37,18 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
         }
     }
     assert_ne!(j["cause"], "none");
+    // One test: the cause's parameters revolution by revolution, from the second.
+    let spread = j["parameter_spread"].as_object().expect("parameter_spread");
+    for (name, s) in spread {
+        assert!(s["tests"].as_u64().unwrap() >= 3, "{name}: {s}");
+        assert!(s["per_test"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .all(|k| k.contains(" cycle ")));
+        assert!(j["parameters"].get(name).is_some(), "{name}");
+    }
+    assert!(!spread.is_empty());
     assert!(j["gain"].as_f64().unwrap() > 0.0);
     assert!(dir.join("out/diagnosis.html").exists());
     assert!(!dir.join("out/INCOMPLETE").exists());

@@ -112,8 +112,8 @@ pub struct Diagnosis {
     pub parameters: BTreeMap<String, f64>,
     /// 95% interval of every parameter of the cause.
     pub parameter_intervals: BTreeMap<String, [f64; 2]>,
-    /// Every parameter of the cause fitted to each test alone, and its spread across tests
-    /// (three tests or more; empty otherwise).
+    /// Every parameter of the cause fitted to each test alone (fewer than three tests: to each
+    /// cycle from the second), and its spread across them.
     pub parameter_spread: BTreeMap<String, ParameterSpread>,
     /// Which limit of free play behind a contact stiffness the data support, when a compliant
     /// or gap cause is in play.
@@ -399,6 +399,7 @@ fn parameter_spread(
     x: &[f64],
     data: &[Measurement],
     windows: &[Window],
+    labels: &[String],
     opts: &DiagnoseOptions,
     sigma: f64,
     scale: f64,
@@ -430,13 +431,13 @@ fn parameter_spread(
         .map(|c| {
             let mut values = BTreeMap::new();
             let mut pts: Vec<(f64, f64)> = Vec::new();
-            for (w, r) in windows.iter().zip(&per_test) {
+            for (label, r) in labels.iter().zip(&per_test) {
                 // A test bounds the parameter when its own 95% interval is within a factor of 10.
                 let v = r.as_ref().and_then(|(xi, var)| {
                     (var[c] > 0.0 && Z95 * var[c].sqrt() < 10f64.ln() && xi[c] > 0.0)
                         .then_some((xi[c], var[c]))
                 });
-                values.insert(data[w.test].name.clone(), v.map(|v| v.0));
+                values.insert(label.clone(), v.map(|v| v.0));
                 if let Some((xi, var)) = v {
                     pts.push((xi.ln(), 1.0 / var));
                 }
@@ -1230,11 +1231,33 @@ pub fn diagnose(
     // (in ln x, in quadrature with the noise and model-form half-width).
     let mut param_iv = param_iv;
     let mut spreads = BTreeMap::new();
-    if let (Some((row, Some(_), _, x)), true) = (chosen, data.len() >= 3) {
+    // Three tests or more: test by test; fewer (a flight record): cycle by cycle from the second.
+    let (spread_w, labels): (Vec<Window>, Vec<String>) = if data.len() >= 3 {
+        let labels = data.iter().map(|m| m.name.clone()).collect();
+        (all_w.clone(), labels)
+    } else {
+        data.iter()
+            .enumerate()
+            .flat_map(|(i, m)| {
+                let per_cycle = m.cycle_start(1.0).max(1);
+                (1..m.cycles().ceil() as usize).filter_map(move |c| {
+                    let w = Window {
+                        test: i,
+                        from: m.cycle_start(c as f64),
+                        to: m.cycle_start(c as f64 + 1.0).min(m.time_s.len()),
+                    };
+                    // A last cycle cut short counts when at least half of it was recorded.
+                    (2 * (w.to - w.from) >= per_cycle)
+                        .then(|| (w, format!("{} cycle {}", m.name, c + 1)))
+                })
+            })
+            .unzip()
+    };
+    if let (Some((row, Some(_), _, x)), true) = (chosen, spread_w.len() >= 3) {
         if let Some(causes) = causes_of(&row.cause) {
             if let Some(spec) = combined_params(&causes, base, scales) {
                 let spread = parameter_spread(
-                    &causes, scales, base, &spec, x, data, &all_w, opts, sigma, scale,
+                    &causes, scales, base, &spec, x, data, &spread_w, &labels, opts, sigma, scale,
                 );
                 for ((p, xc), sp) in spec.iter().zip(x).zip(spread) {
                     if let Some(iv) = param_iv.get_mut(p.name) {
