@@ -1272,7 +1272,7 @@ pub fn diagnose(
             }
         }
     }
-    let free_play_limit = free_play_limit(&cause, &evaluated);
+    let free_play_limit = free_play_limit(&cause, &evaluated, &param_iv);
     for c in &mut companions {
         c.kept = c.pair == cause;
         if c.passes && !c.kept {
@@ -1351,6 +1351,7 @@ pub fn diagnose(
             }
         })
         .collect();
+    // The cause's row carries the intervals it is reported with.
     let mut cand_rows: Vec<Candidate> = evaluated.iter().map(|e| e.0.clone()).collect();
     if let Some(r) = cand_rows.iter_mut().find(|r| r.cause == cause) {
         r.intervals = param_iv.clone();
@@ -1462,7 +1463,13 @@ const BIC_STRONG: f64 = 10.0;
 /// Which limit of a gap behind a contact stiffness the data support: the compliant free play
 /// nests the pure compliance (gap -> 0, `mount_compliance`) and the rigid gap (stiffness -> inf,
 /// `free_play`); compared by BIC, with the fitted intervals.
-fn free_play_limit(cause: &str, evaluated: &[Evaluated]) -> Option<String> {
+/// `cause_iv`: the cause's intervals (with its spread across tests), used when the compliant
+/// free play is the cause.
+fn free_play_limit(
+    cause: &str,
+    evaluated: &[Evaluated],
+    cause_iv: &BTreeMap<String, [f64; 2]>,
+) -> Option<String> {
     let names = ["compliant_free_play", "mount_compliance", "free_play"];
     if !cause.split('+').any(|c| names.contains(&c)) {
         return None;
@@ -1478,12 +1485,12 @@ fn free_play_limit(cause: &str, evaluated: &[Evaluated]) -> Option<String> {
         cfp.parameters.get("gap_m")?,
         cfp.parameters.get("contact_stiffness_N_per_m")?,
     );
-    let iv = |p: &str| {
-        cfp.intervals
-            .get(p)
-            .copied()
-            .unwrap_or([0.0, f64::INFINITY])
+    let ivs = if cfp.cause == cause {
+        cause_iv
+    } else {
+        &cfp.intervals
     };
+    let iv = |p: &str| ivs.get(p).copied().unwrap_or([0.0, f64::INFINITY]);
     let (gi, ki) = (iv("gap_m"), iv("contact_stiffness_N_per_m"));
     let d_mount = row(names[1]).map_or(f64::INFINITY, |r| r.bic - cfp.bic);
     let d_rigid = row(names[2]).map_or(f64::INFINITY, |r| r.bic - cfp.bic);

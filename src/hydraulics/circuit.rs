@@ -203,7 +203,7 @@ impl CircuitParams {
     }
 
     /// Bulk modulus of the contents of chamber k at p: Eq. (3), or the oil/air mixture.
-    #[inline]
+    #[inline(always)]
     pub fn bulk(&self, k: usize, p: f64) -> (f64, f64) {
         match self.ext.air_of(k) {
             None => self.fluid.bulk(p),
@@ -241,7 +241,7 @@ impl CircuitParams {
     /// `contact`: `None` decides seat contact from `y` ([`ReliefValve::poppet_rate`]);
     /// `Some(held)` imposes it (valve k held on its seat iff `held[k]`), as the implicit scheme does
     /// over a sub-step.
-    #[inline]
+    #[inline(always)]
     pub fn evaluate<const JAC: bool>(
         &self,
         t: f64,
@@ -273,25 +273,15 @@ impl CircuitParams {
 
     /// Eq. (1) for chamber k at pressure p, volume v, net inflow `qn` and stroke rate `d_dot`:
     /// `(p_dot, dp_dot/dp, dp_dot/dQ)`, with the bulk modulus of the chamber's contents.
-    #[inline]
+    #[inline(always)]
     pub fn pressure_rate(&self, k: usize, p: f64, v: f64, qn: f64, d_dot: f64) -> (f64, f64, f64) {
-        match self.ext.air_of(k) {
-            None => self.chambers[k].pressure_rate(&self.fluid, p, v, qn, d_dot),
-            Some(a) => self.chambers[k].pressure_rate_with_bulk(
-                &self.fluid,
-                a.bulk(&self.fluid, p),
-                p,
-                v,
-                qn,
-                d_dot,
-            ),
-        }
+        self.chambers[k].pressure_rate_with_bulk(&self.fluid, self.bulk(k, p), p, v, qn, d_dot)
     }
 
     /// Everything of [`CircuitParams::evaluate`] but the chamber pressure rates: the poppet
     /// rates, the impulse rate (Eq. 8), the flows and the net inflow into each chamber, which
     /// with the stroke rate give the pressure rates (Eq. 1).
-    #[inline]
+    #[inline(always)]
     pub fn flow_part<const JAC: bool>(
         &self,
         t: f64,

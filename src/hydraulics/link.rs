@@ -9,11 +9,12 @@
 //! `k_c (v - d_dot) = A0 p0_dot(v) - A1 p1_dot(v)`, with `k_c = k` in contact and 0 inside the gap,
 //! and the pressure rates of Eq. (1) linear in `v` (piecewise, where the cavitation factor acts
 //! on an outflow), so `v` has a closed form. Runge-Kutta schemes keep linear invariants, so the
-//! balance holds to round-off while the link stays in one regime; a sub-step that crosses into or
-//! out of contact is put back on it by a projection (contact) or relaxes to it over a few
-//! sub-steps (inside the gap, `F_dot = -F/tau`).
+//! balance holds to round-off while the link stays in one regime. A sub-step in which the link
+//! crosses the edge of the gap is split at the crossing; what the split leaves of the balance is
+//! put back by a projection (contact) or relaxes over a few sub-steps (inside the gap,
+//! `F_dot = -F/tau`).
 use super::circuit::{CircuitDevice, CircuitParams, State, IIMP, IP0, IP1, IV0, IV1, IX0, IX1, NS};
-use super::integrators::{integrate, IntegratorOptions, OdeSystem};
+use super::integrators::{explicit_step, OdeSystem, RK4};
 use super::{check_step, Device, HydraulicError, StepForce};
 use nalgebra::{SMatrix, SVector};
 
@@ -48,6 +49,18 @@ impl Link {
         }
     }
 
+    /// Which side is in contact at deflection `e`: +1 or -1, 0 inside the gap (no gap: +1).
+    #[inline]
+    pub fn side(&self, e: f64) -> i8 {
+        if self.half_gap <= 0.0 || e > self.half_gap {
+            1
+        } else if e < -self.half_gap {
+            -1
+        } else {
+            0
+        }
+    }
+
     /// The deflection carrying a force `f` (centred in the gap when it is zero): where a link
     /// starts from a device's initial force.
     #[inline]
@@ -63,6 +76,7 @@ impl Link {
 }
 
 /// The circuit and link over one step, the end's stroke linear in time from `d_i` at `t_i`.
+#[derive(Clone, Copy)]
 struct LinkSystem<'a> {
     params: &'a CircuitParams,
     link: Link,
@@ -70,46 +84,14 @@ struct LinkSystem<'a> {
     d_i: f64,
     d_dot: f64,
     tau: f64,
+    /// The side in contact (`Link::side`) held over a sub-step, so that no Runge-Kutta stage
+    /// takes the other regime's law.
+    side: i8,
 }
 
 #[inline]
 fn circuit_part(y: &LState) -> State {
     State::from_fn(|i, _| y[i])
-}
-
-/// Eq. (1) of both chambers at one state as affine functions of the piston velocity `v`:
-/// `p_dot_k = g_k(net_k) net_k`, `net_k = qn_k - A_k lambda_k v`, with `g_k = B/V` on an inflow and
-/// `B s(p)/V` on an outflow (the cavitation factor).
-struct Rates {
-    qn: [f64; 2],
-    a_lambda: [f64; 2],
-    area: [f64; 2],
-    g_in: [f64; 2],
-    g_out: [f64; 2],
-}
-
-impl Rates {
-    /// `h(v) = A0 p0_dot - A1 p1_dot - k_c (v - d_dot) + relax`, its slope, and the two rates.
-    #[inline]
-    fn balance(&self, k_c: f64, d_dot: f64, relax: f64, v: f64) -> (f64, f64, [f64; 2]) {
-        let mut rate = [0.0; 2];
-        let mut slope = [0.0; 2];
-        for k in 0..2 {
-            let net = self.qn[k] - self.a_lambda[k] * v;
-            let g = if net < 0.0 {
-                self.g_out[k]
-            } else {
-                self.g_in[k]
-            };
-            rate[k] = g * net;
-            slope[k] = -g * self.a_lambda[k];
-        }
-        (
-            self.area[0] * rate[0] - self.area[1] * rate[1] - k_c * (v - d_dot) + relax,
-            self.area[0] * slope[0] - self.area[1] * slope[1] - k_c,
-            rate,
-        )
-    }
 }
 
 impl OdeSystem<NL> for LinkSystem<'_> {
@@ -118,45 +100,51 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         let e = y[IE];
         let yc = circuit_part(y);
         let part = self.params.flow_part::<false>(t, d + e, &yc, None)?;
-        let (f_link, contact) = self.link.force(e);
+        let contact = self.side != 0;
         let k_c = if contact { self.link.k } else { 0.0 };
         // Inside the gap the force relaxes to zero; in contact the projection keeps the balance.
         let relax = if contact {
             0.0
         } else {
-            (self.params.force(&yc) - f_link) / self.tau
+            self.params.force(&yc) / self.tau
         };
-        let mut rt = Rates {
-            qn: part.qn,
-            a_lambda: [0.0; 2],
-            area: [0.0; 2],
-            g_in: [0.0; 2],
-            g_out: [0.0; 2],
+        let d_dot = self.d_dot;
+        let ch = &self.params.chambers;
+        let p = [yc[IP0], yc[IP1]];
+        // h(v) = A0 p0_dot(v) - A1 p1_dot(v) - k_c (v - d_dot) + relax, its slope and the two
+        // pressure rates: Eq. (1) of each chamber, affine in v on either side of a zero net
+        // inflow (its factor, B/V or B s(p)/V with the cavitation factor s, is returned with it).
+        let balance = |v: f64| -> (f64, f64, [f64; 2]) {
+            let mut rate = [0.0; 2];
+            let mut slope = [0.0; 2];
+            for k in 0..2 {
+                let (r, _, g) = self
+                    .params
+                    .pressure_rate(k, p[k], part.vol[k], part.qn[k], v);
+                rate[k] = r;
+                slope[k] = -g * ch[k].area * ch[k].lambda;
+            }
+            (
+                ch[0].area * rate[0] - ch[1].area * rate[1] - k_c * (v - d_dot) + relax,
+                ch[0].area * slope[0] - ch[1].area * slope[1] - k_c,
+                rate,
+            )
         };
         // h is continuous, decreasing and affine between the velocities where a chamber's net
         // inflow changes sign with a cavitation factor below one: the root lies between the
         // kinks that bracket it, where one affine solve finds it.
         let mut kinks = [f64::NAN; 2];
-        for k in 0..2 {
-            let c = &self.params.chambers[k];
-            let p = yc[if k == 0 { IP0 } else { IP1 }];
-            let (b, _) = self.params.bulk(k, p);
-            let s = self.params.fluid.cavitation_factor(p).0;
-            rt.a_lambda[k] = c.area * c.lambda;
-            rt.area[k] = c.area;
-            rt.g_in[k] = b / part.vol[k];
-            rt.g_out[k] = b * s / part.vol[k];
-            if s != 1.0 {
-                kinks[k] = part.qn[k] / rt.a_lambda[k];
+        for (k, kink) in kinks.iter_mut().enumerate() {
+            if self.params.fluid.cavitation_factor(p[k]).0 != 1.0 {
+                *kink = part.qn[k] / (ch[k].area * ch[k].lambda);
             }
         }
         if kinks[0] > kinks[1] || kinks[0].is_nan() {
             kinks.swap(0, 1);
         }
-        let d_dot = self.d_dot;
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         for &v in kinks.iter().filter(|v| v.is_finite()) {
-            if rt.balance(k_c, d_dot, relax, v).0 > 0.0 {
+            if balance(v).0 > 0.0 {
                 lo = v;
             } else {
                 hi = v;
@@ -169,7 +157,7 @@ impl OdeSystem<NL> for LinkSystem<'_> {
             (false, true) => hi.min(d_dot) - 1.0,
             (false, false) => d_dot,
         };
-        let (h, slope, _) = rt.balance(k_c, d_dot, relax, probe);
+        let (h, slope, _) = balance(probe);
         // A slope of zero: nothing resists the piston (both chambers emptied inside the gap);
         // it then moves with the end.
         let v = if slope < 0.0 {
@@ -177,14 +165,12 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         } else {
             d_dot
         };
-        let (_, _, rates) = rt.balance(k_c, d_dot, relax, v);
+        let (_, _, rates) = balance(v);
         let mut f = LState::zeros();
-        for i in 0..NS {
-            f[i] = part.f[i];
-        }
+        f.fixed_rows_mut::<NS>(0).copy_from(&part.f);
         f[IP0] = rates[0];
         f[IP1] = rates[1];
-        f[IE] = v - self.d_dot;
+        f[IE] = v - d_dot;
         Ok(f)
     }
 
@@ -240,7 +226,7 @@ pub struct LinkedCircuit {
 
 impl LinkedCircuit {
     /// A compliant free play (`gap_m > 0`) or a series mount (`gap_m = 0`) of stiffness
-    /// `k_n_per_m` around `inner`, integrated with its options (explicit schemes only).
+    /// `k_n_per_m` around `inner`, integrated by RK4 with the circuit's sub-steps.
     pub fn new(inner: CircuitDevice, gap_m: f64, k_n_per_m: f64) -> Self {
         Self {
             inner,
@@ -265,6 +251,51 @@ impl LinkedCircuit {
     }
 }
 
+impl LinkedCircuit {
+    /// RK4 over `n` equal sub-steps, projecting after each. A sub-step in which the link crosses
+    /// the edge of the gap is split at the crossing (located by linear interpolation of the
+    /// deflection), so that no sub-step mixes the two regimes' laws beyond the interpolation's
+    /// error: the regime switch is an event, not a kink inside a Runge-Kutta step.
+    fn integrate(
+        &self,
+        sys: &LinkSystem,
+        n: usize,
+        t0: f64,
+        dt: f64,
+        y0: &LState,
+    ) -> Result<LState, HydraulicError> {
+        let h = dt / n as f64;
+        let g = self.link.half_gap;
+        let mut y = *y0;
+        let on = |side: i8| LinkSystem { side, ..*sys };
+        for s in 0..n {
+            let t = t0 + s as f64 * h;
+            let side0 = self.link.side(y[IE]);
+            let mut y1 = explicit_step(&RK4, &on(side0), t, &y, h)?;
+            let side1 = self.link.side(y1[IE]);
+            if side1 != side0 {
+                // The edge crossed: the one the link leaves or reaches.
+                let (e0, e1) = (y[IE], y1[IE]);
+                let edge = g * f64::from(if side0 != 0 { side0 } else { side1 });
+                let theta = ((edge - e0) / (e1 - e0)).clamp(0.0, 1.0);
+                let mut ym = explicit_step(&RK4, &on(side0), t, &y, theta * h)?;
+                ym[IE] = edge;
+                sys.project(&mut ym);
+                y1 = explicit_step(&RK4, &on(side1), t + theta * h, &ym, (1.0 - theta) * h)?;
+            }
+            sys.project(&mut y1);
+            if let Some(c) = y1.iter().position(|v| !v.is_finite()) {
+                return Err(HydraulicError::NonFinite {
+                    t: t + h,
+                    component: c,
+                });
+            }
+            y = y1;
+        }
+        Ok(y)
+    }
+}
+
 impl Device for LinkedCircuit {
     fn trial_step(
         &mut self,
@@ -277,24 +308,23 @@ impl Device for LinkedCircuit {
         if self.fresh {
             self.d_h = d_i + self.link.deflection_of(self.inner.committed_force());
         }
-        let opts: IntegratorOptions = self.inner.options();
+        let opts = self.inner.options();
         let params = self.inner.params();
         let n = opts.substeps.max(1);
-        let mut sys = LinkSystem {
+        let sys = LinkSystem {
             params,
             link: self.link,
             t_i,
             d_i,
             d_dot: (d_f - d_i) / dt,
             tau: RELAX_SUBSTEPS * dt / n as f64,
+            side: 0,
         };
         let mut y0 = LState::zeros();
-        for (i, v) in self.inner.state().iter().enumerate() {
-            y0[i] = *v;
-        }
+        y0.fixed_rows_mut::<NS>(0).copy_from(self.inner.state());
         y0[IIMP] = 0.0;
         y0[IE] = self.d_h - d_i;
-        let y = integrate(&opts, &mut sys, t_i, dt, &y0)?;
+        let y = self.integrate(&sys, n, t_i, dt, &y0)?;
         let yc = circuit_part(&y);
         let d_h = d_f + y[IE];
         let (_, contact) = self.link.force(y[IE]);
