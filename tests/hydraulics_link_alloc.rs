@@ -19,6 +19,7 @@ fn link_steps_do_not_allocate() {
     for ext in [
         "free_play_m = 1.0e-4\nfree_play_contact_stiffness_N_per_m = 1.0e8",
         "mount_stiffness_N_per_m = 1.0e8",
+        "free_play_m = 1.0e-4\nfree_play_contact_stiffness_N_per_m = 1.0e8\nlink_mass_kg = 1.0\nlink_damping_ratio = 0.05",
     ] {
         let deck = DamperDeck::from_toml_str(
             &format!("{text}\n[damper.physical.extensions]\n{ext}\n"),

@@ -1,6 +1,7 @@
 //! The candidate model extensions: each a physical element of the hydraulic library (or a
 //! re-calibration of uncertain nominal coefficients), with its fitted parameters and bounds.
 use crate::hydraulics::{DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction};
+use std::borrow::Cow;
 
 /// Named causes (docs/formats.md `cause`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -211,8 +212,33 @@ pub fn combined_name(causes: &[Cause]) -> String {
         .join("+")
 }
 
+/// The base a combination is built on. A moving mass on the data sheet (`link_mass_kg`) is
+/// modelled behind one link on the bare circuit (src/hydraulics/link.rs); beside seal friction,
+/// a rigid gap or a second link the link is quasi-static, so such a combination leaves the mass
+/// out.
+fn combination_base<'a>(causes: &[Cause], base: &'a DamperDeck) -> Cow<'a, DamperDeck> {
+    let links = causes
+        .iter()
+        .filter(|c| matches!(c, Cause::CompliantFreePlay | Cause::MountCompliance))
+        .count();
+    let e = &base.extensions;
+    let beside = e.friction.is_some()
+        || e.free_play.is_some() && e.free_play_contact_stiffness_n_per_m.is_none()
+        || causes
+            .iter()
+            .any(|c| matches!(c, Cause::SealFriction | Cause::FreePlay));
+    if base.extensions.link_mass.is_some() && links > 0 && (links > 1 || beside) {
+        let mut b = base.clone();
+        b.extensions.link_mass = None;
+        Cow::Owned(b)
+    } else {
+        Cow::Borrowed(base)
+    }
+}
+
 /// Parameters of a combination (concatenated; None if any cause is not applicable).
 pub fn combined_params(causes: &[Cause], base: &DamperDeck, s: Scales) -> Option<Vec<ParamSpec>> {
+    let base = &*combination_base(causes, base);
     let mut v = Vec::new();
     for c in causes {
         v.extend(c.params(base, s)?);
@@ -222,6 +248,7 @@ pub fn combined_params(causes: &[Cause], base: &DamperDeck, s: Scales) -> Option
 
 /// The base deck with every cause of a combination applied, each taking its share of `x`.
 pub fn apply_all(causes: &[Cause], base: &DamperDeck, s: Scales, x: &[f64]) -> DamperDeck {
+    let base = &*combination_base(causes, base);
     let mut d = base.clone();
     let mut i = 0;
     for c in causes {

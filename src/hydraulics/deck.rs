@@ -9,7 +9,7 @@ use super::extensions::{
 };
 use super::fluid::Fluid;
 use super::integrators::{IntegratorOptions, Scheme};
-use super::link::LinkedCircuit;
+use super::link::{LinkMass, LinkedCircuit};
 use super::Device;
 use std::path::Path;
 use toml::{Table, Value};
@@ -108,6 +108,10 @@ pub struct DeviceExtensions {
     pub mount_stiffness_n_per_m: Option<f64>,
     /// Contact stiffness behind the free play [N/m] (None: a rigid gap).
     pub free_play_contact_stiffness_n_per_m: Option<f64>,
+    /// Moving mass between the link (compliant free play or mount) and the oil, and the link's
+    /// damping (None: a massless, quasi-static link; without a link the mass moves with the end
+    /// and its inertia force is left out).
+    pub link_mass: Option<LinkMass>,
 }
 
 /// Keys of `[damper.physical.extensions]` (all optional; absent or 0 = off).
@@ -124,6 +128,8 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "air_fraction_1",
     "mount_stiffness_N_per_m",
     "free_play_contact_stiffness_N_per_m",
+    "link_mass_kg",
+    "link_damping_ratio",
 ];
 
 struct Ctx<'a> {
@@ -575,6 +581,24 @@ impl DamperDeck {
             )?,
             ..Default::default()
         };
+        let mass = opt("link_mass_kg", "a positive mass in kg", positive)?;
+        let zeta = opt(
+            "link_damping_ratio",
+            "a non-negative fraction of critical damping",
+            non_negative,
+        )?;
+        if let Some(m) = mass {
+            e.link_mass = Some(LinkMass {
+                mass_kg: m,
+                damping_ratio: zeta.unwrap_or(0.0),
+            });
+        } else if zeta.is_some() {
+            return Err(cx.bad(
+                &format!("{p}.link_damping_ratio"),
+                &t["link_damping_ratio"],
+                "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
+            ));
+        }
         let f_c = f_c.unwrap_or(0.0);
         let f_s = f_s.unwrap_or(f_c);
         if f_c > 0.0 || f_s > 0.0 {
@@ -669,10 +693,31 @@ impl DamperDeck {
                     (None, Some(k)) => Some((0.0, k)),
                     _ => None,
                 };
-                if let Some((gap, k)) = link.filter(|_| {
-                    e.friction.is_none() && rigid_play.is_none() && opts.scheme == Scheme::Rk4
-                }) {
-                    return Ok(Box::new(LinkedCircuit::new(dev, gap, k)));
+                let one_ode = e.friction.is_none() && rigid_play.is_none();
+                if let Some((gap, k)) = link.filter(|_| one_ode && opts.scheme == Scheme::Rk4) {
+                    let linked = LinkedCircuit::new(dev, gap, k);
+                    return Ok(Box::new(match e.link_mass {
+                        Some(m) => linked.with_mass(m),
+                        None => linked,
+                    }));
+                }
+                let two_links = e.free_play_contact_stiffness_n_per_m.is_some()
+                    && e.mount_stiffness_n_per_m.is_some();
+                // Without a link the moving mass moves with the end (its m a is left out).
+                if e.link_mass.is_some() && (link.is_some() || two_links) {
+                    let why = if two_links {
+                        "a moving mass needs one link: a compliant free play or a mount, not both"
+                    } else if !one_ode {
+                        "a moving mass is modelled on the bare circuit: no seal friction or rigid gap beside it"
+                    } else {
+                        "a moving mass is integrated by RK4 only (scheme rk4)"
+                    };
+                    return Err(DeckError::BadValue {
+                        file: self.source.clone(),
+                        key: "damper.physical.extensions.link_mass_kg".into(),
+                        value: format!("{}", e.link_mass.map_or(0.0, |m| m.mass_kg)),
+                        expected: why.into(),
+                    });
                 }
                 let dev: Box<dyn Device> = if e.friction.is_some() || rigid_play.is_some() {
                     Box::new(ExtendedDamper::new(dev, e.friction, rigid_play))
@@ -799,6 +844,10 @@ impl DamperDeck {
             }
             if let Some(k) = e.mount_stiffness_n_per_m {
                 ext.push(("mount_stiffness_N_per_m", k));
+            }
+            if let Some(m) = e.link_mass {
+                ext.push(("link_mass_kg", m.mass_kg));
+                ext.push(("link_damping_ratio", m.damping_ratio));
             }
             if let Some(a) = c.ext.air {
                 ext.push(("air_fraction", a.fraction));

@@ -74,7 +74,7 @@ pub use extensions::{
 };
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
-pub use link::LinkedCircuit;
+pub use link::{LinkMass, LinkedCircuit};
 
 /// Result of one trial step of a device.
 #[derive(Debug, Clone, Copy, PartialEq)]
