@@ -87,7 +87,12 @@ impl Cause {
             Cause::None => vec![],
             Cause::SealFriction => {
                 let f = s.peak_force_n.max(1.0);
-                vec![p("F_c_N", 1e-3 * f, 0.3 * f, vec![0.01 * f, 0.05 * f])]
+                // Presliding from a tenth of a micron (the sliding law at any stroke here) to
+                // a millimetre.
+                vec![
+                    p("F_c_N", 1e-3 * f, 0.3 * f, vec![0.01 * f, 0.05 * f]),
+                    p("presliding_m", 1e-7, 1e-3, vec![1e-5]),
+                ]
             }
             Cause::FreePlay => {
                 let a = s.min_amplitude_m;
@@ -157,7 +162,12 @@ impl Cause {
         };
         match self {
             Cause::None => {}
-            Cause::SealFriction => d.extensions.friction = Some(SealFriction::coulomb(x[0])),
+            Cause::SealFriction => {
+                d.extensions.friction = Some(SealFriction {
+                    presliding_m: x.get(1).copied().unwrap_or(0.0),
+                    ..SealFriction::coulomb(x[0])
+                })
+            }
             Cause::FreePlay => d.extensions.free_play = Some(FreePlay { gap: x[0] }),
             Cause::CompliantFreePlay => {
                 d.extensions.free_play = Some(FreePlay { gap: x[0] });

@@ -120,6 +120,7 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "stribeck_static_N",
     "stribeck_velocity_m_s",
     "friction_smoothing_m_s",
+    "seal_presliding_m",
     "free_play_m",
     "air_fraction",
     "leakage_m3_per_s_Pa",
@@ -599,6 +600,11 @@ impl DamperDeck {
                 "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
             ));
         }
+        let presliding = opt(
+            "seal_presliding_m",
+            "a non-negative presliding displacement in m (0: none)",
+            non_negative,
+        )?;
         let f_c = f_c.unwrap_or(0.0);
         let f_s = f_s.unwrap_or(f_c);
         if f_c > 0.0 || f_s > 0.0 {
@@ -608,7 +614,14 @@ impl DamperDeck {
                 f_s,
                 v_s: v_s.unwrap_or(d.v_s),
                 v_eps: v_eps.unwrap_or(d.v_eps),
+                presliding_m: presliding.unwrap_or(0.0),
             });
+        } else if presliding.is_some_and(|x| x > 0.0) {
+            return Err(cx.bad(
+                &format!("{p}.seal_presliding_m"),
+                &t["seal_presliding_m"],
+                "presliding belongs to the seal friction: give seal_friction_N too",
+            ));
         }
         if let Some(g) = gap.filter(|g| *g > 0.0) {
             e.free_play = Some(FreePlay { gap: g });
@@ -835,6 +848,9 @@ impl DamperDeck {
                 ext.push(("stribeck_static_N", f.f_s));
                 ext.push(("stribeck_velocity_m_s", f.v_s));
                 ext.push(("friction_smoothing_m_s", f.v_eps));
+                if f.has_presliding() {
+                    ext.push(("seal_presliding_m", f.presliding_m));
+                }
             }
             if let Some(p) = e.free_play {
                 ext.push(("free_play_m", p.gap));

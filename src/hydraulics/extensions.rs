@@ -31,6 +31,10 @@ pub struct SealFriction {
     pub v_s: f64,
     /// Regularisation velocity v_eps [m/s].
     pub v_eps: f64,
+    /// Presliding displacement x_p [m] (0: none). After a reversal the force approaches the
+    /// sliding law over a stroke of about x_p, `dF/dd = (F_slide(v) - F) sign(d_dot) / x_p` (a
+    /// Dahl-type first-order law; F_c/x_p is the seal's presliding stiffness).
+    pub presliding_m: f64,
 }
 
 impl SealFriction {
@@ -41,6 +45,7 @@ impl SealFriction {
             f_s: f_c,
             v_s: 0.01,
             v_eps: 1e-4,
+            presliding_m: 0.0,
         }
     }
 
@@ -49,6 +54,33 @@ impl SealFriction {
     pub fn force(&self, v: f64) -> f64 {
         let s = (-(v / self.v_s).powi(2)).exp();
         -(self.f_c + (self.f_s - self.f_c) * s) * (v / self.v_eps).tanh()
+    }
+
+    /// With presliding: the force at the end of a step and its mean over the step, from `f0` at
+    /// its start, the stroke moving by `dd` at the constant rate `v`. The law is linear in the
+    /// force along the stroke, so the step is exact: `F = F* + (f0 - F*) exp(-|s|/x_p)` with
+    /// `F* = force(v)`, s the stroke travelled.
+    #[inline]
+    pub fn presliding_step(&self, f0: f64, v: f64, dd: f64) -> (f64, f64) {
+        let target = self.force(v);
+        let lambda = dd.abs() / self.presliding_m;
+        let decay = (-lambda).exp();
+        // (1 - e^-lambda)/lambda, 1 at lambda = 0.
+        let mean_decay = if lambda > 1e-12 {
+            -(-lambda).exp_m1() / lambda
+        } else {
+            1.0
+        };
+        (
+            target + (f0 - target) * decay,
+            target + (f0 - target) * mean_decay,
+        )
+    }
+
+    /// Whether the friction has presliding (a state).
+    #[inline]
+    pub fn has_presliding(&self) -> bool {
+        self.presliding_m > 0.0
     }
 }
 
@@ -163,9 +195,11 @@ pub struct ExtendedDamper {
     d_h: f64,
     contact: bool,
     v_h: f64,
+    /// Friction force at the committed state (presliding friction only) [N].
+    f_fric: f64,
     /// No step taken since the reset: the piston starts centred in the gap at the first stroke.
     fresh: bool,
-    trial: Option<(f64, bool, f64)>,
+    trial: Option<(f64, bool, f64, f64)>,
 }
 
 impl ExtendedDamper {
@@ -181,6 +215,7 @@ impl ExtendedDamper {
             d_h: 0.0,
             contact: play.is_none(),
             v_h: 0.0,
+            f_fric: 0.0,
             fresh: true,
             trial: None,
         }
@@ -199,7 +234,14 @@ impl ExtendedDamper {
         if !contact {
             return 0.0;
         }
-        hydraulic + self.friction.map_or(0.0, |f| f.force(v_h))
+        hydraulic
+            + self.friction.map_or(0.0, |f| {
+                if f.has_presliding() {
+                    self.f_fric
+                } else {
+                    f.force(v_h)
+                }
+            })
     }
 }
 
@@ -224,23 +266,32 @@ impl Device for ExtendedDamper {
         };
         let v_h = (dh_f - dh_i) / dt;
         let sf = self.inner.trial_step(t_i, dt, dh_i, dh_f)?;
-        let fr = self.friction.map_or(0.0, |f| f.force(v_h));
-        let out = StepForce {
-            force_mean: if contact { sf.force_mean + fr } else { 0.0 },
-            dforce_dstroke: if contact { sf.dforce_dstroke } else { 0.0 },
-            force_end: self.out_force(sf.force_end, contact, v_h),
+        let (fr_end, fr_mean) = match self.friction {
+            Some(f) if f.has_presliding() => f.presliding_step(self.f_fric, v_h, dh_f - dh_i),
+            Some(f) => (f.force(v_h), f.force(v_h)),
+            None => (0.0, 0.0),
         };
-        self.trial = Some((dh_f, contact, v_h));
+        let out = StepForce {
+            force_mean: if contact {
+                sf.force_mean + fr_mean
+            } else {
+                0.0
+            },
+            dforce_dstroke: if contact { sf.dforce_dstroke } else { 0.0 },
+            force_end: if contact { sf.force_end + fr_end } else { 0.0 },
+        };
+        self.trial = Some((dh_f, contact, v_h, fr_end));
         Ok(out)
     }
 
     fn commit(&mut self) {
-        if let Some((d_h, c, v)) = self.trial.take() {
+        if let Some((d_h, c, v, f)) = self.trial.take() {
             self.inner.commit();
             self.fresh = false;
             self.d_h = d_h;
             self.contact = c;
             self.v_h = v;
+            self.f_fric = f;
         }
     }
 
@@ -265,10 +316,12 @@ impl Device for ExtendedDamper {
         self.d_h = 0.0;
         self.contact = self.play.is_none();
         self.v_h = 0.0;
+        self.f_fric = 0.0;
         self.fresh = true;
         self.trial = None;
     }
 
+    /// `[d_h, contact, v_h, fresh, circuit...]`, then the friction force with presliding.
     fn state_values(&self) -> Vec<f64> {
         let mut v = vec![
             self.d_h,
@@ -277,15 +330,24 @@ impl Device for ExtendedDamper {
             f64::from(u8::from(self.fresh)),
         ];
         v.extend(self.inner.state_values());
+        if self.friction.is_some_and(|f| f.has_presliding()) {
+            v.push(self.f_fric);
+        }
         v
     }
 
     fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        if v.len() < 4 {
-            return super::check_state_len("extended damper", v, 4);
+        let tail = usize::from(self.friction.is_some_and(|f| f.has_presliding()));
+        if v.len() < 4 + tail {
+            return super::check_state_len("extended damper", v, 4 + tail);
         }
+        let (v, rest) = v.split_at(v.len() - tail);
         self.inner.set_state_values(&v[4..])?;
         super::check_state_len("extended damper", &v[..4], 4)?;
+        if let Some(&f) = rest.first() {
+            super::check_state_len("extended damper", rest, 1)?;
+            self.f_fric = f;
+        }
         self.d_h = v[0];
         self.contact = v[1] != 0.0;
         self.v_h = v[2];
