@@ -196,9 +196,10 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
     let p = |k: &str| params.get(k).copied().unwrap_or(f64::NAN);
     match cause {
         "seal_friction" => format!(
-            "seal friction F_c = {:.0} N: the force jumps by ~2 F_c = {:.0} N at every velocity reversal",
+            "seal friction F_c = {:.0} N: the force swings by ~2 F_c = {:.0} N at every velocity reversal, over a presliding stroke of ~{:.1} um",
             p("F_c_N"),
-            2.0 * p("F_c_N")
+            2.0 * p("F_c_N"),
+            1e6 * p("presliding_m")
         ),
         "free_play" => format!(
             "free play of {:.3} mm in the attachments: no force is transmitted while the stroke crosses the gap after each reversal",
