@@ -281,6 +281,12 @@ fn blind_subset_intervals_cover_the_truth() {
     assert!(r.coverage() >= 0.9, "{r}");
 }
 
+/// RMS difference of two histories over their last `pc` samples.
+fn last_cycle_rms(a: &[f64], b: &[f64], pc: usize) -> f64 {
+    let (a, b) = (&a[a.len() - pc..], &b[b.len() - pc..]);
+    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / pc as f64).sqrt()
+}
+
 #[test]
 fn truth_link_tends_to_the_librarys_quasi_static_gap_as_mass_and_damping_vanish() {
     // The truth's free play (gap, contact stiffness, moving mass, contact damping) against the
@@ -318,14 +324,7 @@ fn truth_link_tends_to_the_librarys_quasi_static_gap_as_mass_and_damping_vanish(
             mass,
         });
         let f = force_at(&t, &stroke, &time_s, Tolerance::default()).unwrap();
-        (f[n - pc..]
-            .iter()
-            .zip(&lib[n - pc..])
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            / pc as f64)
-            .sqrt()
-            / peak
+        last_cycle_rms(&f, &lib, pc) / peak
     };
     let hardware = rms_diff(blind_support::truth::LINK_MASS_KG, 0.05);
     let light = rms_diff(0.01, 0.0);
@@ -340,16 +339,7 @@ fn truth_link_tends_to_the_librarys_quasi_static_gap_as_mass_and_damping_vanish(
     let mut t = Truth::new(Sheet::nominal());
     t.link = Some(blind_support::truth::Link::new(g, k));
     let tf = force_at(&t, &stroke, &time_s, Tolerance::default()).unwrap();
-    let d = |a: &[f64]| {
-        (tf[n - pc..]
-            .iter()
-            .zip(&a[n - pc..])
-            .map(|(x, y)| (x - y).powi(2))
-            .sum::<f64>()
-            / pc as f64)
-            .sqrt()
-            / peak
-    };
+    let d = |a: &[f64]| last_cycle_rms(&tf, a, pc) / peak;
     eprintln!(
         "truth's hardware link against the library's: massless {:.3}%, with its mass and damping {:.3}%",
         100.0 * d(&lib),

@@ -44,6 +44,15 @@ fn sealed_linear() -> CircuitParams {
     }
 }
 
+/// `k_oil = B (A0^2/V0 + A1^2/V1)` (Eq. 16) at the initial pressure.
+fn oil_stiffness(p: &CircuitParams) -> f64 {
+    let b = p.fluid.bulk(p.p_init[0]).0;
+    p.chambers
+        .iter()
+        .map(|c| b * c.area * c.area / c.volume0)
+        .sum()
+}
+
 /// Force at the step ends over the last two drive periods of a mount (stiffness k, damping
 /// ratio zeta, mass m) on the sealed damper, driven at `d = X sin(w t)` from rest (the stroke
 /// linear within each of `n` steps per period), and the exact steady state of
@@ -54,12 +63,7 @@ fn mount_run(substeps: usize) -> (Vec<f64>, Vec<f64>, f64) {
     let p = sealed_linear();
     let (k, m, zeta): (f64, f64, f64) = (1.0e8, 1.5, 0.2);
     let c = 2.0 * zeta * (k * m).sqrt();
-    let b = p.fluid.bulk(p.p_init[0]).0;
-    let k_oil: f64 = p
-        .chambers
-        .iter()
-        .map(|c| b * c.area * c.area / c.volume0)
-        .sum();
+    let k_oil = oil_stiffness(&p);
     let w_n = ((k + k_oil) / m).sqrt();
     let (x_amp, w) = (1.0e-7, 0.6 * w_n);
     // Steady state, complex amplitudes of d = X e^{i w t}.
@@ -131,15 +135,10 @@ fn moving_mass_behind_a_mount_is_the_damped_two_spring_oscillator() {
     assert!(e1 / e2 > 12.0, "order: {e1:e} -> {e2:e}");
 }
 
-/// The sub-steps the device picks for `mount_run` (h omega <= 1/2 of the mass's frequency).
+/// The sub-steps the device picks for `mount_run` (h omega <= 1/4 of the mass's frequency).
 fn own_substeps() -> usize {
     let p = sealed_linear();
-    let b = p.fluid.bulk(p.p_init[0]).0;
-    let k_oil: f64 = p
-        .chambers
-        .iter()
-        .map(|c| b * c.area * c.area / c.volume0)
-        .sum();
+    let k_oil = oil_stiffness(&p);
     let w_n = ((1.0e8 + k_oil) / 1.5f64).sqrt();
     let dt = 2.0 * PI / (0.6 * w_n) / STEPS_PER_PERIOD as f64;
     (dt * w_n / 0.25).ceil() as usize
