@@ -4,17 +4,11 @@ use rotorsim::hydraulics::bench::{harmonic_run, replay, BenchTest};
 use rotorsim::hydraulics::circuit::{State, IP0, IP1, NS};
 use rotorsim::hydraulics::*;
 
-fn nominal_text() -> String {
-    std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/flightdata/damper_nominal.toml"
-    ))
-    .unwrap()
-}
+mod deck_support;
+use deck_support::nominal_text;
 
 fn deck_with(ext: &str) -> DamperDeck {
-    let text = format!("{}\n[damper.physical.extensions]\n{ext}\n", nominal_text());
-    DamperDeck::from_toml_str(&text, "test deck").unwrap()
+    deck_support::deck_with(ext, "test deck")
 }
 
 fn opts() -> IntegratorOptions {

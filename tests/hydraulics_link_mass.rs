@@ -4,17 +4,8 @@
 use rotorsim::hydraulics::*;
 use std::f64::consts::PI;
 
-fn nominal_text() -> String {
-    std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/flightdata/damper_nominal.toml"
-    ))
-    .unwrap()
-}
-
-fn deck_text(ext: &str) -> String {
-    format!("{}\n[damper.physical.extensions]\n{ext}\n", nominal_text())
-}
+mod deck_support;
+use deck_support::{deck_text, nominal_text};
 
 /// A sealed damper (no flow paths), beta = 0: for strokes of a tenth of a
 /// micron, a linear spring of `k_oil = B (A0^2/V0 + A1^2/V1)` (Eq. 16, B at the initial pressure)

@@ -4,20 +4,11 @@
 use rotorsim::hydraulics::*;
 use std::f64::consts::PI;
 
-fn nominal_text() -> String {
-    std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/flightdata/damper_nominal.toml"
-    ))
-    .unwrap()
-}
+mod deck_support;
+use deck_support::nominal_text;
 
 fn deck(ext: &str) -> DamperDeck {
-    DamperDeck::from_toml_str(
-        &format!("{}\n[damper.physical.extensions]\n{ext}\n", nominal_text()),
-        "deck.toml",
-    )
-    .unwrap()
+    deck_support::deck_with(ext, "deck.toml")
 }
 
 #[test]

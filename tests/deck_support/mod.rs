@@ -1,0 +1,23 @@
+//! The shipped nominal damper deck, with `[damper.physical.extensions]` keys added, for the
+//! hydraulics tests.
+#![allow(dead_code)]
+use rotorsim::hydraulics::DamperDeck;
+
+/// flightdata/damper_nominal.toml as text.
+pub fn nominal_text() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/flightdata/damper_nominal.toml"
+    ))
+    .unwrap()
+}
+
+/// The nominal deck's text with the extension keys `ext`.
+pub fn deck_text(ext: &str) -> String {
+    format!("{}\n[damper.physical.extensions]\n{ext}\n", nominal_text())
+}
+
+/// The nominal deck with the extension keys `ext`, read as source `source`.
+pub fn deck_with(ext: &str, source: &str) -> DamperDeck {
+    DamperDeck::from_toml_str(&deck_text(ext), source).unwrap()
+}
