@@ -1,6 +1,6 @@
 //! Seal friction with presliding (`seal_presliding_m`): the step law against the exact solution
-//! of `dF/ds = (F* - F)/x_p` along the stroke, its order when the rate varies, the sliding law as
-//! the presliding vanishes, and the deck key.
+//! of `dF/ds = (F* - F)/x_p` along the stroke, its tangent against finite differences, its order
+//! when the rate varies, the sliding law as the presliding vanishes, and the deck key.
 use rotorsim::hydraulics::*;
 use std::f64::consts::PI;
 
@@ -41,6 +41,37 @@ fn presliding_step_is_exact_at_a_constant_rate() {
     }
     // No stroke, no change.
     assert_eq!(f.presliding_step(123.0, 0.0, 0.0), (123.0, 123.0));
+}
+
+#[test]
+fn presliding_tangent_matches_finite_differences() {
+    // d(mean force)/d(end stroke) of a step against central differences of the step law, at
+    // reversals (small strokes, the force far from the sliding law), mid-stroke and with a
+    // Stribeck peak, and below lambda = 1e-4 where M and M' are series; steps in the stroke of 1e-4
+    // of the step's own.
+    let f = SealFriction {
+        f_s: 650.0,
+        presliding_m: 2.0e-5,
+        ..SealFriction::coulomb(500.0)
+    };
+    let dt = 5.0e-4;
+    let mut checked = 0;
+    for &f0 in &[-500.0, -120.0, 0.0, 300.0, 640.0] {
+        for &dd in &[
+            -4.0e-4, -3.0e-5, -2.0e-6, -1.0e-7, -1.0e-9, 1.0e-9, 1.0e-7, 2.0e-6, 3.0e-5, 4.0e-4,
+        ] {
+            let an = f.presliding_tangent(f0, dd, dt);
+            let h = 1e-4 * dd.abs();
+            let mean = |x: f64| f.presliding_step(f0, x / dt, x).1;
+            let fd = (mean(dd + h) - mean(dd - h)) / (2.0 * h);
+            assert!(
+                (an - fd).abs() <= 1e-5 * fd.abs().max(an.abs()) + 1e-3,
+                "f0 {f0}, dd {dd:e}: analytic {an:e}, FD {fd:e} N/m"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 50);
 }
 
 /// The friction force over the last cycle of a harmonic stroke taken in `n` steps per cycle.

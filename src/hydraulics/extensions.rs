@@ -77,6 +77,37 @@ impl SealFriction {
         )
     }
 
+    /// Slope `dF*/dv` of the sliding law [N s/m].
+    #[inline]
+    pub fn force_slope(&self, v: f64) -> f64 {
+        let s = (-(v / self.v_s).powi(2)).exp();
+        let g = self.f_c + (self.f_s - self.f_c) * s;
+        let dg = (self.f_s - self.f_c) * s * (-2.0 * v / (self.v_s * self.v_s));
+        let th = (v / self.v_eps).tanh();
+        -dg * th - g * (1.0 - th * th) / self.v_eps
+    }
+
+    /// With presliding: the derivative of [`SealFriction::presliding_step`]'s mean force with
+    /// respect to the stroke at the step's end (its start and `f0` held, the rate `dd/dt`):
+    /// `F*'(v) (1 - M)/dt + (f0 - F*) M'(lambda) sign(dd)/x_p`, `M = (1 - e^-lambda)/lambda`.
+    #[inline]
+    pub fn presliding_tangent(&self, f0: f64, dd: f64, dt: f64) -> f64 {
+        let v = dd / dt;
+        let target = self.force(v);
+        let lambda = dd.abs() / self.presliding_m;
+        // M and M' = (e^-l (1 + l) - 1)/l^2, by their series near 0 (-1/2 + l/3 at l = 0).
+        let (m, dm) = if lambda > 1e-4 {
+            let e = (-lambda).exp();
+            (
+                -(-lambda).exp_m1() / lambda,
+                (e * (1.0 + lambda) - 1.0) / (lambda * lambda),
+            )
+        } else {
+            (1.0 - 0.5 * lambda, -0.5 + lambda / 3.0)
+        };
+        self.force_slope(v) * (1.0 - m) / dt + (f0 - target) * dm * dd.signum() / self.presliding_m
+    }
+
     /// Whether the friction has presliding (a state).
     #[inline]
     pub fn has_presliding(&self) -> bool {
@@ -266,10 +297,16 @@ impl Device for ExtendedDamper {
         };
         let v_h = (dh_f - dh_i) / dt;
         let sf = self.inner.trial_step(t_i, dt, dh_i, dh_f)?;
-        let (fr_end, fr_mean) = match self.friction {
-            Some(f) if f.has_presliding() => f.presliding_step(self.f_fric, v_h, dh_f - dh_i),
-            Some(f) => (f.force(v_h), f.force(v_h)),
-            None => (0.0, 0.0),
+        // The sliding law's tangent is left out (its slope F_c/v_eps at reversal would swamp
+        // the damper's); presliding adds its bounded one, the seal's presliding stiffness.
+        let (fr_end, fr_mean, fr_slope) = match self.friction {
+            Some(f) if f.has_presliding() => {
+                let dd = dh_f - dh_i;
+                let (end, mean) = f.presliding_step(self.f_fric, v_h, dd);
+                (end, mean, f.presliding_tangent(self.f_fric, dd, dt))
+            }
+            Some(f) => (f.force(v_h), f.force(v_h), 0.0),
+            None => (0.0, 0.0, 0.0),
         };
         let out = StepForce {
             force_mean: if contact {
@@ -277,7 +314,11 @@ impl Device for ExtendedDamper {
             } else {
                 0.0
             },
-            dforce_dstroke: if contact { sf.dforce_dstroke } else { 0.0 },
+            dforce_dstroke: if contact {
+                sf.dforce_dstroke + fr_slope
+            } else {
+                0.0
+            },
             force_end: if contact { sf.force_end + fr_end } else { 0.0 },
         };
         self.trial = Some((dh_f, contact, v_h, fr_end));
