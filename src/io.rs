@@ -131,6 +131,28 @@ fn new_run_id(t: SystemTime) -> String {
     )
 }
 
+/// Fingerprint of what defines a run's model: the sha256 of the `files`' sha256s (contents, not
+/// paths, in order) and of the `extra` lines (e.g. `--set` values). Equal fingerprints mean the
+/// same deck, record and overrides wherever the files lie.
+pub fn inputs_fingerprint(files: &[PathBuf], extra: &[String]) -> std::io::Result<String> {
+    let mut h = Sha256::new();
+    for f in files {
+        let (sha, _) = sha256_file(f)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", f.display())))?;
+        h.update(sha.as_bytes());
+        h.update(b"\n");
+    }
+    for e in extra {
+        h.update(e.as_bytes());
+        h.update(b"\n");
+    }
+    let mut hex = String::with_capacity(64);
+    for b in h.finalize().iter() {
+        let _ = write!(hex, "{b:02x}");
+    }
+    Ok(hex)
+}
+
 /// sha256 (lower-case hex) and size of a file.
 pub fn sha256_file(path: &Path) -> std::io::Result<(String, u64)> {
     use std::io::Read;

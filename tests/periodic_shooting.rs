@@ -198,6 +198,8 @@ fn warm_start_from_a_saved_state_is_periodic_at_once() {
         period_s: first.period_s,
         converged: true,
         residual: first.periodic.residual,
+        inputs_sha256: None,
+        overrides: vec![],
         state: first.periodic_state.clone().unwrap(),
     };
     let json = serde_json::to_string(&file).unwrap();

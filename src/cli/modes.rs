@@ -62,10 +62,17 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
         .ok_or_else(|| anyhow::anyhow!("give a model deck or --rotor"))?;
     let (deck, mut model) = load_deck_within(&path, |d| {
         let (ndof, _) = d.size_estimate();
+        let hint = match d.beams.iter().max_by_key(|b| b.elements) {
+            Some(b) => format!(
+                "the largest element count is [[beam]] `{}` elements = {}; use fewer or longer elements",
+                b.name, b.elements
+            ),
+            None => "use fewer nodes, bodies or joints".into(),
+        };
         crate::solver::budget::dense_modal_of(ndof)
             .check(
                 &format!("modal analysis of {ndof:.0} unknowns (dense)"),
-                "use fewer or longer elements",
+                &hint,
             )
             .map_err(|e| e.to_string())
     })?;
@@ -203,8 +210,15 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
         if h.is_nan() || h <= 0.0 || b < a {
             return Err(bad("STEP must be positive and STOP >= START"));
         }
-        let n = ((b - a) / h + 1e-9).floor() as usize;
-        (0..=n)
+        let n = ((b - a) / h + 1e-9).floor();
+        if n >= MAX_SPEEDS as f64 {
+            return Err(bad(&format!(
+                "{} speeds, beyond the {MAX_SPEEDS} a fan plot may have (each is a static \
+                 solve and an eigen-analysis); use a larger STEP",
+                sig_count(n + 1.0)
+            )));
+        }
+        (0..=n as usize)
             .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
             .collect()
     } else {
@@ -213,7 +227,70 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
     if v.is_empty() || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
         return Err(bad("fractions must be finite and non-negative"));
     }
+    if v.len() > MAX_SPEEDS {
+        return Err(bad(&format!(
+            "{} speeds, beyond the {MAX_SPEEDS} a fan plot may have",
+            v.len()
+        )));
+    }
     Ok(v)
+}
+
+/// Speeds of one fan plot at most: each is a static solve and an eigen-analysis.
+const MAX_SPEEDS: usize = 10_000;
+
+/// Largest speed fraction of a fan plot: the centrifugal load grows with its square, and rotors
+/// run within about 1.2 of their nominal speed; far beyond, the eigen-analysis is meaningless
+/// (non-finite modes).
+const MAX_SPEED_FRACTION: f64 = 3.0;
+
+fn sig_count(n: f64) -> String {
+    if n < 1e6 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.2e}")
+    }
+}
+
+/// Refuses speed fractions far beyond the deck's nominal speed (`key` in `deck`).
+fn check_fractions(
+    fractions: &[f64],
+    nominal: f64,
+    unit: &str,
+    deck: &std::path::Path,
+    key: &str,
+) -> anyhow::Result<()> {
+    if let Some(&f) = fractions.iter().find(|&&f| f > MAX_SPEED_FRACTION) {
+        anyhow::bail!(
+            "--speeds: fraction {f} of the nominal speed ({} {key} = {nominal} {unit}) is beyond \
+             sense: expected at most {MAX_SPEED_FRACTION} (the speeds are fractions of the \
+             nominal, not {unit})",
+            deck.display()
+        );
+    }
+    Ok(())
+}
+
+/// Refuses a modal solution with a non-finite frequency (a zero-frequency mode may have an
+/// undefined damping ratio; a frequency is always defined).
+fn check_finite_modes<'a>(
+    speeds: impl Iterator<Item = (f64, &'a [Mode])>,
+    deck: &std::path::Path,
+) -> anyhow::Result<()> {
+    for (fraction, ms) in speeds {
+        if let Some((i, m)) = ms.iter().enumerate().find(|(_, m)| !m.freq_hz.is_finite()) {
+            anyhow::bail!(
+                "{}: the modal analysis at speed fraction {fraction} gave mode {} a non-finite \
+                 frequency ({} Hz, damping ratio {}): the equilibrium or the eigen-solution \
+                 broke down; check the deck's stiffness and mass values",
+                deck.display(),
+                i + 1,
+                m.freq_hz,
+                m.damping_ratio
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Default digitized UH-60A fan plot: `data/fanplot_uh60a_bowen-davies-PhD.txt` next to the
@@ -242,6 +319,26 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     }
     let deck = crate::rotor::RotorDeck::from_file(path)?;
     let fractions = parse_speeds(&args.speeds)?;
+    check_fractions(
+        &fractions,
+        deck.spec.rotor.omega_rad_s,
+        "rad/s",
+        path,
+        "rotor.omega_rad_s",
+    )?;
+    let (ndof, _) = deck.spec.size_estimate();
+    let one = crate::solver::budget::dense_modal_of(ndof);
+    deck.spec.check_budget(
+        path,
+        &format!(
+            "a fan plot of {} speed(s), a dense modal analysis each,",
+            fractions.len()
+        ),
+        crate::solver::budget::Estimate {
+            cpu_s: one.cpu_s * fractions.len() as f64,
+            bytes: one.bytes,
+        },
+    )?;
     let mut inputs = deck.input_files();
     let reference = match &args.reference {
         Some(p) => {
@@ -260,7 +357,10 @@ fn run_rotor(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
         }
     };
     let out = OutDir::create(&args.out, &inputs)?;
-    let pts = match fan(&deck, &fractions, args.count.max(5)) {
+    let pts = match fan(&deck, &fractions, args.count.max(5)).and_then(|p| {
+        check_finite_modes(p.iter().map(|p| (p.fraction, &p.modes[..])), path)?;
+        Ok(p)
+    }) {
         Ok(p) => p,
         Err(e) => {
             out.mark_incomplete(&e.to_string())?;
@@ -401,6 +501,13 @@ fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     let spec = HingedSpec::from_file(path)?;
     let mut fractions = parse_speeds(&args.speeds)?;
     let rpm_n = spec.rpm();
+    check_fractions(
+        &fractions,
+        spec.rotor.omega_rad_s,
+        "rad/s",
+        path,
+        "rotor.omega_rad_s",
+    )?;
     let mut inputs = vec![path.to_path_buf()];
     let ref_path = args.reference.clone().or_else(|| spec.reference_path(path));
     let label = spec
@@ -420,7 +527,10 @@ fn run_hinged(path: &std::path::Path, args: &ModesArgs) -> anyhow::Result<()> {
     fractions.sort_by(f64::total_cmp);
     fractions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     let out = OutDir::create(&args.out, &inputs)?;
-    let pts = match fan(&spec, path, &fractions, args.count.max(TRACKED.len())) {
+    let pts = match fan(&spec, path, &fractions, args.count.max(TRACKED.len())).and_then(|p| {
+        check_finite_modes(p.iter().map(|p| (p.fraction, &p.modes[..])), path)?;
+        Ok(p)
+    }) {
         Ok(p) => p,
         Err(e) => {
             out.mark_incomplete(&e.to_string())?;

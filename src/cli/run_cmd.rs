@@ -271,11 +271,40 @@ pub fn check(args: &RunArgs) -> anyhow::Result<()> {
         "sdof" => true,
         m => bail!("--model: unknown rotor model '{m}' (expected uh60a, rigid or sdof)"),
     };
-    FlightRecord::read(&args.flight)
+    let record = FlightRecord::read(&args.flight)
         .with_context(|| format!("reading flight record {}", args.flight.display()))?;
-    let (_, deck) = load_decks(args, sdof)?;
+    let (rotor, deck) = load_decks(args, sdof)?;
     for m in &models {
         deck.require(*m)?;
+    }
+    check_rotor(args, rotor.as_ref(), &record, models.len())
+}
+
+/// The record must be of the deck's rotor, and the elastic model's cost within the budget.
+fn check_rotor(
+    args: &RunArgs,
+    rotor: Option<&RotorDeck>,
+    record: &FlightRecord,
+    n_models: usize,
+) -> anyhow::Result<()> {
+    let Some(r) = rotor else { return Ok(()) };
+    r.spec.check_record(record, &args.rotor)?;
+    if args.model == "uh60a" {
+        let (ndof, nnz) = r.spec.size_estimate();
+        let steps = (args.revs * args.steps_per_rev) as f64;
+        let e = crate::solver::budget::time_integration_of(ndof, nnz, steps, 3.0);
+        let e = crate::solver::budget::Estimate {
+            cpu_s: e.cpu_s * n_models as f64,
+            bytes: e.bytes * n_models as f64,
+        };
+        r.spec.check_budget(
+            &args.rotor,
+            &format!(
+                "{n_models} model(s) x {} revolutions x {} steps",
+                args.revs, args.steps_per_rev
+            ),
+            e,
+        )?;
     }
     Ok(())
 }
@@ -326,6 +355,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     for m in &models {
         deck.require(*m)?;
     }
+    check_rotor(&args, rotor.as_ref(), &record, models.len())?;
     let hydraulics = IntegratorOptions {
         scheme,
         substeps: args.substeps,
@@ -366,6 +396,13 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         (None, Some(_)) => {}
     }
     inputs.extend(args.damper_deck.clone());
+    let set_lines: Vec<String> = args
+        .set
+        .iter()
+        .map(|o| format!("{}={}", o.key, o.value_text()))
+        .collect();
+    let inputs_sha256 = crate::io::inputs_fingerprint(&inputs, &set_lines)
+        .map_err(|e| anyhow::anyhow!("reading the inputs: {e}"))?;
     match &args.initial_state {
         Some(p) if p.is_dir() => inputs.extend(
             models
@@ -409,9 +446,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             initial_state: init,
             min_floquet_dirs: 0,
             keep_all_revs: args.write_all_revs,
+            inputs_sha256: Some(inputs_sha256.clone()),
         })
         .collect();
-    let outcomes = if args.quiet {
+    let mut outcomes = if args.quiet {
         run::run_models(&models, &popts, &build, &Silent)
     } else if tty {
         let bars = Bars::new(&models, args.revs);
@@ -420,6 +458,15 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         let lines = Lines::new(&models, PLAIN_PROGRESS_EVERY_S);
         run::run_models(&models, &popts, &build, &lines)
     };
+    // a failure of the physical model names the deck values behind it, where they are unusual
+    for o in outcomes
+        .iter_mut()
+        .filter(|o| o.model == DamperModel::Physical)
+    {
+        if let Err(e) = &mut o.result {
+            *e = deck.with_review(std::mem::take(e));
+        }
+    }
     let info = RunInfo {
         rotor: args.rotor.display().to_string(),
         rotor_model: if sdof {
@@ -449,6 +496,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             .iter()
             .map(|o| (o.key.clone(), o.value_text()))
             .collect(),
+        inputs_sha256: Some(inputs_sha256),
         synthetic: record.meta.synthetic,
         counter: record.meta.counter.clone(),
         wall_s: t0.elapsed().as_secs_f64(),
@@ -529,6 +577,9 @@ fn print_summary(outcomes: &[ModelOutcome], measured: &Result<Measured, String>)
                         "warning: {}: blade root loads differ from the resultant of the applied, inertial, damper and pitch-link loads by {:.2e} of {}'s peak-to-peak (above {:.1e}): the structural solution is not in equilibrium to the accuracy the loads need",
                         r.label, c.max_rel_error, c.channel, c.tolerance
                     );
+                }
+                if r.converged() && r.periodic.message.starts_with("warm start") {
+                    outln!("note: {}: {}", r.label, r.periodic.message);
                 }
                 if !r.converged() {
                     outln!(

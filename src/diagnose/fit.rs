@@ -212,6 +212,8 @@ pub fn simulate(
                     return Err(HydraulicError::NonFinite {
                         t: m.time_s[k + 1],
                         component: 0,
+                        substep_s: f64::NAN,
+                        rate_per_s: f64::NAN,
                     });
                 }
                 out.push(sf.force_end);

@@ -352,6 +352,7 @@ fn rotor_check(
             periodic_tol: crate::run::periodic::DEFAULT_TOL,
             initial_state: None,
             overrides: Vec::new(),
+            inputs_sha256: None,
             synthetic: rec.meta.synthetic,
             counter: rec.meta.counter.clone(),
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
@@ -659,7 +660,7 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
         max_substep_s: args.max_substep,
         ..Default::default()
     };
-    let outcome = super::diagnose(&deck, &data, &opts)?;
+    let outcome = diagnose_with_progress(&deck, &data, &opts, say)?;
     let d = &outcome.diagnosis;
     let mut inputs: Vec<PathBuf> = args.deck.iter().cloned().collect();
     if let Some(r) = &args.rotor {
@@ -750,5 +751,69 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
         outcome,
         stroke_info,
         check,
+    })
+}
+
+/// Interval of the diagnosis's heartbeat lines [s].
+const HEARTBEAT_S: u64 = 15;
+
+/// The diagnosis of `data`, its cost bounded from below first (refused when even that is beyond
+/// the budget, named with its samples), then a line every [`HEARTBEAT_S`] while it runs: a long
+/// bench file is never silent.
+fn diagnose_with_progress(
+    deck: &crate::hydraulics::DamperDeck,
+    data: &[super::Measurement],
+    opts: &super::DiagnoseOptions,
+    say: Say,
+) -> anyhow::Result<super::Outcome> {
+    let samples: usize = data.iter().map(|m| m.time_s.len()).sum();
+    // sub-steps of one replay of every test (a sample interval is cut to max_substep_s)
+    let substeps: f64 = data
+        .iter()
+        .map(|m| {
+            m.time_s
+                .windows(2)
+                .map(|w| ((w[1] - w[0]) / opts.max_substep_s).ceil().max(1.0))
+                .sum::<f64>()
+        })
+        .sum();
+    // full replays: the baseline and each candidate's, its held-out test and its intervals
+    // (~4 per candidate); the fits run on a few cycles and are not counted (a lower bound)
+    let replays = 4.0 * (opts.candidates.len() as f64 + 1.0);
+    let estimate = crate::solver::budget::substeps(substeps * replays).plus(
+        crate::solver::budget::samples(samples as f64, 8.0 * replays),
+    );
+    estimate.check(
+        &format!(
+            "the diagnosis of {samples} samples in {} test(s) ({} candidates; a lower bound)",
+            data.len(),
+            opts.candidates.len()
+        ),
+        "give fewer or shorter tests (a few dozen cycles per amplitude suffice), or a larger --max-substep",
+    )?;
+    if samples > 20_000 {
+        say(&format!(
+            "diagnose: {samples} samples in {} test(s), {} candidates: a long diagnosis (a few \
+             dozen cycles per amplitude suffice); progress every {HEARTBEAT_S} s",
+            data.len(),
+            opts.candidates.len()
+        ));
+    }
+    let (tx, rx) = std::sync::mpsc::channel::<()>();
+    let t0 = std::time::Instant::now();
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+                rx.recv_timeout(std::time::Duration::from_secs(HEARTBEAT_S))
+            {
+                say(&format!(
+                    "diagnose: fitting the candidates, {:.0} s so far",
+                    t0.elapsed().as_secs_f64()
+                ));
+            }
+        });
+        let r = super::diagnose(deck, data, opts);
+        drop(tx);
+        r.map_err(Into::into)
     })
 }

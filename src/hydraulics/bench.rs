@@ -288,7 +288,7 @@ pub struct BenchTest {
 
 /// (quantity, accepted headers with their factor to SI)
 const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
-    ("time", &[("time_s", 1.0)]),
+    ("time", &[("time_s", 1.0), ("time_ms", 1e-3)]),
     ("stroke", &[("stroke_m", 1.0), ("stroke_in", IN_TO_M)]),
     ("force", &[("force_N", 1.0), ("force_lb", LB_TO_N)]),
     (

@@ -300,6 +300,8 @@ impl CircuitParams {
                     volume_m3: vol[k],
                     stroke_m: d,
                     t,
+                    area_m2: c.area,
+                    volume0_m3: c.volume0,
                 });
             }
         }

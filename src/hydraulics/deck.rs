@@ -664,6 +664,76 @@ impl DamperDeck {
         Ok(e)
     }
 
+    /// Physical values of the `[damper.physical]` table beyond the usual, each with its key and
+    /// the reason: said beside a failure of the physical model, whose message alone (a
+    /// non-finite state, a Newton failure) cannot name the deck value behind it. Validation
+    /// accepts them: a research deck may go there on purpose.
+    pub fn physical_review(&self) -> Vec<String> {
+        let mut v = vec![];
+        let Some(c) = &self.physical else { return v };
+        let b = 1.0 / c.fluid.alpha;
+        if b > 1e12 {
+            v.push(format!(
+                "damper.physical.bulk_alpha_per_Pa = {:e} /Pa is a bulk modulus of {b:.3e} Pa, \
+                 stiffer than any solid (steel 1.6e11 Pa; hydraulic oils 1-2e9 Pa)",
+                c.fluid.alpha
+            ));
+        } else if b < 1e7 {
+            v.push(format!(
+                "damper.physical.bulk_alpha_per_Pa = {:e} /Pa is a bulk modulus of {b:.3e} Pa, \
+                 softer than oil holding much air (hydraulic oils 1-2e9 Pa)",
+                c.fluid.alpha
+            ));
+        }
+        for (k, ch) in c.chambers.iter().enumerate() {
+            let travel = ch.volume0 / ch.area;
+            if travel < 1e-3 {
+                v.push(format!(
+                    "damper.physical.V{k}_m3 / A{k}_m2 = {:e} m^3 / {:e} m^2 gives chamber {k} a \
+                     travel of {travel:.3e} m, below a millimetre (a lead-lag damper strokes \
+                     about 10 mm either way)",
+                    ch.volume0, ch.area
+                ));
+            }
+        }
+        v
+    }
+
+    /// Refuses a stroke history reaching `max_stroke_m` (either way; `what` names it) that
+    /// empties a chamber of the physical table: `A |d| >= V` (Eq. 2).
+    pub fn check_stroke(&self, max_stroke_m: f64, what: &str) -> Result<(), String> {
+        let Some(c) = &self.physical else {
+            return Ok(());
+        };
+        for (k, ch) in c.chambers.iter().enumerate() {
+            let travel = ch.volume0 / ch.area;
+            if max_stroke_m >= travel {
+                return Err(format!(
+                    "{what}: a stroke of {max_stroke_m:.4e} m empties chamber {k} of the damper \
+                     deck {}: its travel is damper.physical.V{k}_m3 / A{k}_m2 = {:e} m^3 / {:e} \
+                     m^2 = {travel:.4e} m (Eq. 2: V = V0 + A lambda d must stay positive); check \
+                     the areas and volumes, or the stroke's units",
+                    self.source, ch.volume0, ch.area
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `error` with the deck's [`DamperDeck::physical_review`] beside it, when it has one.
+    pub fn with_review(&self, error: String) -> String {
+        let r = self.physical_review();
+        if r.is_empty() {
+            error
+        } else {
+            format!(
+                "{error}; the damper deck {} has values beyond the usual: {}",
+                self.source,
+                r.join("; ")
+            )
+        }
+    }
+
     /// Errors unless the deck holds the table of `model`.
     pub fn require(&self, model: DamperModel) -> Result<(), DeckError> {
         let present = match model {

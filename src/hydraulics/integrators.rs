@@ -409,10 +409,26 @@ pub fn integrate<const N: usize>(
             return Err(HydraulicError::NonFinite {
                 t: t + h,
                 component: c,
+                substep_s: h,
+                rate_per_s: fastest_rate(sys, t0, y0),
             });
         }
     }
     Ok(y)
+}
+
+/// The fastest rate of `sys` at (t, y), max |df_i/dy_i| [1/s] (NaN when the Jacobian cannot be
+/// had): the diagonal is in consistent units whatever the state's, and for the chamber
+/// pressures it is the stiff `B/V dQ/dp` that limits an explicit sub-step. Only on failure,
+/// at the step's starting state (the last iterates before a blow-up say nothing).
+pub fn fastest_rate<const N: usize>(sys: &impl OdeSystem<N>, t: f64, y: &SVector<f64, N>) -> f64 {
+    match sys.jacobian(t, y) {
+        Ok(j) => (0..N)
+            .map(|i| j[(i, i)].abs())
+            .filter(|v| v.is_finite())
+            .fold(f64::NAN, f64::max),
+        Err(_) => f64::NAN,
+    }
 }
 
 #[cfg(test)]

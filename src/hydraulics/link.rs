@@ -374,6 +374,12 @@ fn integrate<const N: usize, S: Sided<N>>(
             return Err(HydraulicError::NonFinite {
                 t: t + h,
                 component: c,
+                substep_s: h,
+                rate_per_s: crate::hydraulics::integrators::fastest_rate(
+                    &sys.with_side(link.side(y0[IE])),
+                    t0,
+                    y0,
+                ),
             });
         }
         y = y1;

@@ -92,14 +92,24 @@ pub struct StepForce {
 /// Errors of the hydraulic models, with the time at which they occurred.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HydraulicError {
-    #[error("non-finite hydraulic state at t = {t} s (component {component}); with RK4 this is usually the explicit stability limit: more sub-steps or the implicit scheme")]
-    NonFinite { t: f64, component: usize },
-    #[error("chamber {chamber} volume {volume_m3} m^3 is not positive at stroke {stroke_m} m (t = {t} s): stroke beyond the device's travel")]
+    #[error("non-finite hydraulic state at t = {t} s (component {component}); {}", stability_advice(*.substep_s, *.rate_per_s))]
+    NonFinite {
+        t: f64,
+        component: usize,
+        /// The sub-step that failed [s] (NaN when unknown).
+        substep_s: f64,
+        /// The fastest rate of the state where it was last finite, max |df_i/dy_i| [1/s]
+        /// (NaN when unknown).
+        rate_per_s: f64,
+    },
+    #[error("chamber {chamber} volume {volume_m3:.4e} m^3 is not positive at stroke {stroke_m:.4e} m (t = {t} s): the chamber (area A{chamber}_m2 = {area_m2} m^2, volume V{chamber}_m3 = {volume0_m3} m^3 at zero stroke) has a travel of V/A = {:.4e} m, and the stroke is beyond it; check the deck's areas and volumes", .volume0_m3 / .area_m2)]
     ChamberVolume {
         chamber: usize,
         volume_m3: f64,
         stroke_m: f64,
         t: f64,
+        area_m2: f64,
+        volume0_m3: f64,
     },
     #[error("implicit sub-step did not converge at t = {t} s: stage {stage}, iteration {iteration}, scaled residual {residual:.3e}")]
     NewtonDiverged {
@@ -114,6 +124,35 @@ pub enum HydraulicError {
     BadStep { t: f64, reason: String },
     #[error("invalid device state: {reason}")]
     BadState { reason: String },
+}
+
+/// RK4 is stable for h |lambda| below about 2.8 (the real-axis limit of its stability region).
+pub const RK4_STABILITY_LIMIT: f64 = 2.785;
+
+/// What a non-finite state says about the sub-step: h times the fastest rate against RK4's
+/// limit, and what to change.
+fn stability_advice(h: f64, rate: f64) -> String {
+    if h.is_finite() && rate.is_finite() && rate > 0.0 {
+        let x = h * rate;
+        if x > RK4_STABILITY_LIMIT {
+            let need = h * RK4_STABILITY_LIMIT / x;
+            return format!(
+                "the fastest rate of the hydraulic state at the step's start is {rate:.3e} 1/s \
+                 (a chamber's bulk modulus times its flow conductance over its volume), so the \
+                 sub-step of {h:.3e} s gives h x rate = {x:.3e}, beyond RK4's stability limit of \
+                 2.8: sub-steps below {need:.3e} s (more sub-steps) or the implicit scheme; a \
+                 sub-step far below a microsecond means a deck value beyond sense (check the \
+                 bulk modulus 1/bulk_alpha_per_Pa, the areas and the volumes)"
+            );
+        }
+        return format!(
+            "the sub-step of {h:.3e} s is within RK4's stability limit for the rate {rate:.3e} 1/s \
+             where the state was last finite: the state diverged within the sub-step (check the \
+             deck's values and the stroke history)"
+        );
+    }
+    "with RK4 this is usually the explicit stability limit: more sub-steps or the implicit scheme"
+        .into()
 }
 
 /// A hydraulic (or dashpot) device connecting two structural points, as seen by the structure.

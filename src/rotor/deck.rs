@@ -200,6 +200,131 @@ fn yes() -> bool {
 }
 
 impl RotorSpec {
+    /// Unknowns and stored matrix entries of the expanded model, estimated as for a model deck
+    /// (a cubic beam element adds 3 nodes of 6 dofs; a dozen joints and bodies beside them).
+    pub fn size_estimate(&self) -> (f64, f64) {
+        let e: f64 = self.element_counts().iter().map(|(_, n)| *n as f64).sum();
+        let nodes = 3.0 * e + 5.0 + 8.0;
+        let lambdas = 6.0 * 12.0;
+        let ndof = 6.0 * nodes + lambdas;
+        (ndof, 576.0 * e + 324.0 * 12.0 + ndof)
+    }
+
+    /// The element counts of the deck by key.
+    fn element_counts(&self) -> [(&'static str, usize); 5] {
+        [
+            ("blade.elements", self.blade.elements),
+            (
+                "retention.segment1.elements",
+                self.retention.segment1.elements,
+            ),
+            (
+                "retention.segment2.elements",
+                self.retention.segment2.elements,
+            ),
+            (
+                "retention.segment3.elements",
+                self.retention.segment3.elements,
+            ),
+            (
+                "pitch_control.link_elements",
+                self.pitch_control.link_elements,
+            ),
+        ]
+    }
+
+    /// Refuses `estimate` (of `what`, a cost of this deck's model) beyond the budget, naming the
+    /// deck file and its largest element count.
+    pub fn check_budget(
+        &self,
+        deck: &Path,
+        what: &str,
+        estimate: crate::solver::budget::Estimate,
+    ) -> anyhow::Result<()> {
+        let (key, n) = self
+            .element_counts()
+            .into_iter()
+            .max_by_key(|(_, n)| *n)
+            .unwrap_or(("blade.elements", 0));
+        let (ndof, _) = self.size_estimate();
+        estimate
+            .check(
+                &format!("{}: {what} of {ndof:.0} unknowns", deck.display()),
+                &format!("the largest element count is {key} = {n}; use fewer elements"),
+            )
+            .map_err(Into::into)
+    }
+
+    /// The flight record must be of this rotor: its rotor speed (0.1%), radius (1%: records
+    /// quote R rounded) and, where the record states them, the number of blades, the lag hinge
+    /// offset and the damper arm (2%). A record of another rotor, or in other units, is refused
+    /// before anything runs, naming both keys.
+    pub fn check_record(
+        &self,
+        record: &crate::flight::FlightRecord,
+        deck: &Path,
+    ) -> anyhow::Result<()> {
+        let m = &record.meta;
+        let differs = |rkey: &str, rv: f64, dkey: &str, dv: f64, unit: &str, tol: f64| {
+            if rv.is_finite() && (rv - dv).abs() <= tol * dv.abs() {
+                return Ok(());
+            }
+            Err(anyhow::anyhow!(
+                "flight record {rkey} = {rv} {unit} differs from the rotor deck {} {dkey} = {dv} {unit}                  by more than {}%: the record is of another rotor (or in other units)",
+                deck.display(),
+                tol * 100.0
+            ))
+        };
+        let om = self.rotor.omega_rad_s;
+        let rec_om = m.rotor_speed_rad_s;
+        if !rec_om.is_finite() || (rec_om - om).abs() > 1e-3 * om {
+            anyhow::bail!(
+                "flight record rotor speed {rec_om} rad/s differs from the rotor deck's {om} rad/s ({})",
+                deck.display()
+            );
+        }
+        differs(
+            "radius_m",
+            m.radius_m,
+            "rotor.radius_m",
+            self.rotor.radius_m,
+            "m",
+            0.01,
+        )?;
+        let raw = |k: &str| m.raw.get(k).and_then(|v| v.as_f64());
+        if let Some(nb) = raw("number_of_blades") {
+            differs(
+                "number_of_blades",
+                nb,
+                "rotor.blades",
+                self.rotor.blades as f64,
+                "",
+                0.0,
+            )?;
+        }
+        if let Some(e) = raw("lag_hinge_offset_m") {
+            differs(
+                "lag_hinge_offset_m",
+                e,
+                "retention.hinge_r_m",
+                self.retention.hinge_r_m,
+                "m",
+                0.02,
+            )?;
+        }
+        if let Some(a) = raw("damper_arm_m") {
+            differs(
+                "damper_arm_m",
+                a,
+                "damper_attachment.arm_m",
+                self.damper_attachment.arm_m,
+                "m",
+                0.02,
+            )?;
+        }
+        Ok(())
+    }
+
     /// Stations of section loads: (r [m], r/R) in increasing r, the bearing and horn stations
     /// included when asked.
     pub fn load_stations(&self) -> Vec<(f64, f64)> {

@@ -243,14 +243,8 @@ pub fn build_sim(
     if opts.steps_per_rev < 8 {
         anyhow::bail!("steps per revolution {} is below 8", opts.steps_per_rev);
     }
+    spec.check_record(record, file)?;
     let om = spec.rotor.omega_rad_s;
-    let rec_om = record.meta.rotor_speed_rad_s;
-    if (rec_om - om).abs() > 1e-3 * om {
-        anyhow::bail!(
-            "flight record rotor speed {rec_om} rad/s differs from the rotor deck's {om} rad/s ({})",
-            file.display()
-        );
-    }
     let controls = Controls::from_record(&record.meta.controls_deg);
     let period = 2.0 * std::f64::consts::PI / om;
     let h = period / opts.steps_per_rev as f64;

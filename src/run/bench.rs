@@ -54,6 +54,22 @@ pub fn sweep(
         cycles: cfg.cycles,
         steps_per_cycle: cfg.steps_per_cycle,
     };
+    if devices.iter().any(|(m, _)| *m == DamperModel::Physical) {
+        let v_max = sweep
+            .peak_velocities_m_s
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        deck.check_stroke(
+            v_max / sweep.omega_rad_s,
+            &format!(
+                "the bench's largest amplitude (peak velocity {} {} at {} rad/s)",
+                v_max / factor,
+                cfg.velocity_unit,
+                sweep.omega_rad_s
+            ),
+        )
+        .map_err(anyhow::Error::msg)?;
+    }
     let out = OutDir::create(&cfg.out, std::slice::from_ref(&cfg.deck))?;
     let mut all = Vec::new();
     let mut time_histories = Vec::new();
@@ -70,12 +86,15 @@ pub fn sweep(
                 true,
             );
             runs.push(r.map_err(|e| {
-                let msg = format!(
+                let mut msg = format!(
                     "{} model at peak velocity {} {} ({v} m/s): {e}",
                     model.name(),
                     v / factor,
                     cfg.velocity_unit
                 );
+                if *model == DamperModel::Physical {
+                    msg = deck.with_review(msg);
+                }
                 let _ = out.mark_incomplete(&msg);
                 anyhow::anyhow!(msg)
             })?);
@@ -596,6 +615,13 @@ pub fn replay(
         .zip(&cfg.measured)
         .map(|(t, p)| window(cfg, t, p))
         .collect::<anyhow::Result<Vec<_>>>()?;
+    if devices.iter().any(|(m, _)| *m == DamperModel::Physical) {
+        for (t, p) in tests.iter().zip(&cfg.measured) {
+            let d = t.stroke_m.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+            deck.check_stroke(d, &format!("bench file {}", p.display()))
+                .map_err(anyhow::Error::msg)?;
+        }
+    }
     let inputs: Vec<PathBuf> = std::iter::once(cfg.deck.clone())
         .chain(cfg.measured.iter().cloned())
         .collect();
@@ -651,11 +677,17 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
         for (model, dev) in devices {
             let r = bench::replay(dev.as_ref(), test).map_err(|e| {
                 let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
-                anyhow::anyhow!(
-                    "replay of {} with the {} model: {e}",
+                let mut msg = format!(
+                    "replay of {} ({}) with the {} model: {e}{}",
                     test.name,
-                    model.name()
-                )
+                    path.display(),
+                    model.name(),
+                    sampling_hint(test)
+                );
+                if *model == DamperModel::Physical {
+                    msg = deck.with_review(msg);
+                }
+                anyhow::Error::msg(msg)
             })?;
             let h = &r.history;
             let stem = format!("{}_{}", test.name, model.name());
@@ -804,4 +836,24 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
     out.write("bench.html", html.finish().as_bytes())?;
     out.finish()?;
     Ok(())
+}
+
+/// A hint when a test samples slower than a damper bench does (the model steps once per
+/// sample): the median interval, and the likely cause, a time column in milliseconds.
+fn sampling_hint(test: &bench::BenchTest) -> String {
+    let mut dt: Vec<f64> = test.time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    if dt.is_empty() {
+        return String::new();
+    }
+    dt.sort_by(f64::total_cmp);
+    let med = dt[dt.len() / 2];
+    if med >= 0.01 {
+        format!(
+            "; the file samples every {med} s (median), where damper benches sample at 1 kHz or \
+             more and the model steps once per sample: if its time column holds milliseconds, \
+             name it `time_ms` (docs/formats.md)"
+        )
+    } else {
+        String::new()
+    }
 }

@@ -149,8 +149,22 @@ pub struct DecayRun {
 pub fn run_decay(file: &Path, opts: &DecayRunOptions) -> anyhow::Result<DecayRun> {
     let spec = HingedSpec::from_file(file)?;
     let om = opts.omega_rad_s.unwrap_or(spec.rotor.omega_rad_s);
-    let modal = modal_lag(&spec, file, om)?;
     let mut sim = decay_sim(&spec, file, opts)?;
+    let steps_f = opts.duration_s / opts.time_step_s;
+    // Newton iterations per step ~4 (docs/performance.md); the history is 3 columns
+    crate::solver::budget::time_integration(&sim.solver.model, steps_f, 4.0)
+        .plus(crate::solver::budget::samples(steps_f, 3.0))
+        .check(
+            &format!(
+                "{}: the lag decay of {} steps (--duration-s {} / --step-s {})",
+                file.display(),
+                fmt_count(steps_f),
+                fmt_num(opts.duration_s),
+                fmt_num(opts.time_step_s)
+            ),
+            "shorten --duration-s or lengthen --step-s (the decay is analysed from 1 s on; a few seconds of a 5 ms step suffice)",
+        )?;
+    let modal = modal_lag(&spec, file, om)?;
     let n = steps(opts);
     let mut lag_rad = Vec::with_capacity(n);
     for _ in 0..n {
@@ -194,5 +208,23 @@ impl DecayRun {
         row("damped_sine_fit", self.fit);
         row("log_decrement", self.log_decrement);
         s
+    }
+}
+
+/// A count for messages: whole below a million, else with an exponent.
+fn fmt_count(n: f64) -> String {
+    if n < 1e6 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.2e}")
+    }
+}
+
+/// A number for messages: plain in [1e-3, 1e5), else with an exponent.
+fn fmt_num(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }

@@ -242,7 +242,7 @@ pub fn drive_periodic(
         .collect::<anyhow::Result<_>>()?;
     let mut warm_note = None;
     if let Some(f) = &o.initial_state {
-        let (s, note) = f.start_state(sim, model.name())?;
+        let (s, note) = f.start_state(sim, model.name(), o.inputs_sha256.as_deref())?;
         sim.restore_state(&s)
             .map_err(|e| e.context("starting from the saved state (--initial-state)"))?;
         warm_note = note;
@@ -272,7 +272,7 @@ pub fn drive_periodic(
         info.message = format!("{} cannot save its state: marched", sim.label());
     }
     if let Some(n) = warm_note {
-        info.message = n;
+        push_message(&mut info.message, n);
     }
     let periodic_from = sim.periodic_from_s() - 0.5 * dt;
     let mut rev = Revolution::new(nc, n);
@@ -384,9 +384,12 @@ pub fn drive_periodic(
                 Stop::Failed(e) => format!("a revolution failed: {e}"),
                 Stop::Converged => String::new(),
             };
-            info.message = format!(
-                "shooting did not converge ({why}; residual {:.2e}); marching on from its best state",
-                max_nan(&info.residual_by_channel)
+            push_message(
+                &mut info.message,
+                format!(
+                    "shooting did not converge ({why}; residual {:.2e}); marching on from its best state",
+                    max_nan(&info.residual_by_channel)
+                ),
             );
             // march on from the end of the best revolution
             sim.restore_state(&end)?;
@@ -417,10 +420,13 @@ pub fn drive_periodic(
     };
     info.revolutions_integrated = periods;
     info.start_t_s = rev.start_t_s;
-    if !info.converged && info.message.is_empty() {
-        info.message = format!(
-            "not periodic: residual {:.2e} after {periods} revolutions, above the tolerance {:.0e}",
-            info.residual, o.tol
+    if !info.converged && !info.message.contains("did not converge") {
+        push_message(
+            &mut info.message,
+            format!(
+                "not periodic: residual {:.2e} after {periods} revolutions, above the tolerance {:.0e}",
+                info.residual, o.tol
+            ),
         );
     }
     let timing = sim.timing();
@@ -531,4 +537,12 @@ pub fn fmt_measure(m: Option<f64>) -> String {
         Some(_) => "NaN".into(),
         None => "n/a".into(),
     }
+}
+
+/// Appends `m` to a run's message (notes such as a warm start's are kept).
+fn push_message(message: &mut String, m: String) {
+    if !message.is_empty() {
+        message.push_str("; ");
+    }
+    message.push_str(&m);
 }

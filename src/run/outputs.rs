@@ -38,7 +38,7 @@ pub fn write_outputs(
                 if !r.all_revs.is_empty() {
                     summary::write_all_revs(out, r)?;
                 }
-                summary::write_periodic_state(out, r)?;
+                summary::write_periodic_state(out, r, info)?;
             }
         }
     }

@@ -46,6 +46,9 @@ pub struct PeriodicOptions {
     pub min_floquet_dirs: usize,
     /// Keep every revolution along the way (marched ones and accepted shooting iterates).
     pub keep_all_revs: bool,
+    /// Fingerprint of this run's inputs ([`crate::io::inputs_fingerprint`]): saved with the
+    /// periodic state, and compared with a saved state's when starting from one.
+    pub inputs_sha256: Option<String>,
 }
 
 impl PeriodicOptions {
@@ -59,6 +62,7 @@ impl PeriodicOptions {
             initial_state: None,
             min_floquet_dirs: 0,
             keep_all_revs: false,
+            inputs_sha256: None,
         }
     }
     /// Shooting to `tol`, at most `max_revs` revolutions.
@@ -71,6 +75,7 @@ impl PeriodicOptions {
             initial_state: None,
             min_floquet_dirs: 0,
             keep_all_revs: false,
+            inputs_sha256: None,
         }
     }
 }
@@ -325,6 +330,13 @@ pub struct PeriodicStateFile {
     /// Whether the run converged, and its residual.
     pub converged: bool,
     pub residual: f64,
+    /// Fingerprint of the inputs that define the model (deck, section table, damper deck,
+    /// record and `--set` values; [`crate::io::inputs_fingerprint`]); absent in older files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs_sha256: Option<String>,
+    /// The `--set` values of the run it was saved from.
+    #[serde(default)]
+    pub overrides: Vec<(String, String)>,
     pub state: SimState,
 }
 
@@ -352,29 +364,62 @@ impl PeriodicStateFile {
         Ok(f)
     }
 
-    /// The state to start `sim` (damper model `model`) from: the saved one, with the device
-    /// state replaced by the simulation's own when it was saved from another damper model,
-    /// and the time moved to a whole number of periods after the simulation's ramps.
+    /// The state to start `sim` (damper model `model`, inputs fingerprint `inputs_sha256`)
+    /// from: the saved one, with the device state replaced by the simulation's own when it was
+    /// saved from another damper model, and the time moved to a whole number of periods after
+    /// the simulation's ramps. The note says what differs from the run that saved it (another
+    /// damper model, steps per revolution, deck, record or `--set` values): such a state is a
+    /// starting guess, not the periodic solution of this run.
     pub fn start_state(
         &self,
         sim: &dyn ForcedResponse,
         model: &str,
+        inputs_sha256: Option<&str>,
     ) -> anyhow::Result<(SimState, Option<String>)> {
         let own = sim
             .save_state()
             .ok_or_else(|| anyhow::anyhow!("{} cannot start from a saved state", sim.label()))?;
         let mut s = self.state.clone();
-        let mut note = None;
+        let mut notes = vec![];
         if self.model != model {
             if let (Some(a), Some(b)) = (s.solver.as_mut(), own.solver.as_ref()) {
                 a.step_elements.clone_from(&b.step_elements);
             }
             s.aux.clone_from(&own.aux);
-            note = Some(format!(
+            notes.push(format!(
                 "structural state from the {} model's saved state, damper state its own initial one",
                 self.model
             ));
         }
+        let steps = (sim.period_s() / sim.time_step_s()).round() as usize;
+        if self.steps_per_rev != steps {
+            notes.push(format!(
+                "saved state of {} steps per revolution started at {steps}",
+                self.steps_per_rev
+            ));
+        }
+        if let (Some(a), Some(b)) = (self.inputs_sha256.as_deref(), inputs_sha256) {
+            if a != b {
+                let set = if self.overrides.is_empty() {
+                    "no --set values".to_string()
+                } else {
+                    let v: Vec<String> = self
+                        .overrides
+                        .iter()
+                        .map(|(k, v)| format!("{k}={v}"))
+                        .collect();
+                    format!("--set {}", v.join(" "))
+                };
+                notes.push(format!(
+                    "saved state of other inputs (deck, record or --set values differ; it was \
+                     saved with {set})"
+                ));
+            }
+        } else if self.inputs_sha256.is_none() {
+            notes.push("saved state without an inputs fingerprint (an older file): not checked against this run's deck and record".into());
+        }
+        let note = (!notes.is_empty())
+            .then(|| format!("warm start from {}: {}", self.label, notes.join("; ")));
         let period = sim.period_s();
         let k_min = (sim.periodic_from_s() / period - 1e-9).ceil().max(0.0);
         let k = (s.t_s / period).round().max(k_min);

@@ -93,13 +93,7 @@ impl SdofParams {
         use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
         use crate::structure::section::SectionTable;
         // the record must be of this rotor, as the elastic model requires
-        let (om, rec_om) = (spec.rotor.omega_rad_s, record.meta.rotor_speed_rad_s);
-        if !rec_om.is_finite() || (rec_om - om).abs() > 1e-3 * om {
-            anyhow::bail!(
-                "flight record rotor speed {rec_om} rad/s differs from the rotor deck's {om} rad/s ({})",
-                deck_path.display()
-            );
-        }
+        spec.check_record(record, deck_path)?;
         let e = spec.retention.hinge_r_m;
         let (r0, radius) = (spec.blade.root_r_m, spec.rotor.radius_m);
         let csv = deck_path

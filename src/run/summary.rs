@@ -520,6 +520,9 @@ pub struct RunInfo {
     pub initial_state: Option<String>,
     /// Deck values overridden (`--set KEY=VALUE`), in the order given: (key, TOML value).
     pub overrides: Vec<(String, String)>,
+    /// Fingerprint of the inputs that define the model ([`crate::io::inputs_fingerprint`]),
+    /// saved with each periodic state.
+    pub inputs_sha256: Option<String>,
     pub synthetic: bool,
     pub counter: Option<String>,
     pub wall_s: f64,
@@ -744,7 +747,7 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
 }
 
 /// DIR/<model>/periodic_state.json (when the simulation can save its state).
-pub fn write_periodic_state(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
+pub fn write_periodic_state(out: &OutDir, r: &ModelRun, info: &RunInfo) -> anyhow::Result<()> {
     let Some(state) = &r.periodic_state else {
         return Ok(());
     };
@@ -756,6 +759,8 @@ pub fn write_periodic_state(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
         period_s: r.period_s,
         converged: r.periodic.converged,
         residual: r.periodic.residual,
+        inputs_sha256: info.inputs_sha256.clone(),
+        overrides: info.overrides.clone(),
         state: state.clone(),
     };
     out.write(
