@@ -34,17 +34,17 @@ pub enum OutputError {
         #[source]
         source: std::io::Error,
     },
-    #[error("output folder {path} is in use by another rotorsim run (pid {pid}, lock file {lock}); wait for it to end or choose another --out")]
+    #[error("output folder {path} is in use by another rotorsim run ({holder}, lock file {lock}); wait for it to end or choose another --out")]
     Locked {
         path: PathBuf,
-        pid: u32,
+        holder: String,
         lock: PathBuf,
     },
     #[error("output folder {path}: lock file {lock} exists but holds no pid; remove it if no rotorsim run is writing to {path}")]
     BadLock { path: PathBuf, lock: PathBuf },
     #[error("output folder {path}: {msg}")]
     Invalid { path: PathBuf, msg: String },
-    #[error("cannot publish {path} (staged in {staging}): {source}")]
+    #[error("cannot publish {path} (its files are left in {staging}, removed by the next run into it): {source}")]
     Publish {
         path: PathBuf,
         staging: PathBuf,
@@ -69,7 +69,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
     let tmp = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
-    fs::write(&tmp, bytes).map_err(err)?;
+    if let Err(e) = fs::write(&tmp, bytes) {
+        // a full disk leaves a partial temporary file: not ours to leave behind
+        let _ = fs::remove_file(&tmp);
+        return Err(err(e));
+    }
     fs::rename(&tmp, path).map_err(|e| {
         let _ = fs::remove_file(&tmp);
         err(e)
@@ -218,52 +222,127 @@ fn pid_alive(pid: u32) -> bool {
     }
 }
 
-/// Takes the lock file `lock` of folder `target`: created exclusively and holding our pid. A
-/// lock whose pid is no longer running is stale and taken over.
-fn acquire_lock(target: &Path, lock: &Path) -> Result<(), OutputError> {
-    use std::io::Write;
-    let werr = |source| OutputError::Write {
-        path: lock.to_path_buf(),
-        source,
-    };
-    for _ in 0..2 {
-        match fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(lock)
-        {
-            Ok(mut f) => {
-                writeln!(f, "{}", std::process::id()).map_err(werr)?;
-                return Ok(());
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                let text = fs::read_to_string(lock).unwrap_or_default();
-                match text.trim().parse::<u32>() {
-                    Ok(pid) if pid_alive(pid) => {
-                        return Err(OutputError::Locked {
-                            path: target.to_path_buf(),
-                            pid,
-                            lock: lock.to_path_buf(),
-                        })
-                    }
-                    Ok(_) => {
-                        // stale: its run is gone
-                        let _ = fs::remove_file(lock);
-                    }
-                    Err(_) => {
-                        return Err(OutputError::BadLock {
-                            path: target.to_path_buf(),
-                            lock: lock.to_path_buf(),
-                        })
-                    }
-                }
-            }
-            Err(source) => return Err(werr(source)),
+/// This machine's host name (empty when unknown): a lock written on another host of a cluster
+/// cannot be checked with `/proc` here.
+fn host_name() -> String {
+    fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|s| s.trim().to_string())
+        .or_else(|_| std::env::var("HOSTNAME"))
+        .unwrap_or_default()
+}
+
+/// Who holds a lock file, as read from it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LockHolder {
+    /// A running process (or one on another host, which cannot be checked from here).
+    Live { pid: u32, host: String },
+    /// A process that is no longer running.
+    Stale { pid: u32 },
+    /// The file holds no pid.
+    Unreadable,
+}
+
+impl LockHolder {
+    /// `pid 123` or `pid 123 on host h` (another host).
+    pub fn describe(pid: u32, host: &str) -> String {
+        if host.is_empty() || host == host_name() {
+            format!("pid {pid}")
+        } else {
+            format!("pid {pid} on host {host}")
         }
     }
-    Err(werr(std::io::Error::other(
-        "another run took the lock over at the same time",
-    )))
+}
+
+/// Reads the lock file `lock`: its first line is the pid, its second (optional) the host.
+pub fn lock_holder(lock: &Path) -> LockHolder {
+    let text = fs::read_to_string(lock).unwrap_or_default();
+    let mut lines = text.lines();
+    let Some(Ok(pid)) = lines.next().map(|l| l.trim().parse::<u32>()) else {
+        return LockHolder::Unreadable;
+    };
+    let host = lines.next().unwrap_or("").trim().to_string();
+    if (host.is_empty() || host == host_name()) && !pid_alive(pid) {
+        LockHolder::Stale { pid }
+    } else {
+        LockHolder::Live { pid, host }
+    }
+}
+
+/// A lock file held until dropped (then removed).
+#[derive(Debug)]
+pub struct FolderLock {
+    path: PathBuf,
+    /// Set when a stale lock (its process gone) was taken over: say so to the user.
+    pub took_over: Option<String>,
+}
+
+impl FolderLock {
+    /// Takes the lock file `lock` of folder `target`: created exclusively and holding our pid
+    /// and host. A lock whose pid is no longer running on this host is stale and taken over.
+    pub fn acquire(target: &Path, lock: &Path) -> Result<Self, OutputError> {
+        use std::io::Write;
+        let werr = |source| OutputError::Write {
+            path: lock.to_path_buf(),
+            source,
+        };
+        let mut took_over = None;
+        for _ in 0..2 {
+            match fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(lock)
+            {
+                Ok(mut f) => {
+                    let held = Self {
+                        path: lock.to_path_buf(),
+                        took_over,
+                    };
+                    writeln!(f, "{}\n{}", std::process::id(), host_name()).map_err(werr)?;
+                    return Ok(held);
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    match lock_holder(lock) {
+                        LockHolder::Live { pid, host } => {
+                            return Err(OutputError::Locked {
+                                path: target.to_path_buf(),
+                                holder: LockHolder::describe(pid, &host),
+                                lock: lock.to_path_buf(),
+                            })
+                        }
+                        LockHolder::Stale { pid } => {
+                            // its process is gone: nobody writes under this lock any more
+                            let _ = fs::remove_file(lock);
+                            took_over = Some(format!(
+                                "took over the stale lock file {} of pid {pid} (no longer running)",
+                                lock.display()
+                            ));
+                        }
+                        LockHolder::Unreadable => {
+                            return Err(OutputError::BadLock {
+                                path: target.to_path_buf(),
+                                lock: lock.to_path_buf(),
+                            })
+                        }
+                    }
+                }
+                Err(source) => return Err(werr(source)),
+            }
+        }
+        Err(werr(std::io::Error::other(
+            "another run took the lock over at the same time",
+        )))
+    }
+
+    /// The lock file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.path);
+    }
 }
 
 /// A result folder being written: files go to a staging sibling that is published at
@@ -275,8 +354,9 @@ pub struct OutDir {
     target: PathBuf,
     /// Where the files are written until publication.
     staging: PathBuf,
-    /// Lock file (top-level folders; a nested folder is covered by its parent's).
-    lock: Option<PathBuf>,
+    /// Lock (top-level folders; a nested folder is covered by its parent's). Released after
+    /// the folder is published (fields drop after `Drop::drop`).
+    lock: Option<FolderLock>,
     run_id: String,
     start: SystemTime,
     inputs: Vec<serde_json::Value>,
@@ -337,8 +417,7 @@ impl OutDir {
             path: parent.clone(),
             source,
         })?;
-        let lock = parent.join(format!(".{name}.lock"));
-        acquire_lock(path, &lock)?;
+        let lock = FolderLock::acquire(path, &parent.join(format!(".{name}.lock")))?;
         // From here the lock is released by Drop.
         let dir = Self {
             target: path.to_path_buf(),
@@ -385,9 +464,13 @@ impl OutDir {
             path: dir.staging.clone(),
             source,
         })?;
+        if let Err(e) = dir.mark_incomplete("job started, not finished") {
+            // nothing was written yet (full disk, read-only folder): leave no staging behind
+            let _ = fs::remove_dir_all(&dir.staging);
+            return Err(e);
+        }
         let mut dir = dir;
         dir.published = false;
-        dir.mark_incomplete("job started, not finished")?;
         Ok(dir)
     }
 
@@ -476,6 +559,20 @@ impl OutDir {
     /// folder to the final path, an earlier folder there moved aside and then removed.
     fn publish(&mut self, complete: bool) -> Result<(), OutputError> {
         self.published = true;
+        match self.publish_inner(complete) {
+            // a top-level folder that could not be published (full disk, read-only target)
+            // stays in its staging sibling: name it (the next run into the folder removes it)
+            Err(e @ OutputError::Publish { .. }) => Err(e),
+            Err(e) if self.lock.is_some() => Err(OutputError::Publish {
+                path: self.target.clone(),
+                staging: self.staging.clone(),
+                source: std::io::Error::other(e.to_string()),
+            }),
+            r => r,
+        }
+    }
+
+    fn publish_inner(&mut self, complete: bool) -> Result<(), OutputError> {
         let marker = self.staging.join(INCOMPLETE_MARKER);
         let reason = if complete {
             None
@@ -557,10 +654,72 @@ impl Drop for OutDir {
             // The job ended without finish(): publish what it wrote, marked incomplete.
             let _ = self.publish(false);
         }
-        if let Some(lock) = &self.lock {
-            let _ = fs::remove_file(lock);
-        }
     }
+}
+
+/// Checks a published result folder against its manifest.json: the manifest parses and says
+/// `complete` (true or false), every listed output is present with its size and sha256, and
+/// the folder holds no file the manifest does not list. Returns the manifest, or why the
+/// folder cannot be trusted (naming the file, relative to the folder).
+pub fn verify_folder(dir: &Path) -> Result<serde_json::Value, String> {
+    let text = fs::read_to_string(dir.join(MANIFEST))
+        .map_err(|e| format!("{MANIFEST} cannot be read ({e})"))?;
+    let m: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| format!("{MANIFEST} is not a manifest (not JSON: {e})"))?;
+    if !m["complete"].is_boolean() {
+        return Err(format!(
+            "{MANIFEST} is not a manifest (`complete` missing or not true/false)"
+        ));
+    }
+    let listed = m["outputs"]
+        .as_array()
+        .ok_or_else(|| format!("{MANIFEST} is not a manifest (`outputs` missing or not a list)"))?;
+    let mut paths = Vec::with_capacity(listed.len());
+    for o in listed {
+        let (Some(rel), Some(sha), Some(size)) =
+            (o["path"].as_str(), o["sha256"].as_str(), o["size"].as_u64())
+        else {
+            return Err(format!(
+                "{MANIFEST} is not a manifest (an `outputs` entry lacks path, sha256 or size: {o})"
+            ));
+        };
+        // the listed path stays inside the folder
+        if rel.is_empty()
+            || rel.starts_with('/')
+            || rel.split('/').any(|c| c == ".." || c.is_empty())
+        {
+            return Err(format!(
+                "{MANIFEST} lists an output outside the folder: {rel}"
+            ));
+        }
+        let p = dir.join(rel);
+        let meta =
+            fs::metadata(&p).map_err(|_| format!("{rel} is listed in its manifest but missing"))?;
+        if meta.len() != size {
+            return Err(format!(
+                "{rel} size differs from its manifest ({} bytes, listed as {size}): file changed after the run",
+                meta.len()
+            ));
+        }
+        let (got, _) = sha256_file(&p).map_err(|e| format!("{rel} cannot be read ({e})"))?;
+        if got != sha {
+            return Err(format!(
+                "{rel} sha256 differs from its manifest (file changed after the run)"
+            ));
+        }
+        paths.push(rel);
+    }
+    paths.sort_unstable();
+    let files = walk_files(dir).map_err(|e| format!("cannot list the folder ({e})"))?;
+    if let Some((rel, _)) = files
+        .iter()
+        .find(|(rel, _)| rel != MANIFEST && paths.binary_search(&rel.as_str()).is_err())
+    {
+        return Err(format!(
+            "{rel} is not listed in its manifest (added after the run)"
+        ));
+    }
+    Ok(m)
 }
 
 /// Formats a table of numbers as CSV. Values use Rust's shortest round-trip representation,
@@ -675,6 +834,64 @@ mod tests {
         fs::write(root.join(".out.lock"), "999999999\n").unwrap();
         OutDir::create(&dir, &[]).unwrap().finish().unwrap();
         assert_eq!(names(&root), ["out"]);
+        fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_folder_is_checked_against_its_manifest() {
+        let root = tmp("verify");
+        let dir = root.join("out");
+        let out = OutDir::create(&dir, &[]).unwrap();
+        out.write("summary.json", b"{\"x\": 1}").unwrap();
+        out.write("m/last_rev.csv", b"a\n1\n").unwrap();
+        out.finish().unwrap();
+        assert_eq!(verify_folder(&dir).unwrap()["complete"], true);
+        // same size, other bytes
+        fs::write(dir.join("summary.json"), b"{\"x\": 2}").unwrap();
+        let e = verify_folder(&dir).unwrap_err();
+        assert_eq!(
+            e,
+            "summary.json sha256 differs from its manifest (file changed after the run)"
+        );
+        fs::write(dir.join("summary.json"), b"{\"x\": 10}").unwrap();
+        assert!(verify_folder(&dir)
+            .unwrap_err()
+            .contains("summary.json size differs from its manifest (9 bytes, listed as 8)"));
+        fs::write(dir.join("summary.json"), b"{\"x\": 1}").unwrap();
+        fs::write(dir.join("extra.json"), b"{}").unwrap();
+        assert!(verify_folder(&dir)
+            .unwrap_err()
+            .contains("extra.json is not listed"));
+        fs::remove_file(dir.join("extra.json")).unwrap();
+        fs::remove_file(dir.join("m/last_rev.csv")).unwrap();
+        assert!(verify_folder(&dir)
+            .unwrap_err()
+            .contains("m/last_rev.csv is listed in its manifest but missing"));
+        fs::write(dir.join(MANIFEST), b"garbage").unwrap();
+        assert!(verify_folder(&dir).unwrap_err().contains("not JSON"));
+        fs::write(dir.join(MANIFEST), b"{\"complete\": true}").unwrap();
+        assert!(verify_folder(&dir).unwrap_err().contains("`outputs`"));
+        fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_stale_lock_is_taken_over_with_a_note() {
+        let root = tmp("lock");
+        let lock = root.join(".x.lock");
+        fs::write(&lock, "999999999\n").unwrap();
+        let held = FolderLock::acquire(&root, &lock).unwrap();
+        assert!(held.took_over.as_deref().unwrap().contains("pid 999999999"));
+        assert_eq!(
+            lock_holder(&lock),
+            LockHolder::Live {
+                pid: std::process::id(),
+                host: host_name()
+            }
+        );
+        let e = FolderLock::acquire(&root, &lock).unwrap_err().to_string();
+        assert!(e.contains(&format!("pid {}", std::process::id())), "{e}");
+        drop(held);
+        assert!(!lock.exists());
         fs::remove_dir_all(&root).unwrap();
     }
 

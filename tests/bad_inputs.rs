@@ -347,7 +347,10 @@ const CASES: &[Case] = &[
     case("diagnose fit-cycles zero", bench_csv!(BENCH_OK), &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--measured", "{T}/t.csv", "--fit-cycles", "0", "--out", "{T}/out"], &["--fit-cycles"]),
     case("diagnose rotor model unknown", &[], &["diagnose", "--rotor", "{R}/rotors/uh60a.toml", "--flight", "{R}/flightdata/c8534like", "--model", "sdof", "--out", "{T}/out"], &["--model", "sdof"]),
     case("diagnose nothing to diagnose", &[], &["diagnose", "--deck", "{R}/flightdata/damper_nominal.toml", "--out", "{T}/out"], &["--measured"]),
-    case("unknown command", &[], &["simulate"], &["simulate"]),
+    case("unknown command", &[], &["simulate"], &["simulate"]),    case("sweep jobs zero", &[], &["sweep", "sweeps/ci_rigid.toml", "--out", "{T}/out", "--jobs", "0"], &["--jobs", "at least 1"]),
+    case("sweep shards zero", &[], &["sweep", "sweeps/ci_rigid.toml", "--out", "{T}/out", "--emit-slurm", "{T}/job.sh", "--shards", "0"], &["--shards", "at least 1"]),
+    case("sweep plan of 10^9 cases (size guard)", &[("p.toml", Text("[base]\nmodel = \"rigid\"\n[vary]\nrevs = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\nsubsteps = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\nsteps_per_rev = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"damper.physical.A_orf_m2\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"damper.physical.Cd\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"damper.physical.rho_kg_m3\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"damper.physical.V0_m3\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"damper.physical.V1_m3\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n\"bearing.lag_damping_Nms_per_rad\" = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n"), &[])], &["sweep", "{T}/p.toml", "--out", "{T}/out"], &["{T}/p.toml", "1000000000 cases", "\"revs\" 10 x", "beyond the 1000000"]),
+    case("sweep case deck value out of range", &[("p.toml", Text("[base]\nmodel = \"rigid\"\n[vary]\n\"damper.physical.A_orf_m2\" = [1.8e-6, -1.0e-6]\n"), &[])], &["sweep", "{T}/p.toml", "--out", "{T}/out"], &["{T}/p.toml", "case c002", "damper.physical.A_orf_m2", "-0.000001"]),
 ];
 
 fn subst(s: &str, t: &Path) -> String {

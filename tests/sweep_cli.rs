@@ -208,3 +208,169 @@ fn a_case_that_must_be_periodic_and_is_not_is_kept_failed_until_retried() {
     assert!(so.contains("2 run now"), "{so}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The rows of sweep.csv of case `id`.
+fn rows_of(t: &[Vec<String>], id: &str) -> Vec<Vec<String>> {
+    t.iter().filter(|r| r[0] == id).cloned().collect()
+}
+
+#[test]
+fn a_case_folder_that_does_not_match_its_manifest_is_never_merged() {
+    let d = tmp("sweep-tamper");
+    let out = d.join("s");
+    let o = out.to_str().unwrap();
+    ok(&sweep(&[PLAN, "--out", o], &[]));
+    let good = table(&out);
+    let case = |id: &str| out.join("cases").join(id);
+    // c002's summary.json replaced by c001's; c003's manifest garbage; a file of c004 deleted
+    std::fs::copy(
+        case("c001").join("summary.json"),
+        case("c002").join("summary.json"),
+    )
+    .unwrap();
+    std::fs::write(case("c003").join("manifest.json"), "garbage").unwrap();
+    std::fs::remove_file(case("c004").join("linear/last_rev.csv")).unwrap();
+    let m = sweep(&["merge", o], &[]);
+    assert!(!m.status.success(), "a merge of damaged cases must fail");
+    let so = String::from_utf8_lossy(&m.stdout);
+    assert!(
+        so.contains("failed: c002: summary.json size differs from its manifest"),
+        "{so}"
+    );
+    assert!(so.contains("file changed after the run"), "{so}");
+    assert!(
+        so.contains("failed: c003: manifest.json is not a manifest (not JSON"),
+        "{so}"
+    );
+    assert!(
+        so.contains("failed: c004: linear/last_rev.csv is listed in its manifest but missing"),
+        "{so}"
+    );
+    let t = table(&out);
+    assert_eq!(rows_of(&t, "c001"), rows_of(&good, "c001"));
+    for id in ["c002", "c003", "c004"] {
+        let r = rows_of(&t, id);
+        assert_eq!(r.len(), 1, "{id}: one row without results");
+        assert!(r[0].contains(&"failed".to_string()), "{id}: {:?}", r[0]);
+        let numbers = r[0]
+            .iter()
+            .skip(1 + 2 + 2)
+            .filter(|v| !v.is_empty())
+            .count();
+        assert_eq!(
+            numbers, 0,
+            "{id}: a damaged case's numbers were merged: {:?}",
+            r[0]
+        );
+    }
+    // the whole folder of c001 (manifest and all) in place of c002's: consistent with its
+    // manifest, but not c002's settings
+    std::fs::remove_dir_all(case("c002")).unwrap();
+    let cp = std::process::Command::new("cp")
+        .args(["-r"])
+        .arg(case("c001"))
+        .arg(case("c002"))
+        .status()
+        .unwrap();
+    assert!(cp.success());
+    let m = sweep(&["merge", o], &[]);
+    assert!(!m.status.success());
+    let so = String::from_utf8_lossy(&m.stdout);
+    assert!(
+        so.contains("failed: c002: summary.json is of another case"),
+        "{so}"
+    );
+    assert!(so.contains("damper.physical.A_orf_m2 = 0.0000018"), "{so}");
+    // a resume keeps them failed, by id and reason; --retry-failed runs them again
+    let kept = sweep(&[PLAN, "--out", o], &[]);
+    assert!(!kept.status.success());
+    let so = String::from_utf8_lossy(&kept.stdout);
+    assert!(so.contains("0 run now"), "{so}");
+    assert!(so.contains("c003: manifest.json is not a manifest"), "{so}");
+    let retried = ok(&sweep(&[PLAN, "--out", o, "--retry-failed"], &[]));
+    assert!(retried.contains("3 run now"), "{retried}");
+    assert_eq!(table(&out), good);
+    ok(&sweep(&["merge", o], &[]));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_second_sweep_into_a_locked_folder_is_refused_and_a_stale_lock_taken_over() {
+    let d = tmp("sweep-lock");
+    std::fs::create_dir_all(&d).unwrap();
+    let plan = d.join("one.toml");
+    std::fs::write(
+        &plan,
+        "[base]\nmodel = \"rigid\"\ndamper = \"linear\"\nrevs = 2\n[vary]\nsubsteps = [5]\n",
+    )
+    .unwrap();
+    let (p, out) = (plan.to_str().unwrap(), d.join("s"));
+    let o = out.to_str().unwrap();
+    std::fs::create_dir_all(&out).unwrap();
+    // held by a running process (this test)
+    let lock = out.join(".sweep.lock");
+    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
+    let r = sweep(&[p, "--out", o], &[]);
+    assert!(!r.status.success(), "a sweep into a locked folder ran");
+    let e = String::from_utf8_lossy(&r.stderr);
+    assert!(e.contains(".sweep.lock"), "{e}");
+    assert!(e.contains(&format!("pid {}", std::process::id())), "{e}");
+    assert!(
+        !out.join("cases/c001").exists(),
+        "a case ran under another's lock"
+    );
+    // a shard of the locked sweep is refused too
+    let r = sweep(&[p, "--out", o, "--shard", "0/1"], &[]);
+    assert!(!r.status.success());
+    // left by a killed sweep: taken over, with a note
+    std::fs::write(&lock, "999999999\n").unwrap();
+    let r = sweep(&[p, "--out", o], &[]);
+    let e = String::from_utf8_lossy(&r.stderr);
+    assert!(e.contains("took over the stale lock file"), "{e}");
+    assert!(e.contains("pid 999999999"), "{e}");
+    assert!(out.join("cases/c001/manifest.json").exists());
+    assert!(!lock.exists(), "the lock outlived its sweep");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_case_that_fails_at_run_time_names_the_deck_key_and_value() {
+    // a density that passes the deck's validation but makes the hydraulics blow up
+    let d = tmp("sweep-run-failure");
+    std::fs::create_dir_all(&d).unwrap();
+    let plan = d.join("rho.toml");
+    std::fs::write(
+        &plan,
+        "[base]\nmodel = \"rigid\"\ndamper = \"physical\"\nrevs = 3\n[vary]\n\"damper.physical.rho_kg_m3\" = [1.0e-9]\n",
+    )
+    .unwrap();
+    let out = d.join("s");
+    let r = sweep(
+        &[plan.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        &[],
+    );
+    assert!(!r.status.success());
+    let so = String::from_utf8_lossy(&r.stdout);
+    let line = so
+        .lines()
+        .find(|l| l.starts_with("failed: c001"))
+        .unwrap_or_default();
+    assert!(
+        line.contains("damper.physical.rho_kg_m3 = 1e-9 in deck rotors/uh60a.toml"),
+        "{so}"
+    );
+    let reason = std::fs::read_to_string(out.join("cases/c001/INCOMPLETE")).unwrap();
+    assert!(
+        reason.contains("damper.physical.rho_kg_m3 = 1e-9"),
+        "{reason}"
+    );
+    let m: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("cases/c001/manifest.json")).unwrap(),
+    )
+    .unwrap();
+    assert!(m["incomplete_reason"]
+        .as_str()
+        .unwrap()
+        .contains("in deck rotors/uh60a.toml"));
+    let _ = std::fs::remove_dir_all(&d);
+}

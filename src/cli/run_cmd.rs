@@ -15,7 +15,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Args, Debug, Clone)]
@@ -246,6 +246,22 @@ impl Progress for Lines {
 /// Checks `args` as `run` does before it writes anything (options, record, decks with their
 /// overrides), without running.
 pub fn check(args: &RunArgs) -> anyhow::Result<()> {
+    check_with(args, &check_record)
+}
+
+/// Reads the flight record at `path` as `run` does (the check of [`check`]).
+pub fn check_record(path: &Path) -> anyhow::Result<std::sync::Arc<FlightRecord>> {
+    FlightRecord::read(path)
+        .map(std::sync::Arc::new)
+        .with_context(|| format!("reading flight record {}", path.display()))
+}
+
+/// [`check`] with the flight record checked by `record` (a sweep checks each record once, not
+/// once per case: reading it is most of a case's check).
+pub fn check_with(
+    args: &RunArgs,
+    record: &dyn Fn(&Path) -> anyhow::Result<std::sync::Arc<FlightRecord>>,
+) -> anyhow::Result<()> {
     let models = parse_models(&args.damper)?;
     args.scheme
         .parse::<Scheme>()
@@ -271,8 +287,7 @@ pub fn check(args: &RunArgs) -> anyhow::Result<()> {
         "sdof" => true,
         m => bail!("--model: unknown rotor model '{m}' (expected uh60a, rigid or sdof)"),
     };
-    let record = FlightRecord::read(&args.flight)
-        .with_context(|| format!("reading flight record {}", args.flight.display()))?;
+    let record = record(&args.flight)?;
     let (rotor, deck) = load_decks(args, sdof)?;
     for m in &models {
         deck.require(*m)?;
@@ -527,13 +542,37 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         out.finish()?;
         Ok(())
     } else {
-        let msg = format!("model(s) failed: {}", failed.join("; "));
+        let mut msg = format!("model(s) failed: {}", failed.join("; "));
+        if let Some(note) = overrides_note(&args) {
+            msg = format!("{msg}; {note}");
+        }
         out.mark_incomplete(&msg)?;
         bail!(
             "{msg} (the other models' outputs are written in {})",
             out.path().display()
         )
     }
+}
+
+/// The deck values this run overrides, each with its deck file, for a failure's message: a
+/// value set with `--set` (or by a sweep's case) is the first suspect of a failed run.
+fn overrides_note(args: &RunArgs) -> Option<String> {
+    if args.set.is_empty() {
+        return None;
+    }
+    let items: Vec<String> = args
+        .set
+        .iter()
+        .map(|o| {
+            let deck = match (&args.damper_deck, o.is_damper()) {
+                (Some(d), true) => d,
+                _ => &args.rotor,
+            };
+            let value = crate::sweep::plan::display(&o.value);
+            format!("{} = {value} in deck {}", o.key, deck.display())
+        })
+        .collect();
+    Some(format!("this run overrides {}", items.join(", ")))
 }
 
 fn print_summary(outcomes: &[ModelOutcome], measured: &Result<Measured, String>) {

@@ -1,6 +1,7 @@
 //! `rotorsim sweep`: batch forced-response runs from a plan, on this machine or as the shards of
 //! a Slurm job array (docs/sweep.md).
 use super::run_cmd::{self, RunArgs};
+use crate::flight::FlightRecord;
 use crate::sweep::{self, Case, CaseRunner, Plan, SweepOptions, SweepProgress};
 use anyhow::{anyhow, bail, Context};
 use clap::{Args, Parser, Subcommand};
@@ -8,6 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -22,8 +24,8 @@ pub struct SweepArgs {
     /// DIR/sweep.html.
     #[arg(long, required = true)]
     pub out: Option<PathBuf>,
-    /// Cases run at once (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
-    #[arg(long)]
+    /// Cases run at once, at least 1 (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
+    #[arg(long, value_parser = at_least_one)]
     pub jobs: Option<usize>,
     /// Run only shard K of N (K from 0 to N-1); default from SLURM_ARRAY_TASK_ID and
     /// SLURM_ARRAY_TASK_COUNT when both are set. A shard writes only its own case folders;
@@ -40,11 +42,12 @@ pub struct SweepArgs {
     /// runs nothing.
     #[arg(long, value_name = "FILE")]
     pub emit_slurm: Option<PathBuf>,
-    /// Array tasks of the emitted script (default: the plan's warm-start groups, at most 64).
-    #[arg(long)]
+    /// Array tasks of the emitted script, at least 1 (default: the plan's warm-start groups, at
+    /// most 64).
+    #[arg(long, value_parser = at_least_one)]
     pub shards: Option<usize>,
-    /// CPUs per array task of the emitted script.
-    #[arg(long, default_value_t = 1)]
+    /// CPUs per array task of the emitted script, at least 1.
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
     pub cpus_per_task: usize,
 }
 
@@ -57,8 +60,24 @@ pub enum SweepCommand {
     },
 }
 
-/// Runs a case in this process as `rotorsim run` would, printing nothing.
-struct Runner;
+/// A count of at least 1 (`--jobs`, `--shards`, `--cpus-per-task`): 0 would silently mean 1.
+fn at_least_one(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        Ok(_) => Err("expected a whole number of at least 1, found 0".into()),
+        Err(_) => Err(format!(
+            "expected a whole number of at least 1, found `{s}`"
+        )),
+    }
+}
+
+/// Runs a case in this process as `rotorsim run` would, printing nothing. Checks each flight
+/// record once (by path) however many cases use it.
+#[derive(Default)]
+struct Runner {
+    records:
+        std::sync::Mutex<std::collections::HashMap<PathBuf, Result<Arc<FlightRecord>, String>>>,
+}
 
 /// `rotorsim run` arguments of `case` writing to `out`.
 fn run_args(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunArgs> {
@@ -105,7 +124,21 @@ fn run_args(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<R
 
 impl CaseRunner for Runner {
     fn check(&self, case: &Case) -> anyhow::Result<()> {
-        run_cmd::check(&run_args(case, Path::new("unused"), None)?)
+        let record = |p: &Path| -> anyhow::Result<Arc<FlightRecord>> {
+            let known = self.records.lock().ok().and_then(|m| m.get(p).cloned());
+            let r = match known {
+                Some(r) => r,
+                None => {
+                    let r = run_cmd::check_record(p).map_err(|e| format!("{e:#}"));
+                    if let Ok(mut m) = self.records.lock() {
+                        m.insert(p.to_path_buf(), r.clone());
+                    }
+                    r
+                }
+            };
+            r.map_err(|e| anyhow!(e))
+        };
+        run_cmd::check_with(&run_args(case, Path::new("unused"), None)?, &record)
     }
     fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()> {
         run_cmd::run(run_args(case, out, initial)?)
@@ -186,8 +219,10 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     if args.no_warm_start {
         plan.warm_start = false;
     }
-    let runner = Runner;
-    sweep::check(&plan, &runner)?;
+    let runner = Runner::default();
+    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let tty = std::io::stderr().is_terminal();
+    check_with_progress(&plan, &runner, jobs, tty)?;
     if let Some(script) = &args.emit_slurm {
         return emit_slurm(&args, &plan, plan_path, out, script);
     }
@@ -195,9 +230,13 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         Some(s) => Some(sweep::plan::parse_shard(s)?),
         None => env_shard()?,
     };
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("creating sweep folder {}", out.display()))?;
+    let lock = sweep::lock(out, shard)?;
+    for n in &lock.notes {
+        errln!("note: {n}");
+    }
     sweep::prepare(out, &plan)?;
-    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
-    let tty = std::io::stderr().is_terminal();
     let bar = tty.then(|| {
         let b = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
         b.set_style(
@@ -245,8 +284,8 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         }
     }
     if shard.is_none() {
-        let rows = sweep::table::write(&plan, out)?;
-        let (ok, np, failed, not_run) = sweep::table::counts(&rows);
+        let merged = sweep::table::write(&plan, out)?;
+        let (ok, np, failed, not_run) = sweep::table::counts(&merged.rows);
         outln!(
             "rows: {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}  plots: {}",
             out.join("sweep.csv").display(),
@@ -271,8 +310,11 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
 
 fn merge(dir: &Path) -> anyhow::Result<()> {
     let plan = sweep::read_plan_json(dir)?;
-    let rows = sweep::table::write(&plan, dir)?;
-    let (ok, np, failed, not_run) = sweep::table::counts(&rows);
+    let merged = sweep::table::write(&plan, dir)?;
+    for (id, why) in &merged.failed {
+        outln!("failed: {id}: {why}");
+    }
+    let (ok, np, failed, not_run) = sweep::table::counts(&merged.rows);
     outln!(
         "merged {} case(s): rows {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}",
         plan.cases.len(),
@@ -287,6 +329,46 @@ fn merge(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Checks every case before any runs, with a progress bar on a terminal, otherwise a line
+/// every few seconds when checking takes long (a plan of many cases).
+fn check_with_progress(plan: &Plan, runner: &Runner, jobs: usize, tty: bool) -> anyhow::Result<()> {
+    let total = plan.cases.len();
+    let t0 = Instant::now();
+    let last = std::sync::Mutex::new(0.0f64);
+    let bar = (tty && total > 1).then(|| {
+        let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template(
+                "checking the plan [{bar:30}] {pos}/{len} cases ({elapsed}, ETA {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b
+    });
+    let progress = |n: usize, total: usize| {
+        if let Some(b) = &bar {
+            b.set_position(n as u64);
+            return;
+        }
+        let now = t0.elapsed().as_secs_f64();
+        if let Ok(mut l) = last.lock() {
+            if now - *l >= CHECK_PROGRESS_EVERY_S {
+                *l = now;
+                errln!("rotorsim sweep: checked {n} of {total} cases ({now:.0} s)");
+            }
+        }
+    };
+    let r = sweep::check(plan, runner, jobs, &progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    r
+}
+
+/// Seconds between plain lines of the pre-flight check's progress off a terminal.
+const CHECK_PROGRESS_EVERY_S: f64 = 5.0;
+
 fn emit_slurm(
     args: &SweepArgs,
     plan: &Plan,
@@ -295,7 +377,7 @@ fn emit_slurm(
     script: &Path,
 ) -> anyhow::Result<()> {
     let groups = plan.groups().len();
-    let shards = args.shards.unwrap_or(groups.min(64)).max(1);
+    let shards = args.shards.unwrap_or(groups.clamp(1, 64));
     let cwd = std::env::current_dir().context("current folder")?;
     let abs = |p: &Path| {
         if p.is_absolute() {
@@ -319,7 +401,7 @@ fn emit_slurm(
         &abs(plan_path),
         &abs(out),
         shards,
-        args.cpus_per_task.max(1),
+        args.cpus_per_task,
         &extra,
     );
     crate::io::write_atomic(script, text.as_bytes())

@@ -43,12 +43,25 @@ pub trait SweepProgress: Sync {
 /// State of a case folder.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CaseState {
-    /// Published with `complete: true`.
+    /// Published with `complete: true`, its files as its manifest lists them.
     Done,
-    /// Published incomplete (the reason).
+    /// Published incomplete (the reason); its files as its manifest lists them.
     Failed(String),
+    /// Its files do not match its manifest, or the manifest is missing or broken (the
+    /// reason): nothing of it is read. Counted failed.
+    Damaged(String),
     /// No result folder yet.
     Pending,
+}
+
+impl CaseState {
+    /// Why the case is failed (None: done or pending).
+    pub fn failure(&self) -> Option<&str> {
+        match self {
+            CaseState::Failed(why) | CaseState::Damaged(why) => Some(why),
+            _ => None,
+        }
+    }
 }
 
 /// Folder of case `id` in sweep folder `dir`.
@@ -56,16 +69,27 @@ pub fn case_dir(dir: &Path, id: &str) -> PathBuf {
     dir.join("cases").join(id)
 }
 
-/// State of the case folder `path`, by its manifest.
+/// State of the case folder `path`, by its manifest, checked against the folder's files
+/// ([`crate::io::verify_folder`]) so that nothing changed after the run is read as its result.
 pub fn case_state(path: &Path) -> CaseState {
-    let Ok(text) = std::fs::read_to_string(path.join("manifest.json")) else {
-        return if path.join("INCOMPLETE").exists() {
-            CaseState::Failed(std::fs::read_to_string(path.join("INCOMPLETE")).unwrap_or_default())
-        } else {
+    if !path.join(crate::io::MANIFEST).exists() {
+        let marker = path.join(crate::io::INCOMPLETE_MARKER);
+        let empty = std::fs::read_dir(path).map_or(true, |mut d| d.next().is_none());
+        return if marker.exists() {
+            CaseState::Failed(
+                std::fs::read_to_string(marker)
+                    .unwrap_or_default()
+                    .trim()
+                    .to_string(),
+            )
+        } else if empty {
             CaseState::Pending
+        } else {
+            CaseState::Damaged("manifest.json missing (the folder cannot be verified)".into())
         };
-    };
-    match serde_json::from_str::<serde_json::Value>(&text) {
+    }
+    match crate::io::verify_folder(path) {
+        Err(why) => CaseState::Damaged(why),
         Ok(m) if m["complete"] == serde_json::Value::Bool(true) => CaseState::Done,
         Ok(m) => CaseState::Failed(
             m["incomplete_reason"]
@@ -74,8 +98,85 @@ pub fn case_state(path: &Path) -> CaseState {
                 .trim()
                 .to_string(),
         ),
-        Err(e) => CaseState::Failed(format!("unreadable manifest.json: {e}")),
     }
+}
+
+/// State of the folder of `case` in sweep folder `dir`: [`case_state`], and a case whose
+/// summary.json records other settings than the case's (a folder copied from another case,
+/// manifest and all) is damaged too.
+pub fn state_of(dir: &Path, case: &Case) -> CaseState {
+    let path = case_dir(dir, &case.id);
+    let state = case_state(&path);
+    if !matches!(state, CaseState::Done | CaseState::Failed(_)) {
+        return state;
+    }
+    let Ok(text) = std::fs::read_to_string(path.join("summary.json")) else {
+        return state; // a run that failed before its summary
+    };
+    match serde_json::from_str::<serde_json::Value>(&text) {
+        Err(e) => CaseState::Damaged(format!("summary.json is not JSON ({e})")),
+        Ok(s) => match settings_differ(case, &s) {
+            Some(why) => CaseState::Damaged(format!("summary.json is of another case: {why}")),
+            None => state,
+        },
+    }
+}
+
+/// Where summary.json `s` records other settings than `case`'s: its deck overrides and the
+/// run options it echoes as given.
+fn settings_differ(case: &Case, s: &serde_json::Value) -> Option<String> {
+    let mut want: Vec<(String, String)> = case
+        .overrides()
+        .iter()
+        .map(|o| (o.key.clone(), o.value_text()))
+        .collect();
+    want.sort();
+    let mut got: Vec<(String, String)> = s["options"]["overrides"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|o| {
+                    let t = |k: &str| o[k].as_str().unwrap_or_default().to_string();
+                    (t("key"), t("value"))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    got.sort();
+    let show = |v: &[(String, String)]| {
+        v.iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if want != got {
+        return Some(format!(
+            "it records the overrides [{}], the case sets [{}]",
+            show(&got),
+            show(&want)
+        ));
+    }
+    for (opt, at) in [
+        ("revs", &s["options"]["revs"]),
+        ("steps_per_rev", &s["options"]["steps_per_rev"]),
+        ("substeps", &s["options"]["substeps"]),
+        ("rotor", &s["rotor"]),
+        ("flight", &s["flight_record"]),
+    ] {
+        let Some(v) = case.option(opt) else { continue };
+        let same = match v {
+            toml::Value::Integer(i) => at.as_i64() == Some(*i),
+            toml::Value::String(t) => at.as_str() == Some(t.as_str()),
+            _ => true,
+        };
+        if !same {
+            return Some(format!(
+                "it records {opt} = {at}, the case sets {}",
+                plan::display(v)
+            ));
+        }
+    }
+    None
 }
 
 /// Whether every model of the case folder `path` reached its periodicity tolerance (by its
@@ -185,24 +286,132 @@ pub fn prepare(dir: &Path, plan: &Plan) -> anyhow::Result<()> {
     }
 }
 
-/// Checks every case with `runner` before any runs; an error names the plan file and the case.
-pub fn check(plan: &Plan, runner: &dyn CaseRunner) -> anyhow::Result<()> {
-    for c in &plan.cases {
-        runner.check(c).map_err(|e| {
-            let varied: Vec<String> = plan
-                .keys
-                .iter()
-                .filter_map(|k| Some(format!("{k} = {}", plan::display(c.settings.get(k)?))))
-                .collect();
-            anyhow!(
-                "sweep plan {}: case {} ({}): {e:#}",
-                plan.file,
-                c.id,
-                varied.join(", ")
-            )
-        })?;
+/// Checks every case with `runner` before any runs, on `jobs` threads; an error names the
+/// plan file and the first failing case in plan order. `progress(checked, total)` is called
+/// as cases are checked (from any thread).
+pub fn check(
+    plan: &Plan,
+    runner: &dyn CaseRunner,
+    jobs: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> anyhow::Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|e| anyhow!("cannot start {jobs} worker threads: {e}"))?;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let total = plan.cases.len();
+    let first_bad = pool.install(|| {
+        plan.cases.par_iter().find_map_first(|c| {
+            let r = runner.check(c).err().map(|e| (c, e));
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n, total);
+            r
+        })
+    });
+    match first_bad {
+        None => Ok(()),
+        Some((c, e)) => Err(anyhow!(
+            "sweep plan {}: case {} ({}): {e:#}",
+            plan.file,
+            c.id,
+            varied_text(plan, c)
+        )),
     }
-    Ok(())
+}
+
+/// `key = value, ...` of the varied keys `case` sets, for messages.
+pub fn varied_text(plan: &Plan, case: &Case) -> String {
+    plan.keys
+        .iter()
+        .filter_map(|k| Some(format!("{k} = {}", plan::display(case.settings.get(k)?))))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The lock of a sweep (or of one shard of it) on its folder, held until dropped.
+#[derive(Debug)]
+pub struct SweepLock {
+    _lock: crate::io::FolderLock,
+    /// Stale locks of killed sweeps taken over or removed (say so to the user).
+    pub notes: Vec<String>,
+}
+
+/// Lock file of a sweep into DIR: `DIR/.sweep.lock`, or `DIR/.sweep-shard-K-of-N.lock` for a
+/// shard (the shards of one array run at once into DIR: each locks only its own cases).
+pub fn lock_file(dir: &Path, shard: Option<(usize, usize)>) -> PathBuf {
+    match shard {
+        None => dir.join(".sweep.lock"),
+        Some((k, n)) => dir.join(format!(".sweep-shard-{k}-of-{n}.lock")),
+    }
+}
+
+/// The shard a lock file name stands for (Some(None): the whole sweep), None for other files.
+fn lock_scope(name: &str) -> Option<Option<(usize, usize)>> {
+    if name == ".sweep.lock" {
+        return Some(None);
+    }
+    let kn = name.strip_prefix(".sweep-shard-")?.strip_suffix(".lock")?;
+    let (k, n) = kn.split_once("-of-")?;
+    Some(Some((k.parse().ok()?, n.parse().ok()?)))
+}
+
+/// Takes the lock of a sweep (or shard) into DIR, which must exist: refused while another
+/// sweep runs cases that may be ours (the whole sweep, or a shard of another count; the other
+/// shards of the same count have other cases), naming its lock file and pid. Locks of
+/// processes no longer running are stale: taken over or removed, with a note.
+pub fn lock(dir: &Path, shard: Option<(usize, usize)>) -> anyhow::Result<SweepLock> {
+    use crate::io::{lock_holder, FolderLock, LockHolder};
+    let mine = lock_file(dir, shard);
+    let held = FolderLock::acquire(dir, &mine).map_err(|e| match e {
+        crate::io::OutputError::Locked { holder, lock, .. } => anyhow!(
+            "sweep folder {} is in use by another rotorsim sweep ({holder}, lock file {}); wait for it to end, or remove the lock file if that process is not running",
+            dir.display(),
+            lock.display()
+        ),
+        e => anyhow!("{e}"),
+    })?;
+    let mut notes: Vec<String> = held.took_over.iter().cloned().collect();
+    let entries = std::fs::read_dir(dir)
+        .with_context(|| format!("listing sweep folder {}", dir.display()))?;
+    let mut others: Vec<(PathBuf, Option<(usize, usize)>)> = entries
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            Some((e.path(), lock_scope(&name)?))
+        })
+        .filter(|(p, _)| *p != mine)
+        .collect();
+    others.sort();
+    for (other, scope) in others {
+        let overlaps = match (shard, scope) {
+            (Some((_, n)), Some((_, m))) => n != m,
+            _ => true,
+        };
+        match lock_holder(&other) {
+            LockHolder::Stale { pid } => {
+                let _ = std::fs::remove_file(&other);
+                notes.push(format!(
+                    "removed the stale lock file {} of pid {pid} (no longer running)",
+                    other.display()
+                ));
+            }
+            LockHolder::Live { pid, host } if overlaps => bail!(
+                "sweep folder {} is in use by another rotorsim sweep ({}, lock file {}); wait for it to end, or remove the lock file if that process is not running",
+                dir.display(),
+                crate::io::LockHolder::describe(pid, &host),
+                other.display()
+            ),
+            LockHolder::Unreadable if overlaps => bail!(
+                "sweep folder {}: lock file {} holds no pid; remove it if no rotorsim sweep is running into {}",
+                dir.display(),
+                other.display(),
+                dir.display()
+            ),
+            _ => {}
+        }
+    }
+    Ok(SweepLock { _lock: held, notes })
 }
 
 /// Group indices of shard `shard` (all without one).
@@ -226,7 +435,7 @@ pub fn execute(
     let mut report = SweepReport::default();
     let needs = |i: usize, report: &mut SweepReport| -> bool {
         let c = &plan.cases[i];
-        let mut state = case_state(&case_dir(dir, &c.id));
+        let mut state = state_of(dir, c);
         // a case that asked for periodicity and did not reach it is published complete (its
         // best revolution), but it has not done what was asked: failed for the resume
         let requires = c.option("require_periodic") == Some(&toml::Value::Boolean(true));
@@ -238,7 +447,7 @@ pub fn execute(
                 report.skipped.push(c.id.clone());
                 false
             }
-            CaseState::Failed(why) if !opts.retry_failed => {
+            CaseState::Failed(why) | CaseState::Damaged(why) if !opts.retry_failed => {
                 report.failed_kept.push((c.id.clone(), why));
                 false
             }
@@ -267,8 +476,8 @@ pub fn execute(
     let run_one = |i: usize, from: Option<usize>| -> (String, Result<(), String>, bool) {
         let c = &plan.cases[i];
         let init = from
-            .map(|s| case_dir(dir, &plan.cases[s].id))
-            .filter(|p| case_state(p) == CaseState::Done);
+            .filter(|&s| state_of(dir, &plan.cases[s]) == CaseState::Done)
+            .map(|s| case_dir(dir, &plan.cases[s].id));
         let t0 = std::time::Instant::now();
         let r = runner
             .run(c, &case_dir(dir, &c.id), init.as_deref())
@@ -337,5 +546,31 @@ fn shell_quote(s: &str) -> String {
         s.to_string()
     } else {
         format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shard_locks_conflict_only_across_shard_counts() {
+        let d = std::env::temp_dir().join(format!("rotorsim-sweep-lock-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        assert_eq!(lock_scope(".sweep.lock"), Some(None));
+        assert_eq!(lock_scope(".sweep-shard-1-of-4.lock"), Some(Some((1, 4))));
+        assert_eq!(lock_scope("plan.json"), None);
+        let a = lock(&d, Some((0, 2))).unwrap();
+        let b = lock(&d, Some((1, 2))).unwrap();
+        let e = lock(&d, None).unwrap_err().to_string();
+        assert!(e.contains(".sweep-shard-0-of-2.lock"), "{e}");
+        let e = lock(&d, Some((0, 3))).unwrap_err().to_string();
+        assert!(e.contains(&format!("pid {}", std::process::id())), "{e}");
+        drop((a, b));
+        let _whole = lock(&d, None).unwrap();
+        assert!(lock(&d, Some((0, 2))).is_err());
+        drop(_whole);
+        std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -27,6 +27,11 @@ pub const RUN_OPTIONS: &[(&str, OptionType)] = &[
     ("newton", OptionType::Text),
 ];
 
+/// Cases a plan may hold. Each case is a run of seconds at least, its settings and its folder
+/// kept for the whole sweep: beyond a million cases a plan is a typo (one list too many, a
+/// range written out too finely), and expanding it would take the machine's memory.
+pub const MAX_CASES: u64 = 1_000_000;
+
 /// Options that decide the state vector of a case: a case starts from a neighbour's periodic
 /// state only when all of these agree.
 pub const STATE_OPTIONS: &[&str] = &[
@@ -222,9 +227,40 @@ impl Plan {
                 axes.push((k.clone(), list));
             }
         }
+        // counted before anything is expanded: a product of a few lists grows beyond memory
+        let n_explicit = match root.get("case") {
+            Some(Value::Array(list)) => list.len() as u64,
+            _ => 0,
+        };
+        let product = if axes.is_empty() {
+            0
+        } else {
+            axes.iter()
+                .fold(1u64, |n, a| n.saturating_mul(a.1.len() as u64))
+        };
+        let count = product.saturating_add(n_explicit);
+        if count > MAX_CASES {
+            let shown = if count == u64::MAX {
+                "more than 1.8e19".to_string()
+            } else {
+                count.to_string()
+            };
+            return Err(anyhow!(
+                "sweep plan {file}: {shown} cases ([vary] {} = {product}{}), beyond the {MAX_CASES} a sweep may hold; vary fewer keys or fewer values per key, or split the plan into several plans",
+                axes.iter()
+                    .map(|(k, l)| format!("\"{k}\" {}", l.len()))
+                    .collect::<Vec<_>>()
+                    .join(" x "),
+                if n_explicit > 0 {
+                    format!(", plus {n_explicit} [[case]] tables")
+                } else {
+                    String::new()
+                }
+            ));
+        }
         let mut cases = Vec::new();
         if !axes.is_empty() {
-            let total: usize = axes.iter().map(|a| a.1.len()).product();
+            let total = product as usize;
             for i in 0..total {
                 let mut s = base.clone();
                 let mut rem = i;
@@ -435,6 +471,17 @@ mod tests {
             let e = Plan::parse(bad, "p.toml").unwrap_err().to_string();
             assert!(e.contains("p.toml"), "{e}");
         }
+        // counted before expansion: 10^12 cases refused at once with the count and the axes
+        let ten = "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]";
+        let big: String = (0..12).map(|i| format!("\"k.a{i}\" = {ten}\n")).collect();
+        let e = Plan::parse(&format!("[vary]\n{big}"), "big.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("big.toml") && e.contains("1000000000000 cases"),
+            "{e}"
+        );
+        assert!(e.contains("\"k.a0\" 10 x"), "{e}");
         assert_eq!(parse_shard("1/4").unwrap(), (1, 4));
         assert!(parse_shard("4/4").is_err());
     }

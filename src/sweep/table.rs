@@ -1,8 +1,9 @@
 //! DIR/sweep.csv and DIR/sweep.html from the case folders (whoever ran them: this process or
 //! the shards of a cluster job).
-use super::{case_dir, case_state, CaseState, Plan};
+use super::{case_dir, state_of, CaseState, Plan};
 use crate::report::html::HtmlReport;
 use crate::report::plot::Plot;
+use rayon::prelude::*;
 use serde_json::Value;
 use std::path::Path;
 
@@ -82,15 +83,22 @@ fn read_json(p: &Path) -> Option<Value> {
     serde_json::from_str(&std::fs::read_to_string(p).ok()?).ok()
 }
 
-/// Rows of every case of the plan, in plan order, one per case and damper model.
-pub fn rows(plan: &Plan, dir: &Path) -> Vec<Row> {
+/// State of every case folder of the plan, in plan order, each checked against its manifest
+/// (in parallel: checking hashes every file).
+pub fn states(plan: &Plan, dir: &Path) -> Vec<CaseState> {
+    plan.cases.par_iter().map(|c| state_of(dir, c)).collect()
+}
+
+/// Rows of every case of the plan, in plan order, one per case and damper model, from the
+/// case folders in `states` ([`states`]). A damaged folder gives one `failed` row and nothing
+/// of it is read.
+pub fn rows(plan: &Plan, dir: &Path, states: &[CaseState]) -> Vec<Row> {
     let mut out = Vec::new();
-    for c in &plan.cases {
+    for (c, state) in plan.cases.iter().zip(states) {
         let varied = plan.varied(c);
         let cd = case_dir(dir, &c.id);
-        let state = case_state(&cd);
         let summary = match state {
-            CaseState::Pending => None,
+            CaseState::Pending | CaseState::Damaged(_) => None,
             _ => read_json(&cd.join("summary.json")),
         };
         let empty = |status: &str| Row {
@@ -257,10 +265,26 @@ pub fn html(plan: &Plan, rows: &[Row]) -> String {
     h.finish()
 }
 
-/// Writes DIR/sweep.csv and DIR/sweep.html (each atomically); returns the rows.
-pub fn write(plan: &Plan, dir: &Path) -> anyhow::Result<Vec<Row>> {
-    let rows = rows(plan, dir);
+/// What [`write`] wrote: the rows, and the failed cases with the reason (published
+/// incomplete, or a folder that does not match its manifest).
+#[derive(Clone, Debug, Default)]
+pub struct Merged {
+    pub rows: Vec<Row>,
+    pub failed: Vec<(String, String)>,
+}
+
+/// Writes DIR/sweep.csv and DIR/sweep.html (each atomically) from the case folders, each
+/// checked against its manifest first.
+pub fn write(plan: &Plan, dir: &Path) -> anyhow::Result<Merged> {
+    let states = states(plan, dir);
+    let rows = rows(plan, dir, &states);
     crate::io::write_atomic(&dir.join("sweep.csv"), csv(plan, &rows)?.as_bytes())?;
     crate::io::write_atomic(&dir.join("sweep.html"), html(plan, &rows).as_bytes())?;
-    Ok(rows)
+    let failed = plan
+        .cases
+        .iter()
+        .zip(&states)
+        .filter_map(|(c, s)| Some((c.id.clone(), s.failure()?.to_string())))
+        .collect();
+    Ok(Merged { rows, failed })
 }
