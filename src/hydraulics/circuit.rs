@@ -682,6 +682,12 @@ impl Device for CircuitDevice {
         self.params.force(&self.committed)
     }
 
+    fn force_scale(&self) -> f64 {
+        let y = &self.committed;
+        (y[IP0] * self.params.chambers[0].area).abs()
+            + (y[IP1] * self.params.chambers[1].area).abs()
+    }
+
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }

@@ -348,6 +348,10 @@ impl Device for ExtendedDamper {
         self.out_force(self.inner.committed_force(), self.contact, self.v_h)
     }
 
+    fn force_scale(&self) -> f64 {
+        self.inner.force_scale().max(self.committed_force().abs())
+    }
+
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }
@@ -412,6 +416,10 @@ macro_rules! series_link_methods {
         }
 
         series_link_state_methods!($what);
+
+        fn force_scale(&self) -> f64 {
+            self.inner.force_scale()
+        }
     };
 }
 

@@ -592,6 +592,10 @@ impl Device for LinkedCircuit {
         }
     }
 
+    fn force_scale(&self) -> f64 {
+        self.inner.force_scale().max(self.committed_force().abs())
+    }
+
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }

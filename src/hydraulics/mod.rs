@@ -178,6 +178,13 @@ pub trait Device: Send + Sync + std::fmt::Debug {
     fn channels(&self, out: &mut [f64]);
     /// Device force at the committed state [N] (Eq. 8 for the hydraulic devices).
     fn committed_force(&self) -> f64;
+    /// Size of the forces the device force is the sum of, at the committed state [N]: the
+    /// round-off of the device force is relative to it (Newton's convergence floor). A circuit:
+    /// `|p0| A0 + |p1| A1`, since Eq. (8) subtracts the two chamber forces; default: the
+    /// committed force itself.
+    fn force_scale(&self) -> f64 {
+        self.committed_force().abs()
+    }
     /// Deep copy (parameters are shared copy-on-write, so this is cheap).
     fn clone_device(&self) -> Box<dyn Device>;
     /// Back to the initial state (start of a new test).

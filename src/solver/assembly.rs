@@ -414,6 +414,70 @@ impl Assembler {
         Ok(())
     }
 
+    /// The model's force scale at `kin` (Newton's convergence floor, `NewtonOptions::floor`):
+    /// the norm over the node dofs of the sum of the magnitudes of what every element adds to
+    /// the residual, `|| sum_e |r_e| ||`: loads, gravity, inertia at the motion of `kin` (e.g.
+    /// centrifugal), internal forces, and each step element's [`force_scale`] along its line.
+    /// The residual is a sum of these, so its round-off is relative to this sum, not to the
+    /// residual itself (which is ~0 for a model starting in equilibrium). Joints are left out:
+    /// their reactions balance the rest. `res` is scratch (`ndof` long), no allocation.
+    ///
+    /// [`force_scale`]: crate::structure::model::StepElement::force_scale
+    pub fn force_scale(
+        &self,
+        model: &Model,
+        kin: &[NodeKin<f64>],
+        ctx: &EvalCtx,
+        res: &mut [f64],
+    ) -> f64 {
+        let nl6 = 6 * self.n_nodes;
+        res[..nl6].iter_mut().for_each(|r| *r = 0.0);
+        let mut kf = [NodeKin::<f64>::ground(); 4];
+        let mut out = [0.0f64; MAXL];
+        for (ei, e) in model.elements.iter().enumerate() {
+            let nnodes = match e {
+                Element::Beam(_) => 4,
+                Element::Joint(_) => continue,
+                _ => 1,
+            };
+            let dofs = &self.elem_dofs[ei];
+            let n = 6 * nnodes;
+            for l in 0..nnodes {
+                kf[l] = kin[dofs[6 * l] / 6];
+            }
+            out[..n].iter_mut().for_each(|x| *x = 0.0);
+            match e {
+                Element::Beam(b) => {
+                    let kk = [kf[0], kf[1], kf[2], kf[3]];
+                    b.residual_f64(&kk, ctx, &mut out[..n])
+                }
+                _ => element_residual(e, &kf[..nnodes], &[], ctx, &mut out[..n]),
+            }
+            for a in 0..n {
+                res[dofs[a]] += out[a].abs();
+            }
+        }
+        for s in &model.step_elements {
+            let nd = s.nodes();
+            let u: [f64; 3] = std::array::from_fn(|k| kin[nd[1]].x[k] - kin[nd[0]].x[k]);
+            let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let f = s.force_scale();
+            for node in nd {
+                for k in 0..3 {
+                    // along the line of action; without one (zero length) on every axis
+                    let e = if l > 0.0 { (u[k] / l).abs() } else { 1.0 };
+                    res[6 * node + k] += f * e;
+                }
+            }
+        }
+        let f = super::newton::norm(&res[..nl6]);
+        if f.is_finite() {
+            f
+        } else {
+            0.0
+        }
+    }
+
     /// Numeric LU of the assembled matrix (symbolic analysis reused).
     pub fn factor(&mut self) -> Result<(), LinearError> {
         let sym = SymbolicSparseColMatRef::new_checked(

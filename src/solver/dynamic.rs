@@ -144,8 +144,11 @@ pub struct DynamicSolver {
     /// Residual of the last zero-acceleration predictor evaluated (convergence scale), and
     /// whether the last step refactored.
     pub(super) r_ref: f64,
-    /// Largest reference residual seen: the force scale round-off is measured against.
+    /// Largest reference residual seen (with `f_model`, the force scale of the round-off floor).
     pub(super) r_scale: f64,
+    /// The model's force scale at the initial state ([`Assembler::force_scale`]), taken at the
+    /// first step (a turning frame is set after `new`); negative until then.
+    f_model: f64,
     refreshed: bool,
     /// Residual norms of the Newton iterates of the last step (convergence diagnostics).
     pub last_residuals: Vec<f64>,
@@ -255,6 +258,7 @@ impl DynamicSolver {
             prev_lam: vec![],
             r_ref: 0.0,
             r_scale: 0.0,
+            f_model: -1.0,
             refreshed: false,
             last_residuals: Vec::with_capacity(64),
             state,
@@ -517,6 +521,27 @@ impl DynamicSolver {
         Ok((self.res.clone(), self.asm.to_dense()))
     }
 
+    /// The model's force scale at the current (initial) state, in absolute kinematics
+    /// ([`Assembler::force_scale`]; distributed loads at `t`).
+    fn model_force_scale(&mut self, t: f64) -> f64 {
+        self.state.kin(&mut self.kin);
+        if let Some(om) = self.frame_omega {
+            for k in self.kin.iter_mut() {
+                to_frame(k, om);
+            }
+        }
+        self.model.update_distributed_loads(t, &self.kin);
+        let ctx = EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: self.cscale,
+            inertia: true,
+        };
+        self.asm
+            .force_scale(&self.model, &self.kin, &ctx, &mut self.res)
+    }
+
     /// Advance one step of size `h`. On error the state is left at the last converged step.
     pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
         let p = self.params;
@@ -557,6 +582,9 @@ impl DynamicSolver {
         // first step and after each refactorization, and starts from a predictor extrapolated
         // from the last two steps (accelerations and multipliers), whose residual is ~1000x
         // smaller, so that the stored matrix has less to correct.
+        if self.f_model < 0.0 {
+            self.f_model = self.model_force_scale(t_n);
+        }
         let extrapolate = modified && self.prev_vd.len() == n;
         let mut scale_pending = !extrapolate || self.refreshed || self.r_ref == 0.0;
         if !scale_pending {
@@ -600,7 +628,7 @@ impl DynamicSolver {
             }
             if rn <= self.newton.rtol * r0
                 || rn == 0.0
-                || (tiny && rn <= self.newton.floor(self.r_scale.max(r0)))
+                || (tiny && rn <= self.newton.floor(self.f_model.max(self.r_scale).max(r0)))
             {
                 break;
             }

@@ -145,8 +145,19 @@ pub fn static_solve(
         *l = lp / ctx.cscale;
     }
     let mut report = StaticReport::default();
-    // largest initial residual of the load steps: the force scale round-off is measured against
-    let mut r_scale: f64 = 0.0;
+    // force scale of the round-off floor: the model's at the end load factor (loads, inertia of
+    // the steady rotation, device forces; Assembler::force_scale), or the largest initial
+    // residual of the load steps if larger
+    let mut r_scale: f64 = {
+        let g = model.gravity;
+        let lf = opts.end_factor;
+        let c = EvalCtx {
+            load_factor: lf,
+            gravity: fmul(lf, g),
+            ..ctx
+        };
+        asm.force_scale(model, &kin, &c, &mut res)
+    };
     let mut xi: Vec<[f64; 3]> = st.x.clone();
     let nsteps = opts.load_steps.max(1);
     let g = model.gravity;

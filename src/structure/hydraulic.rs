@@ -372,6 +372,10 @@ impl StepElement for HydraulicForceElement {
         self.want_jacobian = yes;
     }
 
+    fn force_scale(&self) -> f64 {
+        self.device.force_scale()
+    }
+
     fn commit(&mut self) {
         self.device.commit();
         if let Some(t) = self.trial.take() {

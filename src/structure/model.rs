@@ -53,6 +53,12 @@ pub trait StepElement: Send {
         out: &mut ElementOutput,
     ) -> Result<(), ElementError>;
     fn commit(&mut self);
+    /// Size of the forces the element's force is made of at the committed state [N] (the
+    /// round-off of its force is relative to it; Newton's convergence floor). Default: 0, the
+    /// element adds nothing to the model's force scale.
+    fn force_scale(&self) -> f64 {
+        0.0
+    }
     /// Whether the following `evaluate` calls need `jac` (false: only `force` is read, so an
     /// element may skip the work of its derivative). Default: ignored.
     fn want_jacobian(&mut self, _yes: bool) {}
