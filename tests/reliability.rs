@@ -198,3 +198,130 @@ fn a_missing_metadata_file_or_record_is_named() {
     assert_eq!(e.matches("os error 2").count(), 1, "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_warm_start_from_another_discretisation_or_deck_says_so() {
+    let dir = tmp("warm_notes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    let common = ["run", "--model", "rigid", "--damper", "linear"];
+    let o = rotorsim(&[&common[..], &["--out", a.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rotorsim(
+        &[
+            &common[..],
+            &[
+                "--steps-per-rev",
+                "128",
+                "--set",
+                "bearing.lag_damping_Nms_per_rad=300.0",
+                "--initial-state",
+                a.to_str().unwrap(),
+                "--out",
+                b.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(b.join("summary.json")).unwrap()).unwrap();
+    let msg = s["models"]["linear"]["periodic"]["message"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    for m in [&msg, &out.to_string()] {
+        assert!(
+            m.contains("256 steps per revolution started at 128")
+                && m.contains("saved state of other inputs"),
+            "{m}"
+        );
+    }
+    // the same inputs: no note
+    let c = dir.join("c");
+    let o = rotorsim(
+        &[
+            &common[..],
+            &[
+                "--initial-state",
+                a.to_str().unwrap(),
+                "--out",
+                c.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success());
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(c.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["models"]["linear"]["periodic"]["message"], "", "{s}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_long_diagnosis_is_never_silent() {
+    // 40 s of a 4.3 Hz test sampled at 1 kHz: minutes of fitting; a heartbeat line must come
+    // within the heartbeat interval (15 s) and a little
+    let dir = tmp("diag_heartbeat");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut csv = String::from("time_s,stroke_m,force_N\n");
+    for i in 0..40_000 {
+        let t = i as f64 * 1e-3;
+        let ph = 2.0 * std::f64::consts::PI * 4.3 * t + 0.3;
+        // a deterministic pseudo-noise keeps the force from looking clipped
+        let noise = 30.0 * ((i as f64 * 12.9898).sin() * 43758.5453).fract();
+        csv.push_str(&format!(
+            "{t:.4},{:.7e},{:.4}\n",
+            1e-3 * ph.sin(),
+            3000.0 * ph.cos() + noise
+        ));
+    }
+    let p = dir.join("long.csv");
+    std::fs::write(&p, csv).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .args([
+            "diagnose",
+            "--deck",
+            repo("flightdata/damper_nominal.toml").to_str().unwrap(),
+            "--measured",
+            p.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for l in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            let _ = tx.send(l);
+        }
+    });
+    let t0 = std::time::Instant::now();
+    let mut lines = vec![];
+    let mut beat = false;
+    while t0.elapsed() < std::time::Duration::from_secs(40) && !beat {
+        if let Ok(l) = rx.recv_timeout(std::time::Duration::from_millis(200)) {
+            beat = l.contains("so far");
+            lines.push(l);
+        }
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        lines.iter().any(|l| l.contains("40000 samples")),
+        "{lines:?}"
+    );
+    assert!(beat, "no heartbeat within 40 s: {lines:?}");
+}
