@@ -256,6 +256,25 @@ fn a_warm_start_from_another_discretisation_or_deck_says_so() {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(c.join("summary.json")).unwrap()).unwrap();
     assert_eq!(s["models"]["linear"]["periodic"]["message"], "", "{s}");
+    // another damper model's state: the structural state only, said so
+    let d = dir.join("d");
+    let o = rotorsim(&[
+        "run",
+        "--model",
+        "rigid",
+        "--damper",
+        "nonlinear",
+        "--initial-state",
+        a.join("linear/periodic_state.json").to_str().unwrap(),
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("note: nonlinear") && out.contains("structural state from the linear model"),
+        "{out}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
