@@ -215,7 +215,7 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
             return Err(bad(&format!(
                 "{} speeds, beyond the {MAX_SPEEDS} a fan plot may have (each is a static \
                  solve and an eigen-analysis); use a larger STEP",
-                sig_count(n + 1.0)
+                crate::solver::budget::count(n + 1.0)
             )));
         }
         (0..=n as usize)
@@ -243,14 +243,6 @@ const MAX_SPEEDS: usize = 10_000;
 /// run within about 1.2 of their nominal speed; far beyond, the eigen-analysis is meaningless
 /// (non-finite modes).
 const MAX_SPEED_FRACTION: f64 = 3.0;
-
-fn sig_count(n: f64) -> String {
-    if n < 1e6 {
-        format!("{n:.0}")
-    } else {
-        format!("{n:.2e}")
-    }
-}
 
 /// Refuses speed fractions far beyond the deck's nominal speed (`key` in `deck`).
 fn check_fractions(

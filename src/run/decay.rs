@@ -158,7 +158,7 @@ pub fn run_decay(file: &Path, opts: &DecayRunOptions) -> anyhow::Result<DecayRun
             &format!(
                 "{}: the lag decay of {} steps (--duration-s {} / --step-s {})",
                 file.display(),
-                fmt_count(steps_f),
+                crate::solver::budget::count(steps_f),
                 fmt_num(opts.duration_s),
                 fmt_num(opts.time_step_s)
             ),
@@ -208,15 +208,6 @@ impl DecayRun {
         row("damped_sine_fit", self.fit);
         row("log_decrement", self.log_decrement);
         s
-    }
-}
-
-/// A count for messages: whole below a million, else with an exponent.
-fn fmt_count(n: f64) -> String {
-    if n < 1e6 {
-        format!("{n:.0}")
-    } else {
-        format!("{n:.2e}")
     }
 }
 

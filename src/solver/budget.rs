@@ -136,6 +136,15 @@ pub fn memory_bytes() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
+/// A count for messages: whole below a million, else with an exponent (1.00e18).
+pub fn count(n: f64) -> String {
+    if n < 1e6 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.2e}")
+    }
+}
+
 fn duration(s: f64) -> String {
     if !s.is_finite() {
         "an unbounded amount".into()

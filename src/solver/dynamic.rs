@@ -502,13 +502,7 @@ impl DynamicSolver {
         let mut q_new = q_prev.clone();
         self.set_iterate(&mut x_new, &mut q_new, &q_prev, &v_new, &vd_new);
         self.model.update_distributed_loads(t, &self.kin);
-        let ctx = EvalCtx {
-            t,
-            load_factor: 1.0,
-            gravity: self.model.gravity,
-            cscale: self.cscale,
-            inertia: true,
-        };
+        let ctx = self.ctx(t);
         let fo = self.frame_omega;
         if !frame_terms {
             self.frame_omega = None;
@@ -521,6 +515,17 @@ impl DynamicSolver {
         Ok((self.res.clone(), self.asm.to_dense()))
     }
 
+    /// The evaluation context of a dynamic residual at time `t` (full loads and inertia).
+    fn ctx(&self, t: f64) -> EvalCtx {
+        EvalCtx {
+            t,
+            load_factor: 1.0,
+            gravity: self.model.gravity,
+            cscale: self.cscale,
+            inertia: true,
+        }
+    }
+
     /// The model's force scale at the current (initial) state, in absolute kinematics
     /// ([`Assembler::force_scale`]; distributed loads at `t`).
     fn model_force_scale(&mut self, t: f64) -> f64 {
@@ -531,13 +536,7 @@ impl DynamicSolver {
             }
         }
         self.model.update_distributed_loads(t, &self.kin);
-        let ctx = EvalCtx {
-            t,
-            load_factor: 1.0,
-            gravity: self.model.gravity,
-            cscale: self.cscale,
-            inertia: true,
-        };
+        let ctx = self.ctx(t);
         self.asm
             .force_scale(&self.model, &self.kin, &ctx, &mut self.res)
     }
@@ -560,13 +559,7 @@ impl DynamicSolver {
         q_prev.clone_from(&self.state.q);
         let mut lam_hat = std::mem::take(&mut self.ws_lam);
         lam_hat.clone_from(&self.lam_hat);
-        let ctx = EvalCtx {
-            t,
-            load_factor: 1.0,
-            gravity: self.model.gravity,
-            cscale: self.cscale,
-            inertia: true,
-        };
+        let ctx = self.ctx(t);
         let mut r0 = 0.0;
         let mut r_prev = 0.0;
         let mut it = 0;
@@ -760,13 +753,7 @@ impl DynamicSolver {
                 }
             }
         };
-        let ctx = EvalCtx {
-            t,
-            load_factor: 1.0,
-            gravity: self.model.gravity,
-            cscale: self.cscale,
-            inertia: true,
-        };
+        let ctx = self.ctx(t);
         self.model.update_distributed_loads(t, &self.kin);
         let xp = self.state.x.clone();
         let zero_lam = vec![0.0; self.lam_hat.len()];
