@@ -170,6 +170,7 @@ const CASES: &[Case] = &[
     case("modes model deck of 200000 elements", cant!("elements = 8", "elements = 200000"), MODES_M, &["m.toml", "elements = 200000", "memory"]),
     case("modes rotor deck of 200000 elements", rotor!("elements = 13 ", "elements = 200000 "), MODES_R, &["r.toml", "blade.elements = 200000", "memory"]),
     case("decay duration 1e9 s", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--duration-s", "1e9", "--out", "{T}/out"], &["tm4760.toml", "--duration-s 1e9", "memory"]),
+    case("decay rotor speed 1000x nominal", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rpm", "660000", "--out", "{T}/out"], &["--rpm 660000", "tm4760.toml", "rotor.omega_rad_s", "beyond sense"]),
     case("decay step 1e-12 s", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--step-s", "1e-12", "--out", "{T}/out"], &["tm4760.toml", "--step-s 1e-12"]),
     case("rigid run record radius 10x the deck's", record!("\"radius_m\": 8.178", "\"radius_m\": 0.8178"), RUN_FLIGHT, &["radius_m = 0.8178", "rotor.radius_m = 8.1786", "uh60a.toml"]),
     case("elastic run record radius 10x the deck's", record!("\"radius_m\": 8.178", "\"radius_m\": 81.78"), &["run", "--flight", "{T}/rec", "--revs", "3", "--out", "{T}/out"], &["radius_m = 81.78", "rotor.radius_m"]),

@@ -149,6 +149,19 @@ pub struct DecayRun {
 pub fn run_decay(file: &Path, opts: &DecayRunOptions) -> anyhow::Result<DecayRun> {
     let spec = HingedSpec::from_file(file)?;
     let om = opts.omega_rad_s.unwrap_or(spec.rotor.omega_rad_s);
+    let nominal = spec.rotor.omega_rad_s;
+    if om > MAX_SPEED_FRACTION * nominal {
+        anyhow::bail!(
+            "--rpm {}: {:.3} times the nominal speed of {} (rotor.omega_rad_s = {} rad/s, \
+             {} rpm), beyond sense: expected at most {MAX_SPEED_FRACTION} times (rotors run \
+             within about 1.2 of their nominal speed)",
+            round6(om * 30.0 / std::f64::consts::PI),
+            om / nominal,
+            file.display(),
+            round6(nominal),
+            round6(spec.rpm())
+        );
+    }
     let mut sim = decay_sim(&spec, file, opts)?;
     let steps_f = opts.duration_s / opts.time_step_s;
     // Newton iterations per step ~4 (docs/performance.md); the history is 3 columns
@@ -210,6 +223,14 @@ impl DecayRun {
         s
     }
 }
+
+/// `x` rounded to 6 decimals (an rpm converted to rad/s and back prints as given).
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+/// Largest rotor speed of a decay, in multiples of the deck's nominal (as a fan plot's).
+const MAX_SPEED_FRACTION: f64 = 3.0;
 
 /// A number for messages: plain in [1e-3, 1e5), else with an exponent.
 fn fmt_num(x: f64) -> String {
