@@ -150,11 +150,16 @@ pub fn inputs_fingerprint(files: &[PathBuf], extra: &[String]) -> std::io::Resul
         h.update(e.as_bytes());
         h.update(b"\n");
     }
-    let mut hex = String::with_capacity(64);
-    for b in h.finalize().iter() {
-        let _ = write!(hex, "{b:02x}");
+    Ok(hex(&h.finalize()))
+}
+
+/// Lower-case hex of a digest.
+fn hex(bytes: &[u8]) -> String {
+    let mut s = String::with_capacity(2 * bytes.len());
+    for b in bytes {
+        let _ = write!(s, "{b:02x}");
     }
-    Ok(hex)
+    s
 }
 
 /// sha256 (lower-case hex) and size of a file.
@@ -172,11 +177,7 @@ pub fn sha256_file(path: &Path) -> std::io::Result<(String, u64)> {
         size += n as u64;
         h.update(&buf[..n]);
     }
-    let mut hex = String::with_capacity(64);
-    for b in h.finalize().iter() {
-        let _ = write!(hex, "{b:02x}");
-    }
-    Ok((hex, size))
+    Ok((hex(&h.finalize()), size))
 }
 
 /// Files under `dir` (recursively, symbolic links not followed), as (relative path with `/`

@@ -3,6 +3,7 @@
 //! `rotorsim modes --rotor DECK --speeds 0:1.2:0.1`: fan plot of a rotor deck with
 //! the digitized UH-60A reference over it (src/rotor/fan.rs).
 use crate::io::{csv_string, OutDir};
+use crate::rotor::MAX_SPEED_FRACTION;
 use crate::solver::modal::{modes, ModalOptions, Mode};
 use crate::solver::statics::check_constraints;
 use crate::solver::{static_solve, State, StaticOptions};
@@ -238,11 +239,6 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
 
 /// Speeds of one fan plot at most: each is a static solve and an eigen-analysis.
 const MAX_SPEEDS: usize = 10_000;
-
-/// Largest speed fraction of a fan plot: the centrifugal load grows with its square, and rotors
-/// run within about 1.2 of their nominal speed; far beyond, the eigen-analysis is meaningless
-/// (non-finite modes).
-const MAX_SPEED_FRACTION: f64 = 3.0;
 
 /// Refuses speed fractions far beyond the deck's nominal speed (`key` in `deck`).
 fn check_fractions(

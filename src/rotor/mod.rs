@@ -149,6 +149,11 @@ pub struct SimState {
 }
 
 pub mod deck;
+
+/// Largest rotor speed of a fan plot or a decay, in multiples of the deck's nominal: the
+/// centrifugal load grows with its square and rotors run within about 1.2 of nominal; far
+/// beyond, the equilibrium and the modes mean nothing (non-finite modes, diverged statics).
+pub const MAX_SPEED_FRACTION: f64 = 3.0;
 pub mod expand;
 pub mod fan;
 pub mod hinged;

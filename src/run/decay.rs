@@ -7,6 +7,7 @@ use crate::rotor::hinged::{
     blade_node_ids, fit_damped_sine, log_decrement, modes_at, track, DecayOptions, DecaySim,
     HingedSpec,
 };
+use crate::rotor::MAX_SPEED_FRACTION;
 use crate::solver::NewtonMethod;
 use std::path::Path;
 
@@ -228,9 +229,6 @@ impl DecayRun {
 fn round6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
-
-/// Largest rotor speed of a decay, in multiples of the deck's nominal (as a fan plot's).
-const MAX_SPEED_FRACTION: f64 = 3.0;
 
 /// A number for messages: plain in [1e-3, 1e5), else with an exponent.
 fn fmt_num(x: f64) -> String {

@@ -65,6 +65,14 @@ impl Estimate {
         Ok(())
     }
 
+    /// `k` such runs one after the other (CPU) or side by side (memory).
+    pub fn times(self, k: f64) -> Estimate {
+        Estimate {
+            cpu_s: self.cpu_s * k,
+            bytes: self.bytes * k,
+        }
+    }
+
     pub fn plus(self, o: Estimate) -> Estimate {
         Estimate {
             cpu_s: self.cpu_s + o.cpu_s,

@@ -356,6 +356,15 @@ fn lock_scope(name: &str) -> Option<Option<(usize, usize)>> {
     Some(Some((k.parse().ok()?, n.parse().ok()?)))
 }
 
+/// The error of a sweep folder held by another sweep (`holder`, its lock file `lock`).
+fn in_use(dir: &Path, holder: &str, lock: &Path) -> anyhow::Error {
+    anyhow!(
+        "sweep folder {} is in use by another rotorsim sweep ({holder}, lock file {}); wait for it to end, or remove the lock file if that process is not running",
+        dir.display(),
+        lock.display()
+    )
+}
+
 /// Takes the lock of a sweep (or shard) into DIR, which must exist: refused while another
 /// sweep runs cases that may be ours (the whole sweep, or a shard of another count; the other
 /// shards of the same count have other cases), naming its lock file and pid. Locks of
@@ -364,11 +373,7 @@ pub fn lock(dir: &Path, shard: Option<(usize, usize)>) -> anyhow::Result<SweepLo
     use crate::io::{lock_holder, FolderLock, LockHolder};
     let mine = lock_file(dir, shard);
     let held = FolderLock::acquire(dir, &mine).map_err(|e| match e {
-        crate::io::OutputError::Locked { holder, lock, .. } => anyhow!(
-            "sweep folder {} is in use by another rotorsim sweep ({holder}, lock file {}); wait for it to end, or remove the lock file if that process is not running",
-            dir.display(),
-            lock.display()
-        ),
+        crate::io::OutputError::Locked { holder, lock, .. } => in_use(dir, &holder, &lock),
         e => anyhow!("{e}"),
     })?;
     let mut notes: Vec<String> = held.took_over.iter().cloned().collect();
@@ -396,12 +401,9 @@ pub fn lock(dir: &Path, shard: Option<(usize, usize)>) -> anyhow::Result<SweepLo
                     other.display()
                 ));
             }
-            LockHolder::Live { pid, host } if overlaps => bail!(
-                "sweep folder {} is in use by another rotorsim sweep ({}, lock file {}); wait for it to end, or remove the lock file if that process is not running",
-                dir.display(),
-                crate::io::LockHolder::describe(pid, &host),
-                other.display()
-            ),
+            LockHolder::Live { pid, host } if overlaps => {
+                return Err(in_use(dir, &LockHolder::describe(pid, &host), &other))
+            }
             LockHolder::Unreadable if overlaps => bail!(
                 "sweep folder {}: lock file {} holds no pid; remove it if no rotorsim sweep is running into {}",
                 dir.display(),
