@@ -18,7 +18,11 @@ python3 -m venv "$work/venv"
 "$work/venv/bin/python" -m pip install --quiet -r examples/python/requirements.txt
 py="$work/venv/bin/python"
 
+# The binary `cargo test --release` built: the same build (tests/one_build.rs), so this is a
+# no-op after the tests, and builds the binary only when the script runs alone.
+built=$SECONDS
 cargo build --release --quiet
+echo "rotorsim binary ready in $((SECONDS - built)) s"
 bin="${CARGO_TARGET_DIR:-$root/target}/release/rotorsim"
 "$bin" run --model rigid --revs 30 --out "$work/run"
 "$bin" sweep sweeps/ci_rigid.toml --out "$work/sweep"

@@ -14,7 +14,11 @@ if [ "$(id -u)" != 0 ]; then
     SUDO="sudo -n"
 fi
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$ROOT/target}
+# The binary `cargo test --release` built: the same build (tests/one_build.rs), so this is a
+# no-op after the tests, and builds the binary only when the script runs alone.
+built=$SECONDS
 cargo build --release --quiet
+echo "rotorsim binary ready in $((SECONDS - built)) s"
 EXE=$CARGO_TARGET_DIR/release/rotorsim
 
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null || ! command -v munged >/dev/null; then
