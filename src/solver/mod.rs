@@ -2,6 +2,7 @@
 // Index loops mirror the component formulas of the formulation.
 #![allow(clippy::needless_range_loop)]
 pub mod assembly;
+pub mod bordered;
 pub mod budget;
 pub mod dynamic;
 pub mod fdcheck;
