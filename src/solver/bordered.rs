@@ -16,7 +16,10 @@ use super::assembly::LinearError;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solve};
 use faer::perm::PermRef;
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{
+    factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
+};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, MatRef, Par};
 use rayon::prelude::*;
@@ -223,7 +226,13 @@ impl BorderedLu {
                 cp[lj + 1] = ri.len();
             }
             let sym = SymbolicSparseColMatRef::new_checked(nk, nk, &cp, None, &ri);
-            let symbolic = factorize_symbolic_lu(sym, Default::default())
+            // supernodal, as the structural solver's LU: on a blade's banded pattern its dense
+            // kernels beat the simplicial LU (docs/performance.md)
+            let params = LuSymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            let symbolic = factorize_symbolic_lu(sym, params)
                 .map_err(|e| BorderedError::Linear(LinearError::Singular(format!("{e:?}"))))?;
             let req = StackReq::any_of(&[
                 symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
