@@ -48,6 +48,9 @@ pub struct ReliefRegulation {
     /// Poppet spring k [N/m] and dashpot c [N s/m].
     pub k_n_per_m: f64,
     pub c_n_s_per_m: f64,
+    /// Pressure of the relieved chamber at which the valve cracks with the other chamber at
+    /// p_s: `(F_p + p_s A_back) / A_front` [Pa] (Eq. 5).
+    pub cracking_pressure_pa: f64,
 }
 
 impl ReliefRegulation {
@@ -59,6 +62,7 @@ impl ReliefRegulation {
                 area_ratio: a[k] / v.a_front,
                 k_n_per_m: v.k,
                 c_n_s_per_m: v.c,
+                cracking_pressure_pa: (v.f_p + params.p_s * v.a_back) / v.a_front,
             })
         };
         Some([r(0)?, r(1)?])
