@@ -497,5 +497,30 @@ fn the_elastic_report_reads_for_a_newcomer() {
         }
     }
     assert!(moving > 0, "a relief valve moves within a step");
+    // The valve figures' azimuth window cuts no opening: both valves shut across its edge.
+    let start: f64 = match html.find("Azimuth window ") {
+        Some(i) => html[i + 15..].split(' ').next().unwrap().parse().unwrap(),
+        None => 0.0,
+    };
+    let edge = start.rem_euclid(360.0);
+    let az = at("azimuth_deg");
+    let k = rows
+        .iter()
+        .position(|r| r[az] == edge)
+        .expect("a row at the edge");
+    let before = (k + rows.len() - 1) % rows.len();
+    for v in ["x_valve0_substep_max_m", "x_valve1_substep_max_m"] {
+        assert_eq!(rows[k][at(v)], 0.0, "{v} open at the window edge {edge}");
+        assert_eq!(rows[before][at(v)], 0.0, "{v} open just before {edge}");
+    }
+    let opens = rows
+        .iter()
+        .any(|r| r[at("x_valve0_substep_max_m")] > 0.0 && r[az] > 300.0)
+        && rows
+            .iter()
+            .any(|r| r[at("x_valve0_substep_max_m")] > 0.0 && r[az] < 10.0);
+    if opens {
+        assert_ne!(start, 0.0, "an opening across 0 deg needs a shifted window");
+    }
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -1413,3 +1413,34 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn without_a_recorded_stroke_the_split_says_why_it_cannot_be_made() {
+        let m = Measured {
+            azimuth_deg: vec![0.0, 90.0, 180.0, 270.0],
+            force_n: vec![1.0, 0.0, -1.0, 0.0],
+            stroke_m: None,
+            revolutions: 1,
+            synthetic: false,
+        };
+        let s = rotor_damper_split(&[], &m);
+        assert_eq!(s.len(), 1);
+        assert!(s[0].contains("cannot be made") && s[0].contains("no damper stroke"));
+    }
+
+    #[test]
+    fn hub_channels_read_as_words_with_units() {
+        assert_eq!(
+            readable_channel("hub_fx_fixed_N"),
+            "hub force x, fixed frame [N]"
+        );
+        assert_eq!(
+            readable_channel("hub_my_fixed_Nm"),
+            "hub moment y, fixed frame [N m]"
+        );
+    }
+}
