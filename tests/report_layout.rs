@@ -325,6 +325,17 @@ fn check_newcomer_points(html: &str) {
         assert_ne!(r[cz], "1.0000", "{r:?}");
     }
     assert!(html.contains("no aerodynamic damping"));
+    // Chambers named, each with its relief valve's cracking pressure.
+    if html.contains("Inside the physical damper") {
+        for want in [
+            "p0: chamber 0 (compression)",
+            "p1: chamber 1 (extension)",
+            "valve 0 cracks at",
+            "valve 1 cracks at",
+        ] {
+            assert!(html.contains(want), "{want}");
+        }
+    }
 }
 
 #[test]

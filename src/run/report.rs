@@ -527,15 +527,22 @@ fn pressure_plot(phys: &[&ModelRun]) -> Plot {
             }
         }
     }
-    if let Some(reg) = phys.iter().find_map(|r| r.relief_regulation) {
-        for (k, g) in reg.iter().enumerate() {
-            let pc = g.cracking_pressure_pa;
+    // The cracking pressure follows the other chamber's pressure (Eq. 5), so a line, not a level.
+    for r in phys {
+        let (Some(reg), Some(p0), Some(p1)) =
+            (r.relief_regulation, r.channel("p0_Pa"), r.channel("p1_Pa"))
+        else {
+            continue;
+        };
+        let pre = if multi {
+            format!("{} ", r.label)
+        } else {
+            String::new()
+        };
+        for (k, (g, other)) in reg.iter().zip([p1, p0]).enumerate() {
+            let pc: Vec<f64> = other.iter().map(|po| g.cracking_pressure_pa(*po)).collect();
             p = p
-                .dashed(
-                    &format!("valve {k} cracking pressure"),
-                    &[0.0, 360.0],
-                    &[pc, pc],
-                )
+                .dashed(&format!("{pre}valve {k} cracks at"), &r.azimuth_deg, &pc)
                 .colour(SIDE_COLOURS[k]);
         }
     }
@@ -1116,7 +1123,7 @@ pub fn report_html(
         rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
         svg(
             &mut rep,
-            "Chamber pressures (cf. Fig. 18). Chamber 0 grows with the stroke, so it is compressed (and loaded) when the damper shortens; chamber 1 when it extends (docs/formats.md). Dashed: the pressure at which the chamber's relief valve cracks with the other chamber at the background pressure p_s, (F_p + p_s A_back) / A_front (Eq. 5).",
+            "Chamber pressures (cf. Fig. 18). Chamber 0 grows with the stroke, so it is compressed (and loaded) when the damper shortens; chamber 1 when it extends (docs/formats.md). Dashed, in the chamber's colour: the pressure at which the chamber's relief valve cracks, F_p / A_front + (A_back / A_front) p_other, which follows the other chamber's pressure p_other (Eq. 5); the valve opens where its chamber's pressure reaches that line.",
             &[pressure_plot(&phys)],
         );
         svg(
