@@ -428,6 +428,44 @@ pub struct StepSystem<'a> {
     pub d_dot: f64,
     /// Seat contact frozen over the current implicit sub-step.
     pub contact: Option<[bool; 2]>,
+    /// Relief-valve extremes over the sub-steps integrated (None: not recorded).
+    pub envelope: Option<SubstepEnvelope>,
+}
+
+/// Relief-valve poppet displacement, velocity and flow of both valves at the end of every
+/// hydraulic sub-step of a step, as their minimum and maximum: the poppets move within a
+/// structural step, so a value sampled once per step aliases that motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubstepEnvelope {
+    /// [x_valve0, x_valve1, v_valve0, v_valve1, q_valve0, q_valve1] (m, m/s, m^3/s).
+    pub min: [f64; 6],
+    pub max: [f64; 6],
+}
+
+impl SubstepEnvelope {
+    /// Nothing seen yet (min +inf, max -inf).
+    pub const EMPTY: Self = SubstepEnvelope {
+        min: [f64::INFINITY; 6],
+        max: [f64::NEG_INFINITY; 6],
+    };
+
+    /// The envelope of one state (both bounds the values at that state).
+    fn at(params: &CircuitParams, t: f64, d: f64, y: &State) -> Self {
+        let mut e = Self::EMPTY;
+        e.add(params, t, d, y);
+        e
+    }
+
+    fn add(&mut self, params: &CircuitParams, t: f64, d: f64, y: &State) {
+        let q = params
+            .evaluate::<false>(t, d, 0.0, y, None)
+            .map_or([f64::NAN; 2], |r| r.2.relief);
+        let v = [y[IX0], y[IX1], y[IV0], y[IV1], q[0], q[1]];
+        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(v) {
+            *lo = lo.min(x);
+            *hi = hi.max(x);
+        }
+    }
 }
 
 impl OdeSystem<NS> for StepSystem<'_> {
@@ -476,6 +514,14 @@ impl OdeSystem<NS> for StepSystem<'_> {
             }
         }
     }
+
+    fn end_substep(&mut self, t: f64, y: &State) {
+        if let Some(mut e) = self.envelope {
+            let d = self.d_i + self.d_dot * (t - self.t_i);
+            e.add(self.params, t, d, y);
+            self.envelope = Some(e);
+        }
+    }
 }
 
 /// How a circuit device estimates `dF_m/dd_f`.
@@ -499,6 +545,9 @@ pub struct CircuitDevice {
     committed_t: f64,
     committed_d: f64,
     trial: Option<(State, f64, f64)>,
+    /// Relief-valve extremes over the sub-steps of the committed step [0] and of the trial [1]
+    /// (boxed: keeps the device small where it is held by value).
+    envelope: Box<[SubstepEnvelope; 2]>,
 }
 
 const DAMPER_CHANNELS: &[&str] = &[
@@ -513,7 +562,29 @@ const DAMPER_CHANNELS: &[&str] = &[
     "q_check1_m3_s",
     "v_valve0_m_s",
     "v_valve1_m_s",
+    // min and max over the hydraulic sub-steps of the step ending at the sample
+    "x_valve0_substep_min_m",
+    "x_valve1_substep_min_m",
+    "v_valve0_substep_min_m_s",
+    "v_valve1_substep_min_m_s",
+    "q_valve0_substep_min_m3_s",
+    "q_valve1_substep_min_m3_s",
+    "x_valve0_substep_max_m",
+    "x_valve1_substep_max_m",
+    "v_valve0_substep_max_m_s",
+    "v_valve1_substep_max_m_s",
+    "q_valve0_substep_max_m3_s",
+    "q_valve1_substep_max_m3_s",
 ];
+
+/// A channel holding the minimum or maximum of a quantity over the hydraulic sub-steps of a
+/// structural step (the damper layout's last channels).
+pub fn is_substep_envelope(name: &str) -> bool {
+    name.contains("_substep_min_") || name.contains("_substep_max_")
+}
+
+/// Channels of the damper layout before the sub-step envelope.
+const DAMPER_POINT_CHANNELS: usize = 11;
 
 const ACTUATOR_CHANNELS: &[&str] = &[
     "p0_Pa",
@@ -534,6 +605,7 @@ const ACTUATOR_CHANNELS: &[&str] = &[
 impl CircuitDevice {
     pub fn new(params: CircuitParams, opts: IntegratorOptions) -> Self {
         let y0 = params.initial_state();
+        let envelope = SubstepEnvelope::at(&params, 0.0, 0.0, &y0);
         Self {
             params: Arc::new(params),
             opts,
@@ -542,6 +614,7 @@ impl CircuitDevice {
             committed_t: 0.0,
             committed_d: 0.0,
             trial: None,
+            envelope: Box::new([envelope; 2]),
         }
     }
 
@@ -610,10 +683,13 @@ impl Device for CircuitDevice {
             d_i,
             d_dot: (d_f - d_i) / dt,
             contact: None,
+            // the step's start included, so consecutive envelopes join
+            envelope: Some(SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed)),
         };
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
         let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
+        let envelope = sys.envelope.take().unwrap_or(SubstepEnvelope::EMPTY);
         let force_mean = y[IIMP] / dt;
         let dforce_dstroke = match self.tangent {
             Tangent::Eq16 => -0.5 * self.params.static_stiffness(&y, d_f),
@@ -632,6 +708,7 @@ impl Device for CircuitDevice {
             force_end: self.params.force(&y),
         };
         self.trial = Some((y, t_i + dt, d_f));
+        self.envelope[1] = envelope;
         Ok(out)
     }
 
@@ -640,6 +717,7 @@ impl Device for CircuitDevice {
             self.committed = y;
             self.committed_t = t;
             self.committed_d = d;
+            self.envelope[0] = self.envelope[1];
         }
     }
 
@@ -667,14 +745,26 @@ impl Device for CircuitDevice {
             fl.entrance[0],
             fl.entrance[1],
         ];
-        // valve (poppet) velocities are appended after the other channels of either layout
-        let n = self.channel_names().len() - 2;
+        // valve (poppet) velocities are appended after the other channels of either layout,
+        // then (damper layout) the sub-step envelope
+        let names = self.channel_names().len();
+        let points = if self.params.entrance.is_some() {
+            names
+        } else {
+            DAMPER_POINT_CHANNELS
+        };
+        let n = points - 2;
         for (o, v) in out.iter_mut().take(n).zip(vals) {
             *o = v;
         }
         if out.len() >= n + 2 {
             out[n] = y[IV0];
             out[n + 1] = y[IV1];
+        }
+        if points < names && out.len() >= names {
+            let e = &self.envelope[0];
+            out[points..points + 6].copy_from_slice(&e.min);
+            out[points + 6..points + 12].copy_from_slice(&e.max);
         }
     }
 
@@ -697,6 +787,7 @@ impl Device for CircuitDevice {
         self.committed_t = 0.0;
         self.committed_d = 0.0;
         self.trial = None;
+        self.envelope[0] = SubstepEnvelope::at(&self.params, 0.0, 0.0, &self.committed);
     }
 
     fn state_values(&self) -> Vec<f64> {
@@ -712,6 +803,13 @@ impl Device for CircuitDevice {
         self.committed_t = v[NS];
         self.committed_d = v[NS + 1];
         self.trial = None;
+        // no sub-steps behind a restored state: its own values
+        self.envelope[0] = SubstepEnvelope::at(
+            &self.params,
+            self.committed_t,
+            self.committed_d,
+            &self.committed,
+        );
         Ok(())
     }
 }

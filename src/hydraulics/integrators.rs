@@ -61,6 +61,9 @@ pub trait OdeSystem<const N: usize> {
     /// Called at the start of every sub-step of an implicit scheme with its initial state, e.g.
     /// to freeze contact conditions over the sub-step (default: nothing).
     fn begin_implicit_substep(&mut self, _t: f64, _y: &SVector<f64, N>) {}
+    /// Called with the (projected) state at the end of every sub-step, e.g. to record what
+    /// moves faster than the step (default: nothing). Must not allocate.
+    fn end_substep(&mut self, _t: f64, _y: &SVector<f64, N>) {}
 }
 
 /// Explicit Runge-Kutta tableau (strictly lower triangular `a`).
@@ -405,6 +408,7 @@ pub fn integrate<const N: usize>(
             }
         };
         sys.project(&mut y);
+        sys.end_substep(t + h, &y);
         if let Some(c) = y.iter().position(|v| !v.is_finite()) {
             return Err(HydraulicError::NonFinite {
                 t: t + h,

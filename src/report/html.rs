@@ -42,6 +42,25 @@ impl Banner {
 pub struct HtmlReport {
     title: String,
     body: String,
+    /// (id, text) of every h2, for the table of contents.
+    sections: Vec<(String, String)>,
+}
+
+/// Where [`HtmlReport::contents`] puts the table of contents (filled in by `finish`, once every
+/// section is known).
+const TOC_MARK: &str = "<!--toc-->";
+
+/// An HTML id from a heading: lowercase letters and digits, the rest as single dashes.
+pub fn slug(text: &str) -> String {
+    let mut s = String::new();
+    for c in text.chars() {
+        if c.is_ascii_alphanumeric() {
+            s.push(c.to_ascii_lowercase());
+        } else if !s.ends_with('-') && !s.is_empty() {
+            s.push('-');
+        }
+    }
+    s.trim_end_matches('-').to_string()
 }
 
 impl HtmlReport {
@@ -49,13 +68,44 @@ impl HtmlReport {
         Self {
             title: title.into(),
             body: String::new(),
+            sections: Vec::new(),
         }
     }
 
+    /// A heading; an h2 gets an id (unique in the report) and an entry in the contents.
     pub fn heading(&mut self, level: u8, text: &str) -> &mut Self {
         let l = level.clamp(1, 6);
-        let _ = writeln!(self.body, "<h{l}>{}</h{l}>", escape(text));
+        if l == 2 {
+            let base = slug(text);
+            let mut id = base.clone();
+            let mut k = 1;
+            while self.sections.iter().any(|s| s.0 == id) {
+                k += 1;
+                id = format!("{base}-{k}");
+            }
+            let _ = writeln!(self.body, "<h2 id=\"{id}\">{}</h2>", escape(text));
+            self.sections.push((id, text.to_string()));
+        } else {
+            let _ = writeln!(self.body, "<h{l}>{}</h{l}>", escape(text));
+        }
         self
+    }
+
+    /// The table of contents goes here: links to every h2 of the report, before and after
+    /// this call.
+    pub fn contents(&mut self) -> &mut Self {
+        self.body.push_str(TOC_MARK);
+        self.body.push('\n');
+        self
+    }
+
+    fn toc(&self) -> String {
+        let mut o = String::from("<nav class=\"toc\"><p class=\"toc-title\">Contents</p><ol>");
+        for (id, text) in &self.sections {
+            let _ = write!(o, "<li><a href=\"#{id}\">{}</a></li>", escape(text));
+        }
+        o.push_str("</ol></nav>");
+        o
     }
 
     pub fn paragraph(&mut self, text: &str) -> &mut Self {
@@ -159,10 +209,12 @@ th{{background:#eee}}figure{{margin:1em 0}}figcaption{{font-size:90%;color:#555}
 .banner.info{{background:#eef;border:1px solid #99b;color:#223}}\
 .verdict{{border:2px solid #333;border-radius:6px;padding:6px 14px;margin:10px 0 18px;background:#fafafa}}\
 .verdict .headline{{font-size:130%;font-weight:bold;margin:6px 0}}\
+.toc{{border:1px solid #ccc;background:#f8f8f8;padding:4px 14px;margin:10px 0 18px}}\
+.toc-title{{font-weight:bold;margin:4px 0}}.toc ol{{columns:2;margin:4px 0}}\
 figure svg{{max-width:100%;height:auto}}\
 </style></head><body>\n<h1>{t}</h1>\n{b}</body></html>\n",
             t = escape(&self.title),
-            b = self.body
+            b = self.body.replacen(TOC_MARK, &self.toc(), 1)
         )
     }
 }
@@ -188,5 +240,19 @@ mod tests {
         assert!(h.contains("<figure><svg width=\"1\"></svg>"));
         assert!(!h.contains("<?xml"));
         assert!(!h.contains("http"), "self-contained");
+    }
+
+    #[test]
+    fn contents_link_every_section_with_unique_ids() {
+        let mut r = HtmlReport::new("t");
+        r.heading(2, "Intro").contents();
+        r.heading(2, "Loops (Fig. 16)")
+            .heading(2, "Loops (Fig. 16)");
+        let h = r.finish();
+        for id in ["intro", "loops-fig-16", "loops-fig-16-2"] {
+            assert!(h.contains(&format!("<h2 id=\"{id}\">")), "{id}");
+            assert!(h.contains(&format!("<a href=\"#{id}\">")), "{id}");
+        }
+        assert!(!h.contains(TOC_MARK));
     }
 }

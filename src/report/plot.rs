@@ -417,7 +417,7 @@ impl Plot {
         if longest == 0 {
             return 0;
         }
-        ((longest as u32) * 8 + 44).min((width * 3 / 10).max(190).min(width / 2))
+        ((longest as u32) * 8 + 44).min((width * 7 / 20).max(190).min(width / 2))
     }
 
     fn draw_on<DB: DrawingBackend>(

@@ -48,9 +48,19 @@ pub struct ReliefRegulation {
     /// Poppet spring k [N/m] and dashpot c [N s/m].
     pub k_n_per_m: f64,
     pub c_n_s_per_m: f64,
+    /// `F_p / A_front` [Pa] and `A_back / A_front` [-]: the valve cracks when the relieved
+    /// chamber's pressure exceeds `F_p / A_front + (A_back / A_front) p_other` (Eq. 5).
+    pub preload_pressure_pa: f64,
+    pub back_area_ratio: f64,
 }
 
 impl ReliefRegulation {
+    /// Pressure of the relieved chamber at which the valve cracks, the other chamber at
+    /// `p_other` [Pa] (Eq. 5 with the poppet at rest on its seat).
+    pub fn cracking_pressure_pa(&self, p_other: f64) -> f64 {
+        self.preload_pressure_pa + self.back_area_ratio * p_other
+    }
+
     /// Per valve from the circuit's areas and relief valves (None without both valves).
     pub fn of(params: &crate::hydraulics::circuit::CircuitParams) -> Option<[Self; 2]> {
         let a = [params.chambers[0].area, params.chambers[1].area];
@@ -59,6 +69,8 @@ impl ReliefRegulation {
                 area_ratio: a[k] / v.a_front,
                 k_n_per_m: v.k,
                 c_n_s_per_m: v.c,
+                preload_pressure_pa: v.f_p / v.a_front,
+                back_area_ratio: v.a_back / v.a_front,
             })
         };
         Some([r(0)?, r(1)?])

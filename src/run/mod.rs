@@ -227,6 +227,9 @@ pub fn drive_periodic(
     }
     let names = sim.channel_names();
     let nc = names.len();
+    let env_channels: Vec<usize> = (0..nc)
+        .filter(|&c| crate::hydraulics::circuit::is_substep_envelope(&names[c]))
+        .collect();
     let idx = |name: &str| -> anyhow::Result<usize> {
         names.iter().position(|n| n == name).ok_or_else(|| {
             anyhow::anyhow!(
@@ -292,7 +295,11 @@ pub fn drive_periodic(
             kept.push(KeptRevolution {
                 shooting_iterate: iterate,
                 start_t_s: rev.start_t_s,
-                samples: rev.samples.clone(),
+                samples: {
+                    let mut v = rev.samples.clone();
+                    align_envelopes(&mut v, &rev.end, &env_channels);
+                    v
+                },
             });
         }
     };
@@ -429,6 +436,7 @@ pub fn drive_periodic(
             ),
         );
     }
+    align_envelopes(&mut rev.samples, &rev.end, &env_channels);
     let timing = sim.timing();
     let blades = sim.blades();
     let mut run = ModelRun {
@@ -453,7 +461,42 @@ pub fn drive_periodic(
         blades,
     };
     loads::finish(&mut run, blades);
+    // the sub-step envelope last, so the columns written before it keep their places
+    let (env, point): (Vec<usize>, Vec<usize>) = (0..run.channel_names.len())
+        .partition(|&c| crate::hydraulics::circuit::is_substep_envelope(&run.channel_names[c]));
+    if !env.is_empty() {
+        let order: Vec<usize> = point.into_iter().chain(env).collect();
+        let reorder = |v: &mut Vec<Vec<f64>>| {
+            let mut old = std::mem::take(v);
+            let n = old.len();
+            *v = order
+                .iter()
+                .filter(|&&c| c < n)
+                .map(|&c| std::mem::take(&mut old[c]))
+                .collect();
+        };
+        run.channel_names = order
+            .iter()
+            .map(|&c| run.channel_names[c].clone())
+            .collect();
+        reorder(&mut run.last_rev);
+        for k in &mut run.all_revs {
+            reorder(&mut k.samples);
+        }
+    }
     Ok(run)
+}
+
+/// A sub-step envelope sampled at the start of step j covers the step before it: shifted so
+/// that row j covers step j (from its azimuth to the next), the last row from the revolution's
+/// end.
+fn align_envelopes(samples: &mut [Vec<f64>], end: &[f64], env: &[usize]) {
+    for &c in env {
+        samples[c].rotate_left(1);
+        if let Some(last) = samples[c].last_mut() {
+            *last = end[c];
+        }
+    }
 }
 
 /// Builds and drives one simulation per model in parallel. A failed model (build or run) is

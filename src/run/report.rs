@@ -63,14 +63,106 @@ fn closed(v: &[f64]) -> Vec<f64> {
     o
 }
 
+/// The verdict's split of the force error into the rotor's part (the stroke it gives the
+/// damper) and the damper's (its 1/rev dynamic stiffness for that stroke), from the summary's
+/// stroke checks; or why the split cannot be made.
+pub fn rotor_damper_split(ok: &[(&ModelRun, &ModelFigures)], m: &Measured) -> Vec<String> {
+    if m.stroke_m.is_none() {
+        return vec!["Rotor or damper? The split cannot be made: the record has no damper stroke, so the force error cannot be divided between the stroke the rotor gives the damper and the damper's force for that stroke.".into()];
+    }
+    let checks: Vec<(&str, &super::summary::StrokeCheck)> = ok
+        .iter()
+        .filter_map(|(r, f)| f.stroke.as_ref().map(|s| (r.label.as_str(), s)))
+        .collect();
+    let Some(first) = checks.first() else {
+        return vec!["Rotor or damper? The split cannot be made: no model has a damper stroke channel to compare with the record's.".into()];
+    };
+    let rec = first.1.rev1_measured.amplitude;
+    let pct: Vec<f64> = checks
+        .iter()
+        .map(|(_, c)| 100.0 * (c.rev1_model.amplitude / rec - 1.0))
+        .collect();
+    let (lo, hi) = pct.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+        (a.0.min(*p), a.1.max(*p))
+    });
+    let span = if (hi - lo).abs() < 0.05 {
+        format!("{:.1}%", lo.abs())
+    } else {
+        format!(
+            "{:.1}-{:.1}%",
+            lo.abs().min(hi.abs()),
+            lo.abs().max(hi.abs())
+        )
+    };
+    let rotor = if hi < 0.0 {
+        format!("Rotor: the model's 1/rev stroke is {span} below the record's {:.2} mm, so every damper model sees too small a stroke.", rec * 1e3)
+    } else if lo > 0.0 {
+        format!("Rotor: the model's 1/rev stroke is {span} above the record's {:.2} mm, so every damper model sees too large a stroke.", rec * 1e3)
+    } else {
+        let each: Vec<String> = checks
+            .iter()
+            .zip(&pct)
+            .map(|((n, _), p)| format!("{n} {p:+.1}%"))
+            .collect();
+        format!(
+            "Rotor: the model's 1/rev stroke against the record's {:.2} mm: {}.",
+            rec * 1e3,
+            each.join(", ")
+        )
+    };
+    let kr = first.1.stiffness_1rev_measured;
+    let each: Vec<String> = checks
+        .iter()
+        .map(|(n, c)| {
+            let k = c.stiffness_1rev_model;
+            format!(
+                "{n} {:.0} / {:.0}",
+                k.storage_N_per_m * 1e-3,
+                k.loss_N_per_m * 1e-3,
+            )
+        })
+        .collect();
+    let loss: Vec<f64> = checks
+        .iter()
+        .map(|(_, c)| 100.0 * (c.stiffness_1rev_model.loss_N_per_m / kr.loss_N_per_m - 1.0))
+        .collect();
+    let (llo, lhi) = loss
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(*p), a.1.max(*p))
+        });
+    let versus = if lhi < 0.0 {
+        format!(
+            "every model's loss K'' is {:.0}-{:.0}% below the record's",
+            -lhi, -llo
+        )
+    } else if llo > 0.0 {
+        format!(
+            "every model's loss K'' is {:.0}-{:.0}% above the record's",
+            llo, lhi
+        )
+    } else {
+        format!("the models' loss K'' is {llo:+.0}% to {lhi:+.0}% of the record's")
+    };
+    let damper = format!(
+        "Damper: for the stroke it gets, the 1/rev dynamic stiffness K' (storage) / K'' (loss) is {} kN/m against the record's {:.0} / {:.0} kN/m: {versus}.",
+        each.join(", "),
+        kr.storage_N_per_m * 1e-3,
+        kr.loss_N_per_m * 1e-3
+    );
+    vec![rotor, damper]
+}
+
 /// Banners and the verdict box; returns nothing, writes to `rep`.
 fn verdict(
     rep: &mut HtmlReport,
     info: &RunInfo,
-    runs: &[&ModelRun],
+    ok: &[(&ModelRun, &ModelFigures)],
     measured: &Result<Measured, String>,
     rank: Option<&Ranking>,
 ) {
+    let runs: Vec<&ModelRun> = ok.iter().map(|x| x.0).collect();
+    let runs = &runs[..];
     if info.synthetic {
         rep.banner(
             Banner::Synthetic,
@@ -136,6 +228,7 @@ fn verdict(
                     )
                 })
                 .collect();
+            lines.extend(rotor_damper_split(ok, m));
             lines.push(format!(
                 "Measurement: the record's damper force averaged over {} revolutions, compared at its own {} azimuths.",
                 m.revolutions,
@@ -178,6 +271,15 @@ fn top_figures(
             }
         }
         p = p.points(&mlabel(m), &m.azimuth_deg, &m.force_n);
+        // The relief-valve cracking forces here, so no second force figure is needed.
+        let limits = runs.iter().find_map(|r| r.force_limits_n);
+        if let Some((lo, hi)) = limits {
+            p = p
+                .dashed("valve 0 cracking force", &[0.0, 360.0], &[hi, hi])
+                .colour(SIDE_COLOURS[0])
+                .dashed("valve 1 cracking force", &[0.0, 360.0], &[lo, lo])
+                .colour(SIDE_COLOURS[1]);
+        }
         let mut pr = Plot::new(
             &format!("Residual: model - {syn}measured, at the measured azimuths"),
             "azimuth [deg]",
@@ -203,7 +305,14 @@ fn top_figures(
         }
         svg(
             rep,
-            &format!("Damper force of the models over the {syn}measured force (top); residual model - measured (bottom)."),
+            &format!(
+                "Damper force of the models over the {syn}measured force (top; {}); residual model - measured (bottom).",
+                if limits.is_some() {
+                    "dashed: the physical damper's relief-valve cracking forces, valve 0 limiting the positive force, valve 1 the negative"
+                } else {
+                    "no model has relief valves"
+                }
+            ),
             &[p, pr],
         );
     }
@@ -243,15 +352,12 @@ fn top_figures(
     }
     if !fs.series.is_empty() {
         rep.heading(2, "Force-stroke and force-velocity loops");
-        let svgs = crate::report::plot::grid_svg(&[fs, fv], 2, W, H);
-        match svgs {
-            Ok(s) => {
-                rep.svg(&format!("Damper force against stroke (left; the area is the energy dissipated per revolution) and against stroke rate (right), last revolution.{loop_note}"), &s);
-            }
-            Err(e) => {
-                rep.notice(&format!("loops could not be drawn: {e}"));
-            }
-        }
+        // Full width each: side by side left a loop under 200 px of data.
+        svg(
+            rep,
+            &format!("Damper force against stroke (top; the area is the energy dissipated per revolution) and against stroke rate (bottom), last revolution.{loop_note}"),
+            &[fs, fv],
+        );
     }
     // 3. Stroke: the record's over the models'.
     let mut ps = channel_plot(runs, "Damper stroke", &[("damper_stroke_m", "")]);
@@ -280,7 +386,7 @@ fn top_figures(
     let mut ph = Plot::new(
         "Damper force harmonics",
         "harmonic [/rev]",
-        "amplitude [kN]",
+        "damper force amplitude [kN]",
     )
     .x_step(1.0)
     .y_scale(1e-3);
@@ -306,32 +412,69 @@ fn top_figures(
             &[ph],
         );
     }
-    // 5. Periodicity history.
+    // 5. Periodicity history. A shooting iterate integrates several revolutions (the marched
+    // ones before it, then one per subspace direction and trial), so the legend says how many.
     rep.heading(2, "Periodicity");
+    let shooting = runs.iter().any(|r| r.periodic.iterations > 0);
     let mut pc = Plot::new(
         "Periodicity residual",
-        "iterate (shooting) or revolution (march)",
-        "log10(residual)",
+        if shooting {
+            "shooting iterate (0: after the marched revolutions) [-]"
+        } else {
+            "revolution [-]"
+        },
+        "log10(periodicity residual) [-]",
     );
-    let mut longest = 1usize;
+    let (mut longest, mut lo, mut hi) = (1usize, f64::INFINITY, f64::NEG_INFINITY);
     for r in runs {
         let h = r.measure_history();
+        let p = &r.periodic;
         longest = longest.max(h.len());
-        let x: Vec<f64> = (1..=h.len()).map(|k| k as f64).collect();
+        let (x, name): (Vec<f64>, String) = if shooting {
+            let per = (p
+                .revolutions_integrated
+                .saturating_sub(p.marched_revolutions)) as f64
+                / (h.len().saturating_sub(1)).max(1) as f64;
+            (
+                (0..h.len()).map(|k| k as f64).collect(),
+                format!("{} ({per:.1} revs/iter)", r.label),
+            )
+        } else {
+            ((1..=h.len()).map(|k| k as f64).collect(), r.label.clone())
+        };
         let y: Vec<f64> = h.iter().map(|m| m.max(1e-16).log10()).collect();
-        pc = pc.line(&r.label, &x, &y);
+        for v in y.iter().filter(|v| v.is_finite()) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        pc = pc.line(&name, &x, &y);
     }
+    let x0 = if shooting { 0.0 } else { 1.0 };
     if let Some(r) = runs.first() {
         let t = r.periodic.tolerance.log10();
+        lo = lo.min(t);
+        hi = hi.max(t);
         pc = pc.dashed(
             &format!("tolerance {:.0e}", r.periodic.tolerance),
-            &[1.0, longest as f64],
+            &[x0, (longest as f64 - 1.0 + x0).max(x0 + 1.0)],
             &[t, t],
         );
     }
+    if lo.is_finite() {
+        // whole decades, at least two, so every decade has a labelled tick
+        let (a, b) = (lo.floor(), hi.ceil().max(lo.floor() + 2.0));
+        pc = pc.y_range(a, b);
+    }
+    if longest <= 12 {
+        pc = pc.x_step(1.0);
+    }
     svg(
         rep,
-        "log10 of the periodicity residual after each shooting iterate (or marched revolution); the dashed line is the tolerance.",
+        &if shooting {
+            format!("log10 of the periodicity residual after each accepted shooting iterate (0: after the marched revolutions, before the first Newton-Picard step). An iterate integrates several revolutions (one per subspace direction, plus trials); the legend gives the average revolutions per iterate of each model; in all: {}. The dashed line is the tolerance.", runs.iter().map(|r| format!("{} {} marched + {} in the iterates", r.label, r.periodic.marched_revolutions, r.periodic.revolutions_integrated.saturating_sub(r.periodic.marched_revolutions))).collect::<Vec<_>>().join(", "))
+        } else {
+            "log10 of the periodicity residual after each marched revolution (one revolution each); the dashed line is the tolerance.".to_string()
+        },
         &[pc],
     );
     let per: Vec<String> = runs
@@ -351,6 +494,192 @@ fn top_figures(
             channel_plot(runs, "Tip twist", &[("tip_twist_rad", "")]),
         ],
     );
+}
+
+/// Colours of chamber/valve 0 and 1 (a valve and its chamber alike).
+const SIDE_COLOURS: [plotters::style::RGBColor; 2] = [
+    crate::report::plot::OTHER_COLOURS[0],
+    crate::report::plot::OTHER_COLOURS[1],
+];
+
+/// Chamber pressures with each relief valve's cracking pressure (dashed, same colour).
+fn pressure_plot(phys: &[&ModelRun]) -> Plot {
+    let mut p = Plot::new(
+        "Chamber pressures",
+        "azimuth [deg]",
+        "chamber pressure [MPa]",
+    )
+    .azimuth()
+    .y_scale(1e-6);
+    let multi = phys.len() > 1;
+    let names = ["p0: chamber 0 (compression)", "p1: chamber 1 (extension)"];
+    for r in phys {
+        let pre = if multi {
+            format!("{} ", r.label)
+        } else {
+            String::new()
+        };
+        for (k, ch) in ["p0_Pa", "p1_Pa"].iter().enumerate() {
+            if let Some(v) = r.channel(ch) {
+                p = p
+                    .line(&format!("{pre}{}", names[k]), &r.azimuth_deg, v)
+                    .colour(SIDE_COLOURS[k]);
+            }
+        }
+    }
+    // The cracking pressure follows the other chamber's pressure (Eq. 5), so a line, not a level.
+    for r in phys {
+        let (Some(reg), Some(p0), Some(p1)) =
+            (r.relief_regulation, r.channel("p0_Pa"), r.channel("p1_Pa"))
+        else {
+            continue;
+        };
+        let pre = if multi {
+            format!("{} ", r.label)
+        } else {
+            String::new()
+        };
+        for (k, (g, other)) in reg.iter().zip([p1, p0]).enumerate() {
+            let pc: Vec<f64> = other.iter().map(|po| g.cracking_pressure_pa(*po)).collect();
+            p = p
+                .dashed(&format!("{pre}valve {k} cracks at"), &r.azimuth_deg, &pc)
+                .colour(SIDE_COLOURS[k]);
+        }
+    }
+    p
+}
+
+/// The relief-valve figures: poppet displacement, velocity and flow of both valves, as their
+/// envelope over the hydraulic sub-steps where the run has it, on an azimuth window that
+/// does not cut a valve opening; and the caption's account of both.
+fn valve_plots(phys: &[&ModelRun]) -> (Vec<Plot>, String) {
+    let env = phys
+        .iter()
+        .all(|r| r.channel("x_valve0_substep_max_m").is_some());
+    // Window start: of 0, -90, -180 deg the one farthest from any sample with a valve open.
+    let mut open: Vec<f64> = vec![];
+    for r in phys {
+        for ch in ["x_valve0", "x_valve1"] {
+            let name = if env {
+                format!("{ch}_substep_max_m")
+            } else {
+                format!("{ch}_m")
+            };
+            if let Some(v) = r.channel(&name) {
+                open.extend(
+                    r.azimuth_deg
+                        .iter()
+                        .zip(v)
+                        .filter(|(_, x)| **x > 1e-9)
+                        .map(|(a, _)| *a),
+                );
+            }
+        }
+    }
+    let gap = |s: f64| {
+        open.iter()
+            .map(|a| {
+                let d = (a - s).rem_euclid(360.0);
+                d.min(360.0 - d)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let start = [0.0, -90.0, -180.0]
+        .into_iter()
+        .fold((0.0, gap(0.0)), |best, s| {
+            let g = gap(s);
+            if g > best.1 + 1e-9 {
+                (s, g)
+            } else {
+                best
+            }
+        })
+        .0;
+    // One revolution from `start`, closed periodically at start + 360.
+    let wrap = |az: &[f64], v: &[f64]| -> (Vec<f64>, Vec<f64>) {
+        let mut pts: Vec<(f64, f64)> = az
+            .iter()
+            .zip(v)
+            .map(|(a, y)| (start + (a - start).rem_euclid(360.0), *y))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some(&(a, y)) = pts.first() {
+            pts.push((a + 360.0, y));
+        }
+        pts.into_iter().unzip()
+    };
+    let multi = phys.len() > 1;
+    let panel = |title: &str, ylabel: &str, q: &str, unit: &str| -> Plot {
+        let (_, scale) = unit_of(unit);
+        let mut p = Plot::new(title, "azimuth [deg]", ylabel)
+            .x_range(start, start + 360.0)
+            .x_step(90.0)
+            .y_scale(scale);
+        for r in phys {
+            let pre = if multi {
+                format!("{} ", r.label)
+            } else {
+                String::new()
+            };
+            for (k, &colour) in SIDE_COLOURS.iter().enumerate() {
+                let series: Vec<(String, SeriesKind)> = if env {
+                    vec![
+                        (format!("{q}{k}_substep_max{unit}"), SeriesKind::Line),
+                        (format!("{q}{k}_substep_min{unit}"), SeriesKind::Dotted),
+                    ]
+                } else {
+                    vec![(format!("{q}{k}{unit}"), SeriesKind::Line)]
+                };
+                for (ch, kind) in series {
+                    let Some(v) = r.channel(&ch) else { continue };
+                    let (x, y) = wrap(&r.azimuth_deg, v);
+                    let what = match (env, kind) {
+                        (false, _) => String::new(),
+                        (true, SeriesKind::Line) => " max".into(),
+                        _ => " min".into(),
+                    };
+                    p = p
+                        .series(kind, &format!("{pre}valve {k}{what}"), &x, &y)
+                        .colour(colour);
+                }
+            }
+        }
+        p
+    };
+    let plots = vec![
+        panel(
+            "Relief valve poppet displacements",
+            "poppet displacement [mm]",
+            "x_valve",
+            "_m",
+        ),
+        panel(
+            "Relief valve poppet velocities",
+            "poppet velocity [mm/s]",
+            "v_valve",
+            "_m_s",
+        ),
+        panel(
+            "Relief valve flows",
+            "relief valve flow [L/s]",
+            "q_valve",
+            "_m3_s",
+        ),
+    ];
+    let sampling = if env {
+        "Each valve's minimum (dotted) and maximum (solid) over the hydraulic sub-steps of every structural step, drawn at the step's starting azimuth: the poppet moves within a step, and one sample per step would alias that motion into apparent chatter."
+    } else {
+        "One sample per structural step (this run has no sub-step envelope): motion within a step is not shown and may alias."
+    };
+    let window = if start == 0.0 {
+        "Azimuth 0-360 deg (no valve opening there straddles 0 deg).".to_string()
+    } else {
+        format!(
+            "Azimuth window {start:.0} to {:.0} deg (a negative azimuth is that plus 360 deg), chosen so that no valve opening is cut at the window's edge.",
+            start + 360.0
+        )
+    };
+    (plots, format!("{sampling} {window}"))
 }
 
 fn svg(rep: &mut HtmlReport, caption: &str, plots: &[Plot]) {
@@ -392,6 +721,33 @@ fn channel_plot(runs: &[&ModelRun], title: &str, channels: &[(&str, &str)]) -> P
         }
     }
     p
+}
+
+/// A channel name in words with its unit ("hub_fx_fixed_N" -> "hub force x, fixed frame [N]").
+pub fn readable_channel(ch: &str) -> String {
+    let (stem, unit) = [("_Nm", "N m"), ("_N", "N")]
+        .iter()
+        .find_map(|(suf, u)| ch.strip_suffix(suf).map(|s| (s, *u)))
+        .unwrap_or((ch, ""));
+    let mut words: Vec<String> = vec![];
+    let mut fixed = false;
+    for w in stem.split('_') {
+        match w {
+            "fixed" => fixed = true,
+            "fx" | "fy" | "fz" => words.push(format!("force {}", &w[1..])),
+            "mx" | "my" | "mz" => words.push(format!("moment {}", &w[1..])),
+            _ => words.push(w.to_string()),
+        }
+    }
+    let mut s = words.join(" ");
+    if fixed {
+        s.push_str(", fixed frame");
+    }
+    if unit.is_empty() {
+        s
+    } else {
+        format!("{s} [{unit}]")
+    }
 }
 
 fn fmt(x: f64, prec: usize) -> String {
@@ -552,15 +908,15 @@ pub fn report_html(
         info.rotor_model, info.flight
     ));
     let syn = if info.synthetic { "SYNTHETIC " } else { "" };
-    let ok_runs: Vec<&ModelRun> = outcomes
+    let ok: Vec<(&ModelRun, &ModelFigures)> = outcomes
         .iter()
         .zip(figs)
         .filter_map(|(o, f)| match (&o.result, f) {
-            (Ok(r), Some(Ok(_))) => Some(r),
+            (Ok(r), Some(Ok(f))) => Some((r, f)),
             _ => None,
         })
         .collect();
-    verdict(&mut rep, info, &ok_runs, measured, rank);
+    verdict(&mut rep, info, &ok, measured, rank);
     rep.paragraph(&format!(
         "Rotor deck {}, damper deck {}, flight record {}{}; at most {} revolutions of {} steps (each model stops once periodic), hydraulics {} with {} sub-steps. Total wall time {:.1} s.",
         info.rotor,
@@ -573,14 +929,6 @@ pub fn report_html(
         info.substeps,
         info.wall_s
     ));
-    let ok: Vec<(&ModelRun, &ModelFigures)> = outcomes
-        .iter()
-        .zip(figs)
-        .filter_map(|(o, f)| match (&o.result, f) {
-            (Ok(r), Some(Ok(f))) => Some((r, f)),
-            _ => None,
-        })
-        .collect();
     for (o, f) in outcomes.iter().zip(figs) {
         match (&o.result, f) {
             (Err(e), _) | (Ok(_), Some(Err(e))) => {
@@ -596,6 +944,7 @@ pub fn report_html(
     if info.rotor_model.contains("rigid-blade") {
         rep.banner(Banner::Info, "Rotor model: the rigid-blade reduction of the rotor deck (--model rigid): the blade rigid on its lag hinge, no flap, no elastic bending or twist, airloads projected with the control pitch (docs/rotor_model.md). For damper comparisons on records of rigid-blade generators; blade loads need the multibody model.");
     }
+    rep.contents();
     top_figures(&mut rep, info, &runs, measured.as_ref().ok());
 
     // The findings in words.
@@ -654,6 +1003,18 @@ pub fn report_html(
     // Metrics table.
     rep.heading(2, "Metrics");
     let mut rows = Vec::new();
+    if let Ok(m) = measured {
+        let st = Stats::of(&m.force_n);
+        let mut row = vec![
+            format!("{syn}measured"),
+            fmt(st.min, 0),
+            fmt(st.max, 0),
+            fmt(st.peak_to_peak, 0),
+            fmt(st.rms, 0),
+        ];
+        row.extend(std::iter::repeat_n("-".to_string(), 7));
+        rows.push(row);
+    }
     for (r, f) in &ok {
         let m = f.metrics.as_ref();
         let t = r.timing;
@@ -674,18 +1035,18 @@ pub fn report_html(
     }
     rep.table(
         &[
-            "model",
-            "F min [N]",
-            "F max [N]",
-            "F p-p [N]",
-            "F RMS [N]",
+            "damper force of",
+            "min [N]",
+            "max [N]",
+            "peak-to-peak [N]",
+            "RMS [N]",
             "RMS error [N]",
-            "p-p error [N]",
-            "correlation",
-            "periodicity residual",
-            "wall [s]",
-            "structure [s]",
-            "hydraulics [s]",
+            "peak-to-peak error [N]",
+            "correlation [-]",
+            "periodicity residual [-]",
+            "wall time [s]",
+            "structure time [s]",
+            "hydraulics time [s]",
         ],
         &rows,
     );
@@ -711,26 +1072,44 @@ pub fn report_html(
             }
         }
         let hdr: Vec<String> = (0..=super::N_HARMONICS)
-            .map(|n| format!("{n}/rev [N]"))
+            .map(|n| {
+                if n == 0 {
+                    "0/rev: |mean| [N]".to_string()
+                } else {
+                    format!("{n}/rev [N]")
+                }
+            })
             .collect();
-        let mut h: Vec<&str> = vec!["damper force amplitude"];
+        rep.paragraph("Damper force harmonics: the amplitude of each harmonic [N], of the measurement, of each model and of each model's residual (model - measured).");
+        let mut h: Vec<&str> = vec!["damper force of"];
         h.extend(hdr.iter().map(|s| s.as_str()));
         rep.table(&h, &hrows);
     }
 
     // Figures.
-    rep.heading(2, "Damper force (paper Fig. 16)");
-    let mut pf = channel_plot(&runs, "Damper force", &[("damper_force_N", "")]);
-    if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
-        pf = pf
-            .dashed("relief-valve limit (max)", &[0.0, 360.0], &[hi, hi])
-            .dashed("relief-valve limit (min)", &[0.0, 360.0], &[lo, lo]);
+    // With a measurement the first figure already shows the force and the cracking forces.
+    if measured.is_err() {
+        rep.heading(2, "Damper force (paper Fig. 16)");
+        let mut pf = channel_plot(&runs, "Damper force", &[("damper_force_N", "")]);
+        if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
+            pf = pf
+                .dashed(
+                    "relief-valve cracking force (max)",
+                    &[0.0, 360.0],
+                    &[hi, hi],
+                )
+                .dashed(
+                    "relief-valve cracking force (min)",
+                    &[0.0, 360.0],
+                    &[lo, lo],
+                );
+        }
+        svg(
+            &mut rep,
+            "Damper force over the last revolution, with the relief-valve cracking forces.",
+            &[pf],
+        );
     }
-    svg(
-        &mut rep,
-        "Damper force over the last revolution, with the relief-valve cracking forces.",
-        &[pf],
-    );
     let phys: Vec<&ModelRun> = runs
         .iter()
         .copied()
@@ -744,12 +1123,8 @@ pub fn report_html(
         rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
         svg(
             &mut rep,
-            "Chamber pressures (cf. Fig. 18).",
-            &[channel_plot(
-                &phys,
-                "Chamber pressures",
-                &[("p0_Pa", "p0"), ("p1_Pa", "p1")],
-            )],
+            "Chamber pressures (cf. Fig. 18). Chamber 0 grows with the stroke, so it is compressed (and loaded) when the damper shortens; chamber 1 when it extends (docs/formats.md). Dashed, in the chamber's colour: the pressure at which the chamber's relief valve cracks, F_p / A_front + (A_back / A_front) p_other, which follows the other chamber's pressure p_other (Eq. 5); the valve opens where its chamber's pressure reaches that line.",
+            &[pressure_plot(&phys)],
         );
         svg(
             &mut rep,
@@ -760,31 +1135,11 @@ pub fn report_html(
                 &[("q_orifice_m3_s", "")],
             )],
         );
-        let mut valve = vec![channel_plot(
-            &phys,
-            "Relief valve displacements",
-            &[("x_valve0_m", "valve 0"), ("x_valve1_m", "valve 1")],
-        )];
-        if phys.iter().any(|r| r.channel("v_valve0_m_s").is_some()) {
-            valve.push(channel_plot(
-                &phys,
-                "Relief valve velocities",
-                &[("v_valve0_m_s", "valve 0"), ("v_valve1_m_s", "valve 1")],
-            ));
-        }
+        let (valves, how) = valve_plots(&phys);
         svg(
             &mut rep,
-            "Relief valve poppet displacement (top) and velocity (bottom) (cf. Fig. 20).",
-            &valve,
-        );
-        svg(
-            &mut rep,
-            "Volumetric flow through the relief valves (cf. Fig. 21).",
-            &[channel_plot(
-                &phys,
-                "Relief valve flows",
-                &[("q_valve0_m3_s", "valve 0"), ("q_valve1_m3_s", "valve 1")],
-            )],
+            &format!("Relief valve poppet displacement (top; cf. Fig. 20), velocity (middle) and flow (bottom; cf. Fig. 21). {how}"),
+            &valves,
         );
     }
 
@@ -823,33 +1178,19 @@ pub fn report_html(
         ],
         &per,
     );
-    let mut frows = Vec::new();
-    for r in &runs {
-        for m in &r.periodic.floquet_multipliers {
-            frows.push(vec![
-                r.label.clone(),
-                if m.mode.is_empty() {
-                    "-".into()
-                } else {
-                    m.mode.clone()
-                },
-                format!("{:.6} {:+.6}i", m.re, m.im),
-                format!("{:.4}", m.magnitude),
-                format!("{:.4}", m.frequency_per_rev),
-                format!("{:.4}", m.damping_ratio),
-            ]);
-        }
-    }
+    let frows = floquet_rows(&runs);
     if !frows.is_empty() {
-        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency; the mode label is the largest of tip lag, flap and twist in the mode.");
+        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode.");
+        rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
         rep.table(
             &[
                 "model",
                 "mode",
+                "kind",
                 "multiplier",
-                "|mu|",
+                "decay per rev |mu|",
                 "frequency [/rev, mod 1]",
-                "damping ratio",
+                "damping ratio [-]",
             ],
             &frows,
         );
@@ -858,6 +1199,93 @@ pub fn report_html(
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: docs/formats.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()
+}
+
+/// Panels of `channels` grouped so that the components in one panel are within a factor 5 of
+/// each other in peak magnitude (over all runs); largest first.
+fn root_groups(
+    runs: &[&ModelRun],
+    title: &str,
+    quantity: &str,
+    channels: &[(&str, &str)],
+) -> Vec<Plot> {
+    let mut peak: Vec<(f64, (&str, &str))> = channels
+        .iter()
+        .filter_map(|c| {
+            let m = runs
+                .iter()
+                .filter_map(|r| r.channel(c.0))
+                .flat_map(|v| v.iter().map(|x| x.abs()))
+                .fold(f64::NAN, f64::max);
+            m.is_finite().then_some((m, *c))
+        })
+        .collect();
+    peak.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut groups: Vec<Vec<(&str, &str)>> = vec![];
+    let mut top = f64::NAN;
+    for (m, c) in peak {
+        match groups.last_mut() {
+            Some(g) if m * 5.0 >= top => g.push(c),
+            _ => {
+                groups.push(vec![c]);
+                top = m;
+            }
+        }
+    }
+    groups
+        .iter_mut()
+        .map(|g| {
+            g.sort_by_key(|c| channels.iter().position(|x| x.0 == c.0));
+            let names: Vec<&str> = g
+                .iter()
+                .map(|c| c.1.split(' ').next().unwrap_or(""))
+                .collect();
+            let plural = if g.len() > 1 { "s" } else { "" };
+            let mut p = channel_plot(runs, &format!("{title}{plural} {}", names.join(", ")), g);
+            let (unit, _) = unit_of(g[0].0);
+            p.y_label = format!("{quantity} [{unit}]");
+            p
+        })
+        .collect()
+}
+
+/// Rows of the Floquet table: a real multiplier is named as such, with no damping ratio (the
+/// formula's 1 for a real positive one is not a damping).
+pub fn floquet_rows(runs: &[&ModelRun]) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    for r in runs {
+        for m in &r.periodic.floquet_multipliers {
+            let (kind, freq, zeta) = if m.im != 0.0 {
+                (
+                    "complex pair",
+                    format!("{:.4}", m.frequency_per_rev),
+                    format!("{:.4}", m.damping_ratio),
+                )
+            } else if m.re >= 0.0 {
+                ("real (non-oscillatory)", "-".into(), "-".into())
+            } else {
+                (
+                    "real negative (sign flips every rev)",
+                    "0.5".into(),
+                    format!("{:.4}", m.damping_ratio),
+                )
+            };
+            rows.push(vec![
+                r.label.clone(),
+                if m.mode.is_empty() {
+                    "-".into()
+                } else {
+                    m.mode.clone()
+                },
+                kind.into(),
+                format!("{:.6} {:+.6}i", m.re, m.im),
+                format!("{:.4}", m.magnitude),
+                freq,
+                zeta,
+            ]);
+        }
+    }
+    rows
 }
 
 /// Radial distributions of the section loads, pitch-link and root loads vs azimuth, and the
@@ -877,14 +1305,16 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     let multi = with.len() > 1;
     let mut plots = vec![];
     for (kind, unit) in SECTION_KINDS.iter().take(3) {
+        let shown = if *unit == "Nm" { "kN m" } else { "kN" };
         let mut p = Plot::new(
             &format!(
                 "{} along the blade: mean (solid), half peak-to-peak (dashed)",
                 kind.replace('_', " ")
             ),
-            "r/R",
-            &format!("[{unit}]"),
-        );
+            "radial station r/R [-]",
+            &format!("{} [{shown}]", kind.replace('_', " ")),
+        )
+        .y_scale(1e-3);
         for r in &with {
             let mut pts: Vec<(f64, f64, f64)> = vec![];
             for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
@@ -926,21 +1356,31 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
             &[("pitch_link_force_N", "")],
         )],
     );
+    // Grouped by magnitude: the centrifugal fx is ten times the shears and would flatten them.
+    let mut root = root_groups(
+        &with,
+        "Root force",
+        "root force",
+        &[
+            ("root_fx_N", "fx (radial)"),
+            ("root_fy_N", "fy (lead)"),
+            ("root_fz_N", "fz (up)"),
+        ],
+    );
+    root.extend(root_groups(
+        &with,
+        "Root moment",
+        "root moment",
+        &[
+            ("root_mx_Nm", "mx (about x)"),
+            ("root_my_Nm", "my (about y)"),
+            ("root_mz_Nm", "mz (about z)"),
+        ],
+    ));
     svg(
         rep,
-        "Blade root loads at the hub centre, rotating hub frame (x outward, y toward the leading edge, z up): forces (top), moments (bottom).",
-        &[
-            channel_plot(
-                &with,
-                "Root forces",
-                &[("root_fx_N", "fx"), ("root_fy_N", "fy"), ("root_fz_N", "fz")],
-            ),
-            channel_plot(
-                &with,
-                "Root moments",
-                &[("root_mx_Nm", "mx"), ("root_my_Nm", "my"), ("root_mz_Nm", "mz")],
-            ),
-        ],
+        "Blade root loads at the hub centre, rotating hub frame (x outward, y toward the leading edge, z up): forces, then moments, each panel holding the components of like magnitude.",
+        &root,
     );
     let mut rows = vec![];
     for r in &with {
@@ -955,7 +1395,7 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
             let nb = r.blades.unwrap_or(4);
             rows.push(vec![
                 r.label.clone(),
-                ch.to_string(),
+                readable_channel(ch),
                 format!("{:.1}", amp(0)),
                 format!("{:.1} ({nb}/rev)", amp(nb)),
                 format!("{:.1} ({}/rev)", amp(2 * nb), 2 * nb),
@@ -975,8 +1415,39 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     if !rows.is_empty() {
         rep.paragraph("Hub loads in the non-rotating frame (x along the reference blade at azimuth 0, z up): the rotor's identical blades' root loads summed, so only multiples of N/rev remain. Amplitudes [N, N m]:");
         rep.table(
-            &["model", "channel", "mean (0/rev)", "N/rev", "2N/rev"],
+            &["model", "hub load", "mean (0/rev)", "N/rev", "2N/rev"],
             &rows,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn without_a_recorded_stroke_the_split_says_why_it_cannot_be_made() {
+        let m = Measured {
+            azimuth_deg: vec![0.0, 90.0, 180.0, 270.0],
+            force_n: vec![1.0, 0.0, -1.0, 0.0],
+            stroke_m: None,
+            revolutions: 1,
+            synthetic: false,
+        };
+        let s = rotor_damper_split(&[], &m);
+        assert_eq!(s.len(), 1);
+        assert!(s[0].contains("cannot be made") && s[0].contains("no damper stroke"));
+    }
+
+    #[test]
+    fn hub_channels_read_as_words_with_units() {
+        assert_eq!(
+            readable_channel("hub_fx_fixed_N"),
+            "hub force x, fixed frame [N]"
+        );
+        assert_eq!(
+            readable_channel("hub_my_fixed_Nm"),
+            "hub moment y, fixed frame [N m]"
         );
     }
 }

@@ -945,6 +945,8 @@ mod tests {
             area_ratio: 80.0,
             k_n_per_m: 2.0e4,
             c_n_s_per_m: 200.0,
+            preload_pressure_pa: 8.9e6,
+            back_area_ratio: 1.0,
         };
         let x = [0.0, 2.0e-5, 1.0e-5];
         let v = [0.0, 0.01, 0.002];
