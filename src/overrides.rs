@@ -70,6 +70,17 @@ pub fn parse_value(text: &str) -> Value {
         .unwrap_or_else(|| Value::String(text.to_string()))
 }
 
+/// A value as plain text for tables and messages (strings unquoted).
+pub fn display(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        // shortest text that reads back to the same number, in exponent form when small or large
+        Value::Float(x) if *x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e6) => format!("{x:e}"),
+        Value::Float(x) => format!("{x:?}"),
+        v => v.to_string(),
+    }
+}
+
 fn type_name(v: &Value) -> &'static str {
     match v {
         Value::String(_) => "a string",

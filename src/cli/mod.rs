@@ -67,6 +67,7 @@ pub mod expand;
 pub mod inspect;
 pub mod modes;
 pub mod run_cmd;
+mod run_console;
 pub mod static_cmd;
 pub mod sweep;
 pub mod verify;

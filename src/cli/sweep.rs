@@ -1,15 +1,12 @@
 //! `rotorsim sweep`: batch forced-response runs from a plan, on this machine or as the shards of
 //! a Slurm job array (docs/sweep.md).
-use super::run_cmd::{self, RunArgs};
-use crate::flight::FlightRecord;
-use crate::sweep::{self, Case, CaseRunner, Plan, SweepOptions, SweepProgress};
-use anyhow::{anyhow, bail, Context};
-use clap::{Args, Parser, Subcommand};
+use crate::sweep::{self, Case, JobRunner, Plan, SweepOptions, SweepProgress};
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -68,80 +65,6 @@ fn at_least_one(s: &str) -> Result<usize, String> {
         Err(_) => Err(format!(
             "expected a whole number of at least 1, found `{s}`"
         )),
-    }
-}
-
-/// Runs a case in this process as `rotorsim run` would, printing nothing. Checks each flight
-/// record once (by path) however many cases use it.
-#[derive(Default)]
-struct Runner {
-    records:
-        std::sync::Mutex<std::collections::HashMap<PathBuf, Result<Arc<FlightRecord>, String>>>,
-}
-
-/// `rotorsim run` arguments of `case` writing to `out`.
-fn run_args(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunArgs> {
-    let mut argv: Vec<String> = vec!["rotorsim".into(), "run".into()];
-    for (k, v) in &case.settings {
-        if k.contains('.') {
-            argv.push("--set".into());
-            argv.push(format!("{k}={v}"));
-            continue;
-        }
-        let flag = format!("--{}", k.replace('_', "-"));
-        match v {
-            toml::Value::Boolean(true) => argv.push(flag),
-            toml::Value::Boolean(false) => {}
-            toml::Value::String(s) => argv.extend([flag, s.clone()]),
-            v => argv.extend([flag, v.to_string()]),
-        }
-    }
-    argv.push("--out".into());
-    argv.push(out.display().to_string());
-    if let Some(p) = initial {
-        argv.push("--initial-state".into());
-        argv.push(p.display().to_string());
-    }
-    let cli = super::Cli::try_parse_from(&argv).map_err(|e| {
-        anyhow!(
-            "{}",
-            e.render()
-                .to_string()
-                .lines()
-                .next()
-                .unwrap_or("bad option")
-                .trim_start_matches("error: ")
-        )
-    })?;
-    match cli.command {
-        super::Command::Run(mut a) => {
-            a.quiet = true;
-            Ok(a)
-        }
-        _ => bail!("internal: not a run command"),
-    }
-}
-
-impl CaseRunner for Runner {
-    fn check(&self, case: &Case) -> anyhow::Result<()> {
-        let record = |p: &Path| -> anyhow::Result<Arc<FlightRecord>> {
-            let known = self.records.lock().ok().and_then(|m| m.get(p).cloned());
-            let r = match known {
-                Some(r) => r,
-                None => {
-                    let r = run_cmd::check_record(p).map_err(|e| format!("{e:#}"));
-                    if let Ok(mut m) = self.records.lock() {
-                        m.insert(p.to_path_buf(), r.clone());
-                    }
-                    r
-                }
-            };
-            r.map_err(|e| anyhow!(e))
-        };
-        run_cmd::check_with(&run_args(case, Path::new("unused"), None)?, &record)
-    }
-    fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()> {
-        run_cmd::run(run_args(case, out, initial)?)
     }
 }
 
@@ -219,7 +142,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     if args.no_warm_start {
         plan.warm_start = false;
     }
-    let runner = Runner::default();
+    let runner = JobRunner::default();
     let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
     let tty = std::io::stderr().is_terminal();
     check_with_progress(&plan, &runner, jobs, tty)?;
@@ -331,7 +254,12 @@ fn merge(dir: &Path) -> anyhow::Result<()> {
 
 /// Checks every case before any runs, with a progress bar on a terminal, otherwise a line
 /// every few seconds when checking takes long (a plan of many cases).
-fn check_with_progress(plan: &Plan, runner: &Runner, jobs: usize, tty: bool) -> anyhow::Result<()> {
+fn check_with_progress(
+    plan: &Plan,
+    runner: &JobRunner,
+    jobs: usize,
+    tty: bool,
+) -> anyhow::Result<()> {
     let total = plan.cases.len();
     let t0 = Instant::now();
     let last = std::sync::Mutex::new(0.0f64);

@@ -14,6 +14,7 @@
 //! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check).
 pub mod bench;
 pub mod decay;
+pub mod job;
 pub mod loads;
 pub mod mcap_out;
 pub mod outputs;

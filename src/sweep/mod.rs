@@ -16,15 +16,17 @@
 //! (and plan.json, the same bytes for every shard), so shards never collide; [`table`] builds
 //! sweep.csv from the case folders whoever ran them.
 pub mod plan;
+pub mod runner;
 pub mod table;
 
 pub use plan::{Case, Plan};
+pub use runner::JobRunner;
 
 use anyhow::{anyhow, bail, Context};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
-/// Runs one case; implemented by the command line (`rotorsim run` without its console output).
+/// Runs one case: [`JobRunner`] (a [`crate::run::job::RunJob`] per case), or a stand-in in tests.
 pub trait CaseRunner: Sync {
     /// Checks the case without running it: options, decks with their overrides, the record.
     fn check(&self, case: &Case) -> anyhow::Result<()>;

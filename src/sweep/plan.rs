@@ -119,19 +119,9 @@ pub struct Plan {
     pub group_size: usize,
 }
 
-fn value_text(v: &Value) -> String {
-    match v {
-        Value::String(s) => s.clone(),
-        // shortest text that reads back to the same number, in exponent form when small or large
-        Value::Float(x) if *x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e6) => format!("{x:e}"),
-        Value::Float(x) => format!("{x:?}"),
-        v => v.to_string(),
-    }
-}
-
 /// A value as plain text for tables and messages (strings unquoted).
 pub fn display(v: &Value) -> String {
-    value_text(v)
+    crate::overrides::display(v)
 }
 
 impl Plan {
@@ -369,7 +359,7 @@ impl Plan {
     pub fn varied(&self, case: &Case) -> Vec<String> {
         self.keys
             .iter()
-            .map(|k| case.settings.get(k).map(value_text).unwrap_or_default())
+            .map(|k| case.settings.get(k).map(display).unwrap_or_default())
             .collect()
     }
 

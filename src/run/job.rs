@@ -1,0 +1,685 @@
+//! One `rotorsim run` as library code: a [`RunJob`] (plain data) checked by [`RunJob::check`]
+//! and run by [`RunJob::execute`] into its result folder. The command line, the sweep's cases
+//! and the Python package all run through it; they differ only in what they show (a
+//! [`RunObserver`]) and print (from the returned [`RunOutcome`]).
+use crate::flight::FlightRecord;
+use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
+use crate::io::OutDir;
+use crate::overrides::Override;
+use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
+use crate::run::outputs::{write_outputs, Written};
+use crate::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams, RIGID_LABEL};
+use crate::run::summary::{Measured, RunInfo};
+use crate::run::{self, fmt_measure, ModelOutcome, ModelRun, PeriodicMethod, Progress, Silent};
+use crate::solver::NewtonMethod;
+use anyhow::{anyhow, bail, Context};
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Defaults of a run (those of `rotorsim run`'s options).
+pub const DEFAULT_ROTOR: &str = "rotors/uh60a.toml";
+pub const DEFAULT_FLIGHT: &str = "flightdata/c8534like";
+pub const DEFAULT_REVS: usize = 75;
+pub const DEFAULT_STEPS_PER_REV: usize = 256;
+pub const DEFAULT_SUBSTEPS: usize = 25;
+
+/// The damper models a run compares: all three side by side, or one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DamperChoice {
+    #[default]
+    All,
+    One(DamperModel),
+}
+
+impl DamperChoice {
+    pub fn models(self) -> Vec<DamperModel> {
+        match self {
+            DamperChoice::All => vec![
+                DamperModel::Linear,
+                DamperModel::Nonlinear,
+                DamperModel::Physical,
+            ],
+            DamperChoice::One(m) => vec![m],
+        }
+    }
+}
+
+impl FromStr for DamperChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "all" => Ok(DamperChoice::All),
+            _ => s
+                .parse()
+                .map(DamperChoice::One)
+                .map_err(|e: String| format!("{e} (or all for the three in parallel)")),
+        }
+    }
+}
+
+/// The rotor model a run drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum RotorModel {
+    /// The multibody model of the rotor deck.
+    #[default]
+    Uh60a,
+    /// The rotor deck's blade rigid on its lag hinge (docs/rotor_model.md, "Rigid-blade
+    /// reduction").
+    Rigid,
+    /// A fast test double of the pipeline, not a rotor model: reads only the `[damper]` table.
+    Sdof,
+}
+
+impl RotorModel {
+    pub fn name(self) -> &'static str {
+        match self {
+            RotorModel::Uh60a => "uh60a",
+            RotorModel::Rigid => "rigid",
+            RotorModel::Sdof => "sdof",
+        }
+    }
+}
+
+impl FromStr for RotorModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "uh60a" => Ok(RotorModel::Uh60a),
+            "rigid" => Ok(RotorModel::Rigid),
+            "sdof" => Ok(RotorModel::Sdof),
+            m => Err(format!(
+                "unknown rotor model '{m}' (expected uh60a, rigid or sdof)"
+            )),
+        }
+    }
+}
+
+impl FromStr for PeriodicMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "shooting" => Ok(PeriodicMethod::Shooting),
+            "march" => Ok(PeriodicMethod::March),
+            m => Err(format!("unknown method '{m}' (expected shooting or march)")),
+        }
+    }
+}
+
+/// A hydraulic sub-step scheme with the name it was given: summary.json records that name
+/// (`sdirk3` stays `sdirk3`, an alias of `implicit`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SchemeChoice {
+    pub scheme: Scheme,
+    pub name: String,
+}
+
+impl Default for SchemeChoice {
+    fn default() -> Self {
+        SchemeChoice {
+            scheme: Scheme::Rk4,
+            name: "rk4".into(),
+        }
+    }
+}
+
+impl FromStr for SchemeChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(SchemeChoice {
+            scheme: s.parse()?,
+            name: s.to_string(),
+        })
+    }
+}
+
+/// `text` parsed as the value of option `flag`, an error naming the option.
+pub fn parse_option<T: FromStr<Err = String>>(flag: &str, text: &str) -> anyhow::Result<T> {
+    text.parse().map_err(|e: String| anyhow!("{flag}: {e}"))
+}
+
+/// The options of a run given by name (on the command line, in a sweep plan), as text.
+#[derive(Clone, Debug)]
+pub struct NamedOptions<'a> {
+    pub damper: &'a str,
+    pub scheme: &'a str,
+    pub newton: &'a str,
+    pub periodic: &'a str,
+    pub model: &'a str,
+}
+
+impl Default for NamedOptions<'_> {
+    fn default() -> Self {
+        NamedOptions {
+            damper: "all",
+            scheme: "rk4",
+            newton: "modified",
+            periodic: "shooting",
+            model: "uh60a",
+        }
+    }
+}
+
+/// One forced-response run (`rotorsim run`): every option, typed. [`RunJob::new`] gives the
+/// command line's defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunJob {
+    /// Rotor deck (docs/rotor_deck.md); the damper deck too without `damper_deck`.
+    pub rotor: PathBuf,
+    /// Flight record: MCAP file or CSV stem (docs/formats.md).
+    pub flight: PathBuf,
+    pub damper: DamperChoice,
+    /// Damper deck overriding the rotor deck's `[damper]` table.
+    pub damper_deck: Option<PathBuf>,
+    /// Most revolutions integrated per model.
+    pub revs: usize,
+    pub periodic: PeriodicMethod,
+    /// Periodicity residual at which a model stops.
+    pub periodic_tol: f64,
+    /// A periodic_state.json, or the folder of an earlier run (one state per model).
+    pub initial_state: Option<PathBuf>,
+    /// A model that does not reach `periodic_tol` makes the run an error.
+    pub require_periodic: bool,
+    /// Also write `<model>/all_revs.csv`.
+    pub write_all_revs: bool,
+    pub steps_per_rev: usize,
+    pub substeps: usize,
+    pub scheme: SchemeChoice,
+    pub model: RotorModel,
+    pub newton: NewtonMethod,
+    /// Deck values overridden by dotted path, applied before validation.
+    pub overrides: Vec<Override>,
+    /// Result folder.
+    pub out: PathBuf,
+}
+
+/// What a run is about to do (after its checks, its result folder created).
+#[derive(Clone, Debug)]
+pub struct RunStart {
+    pub models: Vec<DamperModel>,
+    pub method: PeriodicMethod,
+    pub tol: f64,
+    pub revs: usize,
+    pub steps_per_rev: usize,
+    pub model: RotorModel,
+}
+
+/// What a caller sees of a run while it runs: its start, then the models' progress (from
+/// their threads, model index as in [`RunStart::models`]).
+pub trait RunObserver: Progress {
+    fn start(&self, start: &RunStart);
+}
+
+impl RunObserver for Silent {
+    fn start(&self, _: &RunStart) {}
+}
+
+/// The files of a result folder to open, as published.
+#[derive(Clone, Debug)]
+pub struct Published {
+    pub folder: PathBuf,
+    pub report: PathBuf,
+    pub summary: PathBuf,
+    pub mcap: PathBuf,
+    /// `<model>/last_rev.csv` of each model that ran.
+    pub last_rev: Vec<(DamperModel, PathBuf)>,
+}
+
+/// What a run did, its outputs written.
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// One per model, in the order of [`RunStart::models`].
+    pub outcomes: Vec<ModelOutcome>,
+    /// The record's measured damper force, or why there is none to compare with.
+    pub measured: Result<Measured, String>,
+    /// Which model comes closest to the measured force (None without a measurement).
+    pub verdict: Option<String>,
+    /// The failed models ("model: error").
+    pub failed: Vec<String>,
+    pub published: Published,
+}
+
+impl RunOutcome {
+    /// The models that ran but did not reach the periodicity tolerance.
+    pub fn not_periodic(&self) -> impl Iterator<Item = &ModelRun> {
+        self.outcomes
+            .iter()
+            .filter_map(|o| o.result.as_ref().ok())
+            .filter(|r| !r.converged())
+    }
+}
+
+/// The error of a run that wrote its outputs and then failed (a model failed; a model not
+/// periodic under `require_periodic`), with its outcome. Its message is the run's error.
+#[derive(Debug)]
+pub struct RunFailed {
+    pub outcome: Box<RunOutcome>,
+    error: anyhow::Error,
+}
+
+impl std::fmt::Display for RunFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // the top message only: its causes follow as `source`, as in the error it wraps
+        write!(f, "{}", self.error)
+    }
+}
+
+impl std::error::Error for RunFailed {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.error.chain().nth(1)
+    }
+}
+
+/// Reads the flight record at `path` as a run does.
+pub fn read_record(path: &Path) -> anyhow::Result<Arc<FlightRecord>> {
+    FlightRecord::read(path)
+        .map(Arc::new)
+        .with_context(|| format!("reading flight record {}", path.display()))
+}
+
+/// The damper deck file `path` with the `damper.*` overrides applied, each validated.
+pub fn damper_deck_with(path: &Path, overrides: &[Override]) -> anyhow::Result<DamperDeck> {
+    if overrides.is_empty() {
+        return Ok(DamperDeck::from_file(path)?);
+    }
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow!("damper deck {file}: cannot read: {e}"))?;
+    DamperDeck::from_toml_str(&text, &file)?;
+    let text = crate::overrides::apply_all(&text, &file, overrides, |t, _| {
+        DamperDeck::from_toml_str(t, &file)?;
+        Ok(())
+    })?;
+    Ok(DamperDeck::from_toml_str(&text, &file)?)
+}
+
+impl RunJob {
+    /// A run into `out` with the defaults of `rotorsim run`.
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        RunJob {
+            rotor: DEFAULT_ROTOR.into(),
+            flight: DEFAULT_FLIGHT.into(),
+            damper: DamperChoice::All,
+            damper_deck: None,
+            revs: DEFAULT_REVS,
+            periodic: PeriodicMethod::Shooting,
+            periodic_tol: run::periodic::DEFAULT_TOL,
+            initial_state: None,
+            require_periodic: false,
+            write_all_revs: false,
+            steps_per_rev: DEFAULT_STEPS_PER_REV,
+            substeps: DEFAULT_SUBSTEPS,
+            scheme: SchemeChoice::default(),
+            model: RotorModel::Uh60a,
+            newton: NewtonMethod::Modified,
+            overrides: Vec::new(),
+            out: out.into(),
+        }
+    }
+
+    /// Sets the options given by name, each checked, in the order `rotorsim run` checks its
+    /// options (of several bad ones, the same is named); the counts and the tolerance must be
+    /// set before.
+    pub fn set_named(&mut self, n: &NamedOptions) -> anyhow::Result<()> {
+        self.damper = parse_option("--damper", n.damper)?;
+        self.scheme = parse_option("--scheme", n.scheme)?;
+        self.newton = parse_option("--newton", n.newton)?;
+        run::check_run_options(self.revs, self.steps_per_rev, self.substeps)?;
+        self.periodic = parse_option("--periodic", n.periodic)?;
+        self.check_tol()?;
+        self.model = parse_option("--model", n.model)?;
+        Ok(())
+    }
+
+    fn check_tol(&self) -> anyhow::Result<()> {
+        if !(self.periodic_tol > 0.0 && self.periodic_tol.is_finite()) {
+            bail!(
+                "--periodic-tol must be positive and finite (got {})",
+                self.periodic_tol
+            );
+        }
+        Ok(())
+    }
+
+    /// The options' own checks (counts, cost, tolerance).
+    fn check_options(&self) -> anyhow::Result<()> {
+        run::check_run_options(self.revs, self.steps_per_rev, self.substeps)?;
+        self.check_tol()
+    }
+
+    /// Checks the run as [`RunJob::execute`] does before it writes anything (options, record,
+    /// decks with their overrides), without running.
+    pub fn check(&self) -> anyhow::Result<()> {
+        self.check_with(&read_record)
+    }
+
+    /// [`RunJob::check`] with the flight record read by `record` (a sweep reads each record
+    /// once, not once per case: reading it is most of a case's check).
+    pub fn check_with(
+        &self,
+        record: &dyn Fn(&Path) -> anyhow::Result<Arc<FlightRecord>>,
+    ) -> anyhow::Result<()> {
+        self.check_options()?;
+        let record = record(&self.flight)?;
+        let (rotor, deck) = self.load_decks()?;
+        let models = self.damper.models();
+        for m in &models {
+            deck.require(*m)?;
+        }
+        self.check_rotor(rotor.as_ref(), &record, models.len())
+    }
+
+    /// The rotor deck (None for the sdof test double) and the damper deck, overrides applied
+    /// and validated.
+    pub fn load_decks(&self) -> anyhow::Result<(Option<RotorDeck>, DamperDeck)> {
+        let sdof = self.model == RotorModel::Sdof;
+        let (damper_sets, rotor_sets): (Vec<Override>, Vec<Override>) =
+            if self.damper_deck.is_some() || sdof {
+                self.overrides.iter().cloned().partition(|o| o.is_damper())
+            } else {
+                (Vec::new(), self.overrides.clone())
+            };
+        if sdof {
+            if let Some(o) = rotor_sets.first() {
+                bail!(
+                    "--set {o}: the sdof test double reads only the [damper] table (expected a damper.* key)"
+                );
+            }
+        }
+        let rotor = if sdof {
+            None
+        } else {
+            Some(RotorDeck::from_file_with(&self.rotor, &rotor_sets)?)
+        };
+        let deck = match (&self.damper_deck, &rotor) {
+            (Some(p), _) => damper_deck_with(p, &damper_sets)?,
+            (None, Some(r)) => r.damper()?,
+            (None, None) => damper_deck_with(&self.rotor, &damper_sets)?,
+        };
+        Ok((rotor, deck))
+    }
+
+    /// The record must be of the deck's rotor, and the elastic model's cost within the budget.
+    fn check_rotor(
+        &self,
+        rotor: Option<&RotorDeck>,
+        record: &FlightRecord,
+        n_models: usize,
+    ) -> anyhow::Result<()> {
+        let Some(r) = rotor else { return Ok(()) };
+        r.spec.check_record(record, &self.rotor)?;
+        if self.model == RotorModel::Uh60a {
+            let (ndof, nnz) = r.spec.size_estimate();
+            let steps = (self.revs * self.steps_per_rev) as f64;
+            // the models run side by side: their memory adds up, and their CPU time
+            let e = crate::solver::budget::time_integration_of(ndof, nnz, steps, 3.0)
+                .times(n_models as f64);
+            r.spec.check_budget(
+                &self.rotor,
+                &format!(
+                    "{n_models} model(s) x {} revolutions x {} steps",
+                    self.revs, self.steps_per_rev
+                ),
+                e,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Runs the models side by side into the result folder `out` and writes every output.
+    /// A failed model (the folder is then published incomplete) or, with `require_periodic`,
+    /// a model not periodic (published complete) is an error: a [`RunFailed`] carrying the
+    /// outcome. Errors before the outputs are written carry none.
+    pub fn execute(&self, observer: &dyn RunObserver) -> anyhow::Result<RunOutcome> {
+        let t0 = Instant::now();
+        let models = self.damper.models();
+        self.check_options()?;
+        let method = self.periodic;
+        let initial = match &self.initial_state {
+            None => vec![None; models.len()],
+            Some(p) if p.is_dir() => models
+                .iter()
+                .map(|m| {
+                    run::PeriodicStateFile::read(&p.join(m.name()).join("periodic_state.json"))
+                        .map(Some)
+                })
+                .collect::<anyhow::Result<_>>()?,
+            Some(p) => vec![Some(run::PeriodicStateFile::read(p)?); models.len()],
+        };
+        let (sdof, rigid) = (
+            self.model == RotorModel::Sdof,
+            self.model == RotorModel::Rigid,
+        );
+        let record = FlightRecord::read(&self.flight)
+            .with_context(|| format!("reading flight record {}", self.flight.display()))?;
+        let (rotor, deck) = self.load_decks()?;
+        for m in &models {
+            deck.require(*m)?;
+        }
+        self.check_rotor(rotor.as_ref(), &record, models.len())?;
+        let hydraulics = IntegratorOptions {
+            scheme: self.scheme.scheme,
+            substeps: self.substeps,
+        };
+        let opts = RunOptions {
+            steps_per_rev: self.steps_per_rev,
+            hydraulics,
+            newton: self.newton,
+            // the delayed perturbation damping vanishes on the periodic solution: it only
+            // speeds up marching, and its history would be part of the revolution map's state
+            perturbation_damping: method == PeriodicMethod::March,
+            ..RunOptions::default()
+        };
+        let sdof_params = if sdof {
+            Some(SdofParams::from_record(&record)?)
+        } else {
+            None
+        };
+        let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
+            match (&rotor, &sdof_params) {
+                (_, Some(p)) => Ok(Box::new(LagHingeSdof::new(
+                    p.clone(),
+                    &deck,
+                    m,
+                    hydraulics,
+                    self.steps_per_rev,
+                )?)),
+                (Some(r), None) if rigid => {
+                    Ok(Box::new(rigid_reduction(r, &deck, m, &record, &opts)?))
+                }
+                (Some(r), None) => crate::rotor::build(r, &deck, m, &record, &opts),
+                (None, None) => unreachable!("one rotor model is selected"),
+            }
+        };
+        let measured = Measured::from_record(&record);
+        let mut inputs = FlightRecord::files(&self.flight)?;
+        match (&rotor, &self.damper_deck) {
+            (Some(r), _) => inputs.extend(r.input_files()),
+            (None, None) => inputs.push(self.rotor.clone()),
+            (None, Some(_)) => {}
+        }
+        inputs.extend(self.damper_deck.clone());
+        let set_lines: Vec<String> = self
+            .overrides
+            .iter()
+            .map(|o| format!("{}={}", o.key, o.value_text()))
+            .collect();
+        let inputs_sha256 = crate::io::inputs_fingerprint(&inputs, &set_lines)
+            .map_err(|e| anyhow!("reading the inputs: {e}"))?;
+        match &self.initial_state {
+            Some(p) if p.is_dir() => inputs.extend(
+                models
+                    .iter()
+                    .map(|m| p.join(m.name()).join("periodic_state.json")),
+            ),
+            Some(p) => inputs.push(p.clone()),
+            None => {}
+        }
+        let out = OutDir::create(&self.out, &inputs)?;
+        observer.start(&RunStart {
+            models: models.clone(),
+            method,
+            tol: self.periodic_tol,
+            revs: self.revs,
+            steps_per_rev: self.steps_per_rev,
+            model: self.model,
+        });
+        let popts: Vec<run::PeriodicOptions> = initial
+            .into_iter()
+            .map(|init| run::PeriodicOptions {
+                method,
+                tol: self.periodic_tol,
+                max_revs: self.revs,
+                stop_early: true,
+                initial_state: init,
+                min_floquet_dirs: 0,
+                keep_all_revs: self.write_all_revs,
+                inputs_sha256: Some(inputs_sha256.clone()),
+            })
+            .collect();
+        let mut outcomes = run::run_models(&models, &popts, &build, observer);
+        // a failure of the physical model names the deck values behind it, where they are
+        // unusual
+        for o in outcomes
+            .iter_mut()
+            .filter(|o| o.model == DamperModel::Physical)
+        {
+            if let Err(e) = &mut o.result {
+                *e = deck.with_review(std::mem::take(e));
+            }
+        }
+        let info = self.info(sdof, rigid, inputs_sha256, &record, t0);
+        let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
+        let published = |name: &str| out.published_path(&out.file(name));
+        let published = Published {
+            folder: out.path().to_path_buf(),
+            report: published("report.html"),
+            summary: published("summary.json"),
+            mcap: published("result.mcap"),
+            last_rev: outcomes
+                .iter()
+                .filter(|o| o.result.is_ok())
+                .map(|o| {
+                    (
+                        o.model,
+                        published(&format!("{}/last_rev.csv", o.model.name())),
+                    )
+                })
+                .collect(),
+        };
+        let outcome = RunOutcome {
+            outcomes,
+            measured,
+            verdict,
+            failed,
+            published,
+        };
+        match self.publish(out, &outcome) {
+            Ok(()) => Ok(outcome),
+            Err(error) => Err(anyhow::Error::new(RunFailed {
+                outcome: Box::new(outcome),
+                error,
+            })),
+        }
+    }
+
+    /// Publishes the folder: complete, or incomplete when a model failed; an error when a
+    /// model failed or (`require_periodic`) is not periodic.
+    fn publish(&self, out: OutDir, outcome: &RunOutcome) -> anyhow::Result<()> {
+        let failed = &outcome.failed;
+        let not_periodic: Vec<String> = outcome
+            .not_periodic()
+            .map(|r| format!("{} (residual {})", r.label, fmt_measure(r.last_measure())))
+            .collect();
+        if failed.is_empty() && self.require_periodic && !not_periodic.is_empty() {
+            let summary_path = out.file("summary.json");
+            out.finish()?;
+            bail!(
+                "not periodic (--require-periodic): {}; results in {} (each model's best revolution)",
+                not_periodic.join(", "),
+                summary_path.display()
+            );
+        }
+        if failed.is_empty() {
+            out.finish()?;
+            Ok(())
+        } else {
+            let mut msg = format!("model(s) failed: {}", failed.join("; "));
+            if let Some(note) = self.overrides_note() {
+                msg = format!("{msg}; {note}");
+            }
+            out.mark_incomplete(&msg)?;
+            bail!(
+                "{msg} (the other models' outputs are written in {})",
+                out.path().display()
+            )
+        }
+    }
+
+    /// The run's settings as summary.json and the report record them.
+    fn info(
+        &self,
+        sdof: bool,
+        rigid: bool,
+        inputs_sha256: String,
+        record: &FlightRecord,
+        t0: Instant,
+    ) -> RunInfo {
+        RunInfo {
+            rotor: self.rotor.display().to_string(),
+            rotor_model: if sdof {
+                "lag-hinge sdof test double".into()
+            } else if rigid {
+                RIGID_LABEL.into()
+            } else {
+                "UH-60A multibody rotor".into()
+            },
+            flight: self.flight.display().to_string(),
+            damper_deck: self
+                .damper_deck
+                .as_ref()
+                .unwrap_or(&self.rotor)
+                .display()
+                .to_string(),
+            revs: self.revs,
+            steps_per_rev: self.steps_per_rev,
+            substeps: self.substeps,
+            scheme: self.scheme.name.clone(),
+            newton: self.newton.name().into(),
+            periodic: self.periodic.name().into(),
+            periodic_tol: self.periodic_tol,
+            initial_state: self.initial_state.as_ref().map(|p| p.display().to_string()),
+            overrides: self
+                .overrides
+                .iter()
+                .map(|o| (o.key.clone(), o.value_text()))
+                .collect(),
+            inputs_sha256: Some(inputs_sha256),
+            synthetic: record.meta.synthetic,
+            counter: record.meta.counter.clone(),
+            wall_s: t0.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// The deck values this run overrides, each with its deck file, for a failure's message:
+    /// a value set with `--set` (or by a sweep's case) is the first suspect of a failed run.
+    pub fn overrides_note(&self) -> Option<String> {
+        if self.overrides.is_empty() {
+            return None;
+        }
+        let items: Vec<String> = self
+            .overrides
+            .iter()
+            .map(|o| {
+                let deck = match (&self.damper_deck, o.is_damper()) {
+                    (Some(d), true) => d,
+                    _ => &self.rotor,
+                };
+                let value = crate::overrides::display(&o.value);
+                format!("{} = {value} in deck {}", o.key, deck.display())
+            })
+            .collect();
+        Some(format!("this run overrides {}", items.join(", ")))
+    }
+}

@@ -1,0 +1,76 @@
+//! A sweep's cases run as [`RunJob`]s in this process, showing nothing.
+use super::{Case, CaseRunner};
+use crate::flight::FlightRecord;
+use crate::run::job::{self, NamedOptions, RunJob};
+use crate::run::Silent;
+use anyhow::{anyhow, bail};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use toml::Value;
+
+/// The run of `case` into `out`, starting from the periodic states of the result folder
+/// `initial` when given. The plan has checked the settings' names and types.
+pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunJob> {
+    let mut job = RunJob::new(out);
+    let mut named = NamedOptions::default();
+    let count = |k: &str, i: i64| {
+        usize::try_from(i).map_err(|_| anyhow!("{k}: expected a positive integer, found {i}"))
+    };
+    for (k, v) in &case.settings {
+        if k.contains('.') {
+            continue; // a deck value: job.overrides below
+        }
+        match (k.as_str(), v) {
+            ("rotor", Value::String(s)) => job.rotor = s.into(),
+            ("flight", Value::String(s)) => job.flight = s.into(),
+            ("damper_deck", Value::String(s)) => job.damper_deck = Some(s.into()),
+            ("damper", Value::String(s)) => named.damper = s,
+            ("scheme", Value::String(s)) => named.scheme = s,
+            ("newton", Value::String(s)) => named.newton = s,
+            ("periodic", Value::String(s)) => named.periodic = s,
+            ("model", Value::String(s)) => named.model = s,
+            ("revs", Value::Integer(i)) => job.revs = count(k, *i)?,
+            ("steps_per_rev", Value::Integer(i)) => job.steps_per_rev = count(k, *i)?,
+            ("substeps", Value::Integer(i)) => job.substeps = count(k, *i)?,
+            ("periodic_tol", Value::Float(x)) => job.periodic_tol = *x,
+            ("periodic_tol", Value::Integer(i)) => job.periodic_tol = *i as f64,
+            ("require_periodic", Value::Boolean(b)) => job.require_periodic = *b,
+            (k, v) => bail!("case {}: `{k} = {v}` is not a run option", case.id),
+        }
+    }
+    job.overrides = case.overrides();
+    job.initial_state = initial.map(Path::to_path_buf);
+    job.set_named(&named)?;
+    Ok(job)
+}
+
+/// Runs each case as `rotorsim run` would, showing nothing. Reads each flight record once (by
+/// path) for the checks, however many cases use it.
+#[derive(Default)]
+pub struct JobRunner {
+    records: Mutex<HashMap<PathBuf, Result<Arc<FlightRecord>, String>>>,
+}
+
+impl CaseRunner for JobRunner {
+    fn check(&self, case: &Case) -> anyhow::Result<()> {
+        let record = |p: &Path| -> anyhow::Result<Arc<FlightRecord>> {
+            let known = self.records.lock().ok().and_then(|m| m.get(p).cloned());
+            let r = match known {
+                Some(r) => r,
+                None => {
+                    let r = job::read_record(p).map_err(|e| format!("{e:#}"));
+                    if let Ok(mut m) = self.records.lock() {
+                        m.insert(p.to_path_buf(), r.clone());
+                    }
+                    r
+                }
+            };
+            r.map_err(|e| anyhow!(e))
+        };
+        job_of(case, Path::new("unused"), None)?.check_with(&record)
+    }
+    fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()> {
+        job_of(case, out, initial)?.execute(&Silent).map(|_| ())
+    }
+}
