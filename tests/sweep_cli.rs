@@ -70,6 +70,11 @@ fn a_bad_plan_is_refused_before_any_case_runs() {
             "[base]\nmodel = \"rigid\"\n[vary]\nflight = [\"flightdata/c8534like\", \"flightdata/nope\"]\n",
             "flightdata/nope",
         ),
+        (
+            "blank.toml",
+            "[base]\nmodel = \"rigid\"\n[vary]\nrotor = [\"rotors/uh60a.toml\", \"\"]\n",
+            "`rotor` is empty (expected a file path)",
+        ),
         ("empty.toml", "[base]\nmodel = \"rigid\"\n[vary]\n", "[vary]"),
         ("none.toml", "[base]\nmodel = \"rigid\"\n", "[vary]"),
     ] {

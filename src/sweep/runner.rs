@@ -17,14 +17,20 @@ pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result
     let count = |k: &str, i: i64| {
         usize::try_from(i).map_err(|_| anyhow!("{k}: expected a positive integer, found {i}"))
     };
+    let path = |k: &str, s: &str| -> anyhow::Result<PathBuf> {
+        if s.trim().is_empty() {
+            bail!("case {}: `{k}` is empty (expected a file path)", case.id);
+        }
+        Ok(s.into())
+    };
     for (k, v) in &case.settings {
         if k.contains('.') {
             continue; // a deck value: job.overrides below
         }
         match (k.as_str(), v) {
-            ("rotor", Value::String(s)) => job.rotor = s.into(),
-            ("flight", Value::String(s)) => job.flight = s.into(),
-            ("damper_deck", Value::String(s)) => job.damper_deck = Some(s.into()),
+            ("rotor", Value::String(s)) => job.rotor = path(k, s)?,
+            ("flight", Value::String(s)) => job.flight = path(k, s)?,
+            ("damper_deck", Value::String(s)) => job.damper_deck = Some(path(k, s)?),
             ("damper", Value::String(s)) => named.damper = s,
             ("scheme", Value::String(s)) => named.scheme = s,
             ("newton", Value::String(s)) => named.newton = s,
