@@ -369,7 +369,13 @@ impl ForcedResponse for LagHingeSdof {
         let mut hyd = 0.0;
         let mut converged = None;
         let scale = m_mid.abs().max(kt * z0.abs()).max(1.0);
-        for it in 0..30 {
+        // A relief valve opening inside the step makes the residual kinked in z1, where plain
+        // Newton can cycle: after PLAIN iterations each update is kept inside the bracket of
+        // the residual's sign change seen so far (bisection when it would leave it).
+        const PLAIN: usize = 10;
+        const MAX_IT: usize = 80;
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for it in 0..MAX_IT {
             let th = Instant::now();
             let sf = self.dev.dev().trial_step(t, h, a * z0, a * z1)?;
             hyd += th.elapsed().as_secs_f64();
@@ -379,9 +385,18 @@ impl ForcedResponse for LagHingeSdof {
                 - m_mid
                 - a * sf.force_mean;
             let drdz = 2.0 * i / (h * h) + c / h + 0.5 * kt - a * a * sf.dforce_dstroke;
-            let dz = -r / drdz;
+            if r < 0.0 {
+                lo = lo.max(z1);
+            } else {
+                hi = hi.min(z1);
+            }
+            let mut dz = -r / drdz;
             if !dz.is_finite() {
                 bail!("lag-hinge model: non-finite Newton update at t = {t} s, iteration {it}, residual {r:e} N m");
+            }
+            let bracketed = lo.is_finite() && hi.is_finite() && lo < hi;
+            if it >= PLAIN && bracketed && !(lo < z1 + dz && z1 + dz < hi) {
+                dz = 0.5 * (lo + hi) - z1;
             }
             z1 += dz;
             // Residual small; or the update below 1e-12 rad with the residual below 1e-6 of
@@ -394,7 +409,7 @@ impl ForcedResponse for LagHingeSdof {
                 converged = Some(());
                 break;
             }
-            if it == 29 {
+            if it == MAX_IT - 1 {
                 bail!("lag-hinge model: Newton did not converge at t = {t} s after {} iterations, residual {r:e} N m", it + 1);
             }
         }
