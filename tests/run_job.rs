@@ -50,10 +50,17 @@ fn rigid_job(out: &Path) -> RunJob {
     }
 }
 
-fn rotorsim(args: &[&str]) -> std::process::Output {
+/// `rotorsim run` with the options of [`rigid_job`], then `extra`, into `out`.
+fn run_cli(job: &RunJob, extra: &[&str], out: &Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_rotorsim"))
         .current_dir(support::root())
-        .args(args)
+        .args(["run", "--model", "rigid", "--revs", "3", "--rotor"])
+        .arg(&job.rotor)
+        .arg("--flight")
+        .arg(&job.flight)
+        .args(extra)
+        .arg("--out")
+        .arg(out)
         .output()
         .unwrap()
 }
@@ -137,19 +144,7 @@ fn a_job_reports_to_its_observer_and_writes_what_the_cli_writes() {
     }
 
     let cli_out = t.join("cli");
-    let o = rotorsim(&[
-        "run",
-        "--model",
-        "rigid",
-        "--revs",
-        "3",
-        "--rotor",
-        &job.rotor.display().to_string(),
-        "--flight",
-        &job.flight.display().to_string(),
-        "--out",
-        &cli_out.display().to_string(),
-    ]);
+    let o = run_cli(&job, &[], &cli_out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let lib = support::read_json(&t.join("lib/summary.json"));
     let cli = support::read_json(&cli_out.join("summary.json"));
@@ -179,21 +174,11 @@ fn a_bad_override_fails_with_the_cli_message() {
         "nothing is written before the checks pass"
     );
 
-    let o = rotorsim(&[
-        "run",
-        "--model",
-        "rigid",
-        "--revs",
-        "3",
-        "--rotor",
-        &job.rotor.display().to_string(),
-        "--flight",
-        &job.flight.display().to_string(),
-        "--set",
-        "bearing.no_such_key_m=1.0",
-        "--out",
-        &t.join("out").display().to_string(),
-    ]);
+    let o = run_cli(
+        &job,
+        &["--set", "bearing.no_such_key_m=1.0"],
+        &t.join("out"),
+    );
     assert!(!o.status.success());
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(stderr.trim_end(), format!("error: {lib}"), "{stderr}");

@@ -23,14 +23,14 @@ pub enum LinearError {
 }
 
 impl LinearError {
-    fn of_faer(e: FaerError, ndof: usize) -> Self {
+    pub(crate) fn of_faer(e: FaerError, ndof: usize) -> Self {
         match e {
             FaerError::OutOfMemory | FaerError::IndexOverflow => LinearError::OutOfMemory { ndof },
             other => LinearError::Singular(format!("{other:?}")),
         }
     }
 
-    fn of_lu(e: LuError, ndof: usize) -> Self {
+    pub(crate) fn of_lu(e: LuError, ndof: usize) -> Self {
         match e {
             LuError::Generic(g) => Self::of_faer(g, ndof),
             other => LinearError::Singular(format!("{other:?}")),

@@ -91,7 +91,7 @@ impl Block {
         let stack = MemStack::new(&mut self.buf);
         self.symbolic
             .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
-            .map_err(|e| LinearError::Singular(format!("{e:?}")))?;
+            .map_err(|e| LinearError::of_lu(e, n))?;
         for (v, &(_, _, p)) in self.cv.iter_mut().zip(&self.c) {
             *v = values[p];
         }
@@ -232,8 +232,8 @@ impl BorderedLu {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 ..Default::default()
             };
-            let symbolic = factorize_symbolic_lu(sym, params)
-                .map_err(|e| BorderedError::Linear(LinearError::Singular(format!("{e:?}"))))?;
+            let symbolic =
+                factorize_symbolic_lu(sym, params).map_err(|e| LinearError::of_faer(e, nk))?;
             let req = StackReq::any_of(&[
                 symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
                 symbolic.solve_in_place_scratch::<f64>(nb.max(1), Par::Seq),
@@ -288,8 +288,10 @@ impl BorderedLu {
         self.factored = false;
         let nb = self.border.len();
         let block = |(k, b): (usize, &mut Block)| {
-            b.factor(values, nb)
-                .map_err(|e| LinearError::Singular(format!("block {k}: {e}")))
+            b.factor(values, nb).map_err(|e| match e {
+                LinearError::Singular(s) => LinearError::Singular(format!("block {k}: {s}")),
+                other => other,
+            })
         };
         if self.parallel {
             self.blocks
