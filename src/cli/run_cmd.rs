@@ -73,6 +73,12 @@ pub struct RunArgs {
     /// checked like the deck; `damper.*` keys go to `--damper-deck` when one is given.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
     pub set: Vec<Override>,
+    /// Run every blade of the rotor on its driven hub, each its own model at its own azimuth
+    /// (blade k (k-1) 360/N ahead of blade 1), the hub loads summed from their root loads;
+    /// implied by per-blade differences (`[blades.K...]` in the deck, `--set blades.K...`).
+    /// Writes <model>/blade<K>/ for every blade (docs/run.md).
+    #[arg(long)]
+    pub all_blades: bool,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
@@ -97,6 +103,7 @@ impl RunArgs {
             steps_per_rev: self.steps_per_rev,
             substeps: self.substeps,
             overrides: self.set.clone(),
+            all_blades: self.all_blades,
             ..RunJob::new(&self.out)
         };
         job.set_named(&NamedOptions {

@@ -1,6 +1,5 @@
 //! The console of `rotorsim run`: its first line, then per model a progress bar on a terminal,
 //! plain progress lines otherwise.
-use crate::hydraulics::DamperModel;
 use crate::run::job::{RotorModel, RunObserver, RunStart};
 use crate::run::{fmt_measure, Progress};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -14,19 +13,19 @@ struct Bars {
 }
 
 impl Bars {
-    fn new(models: &[DamperModel], revs: usize) -> Self {
+    fn new(names: &[String], revs: usize) -> Self {
         let mp = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
         let style = ProgressStyle::with_template(
             "{prefix:>10} [{bar:30}] rev {pos}/{len} {msg} ({elapsed})",
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar())
         .progress_chars("=> ");
-        let bars = models
+        let bars = names
             .iter()
             .map(|m| {
                 let b = mp.add(ProgressBar::new(revs as u64));
                 b.set_style(style.clone());
-                b.set_prefix(m.name());
+                b.set_prefix(m.clone());
                 b.set_message("starting");
                 b
             })
@@ -57,19 +56,19 @@ const PLAIN_PROGRESS_EVERY_S: f64 = 5.0;
 /// Plain progress lines on a stderr that is not a terminal: per model, a line at most every
 /// `every` seconds (revolution, periodicity, elapsed time), and one when it ends.
 struct Lines {
-    names: Vec<&'static str>,
+    names: Vec<String>,
     every: f64,
     start: Instant,
     last: std::sync::Mutex<Vec<f64>>,
 }
 
 impl Lines {
-    fn new(models: &[DamperModel], every: f64) -> Self {
+    fn new(names: &[String], every: f64) -> Self {
         Lines {
-            names: models.iter().map(|m| m.name()).collect(),
+            names: names.to_vec(),
             every,
             start: Instant::now(),
-            last: std::sync::Mutex::new(vec![f64::NEG_INFINITY; models.len()]),
+            last: std::sync::Mutex::new(vec![f64::NEG_INFINITY; names.len()]),
         }
     }
 }
@@ -110,9 +109,13 @@ impl RunObserver for Console {
     fn start(&self, s: &RunStart) {
         let names: Vec<&str> = s.models.iter().map(|m| m.name()).collect();
         errln!(
-            "rotorsim run: {} model(s) {}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
+            "rotorsim run: {} model(s) {}{}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
             s.models.len(),
             names.join(", "),
+            match s.blades {
+                Some(n) => format!(" on all {n} blades of a driven hub"),
+                None => String::new(),
+            },
             s.method.name(),
             s.tol,
             s.revs,
@@ -124,9 +127,9 @@ impl RunObserver for Console {
             }
         );
         let display: Box<dyn Progress + Send> = if std::io::stderr().is_terminal() {
-            Box::new(Bars::new(&s.models, s.revs))
+            Box::new(Bars::new(&s.units, s.revs))
         } else {
-            Box::new(Lines::new(&s.models, PLAIN_PROGRESS_EVERY_S))
+            Box::new(Lines::new(&s.units, PLAIN_PROGRESS_EVERY_S))
         };
         let _ = self.display.set(display);
     }

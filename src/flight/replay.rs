@@ -221,6 +221,12 @@ impl AirloadReplay {
         self.at_azimuth(t * self.omega_deg_s, r_m / self.radius_m)
     }
 
+    /// Loads a blade `ahead_deg` ahead of the reference blade sees at time t: those at its own
+    /// azimuth `Omega t + ahead_deg`.
+    pub fn section_loads_ahead(&self, t: f64, r_m: f64, ahead_deg: f64) -> SectionLoads {
+        self.at_azimuth(t * self.omega_deg_s + ahead_deg, r_m / self.radius_m)
+    }
+
     /// Loads at azimuth psi [deg] and r/R. psi counts from the record's time origin (revolution 0,
     /// azimuth 0): in the periodic modes only psi mod 360 matters; in sequence mode psi = 720 + 10
     /// is azimuth 10 deg of revolution 2.

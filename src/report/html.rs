@@ -171,6 +171,16 @@ impl HtmlReport {
     }
 
     pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) -> &mut Self {
+        self.marked_table(header, rows, |_, _| false)
+    }
+
+    /// A table whose cells `(row, column)` for which `marked` holds are highlighted.
+    pub fn marked_table(
+        &mut self,
+        header: &[&str],
+        rows: &[Vec<String>],
+        marked: impl Fn(usize, usize) -> bool,
+    ) -> &mut Self {
         // A wide table scrolls in its own box, not the page.
         self.body
             .push_str("<div style=\"overflow-x:auto\"><table>\n<tr>");
@@ -178,10 +188,11 @@ impl HtmlReport {
             let _ = write!(self.body, "<th>{}</th>", escape(h));
         }
         self.body.push_str("</tr>\n");
-        for r in rows {
+        for (i, r) in rows.iter().enumerate() {
             self.body.push_str("<tr>");
-            for c in r {
-                let _ = write!(self.body, "<td>{}</td>", escape(c));
+            for (j, c) in r.iter().enumerate() {
+                let class = if marked(i, j) { " class=\"mark\"" } else { "" };
+                let _ = write!(self.body, "<td{class}>{}</td>", escape(c));
             }
             self.body.push_str("</tr>\n");
         }
@@ -199,7 +210,7 @@ impl HtmlReport {
         format!(
             "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{t}</title>\n<style>\
 body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}\
-table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}\
+table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}td.mark{{background:#ffe08a;font-weight:bold}}\
 th{{background:#eee}}figure{{margin:1em 0}}figcaption{{font-size:90%;color:#555}}\
 .notice{{background:#fff3cd;border:1px solid #e0c060;padding:6px 10px}}pre{{background:#f6f6f6;padding:8px}}\
 .banner{{padding:8px 12px;margin:6px 0;font-weight:bold;border-radius:4px}}\

@@ -35,6 +35,17 @@ impl Controls {
             th1s_deg: c.longitudinal_cyclic,
         }
     }
+
+    /// The controls a blade `dpsi_deg` ahead in azimuth sees at the same time: the shared
+    /// swashplate's cyclic turned, `theta(psi + dpsi)` written in `psi`.
+    pub fn ahead_by(&self, dpsi_deg: f64) -> Self {
+        let (s, c) = dpsi_deg.to_radians().sin_cos();
+        Controls {
+            th0_deg: self.th0_deg,
+            th1c_deg: self.th1c_deg * c + self.th1s_deg * s,
+            th1s_deg: self.th1s_deg * c - self.th1c_deg * s,
+        }
+    }
 }
 
 /// Node and element names of the expanded model.

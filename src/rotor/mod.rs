@@ -197,6 +197,10 @@ pub struct RunOptions {
     /// It vanishes on the periodic solution and only speeds up marching; shooting turns it off
     /// (its delayed history would be part of the revolution map's state).
     pub perturbation_damping: bool,
+    /// Where this blade sits in a whole-rotor run: its azimuth ahead of blade 1 [deg], which
+    /// turns the cyclic and the airloads it sees; None for the single-blade run (its hub loads
+    /// are then built from the blade by symmetry).
+    pub blade_azimuth_deg: Option<f64>,
 }
 
 impl Default for RunOptions {
@@ -208,6 +212,7 @@ impl Default for RunOptions {
             newton: crate::solver::NewtonMethod::Modified,
             newton_rtol: sim::RTOL,
             perturbation_damping: true,
+            blade_azimuth_deg: None,
         }
     }
 }
@@ -290,4 +295,17 @@ pub fn build(
         record,
         opts,
     )?))
+}
+
+// PLACEHOLDER until per-blade decks land
+impl RotorDeck {
+    pub fn per_blade(&self) -> bool {
+        false
+    }
+    pub fn blade(&self, _k: usize) -> anyhow::Result<RotorDeck> {
+        Ok(self.clone())
+    }
+    pub fn blade_damper_overrides(&self, _k: usize) -> Vec<Override> {
+        Vec::new()
+    }
 }

@@ -25,6 +25,8 @@ use std::time::Instant;
 pub struct BladeAirloads {
     full: AirloadReplay,
     mean: AirloadReplay,
+    /// The blade's azimuth ahead of the reference blade [deg] (whole-rotor runs; else 0).
+    ahead_deg: f64,
     root_r_m: f64,
     t_ramp: f64,
     /// Load scale (static load stepping of the initial equilibrium; 1 in the dynamics).
@@ -108,12 +110,12 @@ pub fn section_pitch(r: &[[f64; 3]; 3]) -> f64 {
 impl DistributedLoad for BladeAirloads {
     fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
         let r = self.root_r_m + p.s_m;
-        let m = self.mean.section_loads(p.t, r);
+        let m = self.mean.section_loads_ahead(p.t, r, self.ahead_deg);
         let w = ramp(p.t, self.t_ramp);
         let l = if w == 0.0 {
             m
         } else {
-            let a = self.full.section_loads(p.t, r);
+            let a = self.full.section_loads_ahead(p.t, r, self.ahead_deg);
             crate::flight::replay::SectionLoads {
                 normal_N_per_m: m.normal_N_per_m + w * (a.normal_N_per_m - m.normal_N_per_m),
                 chord_N_per_m: m.chord_N_per_m + w * (a.chord_N_per_m - m.chord_N_per_m),
@@ -209,6 +211,8 @@ pub struct RotorSim {
     damper_x_start: [[f64; 3]; 2],
     /// Load channels computed (see [`ForcedResponse::set_output_channels`]).
     output_channels: bool,
+    /// A blade of a whole-rotor run (its hub loads come from all blades, not by symmetry).
+    in_whole_rotor: bool,
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -245,7 +249,9 @@ pub fn build_sim(
     }
     spec.check_record(record, file)?;
     let om = spec.rotor.omega_rad_s;
-    let controls = Controls::from_record(&record.meta.controls_deg);
+    let ahead_deg = opts.blade_azimuth_deg.unwrap_or(0.0);
+    // a blade ahead of the reference blade sees the shared swashplate's cyclic turned
+    let controls = Controls::from_record(&record.meta.controls_deg).ahead_by(ahead_deg);
     let period = 2.0 * std::f64::consts::PI / om;
     let h = period / opts.steps_per_rev as f64;
     let xo = ExpandOptions {
@@ -291,6 +297,7 @@ pub fn build_sim(
     let airloads = BladeAirloads {
         full,
         mean,
+        ahead_deg,
         root_r_m: spec.blade.root_r_m,
         t_ramp,
         scale: scale.clone(),
@@ -386,6 +393,7 @@ pub fn build_sim(
         damper_nodes: [n_hub_end, n_blade_end],
         damper_x_start: [[0.0; 3]; 2],
         output_channels: true,
+        in_whole_rotor: opts.blade_azimuth_deg.is_some(),
     })
 }
 
@@ -529,7 +537,7 @@ impl ForcedResponse for RotorSim {
         self.limits
     }
     fn blades(&self) -> Option<usize> {
-        Some(self.spec.rotor.blades)
+        (!self.in_whole_rotor).then_some(self.spec.rotor.blades)
     }
     fn set_output_channels(&mut self, on: bool) {
         self.output_channels = on;

@@ -190,6 +190,9 @@ pub struct RunJob {
     pub newton: NewtonMethod,
     /// Deck values overridden by dotted path, applied before validation.
     pub overrides: Vec<Override>,
+    /// Every blade of the rotor on its driven hub, each its own model (implied by per-blade
+    /// differences in the deck or the overrides).
+    pub all_blades: bool,
     /// Result folder.
     pub out: PathBuf,
 }
@@ -198,6 +201,11 @@ pub struct RunJob {
 #[derive(Clone, Debug)]
 pub struct RunStart {
     pub models: Vec<DamperModel>,
+    /// What runs side by side, in the index order of the progress events: the models, or in a
+    /// whole-rotor run each model's blades ("physical b3").
+    pub units: Vec<String>,
+    /// Blades of a whole-rotor run.
+    pub blades: Option<usize>,
     pub method: PeriodicMethod,
     pub tol: f64,
     pub revs: usize,
@@ -294,6 +302,52 @@ pub fn damper_deck_with(path: &Path, overrides: &[Override]) -> anyhow::Result<D
     Ok(DamperDeck::from_toml_str(&text, &file)?)
 }
 
+/// A unit's periodic_state.json in the result folder `dir` of an earlier run.
+fn state_file(dir: &Path, (m, blade): (DamperModel, Option<usize>)) -> PathBuf {
+    let folder = dir.join(m.name());
+    match blade {
+        Some(k) => folder.join(format!("blade{k}")),
+        None => folder,
+    }
+    .join("periodic_state.json")
+}
+
+/// The blades' outcomes (model-major, as `units`) combined into one outcome per model: the
+/// rotor's run, or the failure of any of its blades.
+fn whole_rotor_outcomes(
+    outcomes: Vec<ModelOutcome>,
+    units: &[(DamperModel, Option<usize>)],
+) -> Vec<ModelOutcome> {
+    let mut by_model: Vec<(DamperModel, Vec<run::ModelRun>, Vec<String>)> = Vec::new();
+    for (o, (m, blade)) in outcomes.into_iter().zip(units) {
+        if by_model.last().is_none_or(|b| b.0 != *m) {
+            by_model.push((*m, Vec::new(), Vec::new()));
+        }
+        let Some(entry) = by_model.last_mut() else {
+            continue;
+        };
+        let k = blade.unwrap_or(1);
+        match o.result {
+            Ok(mut r) => {
+                r.blade = Some(k);
+                entry.1.push(r);
+            }
+            Err(e) => entry.2.push(format!("blade {k}: {e}")),
+        }
+    }
+    by_model
+        .into_iter()
+        .map(|(model, runs, errors)| ModelOutcome {
+            model,
+            result: if errors.is_empty() {
+                run::rotor::combine(runs).map_err(|e| format!("{e:#}"))
+            } else {
+                Err(errors.join("; "))
+            },
+        })
+        .collect()
+}
+
 impl RunJob {
     /// A run into `out` with the defaults of `rotorsim run`.
     pub fn new(out: impl Into<PathBuf>) -> Self {
@@ -314,6 +368,7 @@ impl RunJob {
             model: RotorModel::Uh60a,
             newton: NewtonMethod::Modified,
             overrides: Vec::new(),
+            all_blades: false,
             out: out.into(),
         }
     }
@@ -367,7 +422,81 @@ impl RunJob {
         for m in &models {
             deck.require(*m)?;
         }
-        self.check_rotor(rotor.as_ref(), &record, models.len())
+        let blades = self.blade_decks(rotor.as_ref())?;
+        for (_, d) in &blades {
+            for m in &models {
+                d.require(*m)?;
+            }
+        }
+        self.check_rotor(rotor.as_ref(), &record, models.len() * blades.len().max(1))
+    }
+
+    /// Whether this run is of the whole rotor: asked for, or implied by per-blade differences.
+    pub fn whole_rotor(&self, rotor: Option<&RotorDeck>) -> anyhow::Result<bool> {
+        let per_blade = rotor.is_some_and(|r| r.per_blade());
+        if (self.all_blades || per_blade) && self.model != RotorModel::Uh60a {
+            bail!(
+                "{}: the whole rotor runs the elastic multibody model only (--model uh60a), not --model {}",
+                if self.all_blades {
+                    "--all-blades".to_string()
+                } else {
+                    format!("per-blade differences ([blades.K] tables or --set blades.K...) in {}", self.rotor.display())
+                },
+                self.model.name()
+            );
+        }
+        Ok(self.all_blades || per_blade)
+    }
+
+    /// Each blade's rotor and damper decks (blade 1 first), per-blade differences applied; empty
+    /// unless the run is of the whole rotor.
+    pub fn blade_decks(
+        &self,
+        rotor: Option<&RotorDeck>,
+    ) -> anyhow::Result<Vec<(RotorDeck, DamperDeck)>> {
+        if !self.whole_rotor(rotor)? {
+            return Ok(Vec::new());
+        }
+        let Some(r) = rotor else {
+            return Ok(Vec::new());
+        };
+        let damper_sets: Vec<Override> = self
+            .overrides
+            .iter()
+            .filter(|o| o.is_damper())
+            .cloned()
+            .collect();
+        (1..=r.spec.rotor.blades)
+            .map(|k| {
+                let rk = r.blade(k)?;
+                let dk = match &self.damper_deck {
+                    Some(p) => {
+                        let mut sets = damper_sets.clone();
+                        sets.extend(r.blade_damper_overrides(k));
+                        damper_deck_with(p, &sets)
+                            .with_context(|| format!("blade {k}'s damper deck"))?
+                    }
+                    None => rk.damper()?,
+                };
+                Ok((rk, dk))
+            })
+            .collect()
+    }
+
+    /// The saved state each unit starts from (`initial_state`): one file for all, or from an
+    /// earlier run's folder each unit's own.
+    fn initial_states(
+        &self,
+        units: &[(DamperModel, Option<usize>)],
+    ) -> anyhow::Result<Vec<Option<run::PeriodicStateFile>>> {
+        match &self.initial_state {
+            None => Ok(vec![None; units.len()]),
+            Some(p) if p.is_dir() => units
+                .iter()
+                .map(|u| run::PeriodicStateFile::read(&state_file(p, *u)).map(Some))
+                .collect(),
+            Some(p) => Ok(vec![Some(run::PeriodicStateFile::read(p)?); units.len()]),
+        }
     }
 
     /// The rotor deck (None for the sdof test double) and the damper deck, overrides applied
@@ -436,17 +565,6 @@ impl RunJob {
         let models = self.damper.models();
         self.check_options()?;
         let method = self.periodic;
-        let initial = match &self.initial_state {
-            None => vec![None; models.len()],
-            Some(p) if p.is_dir() => models
-                .iter()
-                .map(|m| {
-                    run::PeriodicStateFile::read(&p.join(m.name()).join("periodic_state.json"))
-                        .map(Some)
-                })
-                .collect::<anyhow::Result<_>>()?,
-            Some(p) => vec![Some(run::PeriodicStateFile::read(p)?); models.len()],
-        };
         let (sdof, rigid) = (
             self.model == RotorModel::Sdof,
             self.model == RotorModel::Rigid,
@@ -457,7 +575,26 @@ impl RunJob {
         for m in &models {
             deck.require(*m)?;
         }
-        self.check_rotor(rotor.as_ref(), &record, models.len())?;
+        let blades = self.blade_decks(rotor.as_ref())?;
+        for (_, d) in &blades {
+            for m in &models {
+                d.require(*m)?;
+            }
+        }
+        let nb = blades.len();
+        // the units that run side by side: one per model, or per model and blade
+        let units: Vec<(DamperModel, Option<usize>)> = models
+            .iter()
+            .flat_map(|&m| -> Vec<(DamperModel, Option<usize>)> {
+                if nb == 0 {
+                    vec![(m, None)]
+                } else {
+                    (1..=nb).map(|k| (m, Some(k))).collect()
+                }
+            })
+            .collect();
+        self.check_rotor(rotor.as_ref(), &record, units.len())?;
+        let initial = self.initial_states(&units)?;
         let hydraulics = IntegratorOptions {
             scheme: self.scheme.scheme,
             substeps: self.substeps,
@@ -476,7 +613,16 @@ impl RunJob {
         } else {
             None
         };
-        let build = |m: DamperModel| -> anyhow::Result<Box<dyn ForcedResponse>> {
+        let build = |u: usize| -> anyhow::Result<Box<dyn ForcedResponse>> {
+            let (m, blade) = units[u];
+            if let Some(k) = blade {
+                let (r, d) = &blades[k - 1];
+                let o = RunOptions {
+                    blade_azimuth_deg: Some(run::rotor::blade_azimuth_deg(k, nb)),
+                    ..opts
+                };
+                return crate::rotor::build(r, d, m, &record, &o);
+            }
             match (&rotor, &sdof_params) {
                 (_, Some(p)) => Ok(Box::new(LagHingeSdof::new(
                     p.clone(),
@@ -508,16 +654,22 @@ impl RunJob {
         let inputs_sha256 = crate::io::inputs_fingerprint(&inputs, &set_lines)
             .map_err(|e| anyhow!("reading the inputs: {e}"))?;
         match &self.initial_state {
-            Some(p) if p.is_dir() => inputs.extend(
-                models
-                    .iter()
-                    .map(|m| p.join(m.name()).join("periodic_state.json")),
-            ),
+            Some(p) if p.is_dir() => {
+                inputs.extend(units.iter().map(|u| state_file(p, *u)));
+            }
             Some(p) => inputs.push(p.clone()),
             None => {}
         }
         let out = OutDir::create(&self.out, &inputs)?;
         observer.start(&RunStart {
+            units: units
+                .iter()
+                .map(|(m, b)| match b {
+                    Some(k) => format!("{} b{k}", m.name()),
+                    None => m.name().to_string(),
+                })
+                .collect(),
+            blades: (nb > 0).then_some(nb),
             models: models.clone(),
             method,
             tol: self.periodic_tol,
@@ -538,16 +690,21 @@ impl RunJob {
                 inputs_sha256: Some(inputs_sha256.clone()),
             })
             .collect();
-        let mut outcomes = run::run_models(&models, &popts, &build, observer);
+        let unit_models: Vec<DamperModel> = units.iter().map(|u| u.0).collect();
+        let mut outcomes = run::run_units(&unit_models, &popts, &build, observer);
         // a failure of the physical model names the deck values behind it, where they are
         // unusual
-        for o in outcomes
-            .iter_mut()
-            .filter(|o| o.model == DamperModel::Physical)
-        {
-            if let Err(e) = &mut o.result {
-                *e = deck.with_review(std::mem::take(e));
+        for (o, (_, blade)) in outcomes.iter_mut().zip(&units) {
+            if o.model != DamperModel::Physical {
+                continue;
             }
+            let d = blade.map_or(&deck, |k| &blades[k - 1].1);
+            if let Err(e) = &mut o.result {
+                *e = d.with_review(std::mem::take(e));
+            }
+        }
+        if nb > 0 {
+            outcomes = whole_rotor_outcomes(outcomes, &units);
         }
         let info = self.info(sdof, rigid, inputs_sha256, &record, t0);
         let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;

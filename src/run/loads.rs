@@ -107,6 +107,7 @@ pub fn is_load_channel(name: &str) -> bool {
         || name == crate::rotor::loads::PITCH_LINK_CHANNEL
         || ROOT_CHANNELS.contains(&name)
         || HUB_CHANNELS.contains(&name)
+        || super::rotor::HUB_ROTATING_CHANNELS.contains(&name)
 }
 
 /// summary.json `loads`: per load channel mean, half peak-to-peak and harmonics 0-10/rev

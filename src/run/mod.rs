@@ -20,6 +20,7 @@ pub mod mcap_out;
 pub mod outputs;
 pub mod periodic;
 pub mod report;
+pub mod rotor;
 pub mod sdof;
 pub mod summary;
 
@@ -77,8 +78,13 @@ pub struct ModelRun {
     pub build_s: f64,
     /// Equilibrium check of the blade loads (models with load channels).
     pub loads_check: Option<loads::EquilibriumCheck>,
-    /// Identical blades of the rotor (for the hub loads).
+    /// Identical blades of the rotor (for the hub loads built by symmetry).
     pub blades: Option<usize>,
+    /// A blade of a whole-rotor run: its number, 1 to N.
+    pub blade: Option<usize>,
+    /// A whole-rotor run: every blade's run, blade 1 first (this run holds blade 1's channels
+    /// and the hub's).
+    pub blade_runs: Vec<ModelRun>,
 }
 
 /// One revolution kept along the way to the periodic solution.
@@ -93,6 +99,14 @@ pub struct KeptRevolution {
 }
 
 impl ModelRun {
+    /// Its folder in the result folder: `<model>`, or `<model>/blade<K>` for a blade of a
+    /// whole-rotor run.
+    pub fn folder(&self) -> String {
+        match self.blade {
+            Some(k) => format!("{}/blade{k}", self.model),
+            None => self.model.clone(),
+        }
+    }
     /// Samples of the channel named `name` over the last revolution.
     pub fn channel(&self, name: &str) -> Option<&[f64]> {
         self.channel_names
@@ -460,6 +474,8 @@ pub fn drive_periodic(
         build_s: 0.0,
         loads_check: None,
         blades,
+        blade: None,
+        blade_runs: Vec::new(),
     };
     loads::finish(&mut run, blades);
     // the sub-step envelope last, so the columns written before it keep their places
@@ -512,9 +528,24 @@ pub fn run_models<B>(
 where
     B: Fn(DamperModel) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
 {
-    // One thread per model, not a pool of one per core: three models on two cores then share
+    run_units(models, opts, &|i: usize| build(models[i]), progress)
+}
+
+/// Builds and drives one simulation per unit in parallel (a model, or a blade of a whole
+/// rotor: `build(i)` builds unit `i`, of damper model `models[i]`). A failed unit (build or
+/// run) is returned as an error message; the others are unaffected.
+pub fn run_units<B>(
+    models: &[DamperModel],
+    opts: &[PeriodicOptions],
+    build: &B,
+    progress: &dyn Progress,
+) -> Vec<ModelOutcome>
+where
+    B: Fn(usize) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
+{
+    // One thread per unit, not a pool of one per core: three models on two cores then share
     // both cores to the end instead of two running first and the third alone while a core
-    // idles. Each model runs on its own thread only, so its results do not depend on how
+    // idles. Each unit runs on its own thread only, so its results do not depend on how
     // many there are.
     std::thread::scope(|scope| {
         let handles: Vec<_> = models
@@ -544,10 +575,10 @@ fn run_one<B>(
     progress: &dyn Progress,
 ) -> ModelOutcome
 where
-    B: Fn(DamperModel) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
+    B: Fn(usize) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
 {
     let t0 = Instant::now();
-    let result = build(model)
+    let result = build(i)
         .map_err(|e| e.context(format!("building the {} model", model.name())))
         .and_then(|mut sim| {
             let build_s = t0.elapsed().as_secs_f64();

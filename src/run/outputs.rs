@@ -39,6 +39,15 @@ pub fn write_outputs(
                     summary::write_all_revs(out, r)?;
                 }
                 summary::write_periodic_state(out, r, info)?;
+                // a whole rotor: every blade's folder (the record's damper is blade 1's)
+                for b in &r.blade_runs {
+                    let m = if b.blade == Some(1) { meas } else { None };
+                    summary::write_last_rev(out, b, m)?;
+                    if !b.all_revs.is_empty() {
+                        summary::write_all_revs(out, b)?;
+                    }
+                    summary::write_periodic_state(out, b, info)?;
+                }
             }
         }
     }

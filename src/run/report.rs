@@ -1196,6 +1196,7 @@ pub fn report_html(
         );
     }
     blade_loads(&mut rep, &runs);
+    whole_rotor(&mut rep, &runs);
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: docs/formats.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()
@@ -1413,12 +1414,115 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
         }
     }
     if !rows.is_empty() {
-        rep.paragraph("Hub loads in the non-rotating frame (x along the reference blade at azimuth 0, z up): the rotor's identical blades' root loads summed, so only multiples of N/rev remain. Amplitudes [N, N m]:");
+        if with.iter().any(|r| !r.blade_runs.is_empty()) {
+            rep.paragraph("Hub loads in the non-rotating frame (x along blade 1 at azimuth 0, z up): every blade's own root loads summed, no symmetry assumed (the harmonics at other than multiples of N/rev are in the section Whole rotor). Amplitudes [N, N m]:");
+        } else {
+            rep.paragraph("Hub loads in the non-rotating frame (x along the reference blade at azimuth 0, z up): the rotor's identical blades' root loads summed, so only multiples of N/rev remain. Amplitudes [N, N m]:");
+        }
         rep.table(
             &["model", "hub load", "mean (0/rev)", "N/rev", "2N/rev"],
             &rows,
         );
     }
+}
+
+/// Share of the largest hub-load harmonic above which a harmonic that is not a multiple of
+/// N/rev is highlighted: numerical noise of a periodic solution sits orders below it.
+const NON_NPREV_MARK: f64 = 1e-3;
+
+/// The whole rotor: each blade's damper force on its own azimuth, the hub loads' harmonics
+/// with the content at other than multiples of N/rev highlighted (it comes only from blades
+/// that differ).
+fn whole_rotor(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+    let whole: Vec<&&ModelRun> = runs.iter().filter(|r| !r.blade_runs.is_empty()).collect();
+    let Some(first) = whole.first() else { return };
+    let n = first.blade_runs.len();
+    rep.heading(2, "Whole rotor");
+    rep.paragraph(&format!(
+        "All {n} blades on a driven hub, each its own model with its own deck values: blade k sits (k-1) x {:.1} deg ahead of blade 1 and sees the shared swashplate's controls and the record's airloads at its own azimuth. On a driven hub the blades are coupled only through prescribed motion, so each blade's periodic solution is the rotor's; the hub loads are the sum of the blades' actual root loads. Each blade's outputs are in <model>/blade<K>/ (docs/run.md).",
+        360.0 / n as f64
+    ));
+    let plots: Vec<Plot> = whole
+        .iter()
+        .map(|r| {
+            let mut p = Plot::new(
+                &format!(
+                    "{}: damper force of every blade at its own azimuth",
+                    r.label
+                ),
+                "blade azimuth [deg]",
+                "damper force [kN]",
+            )
+            .azimuth()
+            .y_scale(1e-3);
+            for b in &r.blade_runs {
+                let k = b.blade.unwrap_or(0);
+                let Some(f) = b.channel("damper_force_N") else {
+                    continue;
+                };
+                let ahead = super::rotor::blade_azimuth_deg(k, n);
+                let mut pts: Vec<(f64, f64)> = b
+                    .azimuth_deg
+                    .iter()
+                    .zip(f)
+                    .map(|(a, v)| ((a + ahead).rem_euclid(360.0), *v))
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (x, y): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
+                p = p.line(&format!("blade {k}"), &closed_x(&x), &closed(&y));
+            }
+            p
+        })
+        .collect();
+    svg(
+        rep,
+        "Damper force of each blade against its own azimuth: identical blades lie on one curve; a blade that differs stands apart.",
+        &plots,
+    );
+    let top = 2 * n;
+    let mut header: Vec<String> = vec!["model".into(), "hub load".into()];
+    header.extend((0..=top).map(|k| format!("{k}/rev")));
+    let mut rows = vec![];
+    let mut marks: Vec<Vec<bool>> = vec![];
+    for r in &whole {
+        for ch in super::loads::HUB_CHANNELS {
+            let Some(v) = r.channel(ch) else { continue };
+            let Ok(h) = crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, top) else {
+                continue;
+            };
+            let amp: Vec<f64> = (0..=top)
+                .map(|k| h.get(k).map_or(f64::NAN, |x| x.amplitude))
+                .collect();
+            // the mean (thrust, torque) would hide an oscillatory load's content
+            let big = amp[1..].iter().cloned().fold(0.0, f64::max);
+            let mut row = vec![r.label.clone(), readable_channel(ch)];
+            row.extend(amp.iter().map(|a| format!("{a:.1}")));
+            let mut m = vec![false, false];
+            m.extend(
+                amp.iter()
+                    .enumerate()
+                    .map(|(k, a)| k % n != 0 && *a > NON_NPREV_MARK * big),
+            );
+            rows.push(row);
+            marks.push(m);
+        }
+    }
+    if !rows.is_empty() {
+        rep.paragraph(&format!(
+            "Harmonics of the fixed-frame hub loads [N, N m]. Identical blades pass only multiples of {n}/rev to the hub; highlighted: a harmonic that is not, above {NON_NPREV_MARK:.0e} of the load's largest oscillatory harmonic, the signature of dissimilar blades (a leaking damper, a blade out of track)."
+        ));
+        let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
+        rep.marked_table(&header, &rows, |i, j| marks[i][j]);
+    }
+}
+
+/// Azimuths of one revolution closed at 360 (pairs with [`closed`]).
+fn closed_x(x: &[f64]) -> Vec<f64> {
+    let mut v = x.to_vec();
+    if let Some(f) = x.first() {
+        v.push(f + 360.0);
+    }
+    v
 }
 
 #[cfg(test)]

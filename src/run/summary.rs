@@ -640,7 +640,35 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "residual": with_unit(serde_json::to_value(&f.residual).unwrap_or(Value::Null), "N"),
         "stroke_check": with_unit(serde_json::to_value(&f.stroke).unwrap_or(Value::Null), "m"),
         "channels": r.channel_names,
+        "blades": blades_json(r),
     })
+}
+
+/// A whole-rotor run's blades: per blade its place, folder, periodicity, damper force and
+/// loads (null for a single-blade run).
+fn blades_json(r: &ModelRun) -> Value {
+    if r.blade_runs.is_empty() {
+        return Value::Null;
+    }
+    let n = r.blade_runs.len();
+    let blades: Vec<Value> = r
+        .blade_runs
+        .iter()
+        .map(|b| {
+            let k = b.blade.unwrap_or(0);
+            let force = figures(b, None).map(|f| f.force).ok();
+            json!({
+                "blade": k,
+                "azimuth_ahead_of_blade_1_deg": super::rotor::blade_azimuth_deg(k, n),
+                "folder": b.folder(),
+                "revolutions": b.revolutions,
+                "periodic": periodic_json(b),
+                "damper_force_N": force,
+                "loads": super::loads::loads_json(b),
+            })
+        })
+        .collect();
+    json!(blades)
 }
 
 /// Members of a metrics-like object in `unit`, suffixed with it (summary.json's rule: every
@@ -764,7 +792,7 @@ pub fn write_periodic_state(out: &OutDir, r: &ModelRun, info: &RunInfo) -> anyho
         state: state.clone(),
     };
     out.write(
-        &format!("{}/periodic_state.json", r.model),
+        &format!("{}/periodic_state.json", r.folder()),
         serde_json::to_string(&f)?.as_bytes(),
     )?;
     Ok(())
@@ -796,7 +824,7 @@ pub fn write_last_rev(
     header.extend(r.channel_names.iter().map(|s| s.as_str()));
     cols.extend(r.last_rev.iter().map(|c| c.as_slice()));
     out.write(
-        &format!("{}/last_rev.csv", r.model),
+        &format!("{}/last_rev.csv", r.folder()),
         csv_from_columns(&header, &cols).as_bytes(),
     )?;
     Ok(())
@@ -831,7 +859,7 @@ pub fn write_all_revs(out: &OutDir, r: &ModelRun) -> anyhow::Result<()> {
     let mut cols: Vec<&[f64]> = vec![&rev, &iterate, &time, &azimuth];
     cols.extend(channels.iter().map(|c| c.as_slice()));
     out.write(
-        &format!("{}/all_revs.csv", r.model),
+        &format!("{}/all_revs.csv", r.folder()),
         csv_from_columns(&header, &cols).as_bytes(),
     )?;
     Ok(())
