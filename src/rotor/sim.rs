@@ -416,6 +416,10 @@ fn set_swash(model: &mut Model, id: usize, pts: &[(f64, f64)]) {
     }
 }
 
+fn norm3(v: [f64; 3]) -> f64 {
+    dot(v, v).sqrt()
+}
+
 /// Twist of the tip section relative to the root section about the root's axis 1 [rad].
 fn rel_twist(r_root: &[[f64; 3]; 3], r_tip: &[[f64; 3]; 3]) -> f64 {
     log_map(&mtm(r_root, r_tip))[0]
@@ -554,7 +558,9 @@ impl ForcedResponse for RotorSim {
             t_s: snap.t_s,
             coords: snap.coords(&self.r0, 1.0 / self.spec.rotor.omega_rad_s),
             solver: Some(snap),
-            aux: vec![],
+            // the damper ends at the start of the step that ended here: the load channels of
+            // the first sample after a restore need them
+            aux: self.damper_x_start.iter().flatten().copied().collect(),
         })
     }
     fn restore_state(&mut self, s: &super::SimState) -> anyhow::Result<()> {
@@ -576,10 +582,22 @@ impl ForcedResponse for RotorSim {
         self.solver
             .restore(&snap)
             .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))?;
-        // the step that ended here is not saved: its start taken as the damper ends turned
-        // back with the shaft (the lag motion over a step is two orders smaller)
-        let back = exp_map([0.0, 0.0, -self.spec.rotor.omega_rad_s * self.h]);
-        self.damper_x_start = self.damper_nodes.map(|i| mv(&back, self.solver.state.x[i]));
+        let saved: Option<[[f64; 3]; 2]> = (s.aux.len() == 6)
+            .then(|| std::array::from_fn(|e| std::array::from_fn(|c| s.aux[3 * e + c])));
+        // saved with this structural state: within a step's travel of the ends (a state
+        // assembled from another model's keeps that model's own)
+        let travel = 2.0 * self.spec.rotor.omega_rad_s * self.h * self.spec.rotor.radius_m;
+        let fits = |x: &[[f64; 3]; 2]| {
+            (0..2).all(|e| norm3(sub(x[e], self.solver.state.x[self.damper_nodes[e]])) <= travel)
+        };
+        self.damper_x_start = if let Some(x) = saved.filter(|x| fits(x)) {
+            x
+        } else {
+            // a state saved without them: the damper ends turned back with the shaft (the lag
+            // motion over a step is two orders smaller)
+            let back = exp_map([0.0, 0.0, -self.spec.rotor.omega_rad_s * self.h]);
+            self.damper_nodes.map(|i| mv(&back, self.solver.state.x[i]))
+        };
         Ok(())
     }
     fn periodic_from_s(&self) -> f64 {

@@ -451,6 +451,25 @@ pub fn drive_periodic(
             ),
         );
     }
+    if info.method_used == PeriodicMethod::Shooting {
+        // The reported revolution starts from a shooting iterate, restored: at its first
+        // sample the accelerations are the iterate's (updated linearly, not from the
+        // equations of motion) and the device reports its last step, of the revolution run
+        // before. The revolution's end is the same point of the periodic solution (within
+        // the residual, measured above) reached by a step: its values stand for the first
+        // sample.
+        let first = |samples: &mut [Vec<f64>]| {
+            for (c, v) in samples.iter_mut().enumerate() {
+                if !env_channels.contains(&c) {
+                    v[0] = rev.end[c];
+                }
+            }
+        };
+        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
+            first(&mut k.samples);
+        }
+        first(&mut rev.samples);
+    }
     align_envelopes(&mut rev.samples, &rev.end, &env_channels);
     let timing = sim.timing();
     let blades = sim.blades();
