@@ -74,15 +74,18 @@ fn a_blade_entry_reaches_that_blade_only() {
     assert!(r.blade_damper_overrides(2).is_empty());
     // a separate damper deck takes the blade's damper entries
     let dpath = root().join("flightdata/damper_nominal.toml");
-    let dtext = std::fs::read_to_string(&dpath).unwrap();
-    let d3 = r.blade_damper_deck(3, &dpath, &dtext).unwrap();
+    let d3 = r.blade_damper_deck(3, &dpath, &[]).unwrap();
     assert_eq!(d3.physical.unwrap().orifice.unwrap().area, 3.6e-6);
-    let d1 = r.blade_damper_deck(1, &dpath, &dtext).unwrap();
+    let d1 = r.blade_damper_deck(1, &dpath, &[]).unwrap();
     assert_eq!(
         d1,
-        rotorsim::hydraulics::DamperDeck::from_toml_str(&dtext, &dpath.display().to_string())
-            .unwrap()
+        rotorsim::hydraulics::DamperDeck::from_file(&dpath).unwrap()
     );
+    // the blade's entry is applied after the damper deck's own --set
+    let d3 = r
+        .blade_damper_deck(3, &dpath, &sets(&["damper.physical.A_orf_m2=2.0e-6"]))
+        .unwrap();
+    assert_eq!(d3.physical.unwrap().orifice.unwrap().area, 3.6e-6);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -206,6 +209,52 @@ fn a_sweep_key_reaches_the_blade() {
             && e.contains("r.toml, blades.5: the rotor has 4 blades"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn with_a_separate_damper_deck_the_blade_damper_entries_go_to_it() {
+    let dir = tmp("blades-damper-deck");
+    deck(&dir, "full.toml", "", "");
+    let full = std::fs::read_to_string(dir.join("full.toml")).unwrap();
+    // the rotor deck without its [damper] tables
+    let cut = full.find("\n[damper]\n").unwrap();
+    let job = |after: &str, set: &[&str]| {
+        let p = dir.join("r.toml");
+        std::fs::write(&p, format!("{}\n{after}", &full[..cut])).unwrap();
+        let mut job = rotorsim::run::job::RunJob::new(dir.join("out"));
+        job.rotor = p;
+        job.damper_deck = Some(root().join("flightdata/damper_nominal.toml"));
+        job.overrides = sets(set);
+        job
+    };
+    let good = job("[blades.3.damper.physical]\nA_orf_m2 = 3.6e-6\n", &[]);
+    let (rotor, damper) = good.load_decks().unwrap();
+    let rotor = rotor.unwrap();
+    assert_eq!(damper.physical.unwrap().orifice.unwrap().area, 1.8e-6);
+    let d3 = rotor
+        .blade_damper_deck(3, good.damper_deck.as_ref().unwrap(), &[])
+        .unwrap();
+    assert_eq!(d3.physical.unwrap().orifice.unwrap().area, 3.6e-6);
+    assert_eq!(
+        rotor.blade_damper_overrides(3),
+        sets(&["damper.physical.A_orf_m2=3.6e-6"])
+    );
+    for (after, set, want) in [
+        (
+            "[blades.3.damper.physical]\nA_orf_mm2 = 3.6e-6\n",
+            &[][..],
+            "r.toml, blades.3.damper.physical.A_orf_mm2: in damper deck ",
+        ),
+        (
+            "",
+            &["blades.2.damper.physical.Cd=-1.0"][..],
+            "--set blades.2.damper.physical.Cd=-1.0: rotor deck ",
+        ),
+    ] {
+        let e = format!("{:#}", job(after, set).load_decks().unwrap_err());
+        assert!(e.contains(want) && e.contains("damper_nominal.toml"), "{e}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -304,20 +304,26 @@ impl RotorDeck {
             .collect()
     }
 
-    /// The separate damper deck `damper` (text of file `damper_file`, its own `--set damper.*`
-    /// overrides already applied) with blade `k`'s `damper.*` entries applied, each validated;
-    /// an error names the rotor deck and the key as written.
+    /// Blade `k`'s damper from the separate damper deck `damper_file` (`--damper-deck`): the
+    /// file with its own `--set damper.*` overrides `damper_sets`, then blade `k`'s `damper.*`
+    /// entries, each validated; an error names the rotor deck and the key as written.
     pub fn blade_damper_deck(
         &self,
         k: usize,
         damper_file: &std::path::Path,
-        damper_text: &str,
+        damper_sets: &[Override],
     ) -> anyhow::Result<DamperDeck> {
         let dfile = damper_file.display().to_string();
-        let mut root: Table = damper_text.parse().map_err(|e: toml::de::Error| {
+        let text = std::fs::read_to_string(damper_file)
+            .map_err(|e| anyhow!("damper deck {dfile}: cannot read: {e}"))?;
+        DamperDeck::from_toml_str(&text, &dfile)?;
+        let mut text = overrides::apply_all(&text, &dfile, damper_sets, |t, _| {
+            DamperDeck::from_toml_str(t, &dfile)?;
+            Ok(())
+        })?;
+        let mut root: Table = text.parse().map_err(|e: toml::de::Error| {
             anyhow!("damper deck {dfile}: {}", e.to_string().trim_end())
         })?;
-        let mut text = damper_text.to_string();
         let file = self.file();
         for e in self
             .blade_entries()?
@@ -329,7 +335,7 @@ impl RotorDeck {
                     &file,
                     e.set.as_ref(),
                     &e.full_key(),
-                    &format!("applied to damper deck {dfile}: {}", inner(&dfile, err)),
+                    &format!("in damper deck {dfile}: {}", inner(&dfile, err)),
                 )
             };
             overrides::apply(&mut root, &e.ov).map_err(|err| ctx(&err))?;
