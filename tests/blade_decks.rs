@@ -126,6 +126,7 @@ fn a_blade_override_wins_over_the_deck_and_reaches_that_blade_only() {
         [20400.0, 20400.0, 20400.0, 30000.0]
     );
     assert!(b.iter().all(|d| d.spec.bearing.flap_k == 21000.0));
+    assert_eq!(r.differing_blades(), [1, 2, 4]);
     // the --set alone makes the deck per-blade
     let only = RotorDeck::from_file_with(&p, &sets(&[])).unwrap();
     assert!(only.per_blade());
@@ -255,6 +256,27 @@ fn with_a_separate_damper_deck_the_blade_damper_entries_go_to_it() {
         let e = format!("{:#}", job(after, set).load_decks().unwrap_err());
         assert!(e.contains(want) && e.contains("damper_nominal.toml"), "{e}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn only_the_differing_blades_are_built() {
+    // a blade count far beyond any rotor must not cost a deck per blade on load
+    let dir = tmp("blades-many");
+    let p = deck(
+        &dir,
+        "r.toml",
+        "",
+        "[blades.2.bearing]\nlag_stiffness_Nm_per_rad = 1.0\n",
+    );
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replacen("blades = 4 ", "blades = 1000000000 ", 1)).unwrap();
+    let t = std::time::Instant::now();
+    let r = RotorDeck::from_file(&p).unwrap();
+    assert_eq!(r.differing_blades(), [2]);
+    assert_eq!(r.input_files().len(), 2);
+    assert_eq!(r.blade(999_999_999).unwrap().spec.bearing.lag_k, 20400.0);
+    assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

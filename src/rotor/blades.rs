@@ -228,6 +228,20 @@ impl RotorDeck {
         self.blades.table.is_some() || !self.blades.sets.is_empty()
     }
 
+    /// The blades that differ from the base deck (ascending; the others' decks equal it).
+    /// Empty when the entries are bad ([`RotorDeck::check_blades`] refuses those on load).
+    pub fn differing_blades(&self) -> Vec<usize> {
+        let mut v: Vec<usize> = self
+            .blade_entries()
+            .unwrap_or_default()
+            .iter()
+            .map(|e| e.blade)
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
     /// Every per-blade entry, the deck's first (blade order), then the `--set` ones in order.
     fn blade_entries(&self) -> anyhow::Result<Vec<Entry>> {
         let file = self.file();
@@ -356,7 +370,8 @@ impl RotorDeck {
         let file = self.file();
         let entries = self.blade_entries()?;
         let dir = self.path.parent().unwrap_or(std::path::Path::new(""));
-        for k in 1..=self.spec.rotor.blades {
+        // only the blades with entries: the others are the base deck, already checked
+        for k in self.differing_blades() {
             let b = self.blade(k)?;
             if b.spec.blade.sections_csv != self.spec.blade.sections_csv {
                 let csv = dir.join(&b.spec.blade.sections_csv);
@@ -385,10 +400,7 @@ impl RotorDeck {
     pub(super) fn blade_section_files(&self) -> Vec<PathBuf> {
         let dir = self.path.parent().unwrap_or(std::path::Path::new(""));
         let mut out: Vec<PathBuf> = Vec::new();
-        if !self.per_blade() {
-            return out;
-        }
-        for k in 1..=self.spec.rotor.blades {
+        for k in self.differing_blades() {
             if let Ok(b) = self.blade(k) {
                 if b.spec.blade.sections_csv != self.spec.blade.sections_csv {
                     let p = dir.join(&b.spec.blade.sections_csv);

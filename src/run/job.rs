@@ -395,8 +395,8 @@ impl RunJob {
         let deck = match (&self.damper_deck, &rotor) {
             (Some(p), _) => {
                 // the blades' damper.* differences apply to this file: refuse bad ones now
-                if let Some(r) = rotor.as_ref().filter(|r| r.per_blade()) {
-                    for k in 1..=r.spec.rotor.blades {
+                if let Some(r) = &rotor {
+                    for k in r.differing_blades() {
                         r.blade_damper_deck(k, p, &damper_sets)?;
                     }
                 }
