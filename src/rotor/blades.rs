@@ -307,7 +307,8 @@ impl RotorDeck {
 
     /// Blade `k`'s `damper.*` overrides (prefix `blades.K.` stripped; the deck's first, then
     /// the `--set` ones), for a run whose damper deck is a separate file (`--damper-deck`):
-    /// apply them to that file after its own `--set damper.*` ones. Empty for a blade without
+    /// apply them to that file after its own `--set damper.*` ones (what
+    /// [`RotorDeck::blade_damper_deck`] does, naming the key as written). Empty for a blade without
     /// any, or when the entries are bad ([`RotorDeck::check_blades`] refuses those on load).
     pub fn blade_damper_overrides(&self, k: usize) -> Vec<Override> {
         self.blade_entries()
