@@ -208,6 +208,18 @@ const CASES: &[Case] = &[
     case("rotor segment elements negative", rotor!("segment1 = { elements = 3", "segment1 = { elements = -3"), EXPAND_R, &["r.toml", "elements"]),
     case("rotor damper orifice negative", rotor!("A_orf_m2 = 1.8e-6", "A_orf_m2 = -1.8e-6"), RUN_R, &["r.toml", "A_orf_m2"]),
     case("rotor cyclic ramp negative", rotor!("cyclic_ramp_revs = 2.0", "cyclic_ramp_revs = -2.0"), EXPAND_R, &["r.toml", "cyclic_ramp_revs"]),
+    // per-blade differences: a [blades.K...] table inserted before [damper], or a --set blades.K...
+    case("rotor blade number beyond rotor.blades", rotor!("[damper]\nmodel", "[blades.5.bearing]\nlag_stiffness_Nm_per_rad = 1.0\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, blades.5", "rotor.blades = 4", "blades.1 to blades.4"]),
+    case("rotor blade number zero", rotor!("[damper]\nmodel", "[blades.0.bearing]\nlag_stiffness_Nm_per_rad = 1.0\n\n[damper]\nmodel"), MODES_R, &["r.toml, blades.0", "blades.1 to blades.4"]),
+    case("rotor blade number not a number", rotor!("[damper]\nmodel", "[blades.third.bearing]\nlag_stiffness_Nm_per_rad = 1.0\n\n[damper]\nmodel"), RUN_R, &["r.toml, blades.third", "not a blade number"]),
+    case("rotor blade entry not a table", rotor!("[damper]\nmodel", "[blades]\n2 = 1.0\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, blades.2", "expected a table"]),
+    case("rotor blade sets the rotor speed", rotor!("[damper]\nmodel", "[blades.2.rotor]\nomega_rad_s = 30.0\n\n[damper]\nmodel"), RUN_R, &["r.toml, blades.2.rotor.omega_rad_s", "shared by all blades"]),
+    case("rotor blade damper unknown key", rotor!("[damper]\nmodel", "[blades.3.damper.physical]\nA_orf_mm2 = 4.0e-6\n\n[damper]\nmodel"), RUN_R, &["r.toml, blades.3.damper.physical.A_orf_mm2", "unknown key"]),
+    case("rotor blade bearing negative", rotor!("[damper]\nmodel", "[blades.2.bearing]\nlag_stiffness_Nm_per_rad = -1.0\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, blades.2.bearing.lag_stiffness_Nm_per_rad", "non-negative"]),
+    case("rotor blade sections csv missing", rotor!("[damper]\nmodel", "[blades.4.blade]\nsections_csv = \"no_such_sections.csv\"\n\n[damper]\nmodel"), RUN_R, &["r.toml, blades.4.blade.sections_csv", "no_such_sections.csv"]),
+    case("run --set blade number beyond rotor.blades", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.5.damper.physical.A_orf_m2=2.0e-6"], &["--set blades.5.damper.physical.A_orf_m2", "r.toml, blades.5", "rotor.blades = 4"]),
+    case("run --set blade unknown key", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.3.damper.physical.A_orf_mm2=2.0e-6"], &["--set blades.3.damper.physical.A_orf_mm2", "r.toml, blades.3.damper.physical.A_orf_mm2", "unknown key"]),
+    case("run --set blade without a deck key", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.2=1.0"], &["--set blades.2=1.0", "r.toml, blades.2", "blades.K.<deck key>"]),
     // ---- damper decks (bench, diagnose, run --damper-deck) ----
     case("damper model unknown", damper!("model = \"physical\"", "model = \"magic\""), BENCH_D, &["d.toml", "model"]),
     case("damper linear c negative", damper!("c_N_s_per_m = 68000.0", "c_N_s_per_m = -68000.0"), BENCH_D, &["d.toml", "c_N_s_per_m"]),

@@ -20,6 +20,10 @@ pub struct RotorSpec {
     /// Read by `DamperDeck` (kept opaque here).
     #[serde(default)]
     pub damper: Option<toml::Value>,
+    /// Per-blade differences `[blades.K.<deck path>]`, read by `RotorDeck` (kept opaque here;
+    /// always None in `RotorDeck::spec`, the base deck).
+    #[serde(default)]
+    pub blades: Option<toml::Value>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

@@ -160,6 +160,7 @@ pub struct SimState {
     pub aux: Vec<f64>,
 }
 
+pub mod blades;
 pub mod deck;
 
 /// Largest rotor speed of a fan plot or a decay, in multiples of the deck's nominal: the
@@ -218,15 +219,19 @@ impl Default for RunOptions {
 }
 
 /// A rotor deck (rotors/*.toml): rotor, blade, root retention, bearing, pitch control, damper
-/// attachment geometry and the `[damper]` table. Schema: docs/rotor_deck.md.
+/// attachment geometry and the `[damper]` table. Schema: docs/rotor_deck.md. It is the base deck
+/// (what a single-blade command reads); per-blade differences (`[blades.K...]`, `--set
+/// blades.K...`) give each blade's deck through [`RotorDeck::blade`] (src/rotor/blades.rs).
 #[derive(Clone, Debug)]
 pub struct RotorDeck {
     /// File the deck was read from (relative paths inside it resolve against its folder).
     pub path: std::path::PathBuf,
-    /// The parsed tables.
+    /// The parsed tables of the base deck (`blades` None).
     pub spec: deck::RotorSpec,
     /// The deck text, overrides applied (the `[damper]` table is read from it).
     text: String,
+    /// The per-blade differences, applied only to the blades' decks.
+    blades: blades::PerBlade,
 }
 
 impl RotorDeck {
@@ -234,36 +239,48 @@ impl RotorDeck {
         Self::from_file_with(path, &[])
     }
     /// Reads the deck with `overrides` applied to its values before validation (`--set`): each
-    /// is validated like the deck itself, the `[damper]` table by the damper deck's rules.
+    /// is validated like the deck itself, the `[damper]` table by the damper deck's rules. The
+    /// `blades.*` overrides are kept for the blades' decks; they and the deck's `[blades]` table
+    /// are checked here ([`RotorDeck::check_blades`]).
     pub fn from_file_with(path: &Path, overrides: &[Override]) -> anyhow::Result<Self> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
         let spec = deck::RotorSpec::parse(&text, &file)?;
-        if overrides.is_empty() {
-            return Ok(RotorDeck {
-                path: path.to_path_buf(),
-                spec,
-                text,
-            });
-        }
-        let text = crate::overrides::apply_all(&text, &file, overrides, |t, ov| {
-            deck::RotorSpec::parse(t, &file)?;
-            if ov.is_damper() {
-                DamperDeck::from_toml_str(t, &file)?;
-            }
-            Ok(())
-        })?;
-        Ok(RotorDeck {
+        let (sets, overrides): (Vec<Override>, Vec<Override>) = overrides
+            .iter()
+            .cloned()
+            .partition(blades::is_blade_override);
+        let (text, mut spec) = if overrides.is_empty() {
+            (text, spec)
+        } else {
+            let text = crate::overrides::apply_all(&text, &file, &overrides, |t, ov| {
+                deck::RotorSpec::parse(t, &file)?;
+                if ov.is_damper() {
+                    DamperDeck::from_toml_str(t, &file)?;
+                }
+                Ok(())
+            })?;
+            let spec = deck::RotorSpec::parse(&text, &file)?;
+            (text, spec)
+        };
+        let table = spec.blades.take();
+        let deck = RotorDeck {
             path: path.to_path_buf(),
-            spec: deck::RotorSpec::parse(&text, &file)?,
+            spec,
             text,
-        })
+            blades: blades::PerBlade { table, sets },
+        };
+        deck.check_blades()?;
+        Ok(deck)
     }
-    /// The files the deck was read from: the deck and its blade section table.
+    /// The files the deck was read from: the deck, its blade section table, then the blades'
+    /// other section tables.
     pub fn input_files(&self) -> Vec<std::path::PathBuf> {
         let dir = self.path.parent().unwrap_or(Path::new(""));
-        vec![self.path.clone(), dir.join(&self.spec.blade.sections_csv)]
+        let mut v = vec![self.path.clone(), dir.join(&self.spec.blade.sections_csv)];
+        v.extend(self.blade_section_files());
+        v
     }
     /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {

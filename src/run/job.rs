@@ -522,7 +522,15 @@ impl RunJob {
             Some(RotorDeck::from_file_with(&self.rotor, &rotor_sets)?)
         };
         let deck = match (&self.damper_deck, &rotor) {
-            (Some(p), _) => damper_deck_with(p, &damper_sets)?,
+            (Some(p), _) => {
+                // the blades' damper.* differences apply to this file: refuse bad ones now
+                if let Some(r) = &rotor {
+                    for k in r.differing_blades() {
+                        r.blade_damper_deck(k, p, &damper_sets)?;
+                    }
+                }
+                damper_deck_with(p, &damper_sets)?
+            }
             (None, Some(r)) => r.damper()?,
             (None, None) => damper_deck_with(&self.rotor, &damper_sets)?,
         };
