@@ -313,16 +313,3 @@ pub fn build(
         opts,
     )?))
 }
-
-// PLACEHOLDER until per-blade decks land
-impl RotorDeck {
-    pub fn per_blade(&self) -> bool {
-        false
-    }
-    pub fn blade(&self, _k: usize) -> anyhow::Result<RotorDeck> {
-        Ok(self.clone())
-    }
-    pub fn blade_damper_overrides(&self, _k: usize) -> Vec<Override> {
-        Vec::new()
-    }
-}

@@ -470,12 +470,7 @@ impl RunJob {
             .map(|k| {
                 let rk = r.blade(k)?;
                 let dk = match &self.damper_deck {
-                    Some(p) => {
-                        let mut sets = damper_sets.clone();
-                        sets.extend(r.blade_damper_overrides(k));
-                        damper_deck_with(p, &sets)
-                            .with_context(|| format!("blade {k}'s damper deck"))?
-                    }
+                    Some(p) => r.blade_damper_deck(k, p, &damper_sets)?,
                     None => rk.damper()?,
                 };
                 Ok((rk, dk))
