@@ -562,28 +562,53 @@ pub fn run_units<B>(
 where
     B: Fn(usize) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
 {
-    // One thread per unit, not a pool of one per core: three models on two cores then share
-    // both cores to the end instead of two running first and the third alone while a core
-    // idles. Each unit runs on its own thread only, so its results do not depend on how
-    // many there are.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let workers = workers_for(models.len(), cores);
+    // Each unit runs on one thread only, so its results do not depend on how many run.
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done: Vec<std::sync::Mutex<Option<ModelOutcome>>> =
+        models.iter().map(|_| std::sync::Mutex::new(None)).collect();
     std::thread::scope(|scope| {
-        let handles: Vec<_> = models
-            .iter()
-            .enumerate()
-            .zip(opts)
-            .map(|((i, &model), o)| scope.spawn(move || run_one(i, model, o, build, progress)))
-            .collect();
-        handles
-            .into_iter()
-            .zip(models)
-            .map(|(h, &model)| {
-                h.join().unwrap_or_else(|_| ModelOutcome {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let (Some(&model), Some(o)) = (models.get(i), opts.get(i)) else {
+                    break;
+                };
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    run_one(i, model, o, build, progress)
+                }))
+                .unwrap_or_else(|_| ModelOutcome {
                     model,
                     result: Err("the model's thread panicked".into()),
-                })
+                });
+                if let Ok(mut slot) = done[i].lock() {
+                    *slot = Some(r);
+                }
+            });
+        }
+    });
+    done.into_iter()
+        .zip(models)
+        .map(|(d, &model)| {
+            d.into_inner().ok().flatten().unwrap_or_else(|| ModelOutcome {
+                model,
+                result: Err("the model's thread panicked".into()),
             })
-            .collect()
-    })
+        })
+        .collect()
+}
+
+/// Threads for `units` equal units on `cores` cores: the fewest, at least `cores`, that give
+/// every thread the same number of units. Three models on two cores get three threads, which
+/// share both cores to the end (two threads would leave a core idle for the third's whole
+/// run); four or eight blades get two, each running its blades in turn rather than eight
+/// threads evicting each other's caches.
+pub fn workers_for(units: usize, cores: usize) -> usize {
+    let least = cores.clamp(1, units.max(1));
+    (least..=units.max(1))
+        .find(|w| units.is_multiple_of(*w))
+        .unwrap_or(units.max(1))
 }
 
 fn run_one<B>(
@@ -639,4 +664,22 @@ fn push_message(message: &mut String, m: String) {
         message.push_str("; ");
     }
     message.push_str(&m);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::workers_for;
+
+    #[test]
+    fn every_thread_gets_the_same_number_of_units() {
+        assert_eq!(workers_for(3, 2), 3);
+        assert_eq!(workers_for(1, 2), 1);
+        assert_eq!(workers_for(4, 2), 2);
+        assert_eq!(workers_for(8, 2), 2);
+        assert_eq!(workers_for(12, 2), 2);
+        assert_eq!(workers_for(6, 4), 6);
+        assert_eq!(workers_for(12, 8), 12);
+        assert_eq!(workers_for(2, 16), 2);
+        assert_eq!(workers_for(0, 2), 1);
+    }
 }
