@@ -356,6 +356,8 @@ fn rotor_check(
             synthetic: rec.meta.synthetic,
             counter: rec.meta.counter.clone(),
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
+            blades: None,
+            blade_differences: Vec::new(),
         };
         let failed = crate::run::outputs::write_outputs(&sub, &info, &[outcome], &measured)?.failed;
         if failed.is_empty() {

@@ -242,6 +242,23 @@ impl RotorDeck {
         v
     }
 
+    /// Every per-blade difference as `blades.K.<deck path> = value`, the deck's first (blade
+    /// order), then the `--set` ones in order (for reports).
+    pub fn blade_differences(&self) -> Vec<String> {
+        self.blade_entries()
+            .unwrap_or_default()
+            .iter()
+            .map(|e| {
+                format!(
+                    "blades.{}.{} = {}",
+                    e.blade,
+                    e.ov.key,
+                    crate::overrides::display(&e.ov.value)
+                )
+            })
+            .collect()
+    }
+
     /// Every per-blade entry, the deck's first (blade order), then the `--set` ones in order.
     fn blade_entries(&self) -> anyhow::Result<Vec<Entry>> {
         let file = self.file();

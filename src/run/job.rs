@@ -709,7 +709,14 @@ impl RunJob {
         if nb > 0 {
             outcomes = whole_rotor_outcomes(outcomes, &units);
         }
-        let info = self.info(sdof, rigid, inputs_sha256, &record, t0);
+        let mut info = self.info(sdof, rigid, inputs_sha256, &record, t0);
+        if nb > 0 {
+            info.blades = Some(nb);
+            info.blade_differences = rotor
+                .as_ref()
+                .map(|r| r.blade_differences())
+                .unwrap_or_default();
+        }
         let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
         let published = |name: &str| out.published_path(&out.file(name));
         let published = Published {
@@ -819,6 +826,8 @@ impl RunJob {
             synthetic: record.meta.synthetic,
             counter: record.meta.counter.clone(),
             wall_s: t0.elapsed().as_secs_f64(),
+            blades: None,
+            blade_differences: Vec::new(),
         }
     }
 

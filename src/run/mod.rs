@@ -471,6 +471,13 @@ pub fn drive_periodic(
         first(&mut rev.samples);
     }
     align_envelopes(&mut rev.samples, &rev.end, &env_channels);
+    if info.method_used == PeriodicMethod::Shooting {
+        // the first step's sub-step envelope then also holds the first sample it starts from
+        widen_first_envelope(&mut rev.samples, &names, &env_channels);
+        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
+            widen_first_envelope(&mut k.samples, &names, &env_channels);
+        }
+    }
     let timing = sim.timing();
     let blades = sim.blades();
     let mut run = ModelRun {
@@ -521,6 +528,28 @@ pub fn drive_periodic(
         }
     }
     Ok(run)
+}
+
+/// Row 0 of each sub-step envelope (`<q>_substep_min_<unit>`, `..._max_...`) widened to hold
+/// its channel's first sample (`<q>_<unit>`).
+fn widen_first_envelope(samples: &mut [Vec<f64>], names: &[String], env: &[usize]) {
+    for &c in env {
+        let Some(name) = names.get(c) else { continue };
+        let (point, is_min) = if let Some((q, u)) = name.split_once("_substep_min_") {
+            (format!("{q}_{u}"), true)
+        } else if let Some((q, u)) = name.split_once("_substep_max_") {
+            (format!("{q}_{u}"), false)
+        } else {
+            continue;
+        };
+        let Some(p) = names.iter().position(|n| *n == point) else {
+            continue;
+        };
+        let (Some(&v), Some(&e)) = (samples[p].first(), samples[c].first()) else {
+            continue;
+        };
+        samples[c][0] = if is_min { e.min(v) } else { e.max(v) };
+    }
 }
 
 /// A sub-step envelope sampled at the start of step j covers the step before it: shifted so
@@ -591,10 +620,13 @@ where
     done.into_iter()
         .zip(models)
         .map(|(d, &model)| {
-            d.into_inner().ok().flatten().unwrap_or_else(|| ModelOutcome {
-                model,
-                result: Err("the model's thread panicked".into()),
-            })
+            d.into_inner()
+                .ok()
+                .flatten()
+                .unwrap_or_else(|| ModelOutcome {
+                    model,
+                    result: Err("the model's thread panicked".into()),
+                })
         })
         .collect()
 }

@@ -1196,7 +1196,7 @@ pub fn report_html(
         );
     }
     blade_loads(&mut rep, &runs);
-    whole_rotor(&mut rep, &runs);
+    whole_rotor(&mut rep, info, &runs);
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: docs/formats.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
     rep.finish()
@@ -1433,7 +1433,7 @@ const NON_NPREV_MARK: f64 = 1e-3;
 /// The whole rotor: each blade's damper force on its own azimuth, the hub loads' harmonics
 /// with the content at other than multiples of N/rev highlighted (it comes only from blades
 /// that differ).
-fn whole_rotor(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+fn whole_rotor(rep: &mut HtmlReport, info: &RunInfo, runs: &[&ModelRun]) {
     let whole: Vec<&&ModelRun> = runs.iter().filter(|r| !r.blade_runs.is_empty()).collect();
     let Some(first) = whole.first() else { return };
     let n = first.blade_runs.len();
@@ -1442,6 +1442,12 @@ fn whole_rotor(rep: &mut HtmlReport, runs: &[&ModelRun]) {
         "All {n} blades on a driven hub, each its own model with its own deck values: blade k sits (k-1) x {:.1} deg ahead of blade 1 and sees the shared swashplate's controls and the record's airloads at its own azimuth. On a driven hub the blades are coupled only through prescribed motion, so each blade's periodic solution is the rotor's; the hub loads are the sum of the blades' actual root loads. Each blade's outputs are in <model>/blade<K>/ (docs/run.md).",
         360.0 / n as f64
     ));
+    if info.blade_differences.is_empty() {
+        rep.paragraph("The blades are identical: every blade has the deck's values.");
+    } else {
+        rep.paragraph("Where the blades differ from the deck:");
+        rep.list(&info.blade_differences);
+    }
     let plots: Vec<Plot> = whole
         .iter()
         .map(|r| {

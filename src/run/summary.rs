@@ -526,6 +526,9 @@ pub struct RunInfo {
     pub synthetic: bool,
     pub counter: Option<String>,
     pub wall_s: f64,
+    /// A whole-rotor run: its blades, and where they differ (`blades.K.<deck path> = value`).
+    pub blades: Option<usize>,
+    pub blade_differences: Vec<String>,
 }
 
 /// summary.json as a JSON value.
@@ -577,6 +580,8 @@ pub fn summary_json(
             "overrides": info.overrides.iter().map(|(k, v)| json!({"key": k, "value": v})).collect::<Vec<_>>(),
             "periodicity_tolerance": info.periodic_tol,
             "harmonics_max_per_rev": N_HARMONICS,
+            "all_blades": info.blades,
+            "blade_differences": info.blade_differences,
         },
         "wall_time_s": info.wall_s,
         "measured": meas,
