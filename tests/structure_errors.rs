@@ -168,3 +168,79 @@ fn cli_marks_output_incomplete_on_divergence() {
     let reason = std::fs::read_to_string(out.join("INCOMPLETE")).unwrap();
     assert!(reason.contains("did not converge"), "{reason}");
 }
+
+const BUSHING: &str = r#"
+[[node]]
+name = "air"
+position_m = [0.0, 0.0, 0.0]
+
+[[rigid_body]]
+name = "body"
+node = "air"
+mass_kg = 500.0
+inertia_kgm2 = [[200.0, 0.0, 0.0], [0.0, 300.0, 0.0], [0.0, 0.0, 400.0]]
+
+[[joint]]
+name = "mount"
+type = "bushing"
+node_b = "air"
+stiffness_N_per_m = [2e5, 3e5, 5e5]
+rot_stiffness_Nm_per_rad = [4e5, 9e5, 0.0]
+"#;
+
+#[test]
+fn bad_bushings_name_the_file_the_joint_and_the_key() {
+    assert!(parse_deck(BUSHING, "test.toml", Path::new(".")).is_ok());
+    let cases = [
+        (
+            BUSHING.replace("[2e5, 3e5, 5e5]", "[2e5, -3e5, 5e5]"),
+            "joint[0] `mount`.stiffness_N_per_m",
+            ">= 0",
+        ),
+        (
+            BUSHING.replace("[4e5, 9e5, 0.0]", "[4e5, 9e5]"),
+            "joint[0] `mount`.rot_stiffness_Nm_per_rad",
+            "expected 3 values",
+        ),
+        (
+            format!("{BUSHING}damping_Ns_per_m = [1.0, nan, 0.0]\n"),
+            "joint[0] `mount`.damping_Ns_per_m",
+            ">= 0",
+        ),
+        (
+            format!("{BUSHING}rot_damping_Nms_per_rad = [1.0, 2.0, 3.0, 4.0]\n"),
+            "joint[0] `mount`.rot_damping_Nms_per_rad",
+            "expected 3 values",
+        ),
+        (
+            format!("{BUSHING}stifness_N_per_m = [1.0, 2.0, 3.0]\n"),
+            "joint[0] `mount`",
+            "unknown field `stifness_N_per_m`",
+        ),
+        (
+            BUSHING
+                .replace("[2e5, 3e5, 5e5]", "[0.0, 0.0, 0.0]")
+                .replace("[4e5, 9e5, 0.0]", "[0.0, 0.0, 0.0]"),
+            "joint[0] `mount`.stiffness_N_per_m",
+            "does nothing",
+        ),
+        (
+            format!("{BUSHING}stiffness_Nm_per_rad = 10.0\n"),
+            "joint[0] `mount`.stiffness_Nm_per_rad",
+            "not allowed on a bushing",
+        ),
+        (
+            format!("{BASE}stiffness_N_per_m = [1.0, 2.0, 3.0]\n"),
+            "joint[0] `root`.stiffness_N_per_m",
+            "only for type = \"bushing\"",
+        ),
+    ];
+    for (text, key, what) in cases {
+        let e = err(&text);
+        println!("{e}");
+        assert!(
+            e.contains("test.toml") && e.contains(key) && e.contains(what),
+            "{e}"
+        );
+    }
+}

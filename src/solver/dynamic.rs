@@ -77,7 +77,9 @@ impl CoRotation {
         let mut grounded = vec![];
         for (ei, e) in model.elements.iter().enumerate() {
             if let Element::Joint(j) = e {
-                if j.node_a.is_none() {
+                // a grounded joint without translational multipliers (bushing) has no
+                // reactions to turn: its springs are node rows, which turn with the nodes
+                if j.node_a.is_none() && j.locks().0 == 3 {
                     grounded.push((asm.lam_start[ei], j.qa));
                 }
                 if let (None, Some(law)) = (j.node_a, &j.prescribed_angle) {

@@ -2,7 +2,7 @@
 //! reference (node, beam, joint) is checked and reported with the deck file and the key.
 use super::beam::BeamLoad;
 use super::hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
-use super::joint::{AngleLaw, JointKind};
+use super::joint::{AngleLaw, BushingCoeffs, JointKind};
 use super::kin::TimeTable;
 use super::model::{frame_from_axis, Element, Model, SensorKind};
 use super::rigid::{PointLoad, RigidBody};
@@ -208,6 +208,36 @@ pub struct JointDeck {
     /// (t_s, factor) pairs scaling displacement_m.
     #[serde(default)]
     pub displacement_table: Option<Vec<[f64; 2]>>,
+    /// Bushing springs and dampers per joint axis [x, y, z] (lists, so that a wrong length is
+    /// reported with the joint's name).
+    #[serde(default, rename = "stiffness_N_per_m")]
+    pub stiffness_t: Option<Vec<f64>>,
+    #[serde(default, rename = "damping_Ns_per_m")]
+    pub damping_t: Option<Vec<f64>>,
+    #[serde(default, rename = "rot_stiffness_Nm_per_rad")]
+    pub stiffness_r: Option<Vec<f64>>,
+    #[serde(default, rename = "rot_damping_Nms_per_rad")]
+    pub damping_r: Option<Vec<f64>>,
+}
+
+impl JointDeck {
+    /// The bushing keys with their values (deck spelling).
+    fn bushing_keys(&self) -> [(&'static str, &Option<Vec<f64>>); 4] {
+        [
+            ("stiffness_N_per_m", &self.stiffness_t),
+            ("damping_Ns_per_m", &self.damping_t),
+            ("rot_stiffness_Nm_per_rad", &self.stiffness_r),
+            ("rot_damping_Nms_per_rad", &self.damping_r),
+        ]
+    }
+}
+
+/// A bushing's per-axis values: absent = zeros; checked by `validate`.
+fn axes3(v: &Option<Vec<f64>>) -> [f64; 3] {
+    match v {
+        Some(v) if v.len() == 3 => [v[0], v[1], v[2]],
+        _ => [0.0; 3],
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -447,9 +477,13 @@ pub fn load_deck_within(
 }
 
 fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
-    let deck: Deck = toml::from_str(text).map_err(|e| DeckError::Parse {
-        file: file.into(),
-        msg: e.to_string().trim_end().to_string(),
+    let deck: Deck = toml::from_str(text).map_err(|e| {
+        let msg = e.to_string().trim_end().to_string();
+        let at = e.span().and_then(|sp| array_table_at(text, sp.start));
+        DeckError::Parse {
+            file: file.into(),
+            msg: at.map(|t| format!("in {t}: {msg}")).unwrap_or(msg),
+        }
     })?;
     validate(&deck).map_err(|(key, msg)| DeckError::Invalid {
         file: file.into(),
@@ -457,6 +491,44 @@ fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
         msg,
     })?;
     Ok(deck)
+}
+
+/// The `[[table]]` entry holding byte `offset` of `text`, as `joint[1] `NAME`` (the spelling
+/// of the value errors), so that a serde error (unknown key, wrong type) names the element too.
+fn array_table_at(text: &str, offset: usize) -> Option<String> {
+    let mut counts: std::collections::HashMap<&str, usize> = Default::default();
+    let mut cur: Option<(&str, usize, usize)> = None; // table, index, byte start of its body
+    let mut pos = 0;
+    for line in text.split_inclusive('\n') {
+        if pos > offset {
+            break;
+        }
+        let t = line.trim();
+        if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
+            let name = name.trim();
+            let i = counts.entry(name).or_insert(0);
+            cur = Some((name, *i, pos + line.len()));
+            *i += 1;
+        } else if t.starts_with('[') {
+            cur = None;
+        }
+        pos += line.len();
+    }
+    let (table, index, body) = cur?;
+    let mut label = format!("{table}[{index}]");
+    for line in text[body..].lines() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            break;
+        }
+        if let Some(v) = t.strip_prefix("name").map(str::trim_start) {
+            if let Some(v) = v.strip_prefix('=') {
+                label = format!("{label} `{}`", v.trim().trim_matches('"'));
+                break;
+            }
+        }
+    }
+    Some(label)
 }
 
 /// A value check: Err names the key and says what was expected.
@@ -509,6 +581,60 @@ fn counted(key: &str, n: usize) -> Check {
     } else {
         Err((key.into(), "0: expected at least 1".into()))
     }
+}
+
+/// Bushing keys: three finite non-negative values each, only on a bushing; a bushing has no
+/// revolute spring, prescribed motion, or all-zero coefficients (it would do nothing).
+fn bushing_values(key: &str, j: &JointDeck) -> Check {
+    let bushing = j.kind == "bushing";
+    for (name, v) in j.bushing_keys() {
+        let Some(v) = v else { continue };
+        let k = format!("{key}.{name}");
+        if !bushing {
+            return Err((
+                k,
+                format!("only for type = \"bushing\" (this joint is `{}`)", j.kind),
+            ));
+        }
+        if v.len() != 3 {
+            return Err((
+                k,
+                format!("{v:?}: expected 3 values [x, y, z] along the joint axes"),
+            ));
+        }
+        for &x in v {
+            non_negative(&k, x)?;
+        }
+    }
+    if !bushing {
+        return Ok(());
+    }
+    let other = [
+        ("stiffness_Nm_per_rad", j.stiffness != 0.0),
+        ("damping_Nms_per_rad", j.damping != 0.0),
+        ("omega_rad_s", j.omega_rad_s.is_some()),
+        ("angle_table", j.angle_table.is_some()),
+        ("displacement_m", j.displacement_m.is_some()),
+        ("displacement_table", j.displacement_table.is_some()),
+    ];
+    if let Some((name, _)) = other.iter().find(|(_, given)| *given) {
+        return Err((
+            format!("{key}.{name}"),
+            "not allowed on a bushing (use rot_stiffness_Nm_per_rad, rot_damping_Nms_per_rad)"
+                .into(),
+        ));
+    }
+    let all_zero = j
+        .bushing_keys()
+        .iter()
+        .all(|(_, v)| v.iter().flatten().all(|&x| x == 0.0));
+    if all_zero {
+        return Err((
+            format!("{key}.stiffness_N_per_m"),
+            "a bushing with all stiffnesses and dampings zero does nothing: give at least one of stiffness_N_per_m, damping_Ns_per_m, rot_stiffness_Nm_per_rad, rot_damping_Nms_per_rad".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// `[[t_s, value], ...]`: finite pairs with non-decreasing times.
@@ -645,6 +771,7 @@ fn validate(d: &Deck) -> Check {
             finite3(&format!("{key}.displacement_m"), u)?;
         }
         time_pairs(&format!("{key}.displacement_table"), &j.displacement_table)?;
+        bushing_values(&key, j)?;
     }
     for (i, l) in d.loads.iter().enumerate() {
         let key = format!("load[{i}] `{}`", l.name);
@@ -873,7 +1000,8 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
             "revolute" => JointKind::Revolute,
             "universal" => JointKind::Universal,
             "spherical" => JointKind::Spherical,
-            other => return Err(inv(format!("{key}.type"), format!("unknown joint type `{other}` (expected clamp, revolute, universal, spherical, prescribed)"))),
+            "bushing" => JointKind::Bushing,
+            other => return Err(inv(format!("{key}.type"), format!("unknown joint type `{other}` (expected clamp, revolute, universal, spherical, prescribed, bushing)"))),
         };
         let a = match j.node_a.as_deref() {
             None | Some("ground") => None,
@@ -894,6 +1022,12 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
         if let Element::Joint(jj) = &mut m.elements[id] {
             jj.spring_nm_per_rad = j.stiffness;
             jj.damper_nms_per_rad = j.damping;
+            jj.bushing = BushingCoeffs {
+                k_n_per_m: axes3(&j.stiffness_t),
+                c_ns_per_m: axes3(&j.damping_t),
+                k_nm_per_rad: axes3(&j.stiffness_r),
+                c_nms_per_rad: axes3(&j.damping_r),
+            };
             if j.omega_rad_s.is_some() || j.angle_table.is_some() {
                 if !matches!(kind, JointKind::Revolute | JointKind::Clamp) {
                     return Err(inv(

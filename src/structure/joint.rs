@@ -1,6 +1,7 @@
 //! Joints as data (rapier style): one constraint implementation parametrised by which relative
 //! translations and rotations are locked in a joint frame, plus optional prescribed motion and a
-//! rotational spring/damper about the joint axis (local z).
+//! rotational spring/damper about the joint axis (local z). A bushing locks nothing and puts
+//! springs and dampers on all six relative motions.
 //!
 //! Relative rotation in joint frames `Rr = (R_A Q_A)^T (R_B Q_B)`; with a prescribed angle
 //! `psi_p(t)` about z, `Rr <- Rz(psi_p)^T Rr`. Locked rotations use
@@ -23,6 +24,48 @@ pub enum JointKind {
     Universal,
     /// Only translations locked.
     Spherical,
+    /// Nothing locked: springs and dampers on every relative motion ([`BushingCoeffs`]).
+    Bushing,
+}
+
+/// Bushing springs and dampers per joint axis (x, y, z of the joint frame of A). Translation:
+/// `u = Q_A^T R_A^T (p_B - p_A)` and its time derivative; rotation: `phi = log(Rr)` and the
+/// relative angular velocity `Q_A^T R_A^T (w_B - w_A)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BushingCoeffs {
+    pub k_n_per_m: [f64; 3],
+    pub c_ns_per_m: [f64; 3],
+    pub k_nm_per_rad: [f64; 3],
+    pub c_nms_per_rad: [f64; 3],
+}
+
+impl BushingCoeffs {
+    /// Whether every coefficient is zero (the bushing would do nothing).
+    pub fn is_zero(&self) -> bool {
+        [
+            self.k_n_per_m,
+            self.c_ns_per_m,
+            self.k_nm_per_rad,
+            self.c_nms_per_rad,
+        ]
+        .iter()
+        .flatten()
+        .all(|&x| x == 0.0)
+    }
+}
+
+/// `T_L(phi)^-1 = I - 1/2 phi~ + g phi~^2`, `g = (1 - t/2 cot(t/2)) / t^2`: `d log(exp(e~) R) =
+/// T_L^-1 e` for `phi = log R` (series below `t^2 = 1e-2`, error ~1e-16).
+pub fn tangent_left_inv(p: V3<f64>) -> M3<f64> {
+    let t2 = dot(p, p);
+    let g = if t2 < 1e-2 {
+        1.0 / 12.0 + t2 * (1.0 / 720.0 + t2 * (1.0 / 30240.0 + t2 / 1209600.0))
+    } else {
+        let t = t2.sqrt();
+        1.0 / t2 - (1.0 + t.cos()) / (2.0 * t * t.sin())
+    };
+    let k = skew(p);
+    madd(&madd(&ident(), &mscale(-0.5, &k)), &mscale(g, &mm(&k, &k)))
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +87,8 @@ pub struct Joint {
     pub prescribed_angle: Option<AngleLaw>,
     pub spring_nm_per_rad: f64,
     pub damper_nms_per_rad: f64,
+    /// Springs and dampers of a bushing (used only by `JointKind::Bushing`).
+    pub bushing: BushingCoeffs,
     /// Unwrapped angle at the last converged step (for the spring and sensors).
     pub angle_prev: f64,
 }
@@ -91,11 +136,16 @@ impl Joint {
             prescribed_angle: None,
             spring_nm_per_rad: 0.0,
             damper_nms_per_rad: 0.0,
+            bushing: BushingCoeffs::default(),
             angle_prev: 0.0,
         }
     }
 
+    /// Locked (translations, rotations).
     pub fn locks(&self) -> (usize, usize) {
+        if self.kind == JointKind::Bushing {
+            return (0, 0);
+        }
         let rot = if self.prescribed_angle.is_some() {
             3
         } else {
@@ -103,7 +153,7 @@ impl Joint {
                 JointKind::Clamp => 3,
                 JointKind::Revolute => 2,
                 JointKind::Universal => 1,
-                JointKind::Spherical => 0,
+                JointKind::Spherical | JointKind::Bushing => 0,
             }
         };
         (3, rot)
@@ -182,6 +232,10 @@ impl Joint {
         self.phi(a, b, ctx.t, &mut ph);
         for k in 0..nl {
             out[nn + k] += ph[k].scale(ctx.cscale);
+        }
+        if self.kind == JointKind::Bushing {
+            self.bushing_residual(a, b, out);
+            return;
         }
         // B columns by dual perturbation of each node dof
         let la: NodeKin<Dual<T>> = lift(a);
@@ -337,6 +391,10 @@ impl Joint {
         ctx: &EvalCtx,
         out: &mut [f64],
     ) {
+        if self.kind == JointKind::Bushing {
+            self.bushing_residual(a, b, out);
+            return;
+        }
         let has_a = self.node_a.is_some();
         let off_b = if has_a { 6 } else { 0 };
         let nn = off_b + 6;
@@ -403,6 +461,10 @@ impl Joint {
         seeds: &[[Seed; 6]],
         out: &mut [f64],
     ) {
+        if self.kind == JointKind::Bushing {
+            self.bushing_tangent(a, b, seeds, out);
+            return;
+        }
         let has_a = self.node_a.is_some();
         let off_b = if has_a { 6 } else { 0 };
         let nn = off_b + 6;
@@ -550,6 +612,128 @@ impl Joint {
     }
 }
 
+/// Bushing: spring/damper forces in the joint frame of A, `s_t = K_t u + C_t u_dot`,
+/// `s_r = K_r phi + C_r Om`, with `u = F^T (p_B - p_A)`, `u_dot = F^T v_g`,
+/// `v_g = v_B - v_A + w_B x rho_B - w_A x (p_B - x_A)` (exact rate of `u`), `phi = log(F^T R_B
+/// Q_B)`, `Om = F^T (w_B - w_A)`, `F = R_A Q_A`. Global force `f = F s_t` at the joint point
+/// `p_B` and moment `m = F s_r`: the force is the gradient of `1/2 u.K_t u` (same gradient as a
+/// joint's translation multipliers), hence rows `[-f, f x (p_B - x_A) - m, f, rho_B x f + m]`
+/// (equal and opposite about any point).
+impl Joint {
+    fn bushing_residual<T: Real>(&self, a: &NodeKin<T>, b: &NodeKin<T>, out: &mut [T]) {
+        let k = &self.bushing;
+        let fa = mm(&a.r, &m3c(&self.qa));
+        let fb = mm(&b.r, &m3c(&self.qb));
+        let rho_a = mv(&a.r, v3c(&self.da));
+        let rho_b = mv(&b.r, v3c(&self.db));
+        let pb_xa = sub(add(b.x, rho_b), a.x);
+        let u = mtv(&fa, sub(pb_xa, rho_a));
+        let vg = sub(add(sub(b.v, a.v), cross(b.w, rho_b)), cross(a.w, pb_xa));
+        let ud = mtv(&fa, vg);
+        let phi = log_map(&mtm(&fa, &fb));
+        let om = mtv(&fa, sub(b.w, a.w));
+        let st: V3<T> =
+            std::array::from_fn(|i| u[i].scale(k.k_n_per_m[i]) + ud[i].scale(k.c_ns_per_m[i]));
+        let sr: V3<T> = std::array::from_fn(|i| {
+            phi[i].scale(k.k_nm_per_rad[i]) + om[i].scale(k.c_nms_per_rad[i])
+        });
+        let f = mv(&fa, st);
+        let m = mv(&fa, sr);
+        let off_b = if self.node_a.is_some() {
+            let ma = sub(cross(f, pb_xa), m);
+            for i in 0..3 {
+                out[i] -= f[i];
+                out[3 + i] += ma[i];
+            }
+            6
+        } else {
+            0
+        };
+        let mb = add(cross(rho_b, f), m);
+        for i in 0..3 {
+            out[off_b + i] += f[i];
+            out[off_b + 3 + i] += mb[i];
+        }
+    }
+
+    /// Closed-form bushing tangent (node columns only, no multipliers), same layout as
+    /// `tangent`. With `d F = th_A~ F`, `d rho = th x rho`:
+    /// `du = F^T (dr - th_A x r)`, `du_dot = F^T (dv_g - th_A x v_g)`,
+    /// `dphi = T_L(phi)^-1 F^T (th_B - th_A)`, `dOm = F^T (dw_B - dw_A - th_A x (w_B - w_A))`,
+    /// `df = th_A x f + F ds_t`, `dm = th_A x m + F ds_r`; the damping parts enter through the
+    /// seeds' `dv`, `dw` (generalized-alpha: `gamma/(beta h)`), as for beams' damping.
+    fn bushing_tangent(
+        &self,
+        a: &NodeKin<f64>,
+        b: &NodeKin<f64>,
+        seeds: &[[Seed; 6]],
+        out: &mut [f64],
+    ) {
+        let k = &self.bushing;
+        let has_a = self.node_a.is_some();
+        let off_b = if has_a { 6 } else { 0 };
+        let n = off_b + 6;
+        let fa = mm(&a.r, &self.qa);
+        let fb = mm(&b.r, &self.qb);
+        let rho_a = mv(&a.r, self.da);
+        let rho_b = mv(&b.r, self.db);
+        let pb_xa = sub(add(b.x, rho_b), a.x);
+        let r = sub(pb_xa, rho_a);
+        let u = mtv(&fa, r);
+        let vg = sub(add(sub(b.v, a.v), cross(b.w, rho_b)), cross(a.w, pb_xa));
+        let ud = mtv(&fa, vg);
+        let phi = log_map(&mtm(&fa, &fb));
+        let tinv = tangent_left_inv(phi);
+        let wg = sub(b.w, a.w);
+        let om = mtv(&fa, wg);
+        let st: V3<f64> = std::array::from_fn(|i| k.k_n_per_m[i] * u[i] + k.c_ns_per_m[i] * ud[i]);
+        let sr: V3<f64> =
+            std::array::from_fn(|i| k.k_nm_per_rad[i] * phi[i] + k.c_nms_per_rad[i] * om[i]);
+        let f = mv(&fa, st);
+        let m = mv(&fa, sr);
+        let zero = [0.0; 3];
+        for col in 0..n {
+            let (l, comp) = (col / 6, col % 6);
+            let sd = &seeds[l][comp];
+            let (dxa, ta, dva, dwa, dxb, tb, dvb, dwb) = if has_a && l == 0 {
+                (sd.dx, sd.dth, sd.dv, sd.dw, zero, zero, zero, zero)
+            } else {
+                (zero, zero, zero, zero, sd.dx, sd.dth, sd.dv, sd.dw)
+            };
+            let drho_a = cross(ta, rho_a);
+            let drho_b = cross(tb, rho_b);
+            let dpb_xa = sub(add(dxb, drho_b), dxa);
+            let dr = sub(dpb_xa, drho_a);
+            let du = mtv(&fa, sub(dr, cross(ta, r)));
+            let dvg = add(
+                add(sub(dvb, dva), add(cross(dwb, rho_b), cross(b.w, drho_b))),
+                fmul(-1.0, add(cross(dwa, pb_xa), cross(a.w, dpb_xa))),
+            );
+            let dud = mtv(&fa, sub(dvg, cross(ta, vg)));
+            let dphi = mv(&tinv, mtv(&fa, sub(tb, ta)));
+            let dom = mtv(&fa, sub(sub(dwb, dwa), cross(ta, wg)));
+            let dst: V3<f64> =
+                std::array::from_fn(|i| k.k_n_per_m[i] * du[i] + k.c_ns_per_m[i] * dud[i]);
+            let dsr: V3<f64> =
+                std::array::from_fn(|i| k.k_nm_per_rad[i] * dphi[i] + k.c_nms_per_rad[i] * dom[i]);
+            let df = add(cross(ta, f), mv(&fa, dst));
+            let dm = add(cross(ta, m), mv(&fa, dsr));
+            let mut c = [0.0; 12];
+            if has_a {
+                let dma = sub(add(cross(df, pb_xa), cross(f, dpb_xa)), dm);
+                c[..3].copy_from_slice(&fmul(-1.0, df));
+                c[3..6].copy_from_slice(&dma);
+            }
+            let dmb = add(add(cross(drho_b, f), cross(rho_b, df)), dm);
+            c[off_b..off_b + 3].copy_from_slice(&df);
+            c[off_b + 3..off_b + 6].copy_from_slice(&dmb);
+            for row in 0..n {
+                out[row * n + col] = c[row];
+            }
+        }
+    }
+}
+
 fn lift<T: Real>(k: &NodeKin<T>) -> NodeKin<Dual<T>> {
     let l = |v: &V3<T>| -> V3<Dual<T>> { std::array::from_fn(|i| Dual::new(v[i], c(0.0))) };
     NodeKin {
@@ -559,5 +743,32 @@ fn lift<T: Real>(k: &NodeKin<T>) -> NodeKin<Dual<T>> {
         w: l(&k.w),
         a: l(&k.a),
         al: l(&k.al),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tangent_left_inv_inverts_tangent_left_on_both_branches() {
+        // |phi|^2 across the series threshold 1e-2 and up to 2.9 rad
+        for p in [
+            [0.0, 0.0, 0.0],
+            [1e-6, -2e-6, 5e-7],
+            [0.05, -0.07, 0.02],
+            [0.06, 0.05, -0.04],
+            [0.1, 0.0, 0.02],
+            [0.4, -0.7, 0.2],
+            [2.0, 1.5, -1.2],
+        ] {
+            let m = mm(&tangent_left_inv(p), &tangent_left::<f64>(p));
+            for (i, row) in m.iter().enumerate() {
+                for (j, x) in row.iter().enumerate() {
+                    let e = (x - if i == j { 1.0 } else { 0.0 }).abs();
+                    assert!(e < 1e-14, "{p:?}: ({i}, {j}) {x}");
+                }
+            }
+        }
     }
 }

@@ -18,7 +18,7 @@ pub use beam::{Beam, BeamLoad, SectionLoad};
 #[doc(hidden)]
 pub use beam_tangent::fixture as beam_tangent_fixture;
 pub use hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
-pub use joint::{AngleLaw, Joint, JointKind};
+pub use joint::{AngleLaw, BushingCoeffs, Joint, JointKind};
 pub use kin::{EvalCtx, NodeKin, Seed, TimeTable};
 pub use model::{
     DistributedLoad, Element, ElementError, ElementOutput, LoadPoint, Model, ModelError, Sensor,
