@@ -24,6 +24,10 @@ pub struct ExpandArgs {
     /// Hydraulic sub-steps per structural step.
     #[arg(long, default_value_t = 25)]
     pub substeps: usize,
+    /// The whole rotor: every blade (its per-blade deck values) on one driven hub, blade k
+    /// named `b<k>.` and turned (k-1) 360/N deg ahead of blade 1.
+    #[arg(long)]
+    pub all_blades: bool,
 }
 
 pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
@@ -60,7 +64,7 @@ pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
         None => damper.model,
     };
     damper.require(model)?;
-    let text = deck.expand(&ExpandOptions {
+    let opts = ExpandOptions {
         controls,
         table_revs: args.revs,
         hydraulic: Some(HydraulicRef {
@@ -70,7 +74,26 @@ pub fn run(args: ExpandArgs) -> anyhow::Result<()> {
             substeps: args.substeps,
         }),
         ..Default::default()
-    });
+    };
+    let text = if args.all_blades || deck.per_blade() {
+        let specs = (1..=deck.spec.rotor.blades)
+            .map(|k| {
+                let b = deck.blade(k)?;
+                // the printed deck names one damper table, the rotor deck's
+                if b.damper()? != damper {
+                    anyhow::bail!(
+                        "rotor deck {}: blade {k}'s damper differs from the deck's ({}): the expanded model deck names one [damper] table for all blades; `rotorsim run` gives each blade its own",
+                        args.rotor.display(),
+                        deck.blade_differences().join(", ")
+                    );
+                }
+                Ok(b.spec)
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        crate::rotor::expand::expand_rotor(&specs, &opts)
+    } else {
+        deck.expand(&opts)
+    };
     out!("{text}");
     Ok(())
 }

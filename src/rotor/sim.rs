@@ -156,6 +156,16 @@ pub fn expanded_model(
     parse_expanded(&expand(spec, opts), file)
 }
 
+/// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub,
+/// parsed (relative paths against `file`'s folder).
+pub fn whole_rotor_model(
+    specs: &[RotorSpec],
+    opts: &ExpandOptions,
+    file: &Path,
+) -> anyhow::Result<Model> {
+    parse_expanded(&super::expand::expand_rotor(specs, opts), file)
+}
+
 /// A model deck expanded from the rotor deck `file`, parsed into a model (relative paths against
 /// the deck's folder, errors naming the deck as expanded).
 pub(crate) fn parse_expanded(text: &str, file: &Path) -> anyhow::Result<Model> {
