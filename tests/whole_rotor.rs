@@ -304,3 +304,60 @@ fn the_whole_rotor_needs_the_elastic_model() {
         "nothing is written before the checks"
     );
 }
+
+#[test]
+fn a_whole_rotor_starts_each_blade_from_its_own_saved_state() {
+    let dir = support::tmp("whole_warm");
+    let first = RunJob {
+        periodic_tol: 1e-4,
+        ..job(
+            &dir.join("first"),
+            DamperChoice::One(DamperModel::Linear),
+            64,
+            true,
+            &[],
+        )
+    };
+    let o = first.execute(&Silent).unwrap();
+    let r = &o.outcomes[0].result.as_ref().unwrap();
+    assert!(r.periodic.converged);
+    let again = RunJob {
+        initial_state: Some(dir.join("first")),
+        ..first.clone()
+    };
+    let again = RunJob {
+        out: dir.join("again"),
+        ..again
+    };
+    let o = again.execute(&Silent).unwrap();
+    let r = o.outcomes[0].result.as_ref().unwrap();
+    for b in &r.blade_runs {
+        assert_eq!(
+            b.periodic.revolutions_integrated, 1,
+            "blade {:?} starts periodic from its own state",
+            b.blade
+        );
+    }
+    // a folder without the blades' states is named in the error
+    let single = dir.join("single");
+    RunJob {
+        all_blades: false,
+        out: single.clone(),
+        ..first.clone()
+    }
+    .execute(&Silent)
+    .unwrap();
+    let e = RunJob {
+        initial_state: Some(single),
+        out: dir.join("bad"),
+        ..first
+    }
+    .execute(&Silent)
+    .unwrap_err();
+    let e = format!("{e:#}");
+    assert!(
+        e.contains("blade1") && e.contains("periodic_state.json"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
