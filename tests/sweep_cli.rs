@@ -286,14 +286,18 @@ fn a_case_folder_that_does_not_match_its_manifest_is_never_merged() {
         "{so}"
     );
     assert!(so.contains("damper.physical.A_orf_m2 = 0.0000018"), "{so}");
-    // a resume keeps them failed, by id and reason; --retry-failed runs them again
+    // c001's manifest gone (a run killed before it published): a folder no run would replace
+    std::fs::remove_file(case("c001").join("manifest.json")).unwrap();
+    // a resume keeps them failed, by id and reason; --retry-failed runs them again (clearing
+    // the sweep's own folder that cannot be verified)
     let kept = sweep(&[PLAN, "--out", o], &[]);
     assert!(!kept.status.success());
     let so = String::from_utf8_lossy(&kept.stdout);
     assert!(so.contains("0 run now"), "{so}");
     assert!(so.contains("c003: manifest.json is not a manifest"), "{so}");
+    assert!(so.contains("c001: manifest.json missing"), "{so}");
     let retried = ok(&sweep(&[PLAN, "--out", o, "--retry-failed"], &[]));
-    assert!(retried.contains("3 run now"), "{retried}");
+    assert!(retried.contains("4 run now"), "{retried}");
     assert_eq!(table(&out), good);
     ok(&sweep(&["merge", o], &[]));
     let _ = std::fs::remove_dir_all(&d);

@@ -455,6 +455,25 @@ pub fn execute(
                 report.failed_kept.push((c.id.clone(), why));
                 false
             }
+            CaseState::Damaged(why) => {
+                // The sweep's own case folder that cannot be verified (no manifest: a run
+                // killed before it published) is not a result: a run refuses to replace a
+                // folder it cannot recognise, so the retry clears it first.
+                let folder = case_dir(dir, &c.id);
+                if folder.is_dir() && !folder.join("manifest.json").exists() {
+                    if let Err(e) = std::fs::remove_dir_all(&folder) {
+                        report.failed_kept.push((
+                            c.id.clone(),
+                            format!(
+                                "{why}; cannot clear {} to run it again: {e}",
+                                folder.display()
+                            ),
+                        ));
+                        return false;
+                    }
+                }
+                true
+            }
             _ => true,
         }
     };
