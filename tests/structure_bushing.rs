@@ -15,10 +15,6 @@ use std::path::Path;
 mod joint_support;
 use joint_support::*;
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
-}
-
 fn model(text: &str) -> Model {
     parse_deck(text, "bushing.toml", Path::new(".")).unwrap().1
 }
@@ -59,18 +55,6 @@ fn bushing_case(
     });
     c.b.r = mm(&mm(&fa, &exp_map(phi)), &transpose(&c.j.qb));
     c
-}
-
-fn moved(k: &NodeKin<f64>, s: &Seed, eps: f64) -> NodeKin<f64> {
-    let st = |x: [f64; 3], d: [f64; 3]| add(x, fmul(eps, d));
-    NodeKin {
-        x: st(k.x, s.dx),
-        r: mm(&exp_map(fmul(eps, s.dth)), &k.r),
-        v: st(k.v, s.dv),
-        w: st(k.w, s.dw),
-        a: st(k.a, s.da),
-        al: st(k.al, s.dal),
-    }
 }
 
 fn res(c: &Case, a: &NodeKin<f64>, b: &NodeKin<f64>) -> Vec<f64> {

@@ -16,27 +16,10 @@ const EXTRAS: [Extra; 5] = [
     Extra::DispSpring,
 ];
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
-}
-
 fn res_f64(c: &Case, a: &NodeKin<f64>, b: &NodeKin<f64>, lam: &[f64]) -> Vec<f64> {
     let mut r = vec![0.0; sizes(c).1];
     c.j.residual_f64(a, b, lam, &c.ctx, &mut r);
     r
-}
-
-/// Node kinematics moved by `eps` along a seed (rotation by `exp(eps dth) R`).
-fn moved(k: &NodeKin<f64>, s: &Seed, eps: f64) -> NodeKin<f64> {
-    let st = |x: [f64; 3], d: [f64; 3]| add(x, fmul(eps, d));
-    NodeKin {
-        x: st(k.x, s.dx),
-        r: mm(&exp_map(fmul(eps, s.dth)), &k.r),
-        v: st(k.v, s.dv),
-        w: st(k.w, s.dw),
-        a: st(k.a, s.da),
-        al: st(k.al, s.dal),
-    }
 }
 
 /// All cases: kinds x grounded x extras x seed types x trials.

@@ -7,7 +7,10 @@ mod support;
 
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::overrides::Override;
+use rotorsim::rotor::loads::ROOT_CHANNELS;
 use rotorsim::run::job::{DamperChoice, RotorModel, RunJob};
+use rotorsim::run::loads::HUB_CHANNELS;
+use rotorsim::run::summary::Stats;
 use rotorsim::run::{ModelRun, Silent};
 use std::path::Path;
 
@@ -87,12 +90,7 @@ fn check_folder(out: &Path, r: &ModelRun) {
 }
 
 fn ptp(v: &[f64]) -> f64 {
-    let (lo, hi) = v
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
-            (l.min(*x), h.max(*x))
-        });
-    hi - lo
+    Stats::of(v).peak_to_peak
 }
 
 /// `v` of the single blade as seen by a blade `shift` samples ahead: `v[(i + shift) % m]`.
@@ -125,15 +123,6 @@ fn worst_difference(blade: &ModelRun, single: &ModelRun, shift: usize) -> (f64, 
     }
     worst
 }
-
-const ROOT: [&str; 6] = [
-    "root_fx_N",
-    "root_fy_N",
-    "root_fz_N",
-    "root_mx_Nm",
-    "root_my_Nm",
-    "root_mz_Nm",
-];
 
 /// Complex 1/rev coefficient `(2/m) sum y_i exp(-i psi_i)` of a revolution sampled at `psi`.
 fn one_per_rev(psi_deg: &[f64], y: &[f64]) -> (f64, f64) {
@@ -174,14 +163,7 @@ fn identical_blades_are_the_single_blade_shifted_by_their_azimuth() {
         );
     }
     // the hub loads: the actual sum against the single blade's symmetric construction
-    for c in [
-        "hub_fx_fixed_N",
-        "hub_fy_fixed_N",
-        "hub_fz_fixed_N",
-        "hub_mx_fixed_Nm",
-        "hub_my_fixed_Nm",
-        "hub_mz_fixed_Nm",
-    ] {
+    for c in HUB_CHANNELS {
         let (a, s) = (whole.channel(c).unwrap(), single.channel(c).unwrap());
         let scale = ptp(s);
         let e = a
@@ -258,8 +240,8 @@ fn a_blade_with_another_orifice_changes_itself_and_the_hub_by_superposition() {
     for k in 1..=n {
         let src = if k == 3 { &other } else { &base };
         let shift = (k - 1) * steps / n;
-        let fx = shifted(src.channel(ROOT[0]).unwrap(), shift);
-        let fy = shifted(src.channel(ROOT[1]).unwrap(), shift);
+        let fx = shifted(src.channel(ROOT_CHANNELS[0]).unwrap(), shift);
+        let fy = shifted(src.channel(ROOT_CHANNELS[1]).unwrap(), shift);
         for i in 0..m {
             let a = (psi[i] + (k - 1) as f64 * 360.0 / n as f64).to_radians();
             let (s, c) = a.sin_cos();

@@ -12,10 +12,6 @@ use crate::structure::model::{Element, Model};
 use crate::structure::rotation::*;
 use std::sync::Mutex;
 
-fn norm(v: [f64; 3]) -> f64 {
-    dot(v, v).sqrt()
-}
-
 /// Prefix of the channels that only feed the equilibrium check (not written as outputs).
 pub const CHECK_PREFIX: &str = "check_";
 
@@ -273,7 +269,7 @@ impl LoadChannels {
         let [a, b] = damper.nodes;
         let u_i = sub(damper.x_start[1], damper.x_start[0]);
         let u_f = sub(st.x[b], st.x[a]);
-        let l_m = 0.5 * (norm(u_i) + norm(u_f));
+        let l_m = 0.5 * (norm3(u_i) + norm3(u_f));
         let e_m = fmul(0.5 / l_m, add(u_i, u_f));
         let f_b = fmul(damper.force_n, e_m);
         let couple = Resultant {

@@ -426,10 +426,6 @@ fn set_swash(model: &mut Model, id: usize, pts: &[(f64, f64)]) {
     }
 }
 
-fn norm3(v: [f64; 3]) -> f64 {
-    dot(v, v).sqrt()
-}
-
 /// Twist of the tip section relative to the root section about the root's axis 1 [rad].
 fn rel_twist(r_root: &[[f64; 3]; 3], r_tip: &[[f64; 3]; 3]) -> f64 {
     log_map(&mtm(r_root, r_tip))[0]

@@ -417,18 +417,26 @@ impl RunJob {
     ) -> anyhow::Result<()> {
         self.check_options()?;
         let record = record(&self.flight)?;
-        let (rotor, deck) = self.load_decks()?;
         let models = self.damper.models();
-        for m in &models {
-            deck.require(*m)?;
-        }
+        let (rotor, _, blades) = self.decks_for(&models)?;
+        self.check_rotor(rotor.as_ref(), &record, models.len() * blades.len().max(1))
+    }
+
+    /// The rotor deck, the damper deck and, for a whole-rotor run, each blade's decks, every
+    /// damper deck holding the parameters of `models`.
+    #[allow(clippy::type_complexity)]
+    fn decks_for(
+        &self,
+        models: &[DamperModel],
+    ) -> anyhow::Result<(Option<RotorDeck>, DamperDeck, Vec<(RotorDeck, DamperDeck)>)> {
+        let require = |d: &DamperDeck| models.iter().try_for_each(|m| d.require(*m));
+        let (rotor, deck) = self.load_decks()?;
+        require(&deck)?;
         let blades = self.blade_decks(rotor.as_ref())?;
         for (_, d) in &blades {
-            for m in &models {
-                d.require(*m)?;
-            }
+            require(d)?;
         }
-        self.check_rotor(rotor.as_ref(), &record, models.len() * blades.len().max(1))
+        Ok((rotor, deck, blades))
     }
 
     /// Whether this run is of the whole rotor: asked for, or implied by per-blade differences.
@@ -574,16 +582,7 @@ impl RunJob {
         );
         let record = FlightRecord::read(&self.flight)
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
-        let (rotor, deck) = self.load_decks()?;
-        for m in &models {
-            deck.require(*m)?;
-        }
-        let blades = self.blade_decks(rotor.as_ref())?;
-        for (_, d) in &blades {
-            for m in &models {
-                d.require(*m)?;
-            }
-        }
+        let (rotor, deck, blades) = self.decks_for(&models)?;
         let nb = blades.len();
         // the units that run side by side: one per model, or per model and blade
         let units: Vec<(DamperModel, Option<usize>)> = models

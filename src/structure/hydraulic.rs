@@ -22,6 +22,7 @@
 //! the element applies the committed device force along `e_m` (then `e_f`), and its tangent is
 //! the geometric term above with `dF/dd = 0`, consistent with that force.
 use super::model::{ElementError, ElementOutput, StepElement};
+use super::rotation::norm3;
 use crate::hydraulics::{Device, StepForce};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -284,11 +285,6 @@ impl HydraulicForceElement {
 #[inline]
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn norm3(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 impl StepElement for HydraulicForceElement {

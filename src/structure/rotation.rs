@@ -39,6 +39,11 @@ pub fn fmul<T: Real>(s: f64, a: V3<T>) -> V3<T> {
 pub fn dot<T: Real>(a: V3<T>, b: V3<T>) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
+/// Euclidean length of a 3-vector.
+#[inline]
+pub fn norm3(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
 #[inline]
 pub fn cross<T: Real>(a: V3<T>, b: V3<T>) -> V3<T> {
     [

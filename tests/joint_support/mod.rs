@@ -159,3 +159,21 @@ pub fn sizes(c: &Case) -> (usize, usize) {
     let nn = if c.j.node_a.is_some() { 12 } else { 6 };
     (nn, nn + c.j.n_lambda())
 }
+
+/// Largest absolute entry.
+pub fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Node kinematics moved by `eps` along a seed (rotation by `exp(eps dth) R`).
+pub fn moved(k: &NodeKin<f64>, s: &Seed, eps: f64) -> NodeKin<f64> {
+    let st = |x: [f64; 3], d: [f64; 3]| add(x, fmul(eps, d));
+    NodeKin {
+        x: st(k.x, s.dx),
+        r: mm(&exp_map(fmul(eps, s.dth)), &k.r),
+        v: st(k.v, s.dv),
+        w: st(k.w, s.dw),
+        a: st(k.a, s.da),
+        al: st(k.al, s.dal),
+    }
+}
