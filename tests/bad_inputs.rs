@@ -220,6 +220,8 @@ const CASES: &[Case] = &[
     case("run --set blade number beyond rotor.blades", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.5.damper.physical.A_orf_m2=2.0e-6"], &["--set blades.5.damper.physical.A_orf_m2", "r.toml, blades.5", "rotor.blades = 4"]),
     case("run --set blade unknown key", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.3.damper.physical.A_orf_mm2=2.0e-6"], &["--set blades.3.damper.physical.A_orf_mm2", "r.toml, blades.3.damper.physical.A_orf_mm2", "unknown key"]),
     case("run --set blade without a deck key", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.2=1.0"], &["--set blades.2=1.0", "r.toml, blades.2", "blades.K.<deck key>"]),
+    case("run --all-blades with the rigid model", R, &["run", "--model", "rigid", "--all-blades", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out"], &["--all-blades", "--model uh60a", "--model rigid"]),
+    case("expand of blades whose dampers differ", rotor!("[damper]\nmodel", "[blades.3.damper.physical]\nA_orf_m2 = 4.0e-6\n\n[damper]\nmodel"), EXPAND_R, &["r.toml", "blade 3's damper differs", "blades.3.damper.physical.A_orf_m2"]),
     // ---- damper decks (bench, diagnose, run --damper-deck) ----
     case("damper model unknown", damper!("model = \"physical\"", "model = \"magic\""), BENCH_D, &["d.toml", "model"]),
     case("damper linear c negative", damper!("c_N_s_per_m = 68000.0", "c_N_s_per_m = -68000.0"), BENCH_D, &["d.toml", "c_N_s_per_m"]),
