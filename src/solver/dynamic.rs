@@ -77,8 +77,9 @@ impl CoRotation {
         let mut grounded = vec![];
         for (ei, e) in model.elements.iter().enumerate() {
             if let Element::Joint(j) = e {
-                // a grounded joint without translational multipliers (bushing) has no
-                // reactions to turn: its springs are node rows, which turn with the nodes
+                // only a full reaction vector turns (multipliers 0..3 along the joint axes);
+                // a bushing's springs are node rows, which turn with the nodes, and a reaction
+                // along fewer locked axes is not a vector (the contraction rule refreshes)
                 if j.node_a.is_none() && j.locks().0 == 3 {
                     grounded.push((asm.lam_start[ei], j.qa));
                 }

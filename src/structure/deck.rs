@@ -218,6 +218,18 @@ pub struct JointDeck {
     pub stiffness_r: Option<Vec<f64>>,
     #[serde(default, rename = "rot_damping_Nms_per_rad")]
     pub damping_r: Option<Vec<f64>>,
+    /// Bushing axes locked by multipliers, any of `AXES` once each.
+    #[serde(default)]
+    pub locked: Option<Vec<String>>,
+}
+
+/// A bushing's axis names in `Joint::bushing_locked` order: translations, then rotations.
+const AXES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+/// Locked flags from checked axis names.
+fn locked_axes(names: &Option<Vec<String>>) -> [bool; 6] {
+    let names = names.as_deref().unwrap_or_default();
+    std::array::from_fn(|i| names.iter().any(|n| n == AXES[i]))
 }
 
 impl JointDeck {
@@ -583,10 +595,31 @@ fn counted(key: &str, n: usize) -> Check {
     }
 }
 
-/// Bushing keys: three finite non-negative values each, only on a bushing; a bushing has no
-/// revolute spring, prescribed motion, or all-zero coefficients (it would do nothing).
+/// Bushing keys: three finite non-negative values each, only on a bushing; `locked` names
+/// axes once each; a bushing has no revolute spring, prescribed motion, spring or damper on a
+/// locked axis, or all-zero coefficients without a lock (either would do nothing).
 fn bushing_values(key: &str, j: &JointDeck) -> Check {
     let bushing = j.kind == "bushing";
+    if let Some(names) = &j.locked {
+        let k = format!("{key}.locked");
+        if !bushing {
+            return Err((
+                k,
+                format!("only for type = \"bushing\" (this joint is `{}`)", j.kind),
+            ));
+        }
+        for (i, n) in names.iter().enumerate() {
+            if !AXES.contains(&n.as_str()) {
+                return Err((
+                    k,
+                    format!("unknown axis `{n}` (expected any of x, y, z, rx, ry, rz)"),
+                ));
+            }
+            if names[..i].contains(n) {
+                return Err((k, format!("axis `{n}` given twice")));
+            }
+        }
+    }
     for (name, v) in j.bushing_keys() {
         let Some(v) = v else { continue };
         let k = format!("{key}.{name}");
@@ -624,14 +657,29 @@ fn bushing_values(key: &str, j: &JointDeck) -> Check {
                 .into(),
         ));
     }
+    let locked = locked_axes(&j.locked);
+    for (n, (name, v)) in j.bushing_keys().iter().enumerate() {
+        // stiffness_N_per_m and damping_Ns_per_m on x, y, z; the rotational ones on rx, ry, rz
+        let first = if n < 2 { 0 } else { 3 };
+        let Some(v) = v else { continue };
+        if let Some(i) = (0..3).find(|&i| v[i] != 0.0 && locked[first + i]) {
+            return Err((
+                format!("{key}.{name}"),
+                format!(
+                    "{v:?}: `{}` is locked, so a spring or damper on it does nothing (give 0.0)",
+                    AXES[first + i]
+                ),
+            ));
+        }
+    }
     let all_zero = j
         .bushing_keys()
         .iter()
         .all(|(_, v)| v.iter().flatten().all(|&x| x == 0.0));
-    if all_zero {
+    if all_zero && !locked.contains(&true) {
         return Err((
             format!("{key}.stiffness_N_per_m"),
-            "a bushing with all stiffnesses and dampings zero does nothing: give at least one of stiffness_N_per_m, damping_Ns_per_m, rot_stiffness_Nm_per_rad, rot_damping_Nms_per_rad".into(),
+            "a bushing with all stiffnesses and dampings zero and no locked axis does nothing: give at least one of stiffness_N_per_m, damping_Ns_per_m, rot_stiffness_Nm_per_rad, rot_damping_Nms_per_rad, locked".into(),
         ));
     }
     Ok(())
@@ -1028,6 +1076,7 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
                 k_nm_per_rad: axes3(&j.stiffness_r),
                 c_nms_per_rad: axes3(&j.damping_r),
             };
+            jj.bushing_locked = locked_axes(&j.locked);
             if j.omega_rad_s.is_some() || j.angle_table.is_some() {
                 if !matches!(kind, JointKind::Revolute | JointKind::Clamp) {
                     return Err(inv(

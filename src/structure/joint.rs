@@ -1,7 +1,7 @@
 //! Joints as data (rapier style): one constraint implementation parametrised by which relative
 //! translations and rotations are locked in a joint frame, plus optional prescribed motion and a
-//! rotational spring/damper about the joint axis (local z). A bushing locks nothing and puts
-//! springs and dampers on all six relative motions.
+//! rotational spring/damper about the joint axis (local z). A bushing puts springs and dampers
+//! on all six relative motions and locks the axes chosen in `Joint::bushing_locked`.
 //!
 //! Relative rotation in joint frames `Rr = (R_A Q_A)^T (R_B Q_B)`; with a prescribed angle
 //! `psi_p(t)` about z, `Rr <- Rz(psi_p)^T Rr`. Locked rotations use
@@ -24,7 +24,8 @@ pub enum JointKind {
     Universal,
     /// Only translations locked.
     Spherical,
-    /// Nothing locked: springs and dampers on every relative motion ([`BushingCoeffs`]).
+    /// Springs and dampers on every relative motion ([`BushingCoeffs`]); the axes chosen in
+    /// [`Joint::bushing_locked`] are locked.
     Bushing,
 }
 
@@ -89,6 +90,13 @@ pub struct Joint {
     pub damper_nms_per_rad: f64,
     /// Springs and dampers of a bushing (used only by `JointKind::Bushing`).
     pub bushing: BushingCoeffs,
+    /// Locked axes of a bushing: translation along the joint axes x, y, z of A, then rotation
+    /// about them (used only by `JointKind::Bushing`). Translation locks are those of the other
+    /// joints; a rotation lock about axis i is the clamp's `1/2 (Rr_kj - Rr_jk)` for that axis,
+    /// exact when it is the only rotation and coupled to the other rotations at second order
+    /// (e.g. roll locked with pitch and yaw free keeps `1/2 (Rr_32 - Rr_23) = 0`, not
+    /// `log(Rr)_x = 0`). Separate from `BushingCoeffs` so that its literals stay valid.
+    pub bushing_locked: [bool; 6],
     /// Unwrapped angle at the last converged step (for the spring and sensors).
     pub angle_prev: f64,
 }
@@ -137,6 +145,7 @@ impl Joint {
             spring_nm_per_rad: 0.0,
             damper_nms_per_rad: 0.0,
             bushing: BushingCoeffs::default(),
+            bushing_locked: [false; 6],
             angle_prev: 0.0,
         }
     }
@@ -144,7 +153,9 @@ impl Joint {
     /// Locked (translations, rotations).
     pub fn locks(&self) -> (usize, usize) {
         if self.kind == JointKind::Bushing {
-            return (0, 0);
+            let l = &self.bushing_locked;
+            let n = |s: &[bool]| s.iter().filter(|&&x| x).count();
+            return (n(&l[..3]), n(&l[3..]));
         }
         let rot = if self.prescribed_angle.is_some() {
             3
@@ -188,9 +199,11 @@ impl Joint {
         if let Some((u, tb)) = &self.displacement_m {
             d = sub(d, fmul(tb.eval(t), v3c(u)));
         }
-        out[..3].copy_from_slice(&d);
+        let ls = self.lock_set();
+        for (q, &k) in ls.trans().iter().enumerate() {
+            out[q] = d[k];
+        }
         let mut rr = self.rel_rot(a, b);
-        let (_, nrot) = self.locks();
         if let Some(law) = &self.prescribed_angle {
             let ang = law.angle(t);
             let rz = [
@@ -200,18 +213,12 @@ impl Joint {
             ];
             rr = mtm(&rz, &rr);
         }
-        match nrot {
-            3 => {
-                out[3] = (rr[2][1] - rr[1][2]).scale(0.5);
-                out[4] = (rr[0][2] - rr[2][0]).scale(0.5);
-                out[5] = (rr[1][0] - rr[0][1]).scale(0.5);
+        for (m, terms) in ls.rot().iter().enumerate() {
+            let mut p = c::<T>(0.0);
+            for &(cf, i, j) in terms.iter() {
+                p += rr[i][j].scale(cf);
             }
-            2 => {
-                out[3] = rr[2][0];
-                out[4] = rr[2][1];
-            }
-            1 => out[3] = rr[0][1],
-            _ => {}
+            out[ls.nt + m] = p;
         }
     }
 
@@ -233,14 +240,11 @@ impl Joint {
         for k in 0..nl {
             out[nn + k] += ph[k].scale(ctx.cscale);
         }
-        if self.kind == JointKind::Bushing {
-            self.bushing_residual(a, b, out);
-            return;
-        }
-        // B columns by dual perturbation of each node dof
+        // B columns by dual perturbation of each node dof (none without multipliers)
         let la: NodeKin<Dual<T>> = lift(a);
         let lb: NodeKin<Dual<T>> = lift(b);
-        for j in 0..nn {
+        let ncols = if nl > 0 { nn } else { 0 };
+        for j in 0..ncols {
             let (node_is_b, comp) = if j >= off_b {
                 (true, j - off_b)
             } else {
@@ -264,6 +268,10 @@ impl Joint {
             }
             out[j] += s.scale(ctx.cscale);
         }
+        if self.kind == JointKind::Bushing {
+            self.bushing_residual(a, b, out);
+            return;
+        }
         if (self.spring_nm_per_rad != 0.0 || self.damper_nms_per_rad != 0.0)
             && self.prescribed_angle.is_none()
         {
@@ -281,9 +289,12 @@ impl Joint {
     }
 }
 
-/// Rotation constraints as sums `sum coef Rr'_ij` (i, j 0-based), indexed by `nrot`:
-/// clamp/prescribed `1/2 axial(Rr' - Rr'^T)`, revolute `Rr_31, Rr_32`, universal `Rr_12`.
-type RotTerms = &'static [&'static [(f64, usize, usize)]];
+/// One rotation constraint `sum coef Rr'_ij` (i, j 0-based).
+type RotTerm = &'static [(f64, usize, usize)];
+
+/// Rotation constraints indexed by `nrot`: clamp/prescribed `1/2 axial(Rr' - Rr'^T)` (also a
+/// bushing's rotation locks, one axis each), revolute `Rr_31, Rr_32`, universal `Rr_12`.
+type RotTerms = &'static [RotTerm];
 const ROT_TERMS: [RotTerms; 4] = [
     &[],
     &[&[(1.0, 0, 1)]],
@@ -294,6 +305,28 @@ const ROT_TERMS: [RotTerms; 4] = [
         &[(0.5, 1, 0), (-0.5, 0, 1)],
     ],
 ];
+
+/// Locked translation axes and rotation constraints in multiplier order (translations first):
+/// all three translations for every kind but the bushing, which locks any subset.
+#[derive(Clone, Copy)]
+struct LockSet {
+    trans: [usize; 3],
+    nt: usize,
+    rot: [RotTerm; 3],
+    nr: usize,
+}
+
+impl LockSet {
+    fn trans(&self) -> &[usize] {
+        &self.trans[..self.nt]
+    }
+    fn rot(&self) -> &[RotTerm] {
+        &self.rot[..self.nr]
+    }
+    fn n(&self) -> usize {
+        self.nt + self.nr
+    }
+}
 
 /// Joint geometry at one configuration (f64), shared by `residual_f64` and `tangent`.
 struct Geo {
@@ -341,22 +374,45 @@ impl Joint {
         }
     }
 
-    fn rot_terms(&self) -> RotTerms {
-        ROT_TERMS[self.locks().1]
+    fn lock_set(&self) -> LockSet {
+        let mut s = LockSet {
+            trans: [0, 1, 2],
+            nt: 3,
+            rot: [&[]; 3],
+            nr: 0,
+        };
+        if self.kind == JointKind::Bushing {
+            s.nt = 0;
+            for (k, _) in self.bushing_locked[..3].iter().enumerate().filter(|p| *p.1) {
+                s.trans[s.nt] = k;
+                s.nt += 1;
+            }
+            for (i, _) in self.bushing_locked[3..].iter().enumerate().filter(|p| *p.1) {
+                s.rot[s.nr] = ROT_TERMS[3][i];
+                s.nr += 1;
+            }
+        } else {
+            let terms = ROT_TERMS[self.locks().1];
+            s.rot[..terms.len()].copy_from_slice(terms);
+            s.nr = terms.len();
+        }
+        s
     }
 
-    /// Whether the spring/damper about the joint axis acts.
+    /// Whether the spring/damper about the joint axis acts (never on a bushing, whose
+    /// springs are its own).
     fn has_spring(&self) -> bool {
         (self.spring_nm_per_rad != 0.0 || self.damper_nms_per_rad != 0.0)
             && self.prescribed_angle.is_none()
+            && self.kind != JointKind::Bushing
     }
 
     /// Constraint gradients w.r.t. the rotation of A of the rotation constraints,
     /// `w_m = sum coef a_i x b_j` (that w.r.t. B is `-w_m`), from `d(a_i . b_j) =
     /// th_A . (a_i x b_j) - th_B . (a_i x b_j)`.
-    fn rot_grads(&self, g: &Geo) -> [V3<f64>; 3] {
+    fn rot_grads(&self, g: &Geo, ls: &LockSet) -> [V3<f64>; 3] {
         let mut w = [[0.0; 3]; 3];
-        for (m, terms) in self.rot_terms().iter().enumerate() {
+        for (m, terms) in ls.rot().iter().enumerate() {
             for &(cf, i, j) in terms.iter() {
                 w[m] = add(w[m], fmul(cf, cross(g.ax[i], g.bx[j])));
             }
@@ -366,16 +422,16 @@ impl Joint {
 
     /// Resultants of the scaled multipliers: force `F = s sum lam_k f_k` on B and moment `M =
     /// s sum lam_m w_m` on A (`-M` on B).
-    fn resultants(&self, g: &Geo, lam: &[f64], s: f64, w: &[V3<f64>; 3]) -> (V3<f64>, V3<f64>) {
+    fn resultants(g: &Geo, lam: &[f64], s: f64, w: &[V3<f64>; 3], ls: &LockSet) -> [V3<f64>; 2] {
         let mut fo = [0.0; 3];
-        for k in 0..3 {
-            fo = add(fo, fmul(s * lam[k], g.f[k]));
+        for (q, &k) in ls.trans().iter().enumerate() {
+            fo = add(fo, fmul(s * lam[q], g.f[k]));
         }
         let mut mo = [0.0; 3];
-        for m in 0..self.locks().1 {
-            mo = add(mo, fmul(s * lam[3 + m], w[m]));
+        for m in 0..ls.nr {
+            mo = add(mo, fmul(s * lam[ls.nt + m], w[m]));
         }
-        (fo, mo)
+        [fo, mo]
     }
 
     /// Residual in closed form, same value and layout as `residual::<f64>` (accumulated).
@@ -391,9 +447,12 @@ impl Joint {
         ctx: &EvalCtx,
         out: &mut [f64],
     ) {
+        let ls = self.lock_set();
         if self.kind == JointKind::Bushing {
             self.bushing_residual(a, b, out);
-            return;
+            if ls.n() == 0 {
+                return;
+            }
         }
         let has_a = self.node_a.is_some();
         let off_b = if has_a { 6 } else { 0 };
@@ -401,18 +460,18 @@ impl Joint {
         let g = self.geo(a, b, ctx.t);
         let s = ctx.cscale;
         let u = self.prescribed_disp(ctx.t);
-        for k in 0..3 {
-            out[nn + k] += s * (dot(g.f[k], g.r) - u[k]);
+        for (q, &k) in ls.trans().iter().enumerate() {
+            out[nn + q] += s * (dot(g.f[k], g.r) - u[k]);
         }
-        for (m, terms) in self.rot_terms().iter().enumerate() {
+        for (m, terms) in ls.rot().iter().enumerate() {
             let p: f64 = terms
                 .iter()
                 .map(|&(cf, i, j)| cf * dot(g.ax[i], g.bx[j]))
                 .sum();
-            out[nn + 3 + m] += s * p;
+            out[nn + ls.nt + m] += s * p;
         }
-        let w = self.rot_grads(&g);
-        let (fo, mo) = self.resultants(&g, lam, s, &w);
+        let w = self.rot_grads(&g, &ls);
+        let [fo, mo] = Self::resultants(&g, lam, s, &w, &ls);
         let mut add_to = |o: usize, v: V3<f64>| {
             for i in 0..3 {
                 out[o + i] += v[i];
@@ -461,42 +520,43 @@ impl Joint {
         seeds: &[[Seed; 6]],
         out: &mut [f64],
     ) {
-        if self.kind == JointKind::Bushing {
-            self.bushing_tangent(a, b, seeds, out);
-            return;
-        }
+        let ls = self.lock_set();
         let has_a = self.node_a.is_some();
         let off_b = if has_a { 6 } else { 0 };
         let nn = off_b + 6;
-        let nrot = self.locks().1;
-        let n = nn + 3 + nrot;
+        let n = nn + ls.n();
         out[..n * n].iter_mut().for_each(|x| *x = 0.0);
+        if self.kind == JointKind::Bushing {
+            self.bushing_tangent(a, b, seeds, n, out);
+            if ls.n() == 0 {
+                return;
+            }
+        }
         let g = self.geo(a, b, ctx.t);
         let s = ctx.cscale;
-        let w = self.rot_grads(&g);
-        let (fo, _) = self.resultants(&g, lam, s, &w);
-        let terms = self.rot_terms();
+        let w = self.rot_grads(&g, &ls);
+        let [fo, _] = Self::resultants(&g, lam, s, &w, &ls);
         let mut set = |row: usize, col: usize, v: V3<f64>| {
             for i in 0..3 {
                 out[(row + i) * n + col] = v[i];
             }
         };
         // multiplier columns: s B^T
-        for k in 0..3 {
+        for (q, &k) in ls.trans().iter().enumerate() {
             let fk = fmul(s, g.f[k]);
             if has_a {
-                set(0, nn + k, fmul(-1.0, fk));
-                set(3, nn + k, cross(fk, g.pb_xa));
+                set(0, nn + q, fmul(-1.0, fk));
+                set(3, nn + q, cross(fk, g.pb_xa));
             }
-            set(off_b, nn + k, fk);
-            set(off_b + 3, nn + k, cross(g.rho_b, fk));
+            set(off_b, nn + q, fk);
+            set(off_b + 3, nn + q, cross(g.rho_b, fk));
         }
-        for m in 0..nrot {
+        for m in 0..ls.nr {
             let wm = fmul(s, w[m]);
             if has_a {
-                set(3, nn + 3 + m, wm);
+                set(3, nn + ls.nt + m, wm);
             }
-            set(off_b + 3, nn + 3 + m, fmul(-1.0, wm));
+            set(off_b + 3, nn + ls.nt + m, fmul(-1.0, wm));
         }
         // spring/damper: moment m z, d m = k d psi + c (d z . (w_B - w_A) + z . (dw_B - dw_A))
         let spring = self.has_spring().then(|| {
@@ -524,13 +584,13 @@ impl Joint {
             let drho_b = cross(tb, g.rho_b);
             let dpb_xa = sub(add(dxb, drho_b), dxa);
             let dr = sub(dpb_xa, drho_a);
-            for k in 0..3 {
-                c[nn + k] = s * (dot(cross(ta, g.f[k]), g.r) + dot(g.f[k], dr));
+            for (q, &k) in ls.trans().iter().enumerate() {
+                c[nn + q] = s * (dot(cross(ta, g.f[k]), g.r) + dot(g.f[k], dr));
             }
             let da: [V3<f64>; 3] = std::array::from_fn(|i| cross(ta, g.ax[i]));
             let db: [V3<f64>; 3] = std::array::from_fn(|j| cross(tb, g.bx[j]));
             let mut dmo = [0.0; 3];
-            for (m, tm) in terms.iter().enumerate() {
+            for (m, tm) in ls.rot().iter().enumerate() {
                 let mut dp = 0.0;
                 let mut dw = [0.0; 3];
                 for &(cf, i, j) in tm.iter() {
@@ -538,8 +598,8 @@ impl Joint {
                     let t = add(cross(da[i], g.bx[j]), cross(g.ax[i], db[j]));
                     dw = add(dw, fmul(cf, t));
                 }
-                c[nn + 3 + m] = s * dp;
-                dmo = add(dmo, fmul(s * lam[3 + m], dw));
+                c[nn + ls.nt + m] = s * dp;
+                dmo = add(dmo, fmul(s * lam[ls.nt + m], dw));
             }
             // node rows: d(B^T s lam), with d F = th_A x F
             let dfo = cross(ta, fo);
@@ -560,7 +620,7 @@ impl Joint {
             c[off_b..off_b + 3].copy_from_slice(&dfo);
             c[off_b + 3..off_b + 6].copy_from_slice(&mom_b);
             for row in 0..n {
-                out[row * n + col] = c[row];
+                out[row * n + col] += c[row];
             }
         }
     }
@@ -656,8 +716,8 @@ impl Joint {
         }
     }
 
-    /// Closed-form bushing tangent (node columns only, no multipliers), same layout as
-    /// `tangent`. With `d F = th_A~ F`, `d rho = th x rho`:
+    /// Closed-form bushing springs' tangent, added to the node rows and columns of `out` (row
+    /// length `n`, same layout as `tangent`; the multiplier parts are the constraint code's). With `d F = th_A~ F`, `d rho = th x rho`:
     /// `du = F^T (dr - th_A x r)`, `du_dot = F^T (dv_g - th_A x v_g)`,
     /// `dphi = T_L(phi)^-1 F^T (th_B - th_A)`, `dOm = F^T (dw_B - dw_A - th_A x (w_B - w_A))`,
     /// `df = th_A x f + F ds_t`, `dm = th_A x m + F ds_r`; the damping parts enter through the
@@ -667,12 +727,13 @@ impl Joint {
         a: &NodeKin<f64>,
         b: &NodeKin<f64>,
         seeds: &[[Seed; 6]],
+        n: usize,
         out: &mut [f64],
     ) {
         let k = &self.bushing;
         let has_a = self.node_a.is_some();
         let off_b = if has_a { 6 } else { 0 };
-        let n = off_b + 6;
+        let nn = off_b + 6;
         let fa = mm(&a.r, &self.qa);
         let fb = mm(&b.r, &self.qb);
         let rho_a = mv(&a.r, self.da);
@@ -692,7 +753,7 @@ impl Joint {
         let f = mv(&fa, st);
         let m = mv(&fa, sr);
         let zero = [0.0; 3];
-        for col in 0..n {
+        for col in 0..nn {
             let (l, comp) = (col / 6, col % 6);
             let sd = &seeds[l][comp];
             let (dxa, ta, dva, dwa, dxb, tb, dvb, dwb) = if has_a && l == 0 {
@@ -727,8 +788,8 @@ impl Joint {
             let dmb = add(add(cross(drho_b, f), cross(rho_b, df)), dm);
             c[off_b..off_b + 3].copy_from_slice(&df);
             c[off_b + 3..off_b + 6].copy_from_slice(&dmb);
-            for row in 0..n {
-                out[row * n + col] = c[row];
+            for row in 0..nn {
+                out[row * n + col] += c[row];
             }
         }
     }
@@ -749,6 +810,38 @@ fn lift<T: Real>(k: &NodeKin<T>) -> NodeKin<Dual<T>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn joint_lock_sets_keep_the_old_layout_and_order_bushing_locks() {
+        let mut j = Joint::new(
+            "j",
+            JointKind::Clamp,
+            None,
+            (0, [0.0; 3], ident()),
+            [0.0; 3],
+            ident(),
+        );
+        for (kind, nrot) in [
+            (JointKind::Clamp, 3),
+            (JointKind::Revolute, 2),
+            (JointKind::Universal, 1),
+            (JointKind::Spherical, 0),
+        ] {
+            j.kind = kind;
+            let ls = j.lock_set();
+            assert_eq!(ls.trans(), &[0, 1, 2]);
+            assert_eq!(ls.rot(), ROT_TERMS[nrot]);
+            assert_eq!(j.locks(), (3, nrot));
+        }
+        j.kind = JointKind::Bushing;
+        assert_eq!(j.locks(), (0, 0));
+        // deck order is irrelevant: translations in axis order, then rotations
+        j.bushing_locked = [false, true, true, true, false, true];
+        let ls = j.lock_set();
+        assert_eq!(ls.trans(), &[1, 2]);
+        assert_eq!(ls.rot(), &[ROT_TERMS[3][0], ROT_TERMS[3][2]]);
+        assert_eq!((j.locks(), j.n_lambda()), ((2, 2), 4));
+    }
 
     #[test]
     fn tangent_left_inv_inverts_tangent_left_on_both_branches() {
