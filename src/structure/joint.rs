@@ -526,11 +526,10 @@ impl Joint {
         let nn = off_b + 6;
         let n = nn + ls.n();
         out[..n * n].iter_mut().for_each(|x| *x = 0.0);
-        if self.kind == JointKind::Bushing {
+        if ls.n() == 0 {
+            // a bushing without locks: its springs alone
             self.bushing_tangent(a, b, seeds, n, out);
-            if ls.n() == 0 {
-                return;
-            }
+            return;
         }
         let g = self.geo(a, b, ctx.t);
         let s = ctx.cscale;
@@ -620,8 +619,11 @@ impl Joint {
             c[off_b..off_b + 3].copy_from_slice(&dfo);
             c[off_b + 3..off_b + 6].copy_from_slice(&mom_b);
             for row in 0..n {
-                out[row * n + col] += c[row];
+                out[row * n + col] = c[row];
             }
+        }
+        if self.kind == JointKind::Bushing {
+            self.bushing_tangent(a, b, seeds, n, out);
         }
     }
 
@@ -680,6 +682,8 @@ impl Joint {
 /// joint's translation multipliers), hence rows `[-f, f x (p_B - x_A) - m, f, rho_B x f + m]`
 /// (equal and opposite about any point).
 impl Joint {
+    // out of line, so that the other joints' residual and tangent stay compact
+    #[inline(never)]
     fn bushing_residual<T: Real>(&self, a: &NodeKin<T>, b: &NodeKin<T>, out: &mut [T]) {
         let k = &self.bushing;
         let fa = mm(&a.r, &m3c(&self.qa));
@@ -722,6 +726,8 @@ impl Joint {
     /// `dphi = T_L(phi)^-1 F^T (th_B - th_A)`, `dOm = F^T (dw_B - dw_A - th_A x (w_B - w_A))`,
     /// `df = th_A x f + F ds_t`, `dm = th_A x m + F ds_r`; the damping parts enter through the
     /// seeds' `dv`, `dw` (generalized-alpha: `gamma/(beta h)`), as for beams' damping.
+    // out of line, so that the other joints' residual and tangent stay compact
+    #[inline(never)]
     fn bushing_tangent(
         &self,
         a: &NodeKin<f64>,
