@@ -222,6 +222,11 @@ const CASES: &[Case] = &[
     case("run --set blade without a deck key", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.2=1.0"], &["--set blades.2=1.0", "r.toml, blades.2", "blades.K.<deck key>"]),
     case("run --all-blades with the rigid model", R, &["run", "--model", "rigid", "--all-blades", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out"], &["--all-blades", "--model uh60a", "--model rigid"]),
     case("expand of blades whose dampers differ", rotor!("[damper]\nmodel", "[blades.3.damper.physical]\nA_orf_m2 = 4.0e-6\n\n[damper]\nmodel"), EXPAND_R, &["r.toml", "blade 3's damper differs", "blades.3.damper.physical.A_orf_m2"]),
+    case("rotor airframe negative mass", rotor!("[damper]\nmodel", "[airframe]\nx = { mass_kg = -5000.0, stiffness_N_per_m = 8.0e5 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, airframe.x.mass_kg", "positive", "-5000"]),
+    case("rotor airframe negative stiffness", rotor!("[damper]\nmodel", "[airframe]\nroll = { inertia_kg_m2 = 9000.0, stiffness_Nm_per_rad = -1.0 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, airframe.roll.stiffness_Nm_per_rad", "positive"]),
+    case("rotor airframe unknown direction", rotor!("[damper]\nmodel", "[airframe]\nyaw = { inertia_kg_m2 = 9000.0, stiffness_Nm_per_rad = 1.0 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml", "yaw"]),
+    case("run --set airframe negative damping", R, &["run", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "airframe.y.mass_kg=5000", "--set", "airframe.y.stiffness_N_per_m=8e5", "--set", "airframe.y.damping_Ns_per_m=-1"], &["airframe.y.damping_Ns_per_m", "non-negative"]),
+    case("run --set blade airframe", R, &["run", "--rotor", "{T}/r.toml", "--revs", "3", "--out", "{T}/out", "--set", "blades.2.airframe.x.mass_kg=5000"], &["blades.2.airframe", "[airframe]"]),
     // ---- damper decks (bench, diagnose, run --damper-deck) ----
     case("damper model unknown", damper!("model = \"physical\"", "model = \"magic\""), BENCH_D, &["d.toml", "model"]),
     case("damper linear c negative", damper!("c_N_s_per_m = 68000.0", "c_N_s_per_m = -68000.0"), BENCH_D, &["d.toml", "c_N_s_per_m"]),

@@ -24,8 +24,9 @@ pub struct ExpandArgs {
     /// Hydraulic sub-steps per structural step.
     #[arg(long, default_value_t = 25)]
     pub substeps: usize,
-    /// The whole rotor: every blade (its per-blade deck values) on one driven hub, blade k
-    /// named `b<k>.` and turned (k-1) 360/N deg ahead of blade 1.
+    /// The whole rotor: every blade (its per-blade deck values) on one hub, blade k named
+    /// `b<k>.` and turned (k-1) 360/N deg ahead of blade 1; the hub driven, or turning on the
+    /// deck's `[airframe]`.
     #[arg(long)]
     pub all_blades: bool,
 }

@@ -76,6 +76,7 @@ pub struct RunArgs {
     /// Run every blade of the rotor on its driven hub, each its own model at its own azimuth
     /// (blade k (k-1) 360/N ahead of blade 1), the hub loads summed from their root loads;
     /// implied by per-blade differences (`[blades.K...]` in the deck, `--set blades.K...`).
+    /// A deck with an `[airframe]` puts the hub on it: the blades then run as one model.
     /// Writes <model>/blade<K>/ for every blade (docs/run.md).
     #[arg(long)]
     pub all_blades: bool,

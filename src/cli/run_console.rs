@@ -112,9 +112,10 @@ impl RunObserver for Console {
             "rotorsim run: {} model(s) {}{}, {} to a residual of {:.0e}, at most {} revolutions x {} steps{}",
             s.models.len(),
             names.join(", "),
-            match s.blades {
-                Some(n) => format!(" on all {n} blades of a driven hub"),
-                None => String::new(),
+            match (s.blades, s.airframe) {
+                (Some(n), true) => format!(" on all {n} blades of a hub on the airframe"),
+                (Some(n), false) => format!(" on all {n} blades of a driven hub"),
+                (None, _) => String::new(),
             },
             s.method.name(),
             s.tol,

@@ -358,6 +358,7 @@ fn rotor_check(
             wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
             blades: None,
             blade_differences: Vec::new(),
+            airframe: Vec::new(),
         };
         let failed = crate::run::outputs::write_outputs(&sub, &info, &[outcome], &measured)?.failed;
         if failed.is_empty() {

@@ -98,6 +98,9 @@ fn check_path(path: &str) -> Result<(), String> {
                 .into(),
         );
     }
+    if first == "airframe" {
+        return Err("the airframe is under the whole rotor: set it in [airframe]".into());
+    }
     if first == KEY {
         return Err(format!(
             "per-blade tables do not nest: expected {KEY}.K.<deck key>"

@@ -24,6 +24,184 @@ pub struct RotorSpec {
     /// always None in `RotorDeck::spec`, the base deck).
     #[serde(default)]
     pub blades: Option<toml::Value>,
+    /// The airframe under the hub (docs/rotor_deck.md); a deck with one runs the whole rotor.
+    #[serde(default)]
+    pub airframe: Option<AirframeTable>,
+}
+
+/// The airframe under the hub: a mass, spring and damper in each of the hub's directions that
+/// move (any subset of x, y, z, roll, pitch; the others are rigid), in the fixed frame.
+/// Roll and pitch turn about the hub centre.
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeTable {
+    #[serde(default)]
+    pub x: Option<AirframeTranslation>,
+    #[serde(default)]
+    pub y: Option<AirframeTranslation>,
+    #[serde(default)]
+    pub z: Option<AirframeTranslation>,
+    #[serde(default)]
+    pub roll: Option<AirframeRotation>,
+    #[serde(default)]
+    pub pitch: Option<AirframeRotation>,
+}
+
+/// A translation of the hub: the airframe's effective mass, spring and damper in it.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeTranslation {
+    pub mass_kg: f64,
+    #[serde(rename = "stiffness_N_per_m")]
+    pub stiffness: f64,
+    #[serde(default, rename = "damping_Ns_per_m")]
+    pub damping: f64,
+}
+
+/// A rotation of the hub about its centre: the airframe's effective inertia, spring, damper.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeRotation {
+    #[serde(rename = "inertia_kg_m2")]
+    pub inertia: f64,
+    #[serde(rename = "stiffness_Nm_per_rad")]
+    pub stiffness: f64,
+    #[serde(default, rename = "damping_Nms_per_rad")]
+    pub damping: f64,
+}
+
+/// One moving direction of the airframe, in the order x, y, z, roll, pitch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AirframeDof {
+    /// `x`, `y`, `z`, `roll` or `pitch` (the deck's key).
+    pub name: &'static str,
+    /// Axis 0-2 (x, y, z) of the hub's fixed frame.
+    pub axis: usize,
+    pub rotation: bool,
+    /// Mass [kg] or inertia [kg m^2].
+    pub mass: f64,
+    /// [N/m] or [N m/rad].
+    pub stiffness: f64,
+    /// [N s/m] or [N m s/rad].
+    pub damping: f64,
+}
+
+impl AirframeDof {
+    /// Undamped natural frequency of the airframe alone in this direction [Hz].
+    pub fn frequency_hz(&self) -> f64 {
+        (self.stiffness / self.mass).sqrt() / (2.0 * std::f64::consts::PI)
+    }
+    /// Damping ratio of the airframe alone in this direction.
+    pub fn damping_ratio(&self) -> f64 {
+        self.damping / (2.0 * (self.stiffness * self.mass).sqrt())
+    }
+    /// Deck keys of the mass, stiffness and damping.
+    pub fn keys(&self) -> [&'static str; 3] {
+        if self.rotation {
+            [
+                "inertia_kg_m2",
+                "stiffness_Nm_per_rad",
+                "damping_Nms_per_rad",
+            ]
+        } else {
+            ["mass_kg", "stiffness_N_per_m", "damping_Ns_per_m"]
+        }
+    }
+}
+
+impl AirframeTable {
+    /// The directions that move, in the order x, y, z, roll, pitch.
+    pub fn dofs(&self) -> Vec<AirframeDof> {
+        let t = |name, axis, v: &Option<AirframeTranslation>| {
+            v.as_ref().map(|v| AirframeDof {
+                name,
+                axis,
+                rotation: false,
+                mass: v.mass_kg,
+                stiffness: v.stiffness,
+                damping: v.damping,
+            })
+        };
+        let r = |name, axis, v: &Option<AirframeRotation>| {
+            v.as_ref().map(|v| AirframeDof {
+                name,
+                axis,
+                rotation: true,
+                mass: v.inertia,
+                stiffness: v.stiffness,
+                damping: v.damping,
+            })
+        };
+        [
+            t("x", 0, &self.x),
+            t("y", 1, &self.y),
+            t("z", 2, &self.z),
+            r("roll", 0, &self.roll),
+            r("pitch", 1, &self.pitch),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+
+    /// Each moving direction in words: mass, spring, damper, frequency and damping ratio.
+    pub fn describe(&self) -> Vec<String> {
+        self.dofs()
+            .iter()
+            .map(|d| {
+                let (m, k, c) = if d.rotation {
+                    ("kg m^2", "N m/rad", "N m s/rad")
+                } else {
+                    ("kg", "N/m", "N s/m")
+                };
+                format!(
+                    "{}: {} {m}, spring {} {k}, damper {} {c} ({:.3} Hz, damping ratio {:.3})",
+                    d.name,
+                    d.mass,
+                    d.stiffness,
+                    d.damping,
+                    d.frequency_hz(),
+                    d.damping_ratio()
+                )
+            })
+            .collect()
+    }
+
+    /// Positive masses and stiffnesses, non-negative dampings, at least one direction;
+    /// `Err((key, expected))`.
+    fn check(&self) -> Result<(), (String, String)> {
+        let dofs = self.dofs();
+        if dofs.is_empty() {
+            return Err((
+                "airframe".into(),
+                "an airframe table without a moving direction: give at least one of x, y, z, roll, pitch".into(),
+            ));
+        }
+        for d in &dofs {
+            let [km, kk, kc] = d.keys();
+            for (k, v, positive) in [
+                (km, d.mass, true),
+                (kk, d.stiffness, true),
+                (kc, d.damping, false),
+            ] {
+                let ok = v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 };
+                if !ok {
+                    let what = if k == kk {
+                        "a positive number (a direction without a spring has no periodic solution; leave the direction out to make it rigid)"
+                    } else if positive {
+                        "a positive number"
+                    } else {
+                        "a non-negative number"
+                    };
+                    return Err((
+                        format!("airframe.{}.{k}", d.name),
+                        format!("expected {what}, found {v}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -389,6 +567,9 @@ impl RotorSpec {
             }
         };
         pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
+        if let Some(a) = &self.airframe {
+            a.check().map_err(|(k, what)| bad(&k, &what))?;
+        }
         if self.rotor.blades == 0 {
             return Err(bad("rotor.blades", "expected at least 1 blade"));
         }

@@ -59,6 +59,8 @@ pub mod names {
     pub const DAMPER_HUB_END: &str = "damper_hub_end";
     pub const DAMPER_BLADE_END: &str = "damper_blade_end";
     pub const BLADE: &str = "blade";
+    /// Prefix of the airframe's chain nodes and joints (`airframe.x`, ...).
+    pub const AIRFRAME: &str = "airframe";
 }
 
 /// Smooth ramp 0 -> 1 over `t_ramp` (0.5 (1 - cos(pi t / t_ramp))): zero rate at both ends so
@@ -635,6 +637,72 @@ pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
     s
 }
 
+/// The airframe as a chain from the ground to the node under the shaft, one link per moving
+/// direction (bushing locking all but that direction, with its spring and damper), so that
+/// each direction has its own mass. A node moves with every link before it, so its mass
+/// counts in all their directions: the translations are ordered by decreasing mass and each
+/// node carries the difference to the next (the last the smallest); the rotations' nodes
+/// carry inertia about their own axis only and no mass. Returns the last node's name.
+pub fn write_airframe(s: &mut String, airframe: &super::deck::AirframeTable) -> Option<String> {
+    let mut dofs = airframe.dofs();
+    let split = dofs.iter().position(|d| d.rotation).unwrap_or(dofs.len());
+    dofs[..split].sort_by(|a, b| b.mass.total_cmp(&a.mass));
+    let mut prev: Option<String> = None;
+    const AXES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+    for (i, d) in dofs.iter().enumerate() {
+        let node = format!("{}.{}", names::AIRFRAME, d.name);
+        let _ = writeln!(
+            s,
+            "[[node]]\nname = \"{node}\"\nposition_m = {}\n",
+            v3([0.0; 3])
+        );
+        let (mass, inertia) = if d.rotation {
+            let mut j = [0.0; 3];
+            j[d.axis] = d.mass;
+            (0.0, j)
+        } else {
+            let next = dofs[i + 1..split].first().map_or(0.0, |n| n.mass);
+            (d.mass - next, [0.0; 3])
+        };
+        let _ = writeln!(
+            s,
+            "[[rigid_body]]\nname = \"{node}.body\"\nnode = \"{node}\"\nmass_kg = {}\ninertia_kgm2 = [[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]\n",
+            f(mass),
+            f(inertia[0]),
+            f(inertia[1]),
+            f(inertia[2])
+        );
+        let free = d.axis + if d.rotation { 3 } else { 0 };
+        let locked: Vec<String> = (0..6)
+            .filter(|&k| k != free)
+            .map(|k| format!("\"{}\"", AXES[k]))
+            .collect();
+        let mut k = [0.0; 3];
+        let mut c = [0.0; 3];
+        k[d.axis] = d.stiffness;
+        c[d.axis] = d.damping;
+        let (kk, ck) = if d.rotation {
+            ("rot_stiffness_Nm_per_rad", "rot_damping_Nms_per_rad")
+        } else {
+            ("stiffness_N_per_m", "damping_Ns_per_m")
+        };
+        let _ = write!(s, "[[joint]]\nname = \"{node}.link\"\ntype = \"bushing\"\n");
+        if let Some(p) = &prev {
+            let _ = writeln!(s, "node_a = \"{p}\"");
+        }
+        let _ = writeln!(
+            s,
+            "node_b = \"{node}\"\nposition_m = {}\nlocked = [{}]\n{kk} = {}\n{ck} = {}\n",
+            v3([0.0; 3]),
+            locked.join(", "),
+            v3(k),
+            v3(c)
+        );
+        prev = Some(node);
+    }
+    prev
+}
+
 /// Hub, blades (section by section), shaft, analysis tables.
 fn write_model(s: &mut String, spec: &RotorSpec, opts: &ExpandOptions, blades: &[BladeWriter]) {
     let om = spec.rotor.omega_rad_s;
@@ -656,10 +724,25 @@ fn write_model(s: &mut String, spec: &RotorSpec, opts: &ExpandOptions, blades: &
         b.bodies(s);
     }
     // joints
+    // the shaft turns the hub on the airframe, or on the ground
+    let mount = match (
+        &spec.airframe,
+        blades.len() > 1 || blades.iter().any(|b| !b.place.prefix.is_empty()),
+    ) {
+        (Some(a), true) => write_airframe(s, a),
+        _ => None,
+    };
+    let _ = write!(
+        s,
+        "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\n",
+        names::SHAFT
+    );
+    if let Some(m) = &mount {
+        let _ = writeln!(s, "node_a = \"{m}\"");
+    }
     let _ = writeln!(
         s,
-        "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_b = \"{}\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
-        names::SHAFT,
+        "node_b = \"{}\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
         names::HUB,
         f(om)
     );

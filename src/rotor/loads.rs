@@ -73,6 +73,11 @@ pub struct LoadChannels {
     link_joint: usize,
     horn_node: usize,
     lam_off: Vec<usize>,
+    /// The blade's frame in the hub's: its azimuth ahead of the hub's x axis (whole rotor).
+    frame: [[f64; 3]; 3],
+    /// The swashplate drive that carries the pitch link to the hub (whole rotor, for the
+    /// loads on the hub).
+    swash_drive: usize,
 }
 
 fn beam_ids<'a>(m: &'a Model, name: &str) -> anyhow::Result<&'a [usize]> {
@@ -89,6 +94,23 @@ fn element(m: &Model, name: &str) -> anyhow::Result<usize> {
 
 impl LoadChannels {
     pub fn new(spec: &RotorSpec, m: &Model) -> anyhow::Result<Self> {
+        Self::for_blade(spec, m, "", 0.0)
+    }
+
+    /// The channels of the blade whose model names start with `prefix` (a whole rotor's
+    /// `b<K>.`), `ahead_rad` ahead of the hub's x axis: its root loads are in its own
+    /// rotating frame (x along the blade).
+    pub fn for_blade(
+        spec: &RotorSpec,
+        m: &Model,
+        prefix: &str,
+        ahead_rad: f64,
+    ) -> anyhow::Result<Self> {
+        let n = |s: &str| format!("{prefix}{s}");
+        let beam_ids = |m: &'_ Model, b: &str| -> anyhow::Result<Vec<usize>> {
+            Ok(beam_ids(m, &n(b))?.to_vec())
+        };
+        let element = |m: &Model, e: &str| element(m, &n(e));
         let r = &spec.retention;
         let mut stations = vec![];
         for (radius, _) in spec.load_stations() {
@@ -101,7 +123,7 @@ impl LoadChannels {
             } else {
                 ("seg1", radius)
             };
-            let elem = loads::element_at(m, beam_ids(m, beam)?, s).ok_or_else(|| {
+            let elem = loads::element_at(m, &beam_ids(m, beam)?, s).ok_or_else(|| {
                 anyhow::anyhow!("no element of `{beam}` at r = {radius} m (outputs station)")
             })?;
             stations.push(Station { elem, s_m: s });
@@ -125,7 +147,7 @@ impl LoadChannels {
         let link_ids = beam_ids(m, "pitch_link")?;
         let half = 0.5 * spec.pitch_control.link_length_m;
         let link = Station {
-            elem: loads::element_at(m, link_ids, half)
+            elem: loads::element_at(m, &link_ids, half)
                 .ok_or_else(|| anyhow::anyhow!("no pitch-link element at mid-length"))?,
             s_m: half,
         };
@@ -133,7 +155,7 @@ impl LoadChannels {
         let hub_cut = vec![beam_ids(m, "seg1")?[0], element(m, "damper_hub_mount")?];
         let mut beams = vec![];
         for b in ["seg1", "seg2", "seg3", names::BLADE] {
-            beams.extend_from_slice(beam_ids(m, b)?);
+            beams.extend_from_slice(&beam_ids(m, b)?);
         }
         let mut rigid = vec![];
         for b in ["pitch_horn", "damper_arm", "damper_horn"] {
@@ -149,6 +171,8 @@ impl LoadChannels {
             .collect::<anyhow::Result<Vec<_>>>()?;
         let scratch = Mutex::new(Vec::with_capacity(beams.len()));
         let link_joint = element(m, "pitch_link_upper")?;
+        let swash_drive = element(m, names::SWASH_DRIVE)?;
+        let (sn, cs) = ahead_rad.sin_cos();
         let horn_node = match &m.elements[link_joint] {
             Element::Joint(j) => j
                 .node_a
@@ -169,7 +193,45 @@ impl LoadChannels {
             link_joint,
             horn_node,
             lam_off: loads::lambda_offsets(m),
+            frame: [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]],
+            swash_drive,
         })
+    }
+
+    /// What this blade's system (retention, blade, damper, pitch link through the
+    /// swashplate) exerts on the hub node, global, moment about the hub centre: the loads the
+    /// hub passes to the shaft.
+    pub fn on_hub(&self, m: &Model, st: &State) -> anyhow::Result<Resultant> {
+        let ctx = EvalCtx {
+            t: st.t,
+            load_factor: 1.0,
+            gravity: m.gravity,
+            cscale: 1.0,
+            inertia: true,
+        };
+        let e0 = self.beams[0];
+        let Element::Beam(b0) = &m.elements[e0] else {
+            anyhow::bail!("element {e0} is not a beam");
+        };
+        let k = b0.nodes.map(|i| st.node_kin(i));
+        let ip = b0.interp(&k);
+        let d = b0.densities_with(&k, &ip.rg, &ctx);
+        let (res, _, _) = b0.recovery(&k, &ip, &d, b0.s_range[0]);
+        let mut load = Resultant {
+            force: [-res[0], -res[1], -res[2]],
+            moment: [-res[3], -res[4], -res[5]],
+        };
+        for &e in self.hub_cut[1..].iter().chain([&self.swash_drive]) {
+            load = load.add(&loads::element_on_node(
+                m,
+                st,
+                &ctx,
+                &self.lam_off,
+                e,
+                self.hub,
+            )?);
+        }
+        Ok(load)
     }
 
     /// Channel names, in the order of [`LoadChannels::values`].
@@ -232,7 +294,7 @@ impl LoadChannels {
             .axial_n;
         i += 1;
         let xh = st.x[self.hub];
-        let rh = quat_to_arr(&st.q[self.hub]);
+        let rh = mm(&quat_to_arr(&st.q[self.hub]), &self.frame);
         // what the blade system exerts on the hub, about the hub centre
         // the retention's first element from this sample's data (its node 0 is the hub)
         let r0 = &data[0];

@@ -185,40 +185,92 @@ pub const RTOL: f64 = 1e-7;
 /// Tolerance accepted on a retry when Newton stalls below it (see `RotorSim::relaxed_steps`).
 pub const RTOL_STALL: f64 = 1e-5;
 
-/// The rotor forced-response simulation.
-pub struct RotorSim {
-    label: String,
-    solver: DynamicSolver,
+/// One blade of the simulation: its deck, controls, swashplate drive, damper and channels.
+struct BladePart {
+    /// Prefix of its model names and channels (`b<K>.` in a whole rotor with an airframe,
+    /// empty for blade 1 and the single blade).
+    prefix: String,
     spec: RotorSpec,
     controls: Controls,
-    period: f64,
-    h: f64,
+    swash: usize,
     probe: Arc<HydraulicProbe>,
     /// Scratch for the probe's values (channels() must not allocate).
     scratch: Mutex<Vec<f64>>,
     dev_names: Vec<String>,
-    physical: bool,
-    limits: Option<(f64, f64)>,
-    regulation: Option<[super::ReliefRegulation; 2]>,
-    swash: usize,
-    hub: usize,
     tip: usize,
     root: usize,
+    /// The blade's frame in the hub's (its azimuth ahead of blade 1).
+    frame: [[f64; 3]; 3],
+    /// Undeformed tip in the blade's frame.
     tip_ref: [f64; 3],
     twist_ref: f64,
-    total_s: f64,
-    relaxed_steps: usize,
-    /// Newton tolerance of a step (relative to the zero-acceleration predictor residual).
-    rtol: f64,
-    /// Reference orientation of every node (the chart of the saved coordinates).
-    r0: Vec<[[f64; 3]; 3]>,
-    /// End of the cyclic ramp [s].
-    t_ramp: f64,
     /// Blade load channels (after the base and device channels).
     loads: super::loads::LoadChannels,
     /// Damper end nodes and their positions at the start of the last step.
     damper_nodes: [usize; 2],
     damper_x_start: [[f64; 3]; 2],
+    /// Relief-valve limits and regulation of its damper (physical model).
+    limits: Option<(f64, f64)>,
+    regulation: Option<[super::ReliefRegulation; 2]>,
+}
+
+/// The airframe under the hub: its moving directions and the node under the shaft.
+struct AirframePart {
+    dofs: Vec<super::deck::AirframeDof>,
+    /// The chain's last node (the shaft's node A).
+    mount: usize,
+}
+
+/// Airframe channel names of one direction: displacement, acceleration, the rotor's load on
+/// the airframe at the hub (fixed frame), and the airframe's own side of its equation of
+/// motion (inertia + damper + spring), consumed by the momentum check.
+pub fn airframe_channel_names(d: &super::deck::AirframeDof) -> [String; 4] {
+    let n = d.name;
+    if d.rotation {
+        [
+            format!("airframe_{n}_rad"),
+            format!("airframe_{n}_accel_rad_s2"),
+            format!("airframe_{n}_hub_moment_Nm"),
+            format!("{AIRFRAME_EOM_PREFIX}airframe_{n}_Nm"),
+        ]
+    } else {
+        [
+            format!("airframe_{n}_m"),
+            format!("airframe_{n}_accel_m_s2"),
+            format!("airframe_{n}_hub_force_N"),
+            format!("{AIRFRAME_EOM_PREFIX}airframe_{n}_N"),
+        ]
+    }
+}
+
+/// Prefix of the channels that feed the airframe's momentum check (not written as outputs).
+pub const AIRFRAME_EOM_PREFIX: &str = "eom_";
+
+/// The residual tolerance of the step that ended at each sample [N] (momentum check).
+pub const AIRFRAME_STEP_TOLERANCE: &str = "eom_step_tolerance_N";
+
+/// The rotor forced-response simulation: one blade on a driven hub, or the whole rotor (every
+/// blade its own copy) on an airframe.
+pub struct RotorSim {
+    label: String,
+    solver: DynamicSolver,
+    period: f64,
+    omega: f64,
+    h: f64,
+    physical: bool,
+    parts: Vec<BladePart>,
+    airframe: Option<AirframePart>,
+    hub: usize,
+    total_s: f64,
+    relaxed_steps: usize,
+    /// Newton tolerance of a step (relative to the zero-acceleration predictor residual).
+    rtol: f64,
+    /// The last step's residual tolerance [N] (for the airframe's momentum check).
+    step_tol: f64,
+    /// Reference orientation of every node (the chart of the saved coordinates).
+    r0: Vec<[[f64; 3]; 3]>,
+    /// End of the cyclic ramp [s].
+    t_ramp: f64,
     /// Load channels computed (see [`ForcedResponse::set_output_channels`]).
     output_channels: bool,
     /// A blade of a whole-rotor run (its hub loads come from all blades, not by symmetry).
@@ -245,7 +297,7 @@ pub fn relief_limits(deck: &DamperDeck) -> Option<(f64, f64)> {
     }
 }
 
-/// Build the simulation (see [`super::build`]).
+/// Build the simulation of one blade (see [`super::build`]).
 pub fn build_sim(
     spec: &RotorSpec,
     file: &Path,
@@ -254,80 +306,173 @@ pub fn build_sim(
     record: &FlightRecord,
     opts: &RunOptions,
 ) -> anyhow::Result<RotorSim> {
+    let ahead = opts.blade_azimuth_deg.unwrap_or(0.0);
+    build_parts(
+        &[(spec, damper, ahead)],
+        false,
+        file,
+        model_kind,
+        record,
+        opts,
+    )
+}
+
+/// Build the whole rotor on its airframe: every blade's deck and damper deck in `blades`
+/// (blade 1 first), coupled through the hub, which moves with the airframe of blade 1's deck.
+pub fn build_rotor_sim(
+    blades: &[(&RotorSpec, &DamperDeck)],
+    file: &Path,
+    model_kind: DamperModel,
+    record: &FlightRecord,
+    opts: &RunOptions,
+) -> anyhow::Result<RotorSim> {
+    let n = blades.len();
+    let parts: Vec<(&RotorSpec, &DamperDeck, f64)> = blades
+        .iter()
+        .enumerate()
+        .map(|(i, (s, d))| (*s, *d, i as f64 * 360.0 / n as f64))
+        .collect();
+    build_parts(&parts, true, file, model_kind, record, opts)
+}
+
+fn build_parts(
+    blades: &[(&RotorSpec, &DamperDeck, f64)],
+    whole: bool,
+    file: &Path,
+    model_kind: DamperModel,
+    record: &FlightRecord,
+    opts: &RunOptions,
+) -> anyhow::Result<RotorSim> {
     if opts.steps_per_rev < 8 {
         anyhow::bail!("steps per revolution {} is below 8", opts.steps_per_rev);
     }
+    let Some(&(spec, _, _)) = blades.first() else {
+        anyhow::bail!("a rotor without blades");
+    };
     spec.check_record(record, file)?;
     let om = spec.rotor.omega_rad_s;
-    let ahead_deg = opts.blade_azimuth_deg.unwrap_or(0.0);
-    // a blade ahead of the reference blade sees the shared swashplate's cyclic turned
-    let controls = Controls::from_record(&record.meta.controls_deg).ahead_by(ahead_deg);
     let period = 2.0 * std::f64::consts::PI / om;
     let h = period / opts.steps_per_rev as f64;
-    let xo = ExpandOptions {
-        controls,
-        table_revs: 1,
-        ..Default::default()
-    };
-    let mut model = expanded_model(spec, &xo, file)?;
-    let swash = joint_id(&model, names::SWASH_DRIVE)?;
-    set_swash(
-        &mut model,
-        swash,
-        &[(0.0, spec.swash_z(spec.pitch_rad(&controls, 0.0)))],
-    );
-    // damper
-    let device = damper.build(model_kind, opts.hydraulics)?;
-    let dev_names: Vec<String> = device
-        .channel_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let n_hub_end = model.node_id(names::DAMPER_HUB_END)?;
-    let n_blade_end = model.node_id(names::DAMPER_BLADE_END)?;
-    // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
-    // the step mean F_m is unstable with generalized-alpha for stiff devices).
-    let elem = HydraulicForceElement::new("damper", n_hub_end, n_blade_end, device)
-        .with_reference_length(spec.damper_attachment.reference_length_m);
-    let probe = elem.probe();
-    let scratch = Mutex::new(vec![0.0; probe.channel_names().len()]);
-    model.add_step_element(Box::new(elem))?;
-    // airloads
-    let full = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
-    let mean = AirloadReplay::new(
-        record,
-        ReplayMode::Average,
-        ReplayOptions {
-            harmonics: Some(0),
+    let base_controls = Controls::from_record(&record.meta.controls_deg);
+    let mut model = if whole {
+        let specs: Vec<RotorSpec> = blades.iter().map(|b| b.0.clone()).collect();
+        let xo = ExpandOptions {
+            controls: base_controls,
+            table_revs: 1,
             ..Default::default()
-        },
-    )?;
+        };
+        whole_rotor_model(&specs, &xo, file)?
+    } else {
+        // a blade ahead of the reference blade sees the shared swashplate's cyclic turned
+        let xo = ExpandOptions {
+            controls: base_controls.ahead_by(blades[0].2),
+            table_revs: 1,
+            ..Default::default()
+        };
+        expanded_model(spec, &xo, file)?
+    };
     let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
     let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
-    let airloads = BladeAirloads {
-        full,
-        mean,
-        ahead_deg,
-        root_r_m: spec.blade.root_r_m,
-        t_ramp,
-        scale: scale.clone(),
-        control_pitch: match spec.blade.airload_frame {
-            AirloadFrame::Deformed => None,
-            AirloadFrame::ControlPitch => {
-                Some(ControlPitch::new(spec, controls, &model, names::BLADE)?)
-            }
-        },
-    };
-    let load = super::transient::blade_load(
-        airloads,
-        &model,
-        names::BLADE,
-        spec,
-        record,
-        opts.steps_per_rev,
-        opts.perturbation_damping,
-    )?;
-    model.add_distributed_load(names::BLADE, load)?;
+    let physical = model_kind == DamperModel::Physical;
+    struct Pending {
+        prefix: String,
+        controls: Controls,
+        swash: usize,
+        probe: Arc<HydraulicProbe>,
+        dev_names: Vec<String>,
+        damper_nodes: [usize; 2],
+        limits: Option<(f64, f64)>,
+        regulation: Option<[super::ReliefRegulation; 2]>,
+    }
+    let mut pending = Vec::with_capacity(blades.len());
+    for (k, &(bspec, damper, ahead_deg)) in blades.iter().enumerate() {
+        let prefix = if whole && k > 0 {
+            format!("b{}.", k + 1)
+        } else if whole {
+            "b1.".to_string()
+        } else {
+            String::new()
+        };
+        let nm = |s: &str| format!("{prefix}{s}");
+        let controls = base_controls.ahead_by(ahead_deg);
+        let swash = joint_id(&model, &nm(names::SWASH_DRIVE))?;
+        set_swash(
+            &mut model,
+            swash,
+            &[(0.0, bspec.swash_z(bspec.pitch_rad(&controls, 0.0)))],
+        );
+        let device = damper.build(model_kind, opts.hydraulics)?;
+        let dev_names: Vec<String> = device
+            .channel_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let n_hub_end = model.node_id(&nm(names::DAMPER_HUB_END))?;
+        let n_blade_end = model.node_id(&nm(names::DAMPER_BLADE_END))?;
+        // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
+        // the step mean F_m is unstable with generalized-alpha for stiff devices).
+        let elem = HydraulicForceElement::new(nm("damper"), n_hub_end, n_blade_end, device)
+            .with_reference_length(bspec.damper_attachment.reference_length_m);
+        let probe = elem.probe();
+        model.add_step_element(Box::new(elem))?;
+        let full = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
+        let mean = AirloadReplay::new(
+            record,
+            ReplayMode::Average,
+            ReplayOptions {
+                harmonics: Some(0),
+                ..Default::default()
+            },
+        )?;
+        let airloads = BladeAirloads {
+            full,
+            mean,
+            ahead_deg,
+            root_r_m: bspec.blade.root_r_m,
+            t_ramp,
+            scale: scale.clone(),
+            control_pitch: match bspec.blade.airload_frame {
+                AirloadFrame::Deformed => None,
+                AirloadFrame::ControlPitch => Some(ControlPitch::new(
+                    bspec,
+                    controls,
+                    &model,
+                    &nm(names::BLADE),
+                )?),
+            },
+        };
+        let load = super::transient::blade_load(
+            airloads,
+            &model,
+            &nm(names::BLADE),
+            bspec,
+            record,
+            opts.steps_per_rev,
+            opts.perturbation_damping,
+        )?;
+        model.add_distributed_load(&nm(names::BLADE), load)?;
+        pending.push(Pending {
+            prefix,
+            controls,
+            swash,
+            probe,
+            dev_names,
+            damper_nodes: [n_hub_end, n_blade_end],
+            limits: if physical {
+                relief_limits(damper)
+            } else {
+                None
+            },
+            regulation: if physical {
+                damper
+                    .physical
+                    .as_ref()
+                    .and_then(super::ReliefRegulation::of)
+            } else {
+                None
+            },
+        });
+    }
     // initial state: rotating static equilibrium under the mean loads and the collective
     let mut st = State::from_model(&model);
     let sopts = StaticOptions {
@@ -350,12 +495,75 @@ pub fn build_sim(
     }
     st.set_rigid_rotation([0.0; 3], [0.0, 0.0, om]);
     let hub = model.node_id(names::HUB)?;
-    let tip = model.node_id(&format!("{}.n{}", names::BLADE, 3 * spec.blade.elements))?;
-    let root = model.node_id(&format!("{}.n0", names::BLADE))?;
-    let tip_ref = model.nodes[tip].x0;
-    let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
+    let airframe = match (&spec.airframe, whole) {
+        (Some(a), true) => {
+            let dofs = a.dofs();
+            let chain = dofs
+                .iter()
+                .map(|d| model.node_id(&format!("{}.{}", names::AIRFRAME, d.name)))
+                .collect::<Result<Vec<usize>, _>>()?;
+            // the airframe does not turn with the rotor: it starts at rest in its deflection
+            for &i in &chain {
+                st.v[i] = [0.0; 3];
+                st.w[i] = [0.0; 3];
+                st.a[i] = [0.0; 3];
+                st.al[i] = [0.0; 3];
+            }
+            let mount = match &model.elements[joint_id(&model, names::SHAFT)?] {
+                Element::Joint(j) => j.node_a,
+                _ => None,
+            }
+            .ok_or_else(|| {
+                anyhow::anyhow!("expanded rotor model: the shaft is not on the airframe")
+            })?;
+            Some(AirframePart { dofs, mount })
+        }
+        _ => None,
+    };
     let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
-    let loads = super::loads::LoadChannels::new(spec, &model)?;
+    let mut parts = Vec::with_capacity(pending.len());
+    for (p, &(bspec, _, ahead_deg)) in pending.into_iter().zip(blades) {
+        let nm = |s: &str| format!("{}{s}", p.prefix);
+        // where the blade sits in the model: turned in the whole rotor's; a single blade
+        // (even one ahead of blade 1 in time) lies along the hub's x axis
+        let ahead_deg = if whole { ahead_deg } else { 0.0 };
+        let tip = model.node_id(&nm(&format!(
+            "{}.n{}",
+            names::BLADE,
+            3 * bspec.blade.elements
+        )))?;
+        let root = model.node_id(&nm(&format!("{}.n0", names::BLADE)))?;
+        let (sn, cs) = ahead_deg.to_radians().sin_cos();
+        let frame = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
+        let tip_ref = mtv(&frame, model.nodes[tip].x0);
+        let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
+        let loads = super::loads::LoadChannels::for_blade(
+            bspec,
+            &model,
+            &p.prefix,
+            ahead_deg.to_radians(),
+        )?;
+        let scratch = Mutex::new(vec![0.0; p.probe.channel_names().len()]);
+        parts.push(BladePart {
+            prefix: p.prefix,
+            spec: bspec.clone(),
+            controls: p.controls,
+            swash: p.swash,
+            probe: p.probe,
+            scratch,
+            dev_names: p.dev_names,
+            tip,
+            root,
+            frame,
+            tip_ref,
+            twist_ref,
+            loads,
+            damper_nodes: p.damper_nodes,
+            damper_x_start: [[0.0; 3]; 2],
+            limits: p.limits,
+            regulation: p.regulation,
+        });
+    }
     let mut solver = DynamicSolver::new(model, st, h, opts.rho_inf)?;
     // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
@@ -363,47 +571,24 @@ pub fn build_sim(
     solver.newton.rtol = opts.newton_rtol;
     solver.newton.method = opts.newton;
     solver.init_accelerations()?;
-    let physical = model_kind == DamperModel::Physical;
     Ok(RotorSim {
         label: model_kind.name().to_string(),
         solver,
-        spec: spec.clone(),
-        controls,
         period,
+        omega: om,
         h,
-        probe,
-        scratch,
-        dev_names,
         physical,
-        limits: if physical {
-            relief_limits(damper)
-        } else {
-            None
-        },
-        regulation: if physical {
-            damper
-                .physical
-                .as_ref()
-                .and_then(super::ReliefRegulation::of)
-        } else {
-            None
-        },
-        swash,
+        parts,
+        airframe,
         hub,
-        tip,
-        root,
-        tip_ref,
-        twist_ref,
         total_s: 0.0,
         relaxed_steps: 0,
         rtol: opts.newton_rtol,
+        step_tol: f64::NAN,
         r0,
         t_ramp,
-        loads,
-        damper_nodes: [n_hub_end, n_blade_end],
-        damper_x_start: [[0.0; 3]; 2],
         output_channels: true,
-        in_whole_rotor: opts.blade_azimuth_deg.is_some(),
+        in_whole_rotor: whole || opts.blade_azimuth_deg.is_some(),
     })
 }
 
@@ -440,12 +625,123 @@ impl RotorSim {
     pub fn relaxed_steps(&self) -> usize {
         self.relaxed_steps
     }
-    /// Lag angle [rad], positive aft (the `lag` joint angle).
+    /// Lag angle [rad] of blade 1, positive aft (the `lag` joint angle).
     pub fn lag_angle_rad(&self) -> f64 {
         let m = &self.solver.model;
-        match m.element_id(names::LAG).map(|i| &m.elements[i]) {
+        let name = format!("{}{}", self.parts[0].prefix, names::LAG);
+        match m.element_id(&name).map(|i| &m.elements[i]) {
             Some(Element::Joint(j)) => j.angle_prev,
             _ => f64::NAN,
+        }
+    }
+    /// Blades in the model (1 for a single blade).
+    pub fn blade_count(&self) -> usize {
+        self.parts.len()
+    }
+    /// Relief-valve limits of blade `k`'s damper (1 to N).
+    pub fn blade_force_limits_n(&self, k: usize) -> Option<(f64, f64)> {
+        self.parts.get(k.wrapping_sub(1)).and_then(|p| p.limits)
+    }
+
+    /// Channel prefix of part `k` (0-based): blade 1 has none, so that the run reads its
+    /// channels as a blade's; the others are `b<K>.`.
+    fn channel_prefix(&self, k: usize) -> &str {
+        if k == 0 {
+            ""
+        } else {
+            &self.parts[k].prefix
+        }
+    }
+
+    fn part_channel_count(&self, p: &BladePart) -> usize {
+        BASE_CHANNELS.len()
+            + if self.physical { p.dev_names.len() } else { 0 }
+            + p.loads.names().len()
+    }
+
+    /// One blade's channels into `out` (its share of `channels`).
+    fn part_channels(&self, p: &BladePart, out: &mut [f64]) {
+        if let Ok(mut buf) = p.scratch.lock() {
+            // probe layout: force_N, stroke_m, stroke_rate_m_s, device channels
+            p.probe.read_into(&mut buf);
+            out[..3].copy_from_slice(&buf[..3]);
+            if self.physical {
+                let n = (buf.len() - 3).min(out.len().saturating_sub(6));
+                out[6..6 + n].copy_from_slice(&buf[3..3 + n]);
+            }
+        }
+        let st = &self.solver.state;
+        let rh = mm(&quat_to_arr(&st.q[self.hub]), &p.frame);
+        let tip = mtv(&rh, sub(st.x[p.tip], st.x[self.hub]));
+        out[3] = tip[2] - p.tip_ref[2];
+        out[4] = -(tip[1] - p.tip_ref[1]);
+        let rr = quat_to_arr(&st.q[p.root]);
+        let rt = quat_to_arr(&st.q[p.tip]);
+        out[5] = rel_twist(&rr, &rt) - p.twist_ref;
+        let nl = p.loads.names().len();
+        let at = out.len() - nl;
+        if !self.output_channels {
+            out[at..].fill(f64::NAN);
+            return;
+        }
+        let damper = super::loads::DamperStep {
+            nodes: p.damper_nodes,
+            x_start: p.damper_x_start,
+            force_n: out[0],
+        };
+        if p.loads
+            .values(&self.solver.model, st, &damper, &mut out[at..])
+            .is_err()
+        {
+            // a wiring error of the load channels, checked when they were resolved
+            out[at..].fill(f64::NAN);
+        }
+    }
+
+    /// The airframe's channels: per direction displacement, acceleration, the rotor's load
+    /// on it at the hub (the sum of every blade's loads on the hub, fixed frame) and its own
+    /// side of the equation of motion.
+    fn airframe_channels(&self, a: &AirframePart, out: &mut [f64]) {
+        let st = &self.solver.state;
+        let m = &self.solver.model;
+        let mut hub_load = crate::loads::Resultant::default();
+        let mut ok = self.output_channels;
+        if ok {
+            for p in &self.parts {
+                match p.loads.on_hub(m, st) {
+                    Ok(l) => hub_load = hub_load.add(&l),
+                    Err(_) => ok = false,
+                }
+            }
+        }
+        let i = a.mount;
+        let phi = log_map(&quat_to_arr(&st.q[i]));
+        for (k, d) in a.dofs.iter().enumerate() {
+            let (u, v, acc, load) = if d.rotation {
+                (
+                    phi[d.axis],
+                    st.w[i][d.axis],
+                    st.al[i][d.axis],
+                    hub_load.moment[d.axis],
+                )
+            } else {
+                (
+                    st.x[i][d.axis] - m.nodes[i].x0[d.axis],
+                    st.v[i][d.axis],
+                    st.a[i][d.axis],
+                    hub_load.force[d.axis],
+                )
+            };
+            let o = &mut out[4 * k..4 * k + 4];
+            o[0] = u;
+            o[1] = acc;
+            if ok {
+                o[2] = load;
+                o[3] = d.mass * acc + d.damping * v + d.stiffness * u;
+            } else {
+                o[2] = f64::NAN;
+                o[3] = f64::NAN;
+            }
         }
     }
 }
@@ -465,13 +761,16 @@ impl ForcedResponse for RotorSim {
     }
     fn step(&mut self) -> anyhow::Result<()> {
         let t0 = Instant::now();
-        self.damper_x_start = self.damper_nodes.map(|i| self.solver.state.x[i]);
         let tn = self.solver.state.t;
         let t1 = tn + self.h;
-        let z0 = self.spec.swash_z(self.spec.pitch_rad(&self.controls, tn));
-        let z1 = self.spec.swash_z(self.spec.pitch_rad(&self.controls, t1));
-        set_swash(&mut self.solver.model, self.swash, &[(tn, z0), (t1, z1)]);
+        for p in &mut self.parts {
+            p.damper_x_start = p.damper_nodes.map(|i| self.solver.state.x[i]);
+            let z0 = p.spec.swash_z(p.spec.pitch_rad(&p.controls, tn));
+            let z1 = p.spec.swash_z(p.spec.pitch_rad(&p.controls, t1));
+            set_swash(&mut self.solver.model, p.swash, &[(tn, z0), (t1, z1)]);
+        }
         let mut r = self.solver.step();
+        self.step_tol = self.solver.residual_tolerance();
         if let Err(NewtonError::Diverged {
             residual, initial, ..
         }) = &r
@@ -483,6 +782,7 @@ impl ForcedResponse for RotorSim {
             if *residual <= RTOL_STALL * initial {
                 self.solver.newton.rtol = RTOL_STALL;
                 r = self.solver.step();
+                self.step_tol = self.solver.residual_tolerance();
                 self.solver.newton.rtol = self.rtol;
                 self.relaxed_steps += 1;
             }
@@ -498,56 +798,43 @@ impl ForcedResponse for RotorSim {
         Ok(())
     }
     fn channel_names(&self) -> Vec<String> {
-        let mut v: Vec<String> = BASE_CHANNELS.iter().map(|s| s.to_string()).collect();
-        if self.physical {
-            v.extend(self.dev_names.iter().cloned());
+        let mut v = Vec::new();
+        for (k, p) in self.parts.iter().enumerate() {
+            let pre = self.channel_prefix(k);
+            v.extend(BASE_CHANNELS.iter().map(|s| format!("{pre}{s}")));
+            if self.physical {
+                v.extend(p.dev_names.iter().map(|s| format!("{pre}{s}")));
+            }
+            v.extend(p.loads.names().iter().map(|s| format!("{pre}{s}")));
         }
-        v.extend(self.loads.names().iter().cloned());
+        if let Some(a) = &self.airframe {
+            for d in &a.dofs {
+                v.extend(airframe_channel_names(d));
+            }
+            v.push(AIRFRAME_STEP_TOLERANCE.to_string());
+        }
         v
     }
     fn channels(&self, out: &mut [f64]) {
-        if let Ok(mut buf) = self.scratch.lock() {
-            // probe layout: force_N, stroke_m, stroke_rate_m_s, device channels
-            self.probe.read_into(&mut buf);
-            out[..3].copy_from_slice(&buf[..3]);
-            if self.physical {
-                let n = (buf.len() - 3).min(out.len().saturating_sub(6));
-                out[6..6 + n].copy_from_slice(&buf[3..3 + n]);
+        let mut at = 0;
+        for p in &self.parts {
+            let n = self.part_channel_count(p).min(out.len() - at);
+            self.part_channels(p, &mut out[at..at + n]);
+            at += n;
+        }
+        if let Some(a) = &self.airframe {
+            let n = 4 * a.dofs.len() + 1;
+            if out.len() - at == n {
+                self.airframe_channels(a, &mut out[at..at + n - 1]);
+                out[at + n - 1] = self.step_tol;
             }
-        }
-        let st = &self.solver.state;
-        let rh = quat_to_arr(&st.q[self.hub]);
-        let p = mtv(&rh, sub(st.x[self.tip], st.x[self.hub]));
-        out[3] = p[2] - self.tip_ref[2];
-        out[4] = -(p[1] - self.tip_ref[1]);
-        let rr = quat_to_arr(&st.q[self.root]);
-        let rt = quat_to_arr(&st.q[self.tip]);
-        out[5] = rel_twist(&rr, &rt) - self.twist_ref;
-        let nl = self.loads.names().len();
-        let at = out.len() - nl;
-        if !self.output_channels {
-            out[at..].fill(f64::NAN);
-            return;
-        }
-        let damper = super::loads::DamperStep {
-            nodes: self.damper_nodes,
-            x_start: self.damper_x_start,
-            force_n: out[0],
-        };
-        if self
-            .loads
-            .values(&self.solver.model, st, &damper, &mut out[at..])
-            .is_err()
-        {
-            // a wiring error of the load channels, checked when they were resolved
-            out[at..].fill(f64::NAN);
         }
     }
     fn force_limits_n(&self) -> Option<(f64, f64)> {
-        self.limits
+        self.parts[0].limits
     }
     fn blades(&self) -> Option<usize> {
-        (!self.in_whole_rotor).then_some(self.spec.rotor.blades)
+        (!self.in_whole_rotor).then_some(self.parts[0].spec.rotor.blades)
     }
     fn set_output_channels(&mut self, on: bool) {
         self.output_channels = on;
@@ -556,17 +843,21 @@ impl ForcedResponse for RotorSim {
         self.output_channels
     }
     fn relief_regulation(&self) -> Option<[super::ReliefRegulation; 2]> {
-        self.regulation
+        self.parts[0].regulation
     }
     fn save_state(&self) -> Option<super::SimState> {
         let snap = self.solver.snapshot();
         Some(super::SimState {
             t_s: snap.t_s,
-            coords: snap.coords(&self.r0, 1.0 / self.spec.rotor.omega_rad_s),
+            coords: snap.coords(&self.r0, 1.0 / self.omega),
             solver: Some(snap),
             // the damper ends at the start of the step that ended here: the load channels of
             // the first sample after a restore need them
-            aux: self.damper_x_start.iter().flatten().copied().collect(),
+            aux: self
+                .parts
+                .iter()
+                .flat_map(|p| p.damper_x_start.iter().flatten().copied())
+                .collect(),
         })
     }
     fn restore_state(&mut self, s: &super::SimState) -> anyhow::Result<()> {
@@ -583,57 +874,91 @@ impl ForcedResponse for RotorSim {
                 s.coords.len()
             );
         }
-        snap.set_coords(&self.r0, 1.0 / self.spec.rotor.omega_rad_s, &s.coords);
+        snap.set_coords(&self.r0, 1.0 / self.omega, &s.coords);
         snap.t_s = s.t_s;
         self.solver
             .restore(&snap)
             .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))?;
-        let saved: Option<[[f64; 3]; 2]> = (s.aux.len() == 6)
-            .then(|| std::array::from_fn(|e| std::array::from_fn(|c| s.aux[3 * e + c])));
-        // saved with this structural state: within a step's travel of the ends (a state
-        // assembled from another model's keeps that model's own)
-        let travel = 2.0 * self.spec.rotor.omega_rad_s * self.h * self.spec.rotor.radius_m;
-        let fits = |x: &[[f64; 3]; 2]| {
-            (0..2).all(|e| norm3(sub(x[e], self.solver.state.x[self.damper_nodes[e]])) <= travel)
-        };
-        self.damper_x_start = if let Some(x) = saved.filter(|x| fits(x)) {
-            x
-        } else {
-            // a state saved without them: the damper ends turned back with the shaft (the lag
-            // motion over a step is two orders smaller)
-            let back = exp_map([0.0, 0.0, -self.spec.rotor.omega_rad_s * self.h]);
-            self.damper_nodes.map(|i| mv(&back, self.solver.state.x[i]))
-        };
+        let np = self.parts.len();
+        let travel = 2.0 * self.omega * self.h * self.parts[0].spec.rotor.radius_m;
+        let back = exp_map([0.0, 0.0, -self.omega * self.h]);
+        let state = &self.solver.state;
+        for (k, p) in self.parts.iter_mut().enumerate() {
+            let saved: Option<[[f64; 3]; 2]> = (s.aux.len() == 6 * np).then(|| {
+                std::array::from_fn(|e| std::array::from_fn(|c| s.aux[6 * k + 3 * e + c]))
+            });
+            // saved with this structural state: within a step's travel of the ends (a state
+            // assembled from another model's keeps that model's own)
+            let fits = |x: &[[f64; 3]; 2]| {
+                (0..2).all(|e| norm3(sub(x[e], state.x[p.damper_nodes[e]])) <= travel)
+            };
+            p.damper_x_start = if let Some(x) = saved.filter(|x| fits(x)) {
+                x
+            } else {
+                // a state saved without them: the damper ends turned back with the shaft (the
+                // lag motion over a step is two orders smaller)
+                p.damper_nodes.map(|i| mv(&back, state.x[i]))
+            };
+        }
         Ok(())
     }
     fn periodic_from_s(&self) -> f64 {
         self.t_ramp
     }
-    /// Largest of the tip lag (-y), tip flap (z) and tip twist about x times R/10 (a coarse
-    /// label: the blade lies along x at the azimuth of a saved state).
+    /// Largest of the tip lag (-y), tip flap (z) and tip twist about x times R/10 of any
+    /// blade, or an airframe direction's displacement (rotations times R); a coarse label.
     fn mode_label(&self, re: &[f64], im: &[f64]) -> String {
         use crate::solver::snapshot::COORDS_PER_NODE as K;
-        let (t, r) = (K * self.tip, K * self.root);
-        if re.len() < t + K || im.len() != re.len() {
+        if im.len() != re.len() {
             return String::new();
         }
-        let mag = |i: usize| re[i].hypot(im[i]);
-        let twist = (re[t + 3] - re[r + 3]).hypot(im[t + 3] - im[r + 3]);
-        let parts = [
-            ("lag", mag(t + 1)),
-            ("flap", mag(t + 2)),
-            ("torsion", twist * self.spec.rotor.radius_m / 10.0),
-        ];
+        let radius = self.parts[0].spec.rotor.radius_m;
+        let mag = |i: usize| {
+            if i < re.len() {
+                re[i].hypot(im[i])
+            } else {
+                0.0
+            }
+        };
+        let mut parts: Vec<(String, f64)> = Vec::new();
+        let np = self.parts.len();
+        for (b, p) in self.parts.iter().enumerate() {
+            let (t, r) = (K * p.tip, K * p.root);
+            if re.len() < t + K || re.len() < r + K {
+                continue;
+            }
+            let twist = (re[t + 3] - re[r + 3]).hypot(im[t + 3] - im[r + 3]);
+            let who = if np > 1 {
+                format!("blade {} ", b + 1)
+            } else {
+                String::new()
+            };
+            parts.push((format!("{who}lag"), mag(t + 1)));
+            parts.push((format!("{who}flap"), mag(t + 2)));
+            parts.push((format!("{who}torsion"), twist * radius / 10.0));
+        }
+        if let Some(a) = &self.airframe {
+            let i = K * a.mount;
+            for d in &a.dofs {
+                let c = i + d.axis + if d.rotation { 3 } else { 0 };
+                let w = if d.rotation { radius } else { 1.0 };
+                parts.push((format!("airframe {}", d.name), mag(c) * w));
+            }
+        }
         parts
-            .iter()
+            .into_iter()
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|p| p.0.to_string())
+            .map(|p| p.0)
             .unwrap_or_default()
     }
     fn timing(&self) -> Timing {
         Timing {
             total_s: self.total_s,
-            hydraulics_s: self.probe.hydraulics_seconds(),
+            hydraulics_s: self
+                .parts
+                .iter()
+                .map(|p| p.probe.hydraulics_seconds())
+                .sum(),
             steps: self.solver.steps,
             iterations: self.solver.total_iterations,
             factorizations: self.solver.factorizations,

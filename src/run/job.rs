@@ -190,7 +190,8 @@ pub struct RunJob {
     pub newton: NewtonMethod,
     /// Deck values overridden by dotted path, applied before validation.
     pub overrides: Vec<Override>,
-    /// Every blade of the rotor on its driven hub, each its own model (implied by per-blade
+    /// Every blade of the rotor on its driven hub, each its own model, or on the deck's
+    /// airframe, all in one model (implied by an `[airframe]` and by per-blade
     /// differences in the deck or the overrides).
     pub all_blades: bool,
     /// Result folder.
@@ -206,6 +207,8 @@ pub struct RunStart {
     pub units: Vec<String>,
     /// Blades of a whole-rotor run.
     pub blades: Option<usize>,
+    /// A whole rotor on an airframe (its blades in one model).
+    pub airframe: bool,
     pub method: PeriodicMethod,
     pub tol: f64,
     pub revs: usize,
@@ -441,14 +444,14 @@ impl RunJob {
 
     /// Whether this run is of the whole rotor: asked for, or implied by per-blade differences.
     pub fn whole_rotor(&self, rotor: Option<&RotorDeck>) -> anyhow::Result<bool> {
-        let per_blade = rotor.is_some_and(|r| r.per_blade());
+        let per_blade = rotor.is_some_and(|r| r.per_blade() || r.spec.airframe.is_some());
         if (self.all_blades || per_blade) && self.model != RotorModel::Uh60a {
             bail!(
                 "{}: the whole rotor runs the elastic multibody model only (--model uh60a), not --model {}",
                 if self.all_blades {
                     "--all-blades".to_string()
                 } else {
-                    format!("per-blade differences ([blades.K] tables or --set blades.K...) in {}", self.rotor.display())
+                    format!("per-blade differences ([blades.K] tables or --set blades.K...) or an [airframe] in {}", self.rotor.display())
                 },
                 self.model.name()
             );
@@ -584,11 +587,13 @@ impl RunJob {
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
         let (rotor, deck, blades) = self.decks_for(&models)?;
         let nb = blades.len();
+        // a rotor on an airframe is one model: its blades are coupled through the hub
+        let coupled = nb > 0 && rotor.as_ref().is_some_and(|r| r.spec.airframe.is_some());
         // the units that run side by side: one per model, or per model and blade
         let units: Vec<(DamperModel, Option<usize>)> = models
             .iter()
             .flat_map(|&m| -> Vec<(DamperModel, Option<usize>)> {
-                if nb == 0 {
+                if nb == 0 || coupled {
                     vec![(m, None)]
                 } else {
                     (1..=nb).map(|k| (m, Some(k))).collect()
@@ -617,6 +622,17 @@ impl RunJob {
         };
         let build = |u: usize| -> anyhow::Result<Box<dyn ForcedResponse>> {
             let (m, blade) = units[u];
+            if coupled {
+                let parts: Vec<(&crate::rotor::deck::RotorSpec, &DamperDeck)> =
+                    blades.iter().map(|(r, d)| (&r.spec, d)).collect();
+                return Ok(Box::new(crate::rotor::sim::build_rotor_sim(
+                    &parts,
+                    &self.rotor,
+                    m,
+                    &record,
+                    &opts,
+                )?));
+            }
             if let Some(k) = blade {
                 let (r, d) = &blades[k - 1];
                 let o = RunOptions {
@@ -672,6 +688,7 @@ impl RunJob {
                 })
                 .collect(),
             blades: (nb > 0).then_some(nb),
+            airframe: coupled,
             models: models.clone(),
             method,
             tol: self.periodic_tol,
@@ -705,7 +722,22 @@ impl RunJob {
                 *e = d.with_review(std::mem::take(e));
             }
         }
-        if nb > 0 {
+        if coupled {
+            for o in &mut outcomes {
+                let limits: Vec<Option<(f64, f64)>> = blades
+                    .iter()
+                    .map(|(_, d)| {
+                        (o.model == DamperModel::Physical)
+                            .then(|| crate::rotor::sim::relief_limits(d))
+                            .flatten()
+                    })
+                    .collect();
+                let taken = std::mem::replace(&mut o.result, Err(String::new()));
+                o.result = taken.and_then(|r| {
+                    run::rotor::combine_coupled(r, nb, &limits).map_err(|e| format!("{e:#}"))
+                });
+            }
+        } else if nb > 0 {
             outcomes = whole_rotor_outcomes(outcomes, &units);
         }
         let mut info = self.info(sdof, rigid, inputs_sha256, &record, t0);
@@ -715,6 +747,13 @@ impl RunJob {
                 .as_ref()
                 .map(|r| r.blade_differences())
                 .unwrap_or_default();
+            if coupled {
+                info.airframe = rotor
+                    .as_ref()
+                    .and_then(|r| r.spec.airframe.as_ref())
+                    .map(crate::rotor::deck::AirframeTable::describe)
+                    .unwrap_or_default();
+            }
         }
         let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
         let published = |name: &str| out.published_path(&out.file(name));
@@ -827,6 +866,7 @@ impl RunJob {
             wall_s: t0.elapsed().as_secs_f64(),
             blades: None,
             blade_differences: Vec::new(),
+            airframe: Vec::new(),
         }
     }
 

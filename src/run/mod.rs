@@ -85,6 +85,8 @@ pub struct ModelRun {
     /// A whole-rotor run: every blade's run, blade 1 first (this run holds blade 1's channels
     /// and the hub's).
     pub blade_runs: Vec<ModelRun>,
+    /// A rotor on an airframe: its equation of motion against the rotor's loads on it.
+    pub airframe_check: Option<rotor::AirframeCheck>,
 }
 
 /// One revolution kept along the way to the periodic solution.
@@ -502,6 +504,7 @@ pub fn drive_periodic(
         blades,
         blade: None,
         blade_runs: Vec::new(),
+        airframe_check: None,
     };
     loads::finish(&mut run, blades);
     // the sub-step envelope last, so the columns written before it keep their places

@@ -1438,10 +1438,17 @@ fn whole_rotor(rep: &mut HtmlReport, info: &RunInfo, runs: &[&ModelRun]) {
     let Some(first) = whole.first() else { return };
     let n = first.blade_runs.len();
     rep.heading(2, "Whole rotor");
-    rep.paragraph(&format!(
-        "All {n} blades on a driven hub, each its own model with its own deck values: blade k sits (k-1) x {:.1} deg ahead of blade 1 and sees the shared swashplate's controls and the record's airloads at its own azimuth. On a driven hub the blades are coupled only through prescribed motion, so each blade's periodic solution is the rotor's; the hub loads are the sum of the blades' actual root loads. Each blade's outputs are in <model>/blade<K>/ (docs/run.md).",
-        360.0 / n as f64
-    ));
+    if info.airframe.is_empty() {
+        rep.paragraph(&format!(
+            "All {n} blades on a driven hub, each its own model with its own deck values: blade k sits (k-1) x {:.1} deg ahead of blade 1 and sees the shared swashplate's controls and the record's airloads at its own azimuth. On a driven hub the blades are coupled only through prescribed motion, so each blade's periodic solution is the rotor's; the hub loads are the sum of the blades' actual root loads. Each blade's outputs are in <model>/blade<K>/ (docs/run.md).",
+            360.0 / n as f64
+        ));
+    } else {
+        rep.paragraph(&format!(
+            "All {n} blades on a hub that moves with the airframe, in one model: blade k sits (k-1) x {:.1} deg ahead of blade 1 and sees the shared swashplate's controls and the record's airloads at its own azimuth; the blades are coupled through the hub, and the periodic solution and Floquet multipliers are those of the whole rotor with its airframe. The hub loads are the sum of the blades' actual root loads. Each blade's outputs are in <model>/blade<K>/ (docs/run.md).",
+            360.0 / n as f64
+        ));
+    }
     if info.blade_differences.is_empty() {
         rep.paragraph("The blades are identical: every blade has the deck's values.");
     } else {
@@ -1519,6 +1526,95 @@ fn whole_rotor(rep: &mut HtmlReport, info: &RunInfo, runs: &[&ModelRun]) {
         ));
         let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
         rep.marked_table(&header, &rows, |i, j| marks[i][j]);
+    }
+    airframe(rep, info, &whole);
+}
+
+/// The airframe under the hub: its directions, its motion over the revolution and the check
+/// of its equation of motion against the rotor's loads on it.
+fn airframe(rep: &mut HtmlReport, info: &RunInfo, whole: &[&&ModelRun]) {
+    if info.airframe.is_empty() {
+        return;
+    }
+    rep.heading(3, "Airframe");
+    rep.paragraph("The airframe under the hub, from the deck's [airframe] (each direction alone, without the rotor):");
+    rep.list(&info.airframe);
+    let mut plots = vec![];
+    for r in whole {
+        for (unit, scale, ylabel) in [
+            ("_m", 1e3, "airframe translation [mm]"),
+            (
+                "_rad",
+                180.0 / std::f64::consts::PI,
+                "airframe rotation [deg]",
+            ),
+        ] {
+            let chans: Vec<(&String, &Vec<f64>)> = r
+                .channel_names
+                .iter()
+                .zip(&r.last_rev)
+                .filter(|(c, _)| {
+                    c.starts_with("airframe_") && c.ends_with(unit) && !c.contains("accel")
+                })
+                .collect();
+            if chans.is_empty() {
+                continue;
+            }
+            let mut p = Plot::new(
+                &format!("{}: airframe motion at the hub", r.label),
+                "azimuth of blade 1 [deg]",
+                ylabel,
+            )
+            .azimuth()
+            .y_scale(scale);
+            for (c, v) in chans {
+                let dir = c
+                    .strip_prefix("airframe_")
+                    .and_then(|x| x.strip_suffix(unit))
+                    .unwrap_or(c);
+                p = p.line(dir, &closed_x(&r.azimuth_deg), &closed(v));
+            }
+            plots.push(p);
+        }
+    }
+    svg(
+        rep,
+        "The airframe's displacement at the hub over the reported revolution (fixed frame), with its static deflection under the mean rotor loads.",
+        &plots,
+    );
+    let mut rows = vec![];
+    for r in whole {
+        let Some(c) = &r.airframe_check else { continue };
+        for d in &c.directions {
+            let unit = if matches!(d.direction.as_str(), "roll" | "pitch") {
+                "N m"
+            } else {
+                "N"
+            };
+            rows.push(vec![
+                r.label.clone(),
+                d.direction.clone(),
+                format!("{:.3e} {unit}", d.max_imbalance),
+                format!("{:.1} {unit}", d.max_hub_load),
+                format!(
+                    "{:.1e}",
+                    d.max_imbalance / d.max_hub_load.max(f64::MIN_POSITIVE)
+                ),
+            ]);
+        }
+    }
+    if !rows.is_empty() {
+        rep.paragraph("Momentum check: the airframe's equation of motion (mass x acceleration + damper + spring) against the rotor's loads on it at the hub, summed from every blade's loads on the hub, at every sample of the reported revolution. The translations balance to the Newton tolerance of the step; roll and pitch to second order in the airframe's rotation (their axes turn with it).");
+        rep.table(
+            &[
+                "model",
+                "direction",
+                "largest imbalance",
+                "largest rotor load",
+                "relative",
+            ],
+            &rows,
+        );
     }
 }
 

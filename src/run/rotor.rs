@@ -76,6 +76,8 @@ pub fn combine(blades: Vec<ModelRun>) -> anyhow::Result<ModelRun> {
     run.blade = None;
     run.blades = None;
     run.periodic_state = None;
+    // the revolutions kept along the way are each blade's, in its folder
+    run.all_revs = Vec::new();
     if have_root {
         for (c, y) in rotating.into_iter().enumerate() {
             run.channel_names.push(HUB_ROTATING_CHANNELS[c].to_string());
@@ -156,5 +158,142 @@ pub fn combine(blades: Vec<ModelRun>) -> anyhow::Result<ModelRun> {
         })
         .max_by(|a, b| a.max_rel_error.total_cmp(&b.max_rel_error));
     run.blade_runs = blades;
+    Ok(run)
+}
+
+/// The airframe's equation of motion against the rotor's loads on it, over the reported
+/// revolution: per moving direction, the largest `|m a + c v + k u - F_hub|` against the
+/// largest `|F_hub|`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AirframeCheck {
+    pub directions: Vec<AirframeBalance>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AirframeBalance {
+    /// `x`, `y`, `z`, `roll` or `pitch`.
+    pub direction: String,
+    /// Largest imbalance [N or N m].
+    pub max_imbalance: f64,
+    /// Largest rotor load on the airframe in this direction [N or N m].
+    pub max_hub_load: f64,
+    /// Largest ratio of the imbalance to the residual tolerance of its step (at most 1: the
+    /// balance holds to what Newton was asked for).
+    pub max_over_step_tolerance: f64,
+}
+
+/// The channels of `run` at `idx`, renamed `names`, as a run of their own (last revolution and
+/// kept revolutions alike).
+fn select(run: &ModelRun, idx: &[usize], names: Vec<String>) -> ModelRun {
+    let mut r = run.clone();
+    r.channel_names = names;
+    r.last_rev = idx.iter().map(|&i| run.last_rev[i].clone()).collect();
+    for (kr, src) in r.all_revs.iter_mut().zip(&run.all_revs) {
+        kr.samples = idx.iter().map(|&i| src.samples[i].clone()).collect();
+    }
+    r.blade_runs = Vec::new();
+    r
+}
+
+/// A whole rotor simulated as one model (blades coupled through a moving hub) split into its
+/// blades' runs and combined as [`combine`] does, with the whole model's periodicity, state and
+/// Floquet multipliers, the airframe's channels and its momentum check. `whole` holds blade 1's
+/// channels without prefix (its equilibrium check already taken), blade K's as `b<K>.`, then
+/// the airframe's; `limits`: each blade's relief-valve limits.
+pub fn combine_coupled(
+    whole: ModelRun,
+    n: usize,
+    limits: &[Option<(f64, f64)>],
+) -> anyhow::Result<ModelRun> {
+    use crate::rotor::sim::AIRFRAME_EOM_PREFIX;
+    let is_airframe = |c: &str| c.starts_with("airframe_") || c.starts_with(AIRFRAME_EOM_PREFIX);
+    let blade_of = |c: &str| -> Option<(usize, String)> {
+        let rest = c.strip_prefix('b')?;
+        let (k, name) = rest.split_once('.')?;
+        Some((k.parse().ok()?, name.to_string()))
+    };
+    let mut blades = Vec::with_capacity(n);
+    for k in 1..=n {
+        let (idx, names): (Vec<usize>, Vec<String>) = whole
+            .channel_names
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match blade_of(c) {
+                Some((j, name)) if j == k => Some((i, name)),
+                None if k == 1 && !is_airframe(c) => Some((i, c.clone())),
+                _ => None,
+            })
+            .unzip();
+        let mut r = select(&whole, &idx, names);
+        r.blade = Some(k);
+        r.blades = None;
+        r.periodic_state = None;
+        r.force_limits_n = limits.get(k - 1).copied().flatten();
+        if k > 1 {
+            super::loads::finish(&mut r, None);
+        }
+        blades.push(r);
+    }
+    let mut run = combine(blades)?;
+    run.periodic = whole.periodic.clone();
+    run.periodic_state = whole.periodic_state.clone();
+    run.revolutions = whole.revolutions;
+    run.timing = whole.timing;
+    run.wall_s = whole.wall_s;
+    run.build_s = whole.build_s;
+    for b in &mut run.blade_runs {
+        b.periodic = whole.periodic.clone();
+        b.periodic.floquet_multipliers = Vec::new();
+    }
+    let mut directions = Vec::new();
+    let tol = whole
+        .channel_names
+        .iter()
+        .position(|c| c == crate::rotor::sim::AIRFRAME_STEP_TOLERANCE)
+        .map(|i| &whole.last_rev[i]);
+    for (i, c) in whole.channel_names.iter().enumerate() {
+        if c == crate::rotor::sim::AIRFRAME_STEP_TOLERANCE {
+            continue;
+        }
+        if let Some(eom) = c.strip_prefix(AIRFRAME_EOM_PREFIX) {
+            // eom_airframe_<dir>_<unit> pairs with airframe_<dir>_hub_{force_N,moment_Nm}
+            let dir = eom
+                .strip_prefix("airframe_")
+                .and_then(|r| r.rsplit_once('_'))
+                .map(|(d, _)| d.to_string())
+                .unwrap_or_default();
+            let hub = whole.channel_names.iter().position(|h| {
+                h == &format!("airframe_{dir}_hub_force_N")
+                    || h == &format!("airframe_{dir}_hub_moment_Nm")
+            });
+            let Some(j) = hub else { continue };
+            let (a, f) = (&whole.last_rev[i], &whole.last_rev[j]);
+            let max_imbalance = a
+                .iter()
+                .zip(f)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            let max_hub_load = f.iter().map(|x| x.abs()).fold(0.0, f64::max);
+            let max_over_step_tolerance = match tol {
+                Some(t) => a
+                    .iter()
+                    .zip(f)
+                    .zip(t)
+                    .map(|((x, y), t)| (x - y).abs() / t)
+                    .fold(0.0, f64::max),
+                None => f64::NAN,
+            };
+            directions.push(AirframeBalance {
+                direction: dir,
+                max_imbalance,
+                max_hub_load,
+                max_over_step_tolerance,
+            });
+        } else if c.starts_with("airframe_") {
+            run.channel_names.push(c.clone());
+            run.last_rev.push(whole.last_rev[i].clone());
+        }
+    }
+    run.airframe_check = Some(AirframeCheck { directions });
     Ok(run)
 }

@@ -529,6 +529,8 @@ pub struct RunInfo {
     /// A whole-rotor run: its blades, and where they differ (`blades.K.<deck path> = value`).
     pub blades: Option<usize>,
     pub blade_differences: Vec<String>,
+    /// A rotor on an airframe: each moving direction described in words (empty without one).
+    pub airframe: Vec<String>,
 }
 
 /// summary.json as a JSON value.
@@ -646,7 +648,53 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "stroke_check": with_unit(serde_json::to_value(&f.stroke).unwrap_or(Value::Null), "m"),
         "channels": r.channel_names,
         "blades": blades_json(r),
+        "airframe": airframe_json(r),
     })
+}
+
+/// A rotor on an airframe: per moving direction its motion (mean, half peak-to-peak,
+/// harmonics) and the momentum check of its equation of motion (null without an airframe).
+fn airframe_json(r: &ModelRun) -> Value {
+    let Some(check) = &r.airframe_check else {
+        return Value::Null;
+    };
+    let mut channels = serde_json::Map::new();
+    for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
+        if !name.starts_with("airframe_") {
+            continue;
+        }
+        let st = Stats::of(v);
+        let h = crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, super::N_HARMONICS)
+            .map(|h| {
+                h.iter()
+                    .map(|x| json!({"n_per_rev": x.n, "amplitude": x.amplitude, "phase_deg": x.phase_deg}))
+                    .collect::<Vec<_>>()
+            })
+            .unwrap_or_default();
+        channels.insert(
+            name.clone(),
+            json!({"mean": st.mean, "half_peak_to_peak": 0.5 * st.peak_to_peak, "harmonics": h}),
+        );
+    }
+    let balance: Vec<Value> = check
+        .directions
+        .iter()
+        .map(|d| {
+            let unit = if matches!(d.direction.as_str(), "roll" | "pitch") {
+                "Nm"
+            } else {
+                "N"
+            };
+            json!({
+                "direction": d.direction,
+                format!("max_imbalance_{unit}"): d.max_imbalance,
+                format!("max_hub_load_{unit}"): d.max_hub_load,
+                "relative": d.max_imbalance / d.max_hub_load.max(f64::MIN_POSITIVE),
+                "max_over_step_tolerance": d.max_over_step_tolerance,
+            })
+        })
+        .collect();
+    json!({"channels": channels, "momentum_check": balance})
 }
 
 /// A whole-rotor run's blades: per blade its place, folder, periodicity, damper force and

@@ -74,6 +74,7 @@ impl CoRotation {
     /// The driven joint of `model`, if it has exactly one.
     fn of(model: &Model, asm: &Assembler) -> Option<Self> {
         let mut found = None;
+        let mut on_node = vec![];
         let mut grounded = vec![];
         for (ei, e) in model.elements.iter().enumerate() {
             if let Element::Joint(j) = e {
@@ -83,13 +84,24 @@ impl CoRotation {
                 if j.node_a.is_none() && j.locks().0 == 3 {
                     grounded.push((asm.lam_start[ei], j.qa));
                 }
-                if let (None, Some(law)) = (j.node_a, &j.prescribed_angle) {
-                    if found.is_some() {
-                        return None;
+                // the driven shaft: on the ground, or else on a node that moves little (a
+                // rotor's airframe, whose own rows then turn with the rest: an approximation
+                // the contraction rule watches)
+                if let Some(law) = &j.prescribed_angle {
+                    match j.node_a {
+                        None => {
+                            if found.is_some() {
+                                return None;
+                            }
+                            found = Some((j.qa, law.clone()));
+                        }
+                        Some(i) => on_node.push((mm(&model.node_r0(i), &j.qa), law.clone())),
                     }
-                    found = Some((j.qa, law.clone()));
                 }
             }
+        }
+        if found.is_none() && on_node.len() == 1 {
+            found = on_node.pop();
         }
         found.map(|(qa, law)| CoRotation {
             axis: [qa[0][2], qa[1][2], qa[2][2]],
@@ -725,6 +737,12 @@ impl DynamicSolver {
             iterations: it,
             residual: r0,
         })
+    }
+
+    /// What the last step's Newton iterations had to reach: `||r|| <= rtol r_ref` [N] (the
+    /// residual's force rows are in N, its moment rows in N m).
+    pub fn residual_tolerance(&self) -> f64 {
+        self.newton.rtol * self.r_ref
     }
 
     /// Consistent initial accelerations: solves `M vd_0 + B^T lambda_0 = -r(q_0, v_0, vd = 0)`
