@@ -136,3 +136,51 @@ fn stiff_airframe_converges_to_the_driven_hub() {
         );
     }
 }
+
+/// The modal form: an x mode and a roll about a centre 1.5 m above the hub (it carries the
+/// hub sideways). The x mode balances to the step's tolerance; the roll to second order in
+/// its angle (its axis turns with the airframe).
+#[test]
+fn modal_airframe_balances_momentum() {
+    let dir = support::tmp("airframe_modal_deck");
+    let root = support::root();
+    let text = std::fs::read_to_string(root.join("rotors/uh60a.toml"))
+        .unwrap()
+        .replace(
+            "sections_csv = \"data/",
+            &format!("sections_csv = \"{}/rotors/data/", root.display()),
+        );
+    let deck = dir.join("modal.toml");
+    std::fs::write(
+        &deck,
+        format!(
+            "{text}\n[[airframe.mode]]\nfrequency_Hz = 14.0\ndamping_ratio = 0.02\ngeneralized_mass_kg = 2000.0\nparticipation = {{ x = 1.0 }}\n\n[[airframe.mode]]\nfrequency_Hz = 12.0\ndamping_ratio = 0.03\ngeneralized_mass_kg = 3000.0\nparticipation = {{ y = 1.5, roll = 1.0 }}\n"
+        ),
+    )
+    .unwrap();
+    let out = support::tmp("airframe_modal");
+    let j = RunJob {
+        rotor: deck,
+        all_blades: false,
+        ..job(&out, &[])
+    };
+    let mut o = j.execute(&Silent).unwrap();
+    let r = o.outcomes.remove(0).result.unwrap();
+    assert!(r.periodic.converged, "{:?}", r.periodic);
+    assert_eq!(
+        r.blade_runs.len(),
+        4,
+        "an [airframe] implies the whole rotor"
+    );
+    let check = r.airframe_check.as_ref().expect("an airframe check");
+    let by = |d: &str| check.directions.iter().find(|x| x.direction == d).unwrap();
+    assert!(by("x").max_over_step_tolerance <= 1.0, "{:?}", by("x"));
+    let roll = by("roll");
+    let theta = Stats::of(channel(&r, "airframe_roll_rad")).peak_to_peak;
+    assert!(
+        roll.max_imbalance <= 10.0 * theta * roll.max_hub_load,
+        "{roll:?}, roll peak-to-peak {theta} rad"
+    );
+    let _ = std::fs::remove_dir_all(out);
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -37,6 +37,7 @@ fn each_airframe_direction_has_its_own_mass_spring_and_damper() {
         z: t(2000.0, 3.0e6, 0.0),
         roll: r(9000.0, 2.0e6, 2.0e4),
         pitch: r(30000.0, 5.0e6, 0.0),
+        mode: Vec::new(),
     };
     let mut deck = String::from("title = \"airframe chain\"\n");
     let mount = write_airframe(&mut deck, &a).expect("a chain");
@@ -77,4 +78,120 @@ fn each_airframe_direction_has_its_own_mass_spring_and_damper() {
             "{name}: damping ratio {z}, expected {zw}"
         );
     }
+}
+
+/// The modal form: each mode becomes one link of the chain (`M / phi^2` and its spring and
+/// damper), a roll that carries the hub sideways (participation in roll and y) a roll about a
+/// centre `y / roll` above the hub. With the hub's mass on the chain each mode's frequency is
+/// `sqrt(k / (m + m_hub))`, for the offset roll `sqrt(k / (I + I_hub + m_hub c^2))`.
+#[test]
+fn airframe_modes_keep_their_frequency_damping_and_hub_participation() {
+    use rotorsim::rotor::deck::{AirframeMode, Participation};
+    let mode = |f: f64, zeta: f64, m: f64, p: Participation| AirframeMode {
+        frequency_hz: f,
+        damping_ratio: zeta,
+        generalized_mass_kg: m,
+        participation: p,
+    };
+    let a = AirframeTable {
+        mode: vec![
+            mode(
+                3.0,
+                0.03,
+                4000.0,
+                Participation {
+                    x: 0.5,
+                    ..Default::default()
+                },
+            ),
+            mode(
+                2.0,
+                0.05,
+                6000.0,
+                Participation {
+                    y: 1.2,
+                    roll: 0.8,
+                    ..Default::default()
+                },
+            ),
+            mode(
+                8.0,
+                0.0,
+                2500.0,
+                Participation {
+                    z: 1.0,
+                    ..Default::default()
+                },
+            ),
+            mode(
+                5.0,
+                0.02,
+                9000.0,
+                Participation {
+                    pitch: 0.3,
+                    ..Default::default()
+                },
+            ),
+        ],
+        ..Default::default()
+    };
+    let mut deck = String::from("title = \"airframe modes\"\n");
+    let mount = write_airframe(&mut deck, &a).expect("a chain");
+    deck.push_str(&format!(
+        "[[node]]\nname = \"hub\"\nposition_m = [0.0, 0.0, 0.0]\n\n[[rigid_body]]\nname = \"hub_body\"\nnode = \"hub\"\nmass_kg = {HUB_KG}\ninertia_kgm2 = [[{HUB_KG_M2}, 0.0, 0.0], [0.0, {HUB_KG_M2}, 0.0], [0.0, 0.0, {HUB_KG_M2}]]\n\n[[joint]]\nname = \"shaft\"\ntype = \"clamp\"\nnode_a = \"{mount}\"\nnode_b = \"hub\"\n"
+    ));
+    let (_, mut model) = parse_deck(&deck, "airframe modes", Path::new(".")).unwrap();
+    let st = State::from_model(&model);
+    let found = modes(
+        &mut model,
+        &st,
+        &ModalOptions {
+            n_modes: 4,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let mut want: Vec<(f64, f64)> = a
+        .mode
+        .iter()
+        .map(|m| {
+            let p = &m.participation;
+            let w = two_pi * m.frequency_hz;
+            let (phi, hub) = if p.roll != 0.0 {
+                let c = p.y / p.roll;
+                (p.roll, HUB_KG_M2 + HUB_KG * c * c)
+            } else if p.pitch != 0.0 {
+                (p.pitch, HUB_KG_M2)
+            } else {
+                (p.x + p.z, HUB_KG)
+            };
+            let mass = m.generalized_mass_kg / (phi * phi);
+            let (k, c) = (mass * w * w, 2.0 * m.damping_ratio * w * mass);
+            let total = mass + hub;
+            ((k / total).sqrt() / two_pi, c / (2.0 * (k * total).sqrt()))
+        })
+        .collect();
+    want.sort_by(|p, q| p.0.total_cmp(&q.0));
+    let mut got: Vec<(f64, f64)> = found.iter().map(|m| (m.freq_hz, m.damping_ratio)).collect();
+    got.sort_by(|p, q| p.0.total_cmp(&q.0));
+    assert_eq!(got.len(), 4, "{got:?}");
+    for ((f, z), (fw, zw)) in got.iter().zip(&want) {
+        assert!((f - fw).abs() <= 1e-9 * fw, "{f} Hz, expected {fw}");
+        assert!((z - zw).abs() <= 1e-9, "damping ratio {z}, expected {zw}");
+    }
+    // the offset roll moves the hub sideways by y / roll per radian: its mode shape at the hub
+    let roll = found
+        .iter()
+        .find(|m| {
+            let h = m.shape.last().unwrap();
+            h[3].abs() > 1e-3 * h.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+        })
+        .expect("a roll mode");
+    let h = roll.shape.last().unwrap();
+    assert!(
+        (h[1] / h[3] - 1.5).abs() < 1e-9,
+        "hub y / roll = {}",
+        h[1] / h[3]
+    );
 }

@@ -45,6 +45,41 @@ pub struct AirframeTable {
     pub roll: Option<AirframeRotation>,
     #[serde(default)]
     pub pitch: Option<AirframeRotation>,
+    /// The modal form: the airframe's modes at the hub (instead of the directions above).
+    #[serde(default)]
+    pub mode: Vec<AirframeMode>,
+}
+
+/// One airframe mode seen from the hub: `q` its modal coordinate, the hub moving `phi q`
+/// (m in x, y, z; rad in roll, pitch), kinetic energy `1/2 M q_dot^2`.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeMode {
+    #[serde(rename = "frequency_Hz")]
+    pub frequency_hz: f64,
+    #[serde(default)]
+    pub damping_ratio: f64,
+    /// Generalized mass M for the mode shape's normalisation [kg].
+    pub generalized_mass_kg: f64,
+    /// The hub's displacement per unit modal coordinate: one of x, y, z, roll, pitch, or a
+    /// rotation with the in-plane translation it carries (roll with y, pitch with x: a roll
+    /// or pitch about a centre below or above the hub).
+    pub participation: Participation,
+}
+
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Participation {
+    #[serde(default)]
+    pub x: f64,
+    #[serde(default)]
+    pub y: f64,
+    #[serde(default)]
+    pub z: f64,
+    #[serde(default)]
+    pub roll: f64,
+    #[serde(default)]
+    pub pitch: f64,
 }
 
 /// A translation of the hub: the airframe's effective mass, spring and damper in it.
@@ -84,6 +119,9 @@ pub struct AirframeDof {
     pub stiffness: f64,
     /// [N s/m] or [N m s/rad].
     pub damping: f64,
+    /// Rotations: height of the axis's centre above the hub centre [m] (0 but for a mode whose
+    /// rotation carries an in-plane hub translation).
+    pub center_z_m: f64,
 }
 
 impl AirframeDof {
@@ -109,7 +147,115 @@ impl AirframeDof {
     }
 }
 
+impl AirframeMode {
+    /// The one direction the mode moves, as the chain builds it (None: an unsupported
+    /// participation, refused by the check). With `phi` the participation of the direction:
+    /// mass `M / phi^2`, spring `M omega^2 / phi^2`, damper `2 zeta omega M / phi^2`.
+    fn dof(&self) -> Option<AirframeDof> {
+        let p = &self.participation;
+        let all = [
+            ("x", p.x),
+            ("y", p.y),
+            ("z", p.z),
+            ("roll", p.roll),
+            ("pitch", p.pitch),
+        ];
+        let nz: Vec<usize> = (0..5).filter(|&i| all[i].1 != 0.0).collect();
+        // (direction index, centre height): a rotation about x through (0, 0, c) moves the hub
+        // by y = c theta; about y, by x = -c theta
+        let (i, center) = match nz.as_slice() {
+            [i] => (*i, 0.0),
+            [1, 3] => (3, p.y / p.roll),
+            [0, 4] => (4, -p.x / p.pitch),
+            _ => return None,
+        };
+        let phi = all[i].1;
+        let w = 2.0 * std::f64::consts::PI * self.frequency_hz;
+        let m = self.generalized_mass_kg / (phi * phi);
+        Some(AirframeDof {
+            name: all[i].0,
+            axis: if i < 3 { i } else { i - 3 },
+            rotation: i >= 3,
+            mass: m,
+            stiffness: m * w * w,
+            damping: 2.0 * self.damping_ratio * w * m,
+            center_z_m: center,
+        })
+    }
+}
+
 impl AirframeTable {
+    /// The modal form's rules: positive frequency and generalized mass, non-negative damping
+    /// ratio, a supported participation, no direction in two modes, no direction keys beside.
+    fn check_modes(&self) -> Result<(), (String, String)> {
+        if let Some(d) = [
+            ("x", self.x.is_some()),
+            ("y", self.y.is_some()),
+            ("z", self.z.is_some()),
+            ("roll", self.roll.is_some()),
+            ("pitch", self.pitch.is_some()),
+        ]
+        .iter()
+        .find(|d| d.1)
+        {
+            return Err((
+                format!("airframe.{}", d.0),
+                "an airframe is given either by directions or by modes ([[airframe.mode]]), not both".into(),
+            ));
+        }
+        let mut used: Vec<&str> = Vec::new();
+        for (i, m) in self.mode.iter().enumerate() {
+            let key = |k: &str| format!("airframe.mode[{i}].{k}");
+            for (k, v, positive) in [
+                ("frequency_Hz", m.frequency_hz, true),
+                ("generalized_mass_kg", m.generalized_mass_kg, true),
+                ("damping_ratio", m.damping_ratio, false),
+            ] {
+                if !(v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 }) {
+                    let what = if positive {
+                        "a positive number"
+                    } else {
+                        "a non-negative number"
+                    };
+                    return Err((key(k), format!("expected {what}, found {v}")));
+                }
+            }
+            let p = &m.participation;
+            if [p.x, p.y, p.z, p.roll, p.pitch]
+                .iter()
+                .any(|v| !v.is_finite())
+            {
+                return Err((key("participation"), "expected finite numbers".into()));
+            }
+            let Some(d) = m.dof() else {
+                return Err((
+                    key("participation"),
+                    "expected one of x, y, z, roll, pitch, or roll with y, or pitch with x (a rotation about a centre above or below the hub); other combinations are not supported".into(),
+                ));
+            };
+            let dirs: Vec<&str> = [
+                ("x", p.x),
+                ("y", p.y),
+                ("z", p.z),
+                ("roll", p.roll),
+                ("pitch", p.pitch),
+            ]
+            .iter()
+            .filter(|v| v.1 != 0.0)
+            .map(|v| v.0)
+            .collect();
+            if let Some(twice) = dirs.iter().find(|x| used.contains(x)) {
+                return Err((
+                    key("participation"),
+                    format!("{twice} moves in an earlier mode too: each hub direction may move in one mode only (the chain gives each mode its own direction)"),
+                ));
+            }
+            used.extend(dirs);
+            let _ = d;
+        }
+        Ok(())
+    }
+
     /// The directions that move, in the order x, y, z, roll, pitch.
     pub fn dofs(&self) -> Vec<AirframeDof> {
         let t = |name, axis, v: &Option<AirframeTranslation>| {
@@ -120,6 +266,7 @@ impl AirframeTable {
                 mass: v.mass_kg,
                 stiffness: v.stiffness,
                 damping: v.damping,
+                center_z_m: 0.0,
             })
         };
         let r = |name, axis, v: &Option<AirframeRotation>| {
@@ -130,8 +277,15 @@ impl AirframeTable {
                 mass: v.inertia,
                 stiffness: v.stiffness,
                 damping: v.damping,
+                center_z_m: 0.0,
             })
         };
+        if !self.mode.is_empty() {
+            let mut v: Vec<AirframeDof> = self.mode.iter().filter_map(AirframeMode::dof).collect();
+            // translations first (the chain's order), rotations after
+            v.sort_by_key(|d| (d.rotation, d.axis));
+            return v;
+        }
         [
             t("x", 0, &self.x),
             t("y", 1, &self.y),
@@ -154,8 +308,13 @@ impl AirframeTable {
                 } else {
                     ("kg", "N/m", "N s/m")
                 };
+                let center = if d.center_z_m != 0.0 {
+                    format!(", about a centre {:.3} m above the hub", d.center_z_m)
+                } else {
+                    String::new()
+                };
                 format!(
-                    "{}: {} {m}, spring {} {k}, damper {} {c} ({:.3} Hz, damping ratio {:.3})",
+                    "{}: {} {m}, spring {} {k}, damper {} {c} ({:.3} Hz, damping ratio {:.3}{center})",
                     d.name,
                     d.mass,
                     d.stiffness,
@@ -170,6 +329,9 @@ impl AirframeTable {
     /// Positive masses and stiffnesses, non-negative dampings, at least one direction;
     /// `Err((key, expected))`.
     fn check(&self) -> Result<(), (String, String)> {
+        if !self.mode.is_empty() {
+            return self.check_modes();
+        }
         let dofs = self.dofs();
         if dofs.is_empty() {
             return Err((

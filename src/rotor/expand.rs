@@ -637,6 +637,31 @@ pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
     s
 }
 
+/// The airframe's directions in the order of its chain from the ground: the translations by
+/// decreasing mass, then the rotations.
+pub fn airframe_chain(airframe: &super::deck::AirframeTable) -> Vec<super::deck::AirframeDof> {
+    let mut dofs = airframe.dofs();
+    let split = dofs.iter().position(|d| d.rotation).unwrap_or(dofs.len());
+    dofs[..split].sort_by(|a, b| b.mass.total_cmp(&a.mass));
+    dofs
+}
+
+/// The translational mass each chain node carries [kg] (in the order of [`airframe_chain`]):
+/// the difference of its direction's mass to the next translation's, the last translation
+/// all of its own, the rotations none.
+pub fn airframe_node_masses(dofs: &[super::deck::AirframeDof]) -> Vec<f64> {
+    let split = dofs.iter().position(|d| d.rotation).unwrap_or(dofs.len());
+    (0..dofs.len())
+        .map(|i| {
+            if i >= split {
+                0.0
+            } else {
+                dofs[i].mass - dofs[i + 1..split].first().map_or(0.0, |n| n.mass)
+            }
+        })
+        .collect()
+}
+
 /// The airframe as a chain from the ground to the node under the shaft, one link per moving
 /// direction (bushing locking all but that direction, with its spring and damper), so that
 /// each direction has its own mass. A node moves with every link before it, so its mass
@@ -644,9 +669,8 @@ pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
 /// node carries the difference to the next (the last the smallest); the rotations' nodes
 /// carry inertia about their own axis only and no mass. Returns the last node's name.
 pub fn write_airframe(s: &mut String, airframe: &super::deck::AirframeTable) -> Option<String> {
-    let mut dofs = airframe.dofs();
-    let split = dofs.iter().position(|d| d.rotation).unwrap_or(dofs.len());
-    dofs[..split].sort_by(|a, b| b.mass.total_cmp(&a.mass));
+    let dofs = airframe_chain(airframe);
+    let masses = airframe_node_masses(&dofs);
     let mut prev: Option<String> = None;
     const AXES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
     for (i, d) in dofs.iter().enumerate() {
@@ -661,8 +685,7 @@ pub fn write_airframe(s: &mut String, airframe: &super::deck::AirframeTable) -> 
             j[d.axis] = d.mass;
             (0.0, j)
         } else {
-            let next = dofs[i + 1..split].first().map_or(0.0, |n| n.mass);
-            (d.mass - next, [0.0; 3])
+            (masses[i], [0.0; 3])
         };
         let _ = writeln!(
             s,
@@ -693,7 +716,7 @@ pub fn write_airframe(s: &mut String, airframe: &super::deck::AirframeTable) -> 
         let _ = writeln!(
             s,
             "node_b = \"{node}\"\nposition_m = {}\nlocked = [{}]\n{kk} = {}\n{ck} = {}\n",
-            v3([0.0; 3]),
+            v3([0.0, 0.0, d.center_z_m]),
             locked.join(", "),
             v3(k),
             v3(c)

@@ -217,8 +217,11 @@ struct BladePart {
 /// The airframe under the hub: its moving directions and the node under the shaft.
 struct AirframePart {
     dofs: Vec<super::deck::AirframeDof>,
-    /// The chain's last node (the shaft's node A).
+    /// The chain's last node (the shaft's node A), and each direction's node (chain order).
     mount: usize,
+    chain: Vec<usize>,
+    /// The translational mass of each chain node [kg].
+    masses: Vec<f64>,
 }
 
 /// Airframe channel names of one direction: displacement, acceleration, the rotor's load on
@@ -497,7 +500,7 @@ fn build_parts(
     let hub = model.node_id(names::HUB)?;
     let airframe = match (&spec.airframe, whole) {
         (Some(a), true) => {
-            let dofs = a.dofs();
+            let dofs = super::expand::airframe_chain(a);
             let chain = dofs
                 .iter()
                 .map(|d| model.node_id(&format!("{}.{}", names::AIRFRAME, d.name)))
@@ -516,7 +519,12 @@ fn build_parts(
             .ok_or_else(|| {
                 anyhow::anyhow!("expanded rotor model: the shaft is not on the airframe")
             })?;
-            Some(AirframePart { dofs, mount })
+            Some(AirframePart {
+                masses: super::expand::airframe_node_masses(&dofs),
+                dofs,
+                mount,
+                chain,
+            })
         }
         _ => None,
     };
@@ -714,15 +722,20 @@ impl RotorSim {
                 }
             }
         }
-        let i = a.mount;
-        let phi = log_map(&quat_to_arr(&st.q[i]));
         for (k, d) in a.dofs.iter().enumerate() {
+            // each direction's own link of the chain: everything after it moves with it
+            let i = a.chain[k];
+            let phi = log_map(&quat_to_arr(&st.q[i]));
             let (u, v, acc, load) = if d.rotation {
+                // about the rotation's centre, which moves with the links before it
+                let before = k.checked_sub(1).map_or([0.0; 3], |j| st.x[a.chain[j]]);
+                let c = add(before, [0.0, 0.0, d.center_z_m]);
+                let about_c = hub_load.moved(st.x[self.hub], c);
                 (
                     phi[d.axis],
                     st.w[i][d.axis],
                     st.al[i][d.axis],
-                    hub_load.moment[d.axis],
+                    about_c.moment[d.axis],
                 )
             } else {
                 (
@@ -732,12 +745,22 @@ impl RotorSim {
                     hub_load.force[d.axis],
                 )
             };
+            // inertia: every node after this link that carries mass, each with its own
+            // acceleration (a massless node's acceleration is not the dynamics' own)
+            let inertia = if d.rotation {
+                d.mass * acc
+            } else {
+                (k..a.dofs.len())
+                    .map(|j| a.masses[j] * st.a[a.chain[j]][d.axis])
+                    .sum()
+            };
             let o = &mut out[4 * k..4 * k + 4];
             o[0] = u;
-            o[1] = acc;
+            // the mass-weighted acceleration of the direction (its nodes with mass)
+            o[1] = if d.rotation { acc } else { inertia / d.mass };
             if ok {
                 o[2] = load;
-                o[3] = d.mass * acc + d.damping * v + d.stiffness * u;
+                o[3] = inertia + d.damping * v + d.stiffness * u;
             } else {
                 o[2] = f64::NAN;
                 o[3] = f64::NAN;
