@@ -195,3 +195,21 @@ fn airframe_modes_keep_their_frequency_damping_and_hub_participation() {
         h[1] / h[3]
     );
 }
+
+/// The shipped airframe example is the shipped deck, unchanged, with an `[airframe]` after it.
+#[test]
+fn the_airframe_example_is_the_shipped_deck_on_an_airframe() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors");
+    let base = std::fs::read_to_string(root.join("uh60a.toml")).unwrap();
+    let with = std::fs::read_to_string(root.join("uh60a_airframe.toml")).unwrap();
+    assert!(
+        with.starts_with(&base),
+        "rotors/uh60a_airframe.toml must begin with rotors/uh60a.toml"
+    );
+    let deck = rotorsim::rotor::RotorDeck::from_file(&root.join("uh60a_airframe.toml")).unwrap();
+    let a = deck.spec.airframe.expect("an [airframe]");
+    for d in a.dofs() {
+        assert!((d.frequency_hz() - 15.0).abs() < 1e-3, "{d:?}");
+        assert!((d.damping_ratio() - 0.02).abs() < 1e-4, "{d:?}");
+    }
+}

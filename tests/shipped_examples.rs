@@ -7,7 +7,8 @@
 //!
 //! Kinds, by the deck's tables: a model deck (`[[beam]]`, ...) runs each of its `[static]`,
 //! `[dynamic]` and `[modes]` analyses (docs/model_deck.md); a rotor deck (`[rotor]`): `expand`,
-//! `modes --rotor` and, with a `[damper]` table, a rigid and an elastic `run` of 2 revolutions
+//! `modes --rotor` and, with a `[damper]` table, a rigid (not on an airframe: that is the whole
+//! rotor) and an elastic `run` of 2 revolutions
 //! (docs/run.md); a damper deck (`[damper]` alone): `bench`; an actuator deck (`[actuator]`):
 //! the dynamic analysis of docs/examples/actuator_pitch_beam.toml with it as the device; a sweep
 //! plan (`[base]`/`[vary]`/`[[case]]`): `--emit-slurm` of the whole plan (every case checked) and
@@ -166,7 +167,13 @@ fn jobs_for(deck: &Path, work: &Path, tag: &str) -> Result<Vec<Job>, String> {
             ));
         }
         if has("damper") && !has("hinge") {
-            for model in ["rigid", "uh60a"] {
+            // a rotor on an airframe is the whole elastic rotor: the rigid reduction is one blade
+            let models: &[&str] = if has("airframe") {
+                &["uh60a"]
+            } else {
+                &["rigid", "uh60a"]
+            };
+            for &model in models {
                 let o = out(&format!("run-{model}"));
                 v.push(job(
                     vec![
