@@ -343,3 +343,33 @@ fn a_whole_rotor_starts_each_blade_from_its_own_saved_state() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `--write-all-revs` on a whole rotor: every blade's kept revolutions in its own folder, with
+/// its own columns; the rotor's folder keeps none (its hub columns were never kept per
+/// revolution).
+#[test]
+fn a_whole_rotor_keeps_each_blades_revolutions_in_its_folder() {
+    let out = support::tmp("whole_all_revs");
+    let j = RunJob {
+        periodic: rotorsim::run::PeriodicMethod::March,
+        revs: 2,
+        write_all_revs: true,
+        ..job(&out, DamperChoice::One(DamperModel::Linear), 64, true, &[])
+    };
+    j.execute(&Silent).unwrap();
+    let model = out.join("linear");
+    assert!(!model.join("all_revs.csv").exists());
+    for k in 1..=4 {
+        let text = std::fs::read_to_string(model.join(format!("blade{k}/all_revs.csv"))).unwrap();
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        assert!(
+            header.contains(&"damper_force_N") && !header.iter().any(|c| c.starts_with("hub_"))
+        );
+        assert_eq!(
+            text.lines().count(),
+            1 + 2 * 64,
+            "blade {k}: 2 revolutions of 64 samples"
+        );
+    }
+    let _ = std::fs::remove_dir_all(out);
+}
