@@ -1600,11 +1600,12 @@ fn airframe(rep: &mut HtmlReport, info: &RunInfo, whole: &[&&ModelRun]) {
                     "{:.1e}",
                     d.max_imbalance / d.max_hub_load.max(f64::MIN_POSITIVE)
                 ),
+                format!("{:.2}", d.max_over_step_tolerance),
             ]);
         }
     }
     if !rows.is_empty() {
-        rep.paragraph("Momentum check: the airframe's equation of motion (mass x acceleration + damper + spring) against the rotor's loads on it at the hub, summed from every blade's loads on the hub, at every sample of the reported revolution. The translations balance to the Newton tolerance of the step; roll and pitch to second order in the airframe's rotation (their axes turn with it).");
+        rep.paragraph("Momentum check: the airframe's equation of motion (mass x acceleration + damper + spring) against the rotor's loads on it at the hub, summed from every blade's loads on the hub, at every sample of the reported revolution. The translations balance to the Newton tolerance of the step (the last column: the largest ratio of the imbalance to the residual tolerance of its step, at most 1); roll and pitch to second order in the airframe's rotation (their axes turn with it).");
         rep.table(
             &[
                 "model",
@@ -1612,6 +1613,7 @@ fn airframe(rep: &mut HtmlReport, info: &RunInfo, whole: &[&&ModelRun]) {
                 "largest imbalance",
                 "largest rotor load",
                 "relative",
+                "of the step's tolerance",
             ],
             &rows,
         );
