@@ -100,23 +100,8 @@ fn tangent_matches_dual_reference_and_central_differences() {
                     worst_phi = worst_phi.max(e);
                     assert!(e < 1e-13, "{tag}: phi {k}");
                 }
-                let mut k = vec![f64::NAN; n * n];
-                let mut kd = vec![f64::NAN; n * n];
-                c.j.tangent(&c.a, &c.b, &c.lam, &c.ctx, &c.seeds, &mut k);
-                c.j.tangent_dual(&c.a, &c.b, &c.lam, &c.ctx, &c.seeds, &mut kd);
-                let scale = max_abs(&kd);
-                for i in 0..n * n {
-                    let e = (k[i] - kd[i]).abs() / scale;
-                    worst_dual = worst_dual.max(e);
-                    assert!(
-                        e < 1e-12,
-                        "{tag}: ({}, {}): {} vs dual {}",
-                        i / n,
-                        i % n,
-                        k[i],
-                        kd[i]
-                    );
-                }
+                let (k, e) = tangent_against_dual(&c, &c.lam, n, 1e-12, &tag);
+                worst_dual = worst_dual.max(e);
                 // central differences of residual_f64: node columns along each seed (eps
                 // |(dx, dth)| = 1e-5), multiplier columns (linear: exact up to round-off)
                 let has_a = c.j.node_a.is_some();

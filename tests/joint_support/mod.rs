@@ -177,3 +177,34 @@ pub fn moved(k: &NodeKin<f64>, s: &Seed, eps: f64) -> NodeKin<f64> {
         al: st(k.al, s.dal),
     }
 }
+
+/// The closed-form tangent of `c` (multipliers `lam`) against its dual-number reference:
+/// every entry within `tol` of the largest dual entry, else a panic naming `tag`, the entry
+/// and both values. Returns the closed-form tangent (n x n, row-major) and the worst error.
+pub fn tangent_against_dual(
+    c: &Case,
+    lam: &[f64],
+    n: usize,
+    tol: f64,
+    tag: &str,
+) -> (Vec<f64>, f64) {
+    let mut k = vec![f64::NAN; n * n];
+    let mut kd = vec![f64::NAN; n * n];
+    c.j.tangent(&c.a, &c.b, lam, &c.ctx, &c.seeds, &mut k);
+    c.j.tangent_dual(&c.a, &c.b, lam, &c.ctx, &c.seeds, &mut kd);
+    let scale = max_abs(&kd);
+    let mut worst: f64 = 0.0;
+    for i in 0..n * n {
+        let e = (k[i] - kd[i]).abs() / scale;
+        worst = worst.max(e);
+        assert!(
+            e < tol,
+            "{tag}: entry ({}, {}): {} vs dual {}",
+            i / n,
+            i % n,
+            k[i],
+            kd[i]
+        );
+    }
+    (k, worst)
+}
