@@ -746,13 +746,11 @@ fn write_model(s: &mut String, spec: &RotorSpec, opts: &ExpandOptions, blades: &
     for b in blades {
         b.bodies(s);
     }
-    // joints
-    // the shaft turns the hub on the airframe, or on the ground
-    let mount = match (
-        &spec.airframe,
-        blades.len() > 1 || blades.iter().any(|b| !b.place.prefix.is_empty()),
-    ) {
-        (Some(a), true) => write_airframe(s, a),
+    // joints: the shaft turns the hub on the airframe (the whole rotor's model, its blades
+    // named b<K>.), or on the ground
+    let whole = blades.iter().any(|b| !b.place.prefix.is_empty());
+    let mount = match &spec.airframe {
+        Some(a) if whole => write_airframe(s, a),
         _ => None,
     };
     let _ = write!(

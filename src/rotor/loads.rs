@@ -87,6 +87,17 @@ fn beam_ids<'a>(m: &'a Model, name: &str) -> anyhow::Result<&'a [usize]> {
         .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no beam `{name}`"))
 }
 
+/// Loads at the state `st` as the solver evaluates them (inertia included).
+fn eval_ctx(m: &Model, st: &State) -> EvalCtx {
+    EvalCtx {
+        t: st.t,
+        load_factor: 1.0,
+        gravity: m.gravity,
+        cscale: 1.0,
+        inertia: true,
+    }
+}
+
 fn element(m: &Model, name: &str) -> anyhow::Result<usize> {
     m.element_id(name)
         .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no element `{name}`"))
@@ -202,13 +213,7 @@ impl LoadChannels {
     /// swashplate) exerts on the hub node, global, moment about the hub centre: the loads the
     /// hub passes to the shaft.
     pub fn on_hub(&self, m: &Model, st: &State) -> anyhow::Result<Resultant> {
-        let ctx = EvalCtx {
-            t: st.t,
-            load_factor: 1.0,
-            gravity: m.gravity,
-            cscale: 1.0,
-            inertia: true,
-        };
+        let ctx = eval_ctx(m, st);
         let e0 = self.beams[0];
         let Element::Beam(b0) = &m.elements[e0] else {
             anyhow::bail!("element {e0} is not a beam");
@@ -216,22 +221,45 @@ impl LoadChannels {
         let k = b0.nodes.map(|i| st.node_kin(i));
         let ip = b0.interp(&k);
         let d = b0.densities_with(&k, &ip.rg, &ctx);
-        let (res, _, _) = b0.recovery(&k, &ip, &d, b0.s_range[0]);
-        let mut load = Resultant {
+        let root = self.root(m, st, &ctx, &ElemData { elem: e0, k, ip, d })?;
+        Ok(root.add(&loads::element_on_node(
+            m,
+            st,
+            &ctx,
+            &self.lam_off,
+            self.swash_drive,
+            self.hub,
+        )?))
+    }
+
+    /// What the blade system exerts on the hub, global, about the hub centre: the
+    /// retention's first element (`first`, its node 0 on the hub) and the damper's hub mount.
+    fn root(
+        &self,
+        m: &Model,
+        st: &State,
+        ctx: &EvalCtx,
+        first: &ElemData,
+    ) -> anyhow::Result<Resultant> {
+        let Element::Beam(b0) = &m.elements[first.elem] else {
+            anyhow::bail!("element {} is not a beam", first.elem);
+        };
+        let (res, _, _) = b0.recovery(&first.k, &first.ip, &first.d, b0.s_range[0]);
+        let mut root = Resultant {
             force: [-res[0], -res[1], -res[2]],
             moment: [-res[3], -res[4], -res[5]],
         };
-        for &e in self.hub_cut[1..].iter().chain([&self.swash_drive]) {
-            load = load.add(&loads::element_on_node(
+        for &e in &self.hub_cut[1..] {
+            root = root.add(&loads::element_on_node(
                 m,
                 st,
-                &ctx,
+                ctx,
                 &self.lam_off,
                 e,
                 self.hub,
             )?);
         }
-        Ok(load)
+        Ok(root)
     }
 
     /// Channel names, in the order of [`LoadChannels::values`].
@@ -248,13 +276,7 @@ impl LoadChannels {
         damper: &DamperStep,
         out: &mut [f64],
     ) -> anyhow::Result<()> {
-        let ctx = EvalCtx {
-            t: st.t,
-            load_factor: 1.0,
-            gravity: m.gravity,
-            cscale: 1.0,
-            inertia: true,
-        };
+        let ctx = eval_ctx(m, st);
         let mut data = self
             .scratch
             .lock()
@@ -295,27 +317,9 @@ impl LoadChannels {
         i += 1;
         let xh = st.x[self.hub];
         let rh = mm(&quat_to_arr(&st.q[self.hub]), &self.frame);
-        // what the blade system exerts on the hub, about the hub centre
-        // the retention's first element from this sample's data (its node 0 is the hub)
-        let r0 = &data[0];
-        let Element::Beam(b0) = &m.elements[r0.elem] else {
-            anyhow::bail!("element {} is not a beam", r0.elem);
-        };
-        let (res, _, _) = b0.recovery(&r0.k, &r0.ip, &r0.d, b0.s_range[0]);
-        let mut root = Resultant {
-            force: [-res[0], -res[1], -res[2]],
-            moment: [-res[3], -res[4], -res[5]],
-        };
-        for &e in &self.hub_cut[1..] {
-            root = root.add(&loads::element_on_node(
-                m,
-                st,
-                &ctx,
-                &self.lam_off,
-                e,
-                self.hub,
-            )?);
-        }
+        // what the blade system exerts on the hub, about the hub centre, from this sample's
+        // data of the retention's first element
+        let root = self.root(m, st, &ctx, &data[0])?;
         // the same from the other side: applied and inertial loads of the blade system plus
         // the pitch link's pull on the horn
         let mut body = loads::applied_and_inertial(m, st, &ctx, &self.rigid, xh)?;

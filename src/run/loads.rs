@@ -110,13 +110,16 @@ pub fn is_load_channel(name: &str) -> bool {
         || super::rotor::HUB_ROTATING_CHANNELS.contains(&name)
 }
 
-/// summary.json `loads`: per load channel mean, half peak-to-peak and harmonics 0-10/rev
-/// (amplitude, phase), and the equilibrium check. Null for a run without load channels.
-pub fn loads_json(r: &ModelRun) -> serde_json::Value {
+/// Per channel of `r` that `keep` selects: mean, half peak-to-peak and harmonics 0-10/rev
+/// (amplitude, phase) over the reported revolution.
+pub fn channels_json(
+    r: &ModelRun,
+    keep: impl Fn(&str) -> bool,
+) -> serde_json::Map<String, serde_json::Value> {
     use serde_json::json;
     let mut channels = serde_json::Map::new();
     for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
-        if !is_load_channel(name) {
+        if !keep(name) {
             continue;
         }
         let st = super::summary::Stats::of(v);
@@ -132,6 +135,14 @@ pub fn loads_json(r: &ModelRun) -> serde_json::Value {
             json!({"mean": st.mean, "half_peak_to_peak": 0.5 * st.peak_to_peak, "harmonics": h}),
         );
     }
+    channels
+}
+
+/// summary.json `loads`: per load channel mean, half peak-to-peak and harmonics 0-10/rev
+/// (amplitude, phase), and the equilibrium check. Null for a run without load channels.
+pub fn loads_json(r: &ModelRun) -> serde_json::Value {
+    use serde_json::json;
+    let channels = channels_json(r, is_load_channel);
     if channels.is_empty() {
         return serde_json::Value::Null;
     }

@@ -658,24 +658,7 @@ fn airframe_json(r: &ModelRun) -> Value {
     let Some(check) = &r.airframe_check else {
         return Value::Null;
     };
-    let mut channels = serde_json::Map::new();
-    for (name, v) in r.channel_names.iter().zip(&r.last_rev) {
-        if !name.starts_with("airframe_") {
-            continue;
-        }
-        let st = Stats::of(v);
-        let h = crate::analysis::harmonics::harmonics(&r.azimuth_deg, v, super::N_HARMONICS)
-            .map(|h| {
-                h.iter()
-                    .map(|x| json!({"n_per_rev": x.n, "amplitude": x.amplitude, "phase_deg": x.phase_deg}))
-                    .collect::<Vec<_>>()
-            })
-            .unwrap_or_default();
-        channels.insert(
-            name.clone(),
-            json!({"mean": st.mean, "half_peak_to_peak": 0.5 * st.peak_to_peak, "harmonics": h}),
-        );
-    }
+    let channels = super::loads::channels_json(r, |c| c.starts_with("airframe_"));
     let balance: Vec<Value> = check
         .directions
         .iter()
