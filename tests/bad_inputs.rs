@@ -257,6 +257,8 @@ const CASES: &[Case] = &[
     case("model start NaN", cant!("start_m = [0.0, 0.0, 0.0]", "start_m = [nan, 0.0, 0.0]"), STATIC_M, &["m.toml", "start_m"]),
     case("model e2 along beam", cant!("e2_direction = [0.0, 1.0, 0.0]", "e2_direction = [1.0, 0.0, 0.0]"), STATIC_M, &["m.toml", "e2_direction"]),
     case("model joint type unknown", cant!("type = \"clamp\"", "type = \"weld\""), STATIC_M, &["m.toml", "weld"]),
+    case("model bushing lock axis unknown", cant!("type = \"clamp\"", "type = \"bushing\"\nlocked = [\"x\", \"y\", \"z\", \"rx\", \"ry\", \"yaw\"]"), STATIC_M, &["m.toml", "locked", "yaw"]),
+    case("model locked on a clamp", cant!("type = \"clamp\"", "type = \"clamp\"\nlocked = [\"x\"]"), STATIC_M, &["m.toml", "locked", "bushing"]),
     case("model joint node unknown", cant!("node_b = \"beam.n0\"", "node_b = \"beam.n99\""), STATIC_M, &["m.toml", "beam.n99"]),
     case("model sensor node unknown", cant!("name = \"tip\"\nnode = \"beam.n24\"", "name = \"tip\"\nnode = \"beam.n77\""), STATIC_M, &["m.toml", "beam.n77"]),
     case("model sensor beyond beam", cant!("s_m = 0.0", "s_m = 20.0"), STATIC_M, &["m.toml", "s_m"]),
