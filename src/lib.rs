@@ -2,6 +2,7 @@
 //!
 //! Reference: O. A. Bauchau and H. Liu, "On the Modeling of Hydraulic Components in Rotorcraft
 //! Systems" (equation numbers in doc comments, "Eq. N", refer to that paper).
+pub mod aero;
 pub mod analysis;
 pub mod cli;
 pub mod diagnose;
