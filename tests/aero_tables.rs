@@ -250,10 +250,7 @@ fn clamping_uses_the_edge_and_counts_it() {
     let t = Arc::new(small());
     let af = Airfoil::Table(t.clone());
     let clamps = ClampCounts::default();
-    let edge = |a: f64, m: f64| {
-        let c = af.coefficients(a.to_radians(), m, &ClampCounts::default());
-        c
-    };
+    let edge = |a: f64, m: f64| af.coefficients(a.to_radians(), m, &ClampCounts::default());
     // Alpha below: the -10 deg row.
     let c = af.coefficients((-30f64).to_radians(), 0.3, &clamps);
     assert_eq!(c, edge(-10.0, 0.3));

@@ -503,7 +503,7 @@ impl C81Table {
             .collect();
         // A final newline leaves an empty last piece, not a line.
         let lines: Vec<&str> = match lines.split_last() {
-            Some((last, init)) if last.is_empty() => init.to_vec(),
+            Some((&"", init)) => init.to_vec(),
             _ => lines,
         };
         let mut first = 0;
@@ -531,7 +531,7 @@ impl C81Table {
             expected: format!(
                 "the count {} ({} of the {} table), a whole number of at least 1",
                 count_names[k],
-                if k % 2 == 0 {
+                if k.is_multiple_of(2) {
                     "Mach numbers"
                 } else {
                     "angles of attack"
