@@ -254,6 +254,8 @@ fn the_manifest_lists_the_inputs_with_their_sha256() {
         PathBuf::from(format!("{stem}.meta.json")),
         PathBuf::from(format!("{stem}.airloads.csv")),
         PathBuf::from(format!("{stem}.damper.csv")),
+        // read too: the record's optional measured blade motion
+        PathBuf::from(format!("{stem}.motion.csv")),
     ];
     for p in &expected {
         let got = inputs

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
-    /// The record: an .mcap file, a CSV stem (flightdata/c8534like) or one of its three files.
+    /// The record: an .mcap file, a CSV stem (flightdata/c8534like) or one of its files.
     pub record: PathBuf,
 }
 
@@ -129,6 +129,9 @@ pub fn summary(rec: &FlightRecord, name: &str) -> String {
         let (lo, hi) = range(dm.iter().filter_map(|x| x.stroke_m));
         let _ = writeln!(s, "    stroke: {lo} .. {hi} m");
     }
+    if let Some(mo) = &rec.motion {
+        let _ = writeln!(s, "{}", motion_line(mo, m.rotor_speed_rad_s));
+    }
     let t_end = rec.time_s(revs[revs.len() - 1], az[az.len() - 1]);
     let _ = writeln!(
         s,
@@ -147,4 +150,38 @@ fn gaps(missing: &[u32]) -> String {
     } else {
         format!(", GAPS: missing revolution(s) {missing:?}")
     }
+}
+
+/// One line on the measured blade motion: revolutions, azimuths, and per channel the mean and
+/// the 1/rev amplitude of the revolution average [deg].
+fn motion_line(mo: &crate::flight::BladeMotion, omega_rad_s: f64) -> String {
+    let revs = mo.revolutions();
+    let head = format!(
+        "  motion (blade 1): flap_deg, lag_deg, pitch_deg; {} revolutions ({}..={}){} x {} azimuths",
+        revs.len(),
+        revs[0],
+        revs[revs.len() - 1],
+        gaps(&crate::flight::record::missing_revolutions_of(revs)),
+        mo.azimuths_deg().len()
+    );
+    let stats = match mo.periodic(1.min(mo.max_harmonics()), omega_rad_s) {
+        Ok(p) => {
+            let mean = p.mean_rad().map(f64::to_degrees);
+            match p.amplitude_rad(1) {
+                Some(a) => {
+                    let a = a.map(f64::to_degrees);
+                    format!(
+                        "flap {:.4} deg mean, {:.4} deg 1/rev; lag {:.4} mean, {:.4} 1/rev; pitch {:.4} mean, {:.4} 1/rev",
+                        mean[0], a[0], mean[1], a[1], mean[2], a[2]
+                    )
+                }
+                None => format!(
+                    "flap {:.4} deg mean; lag {:.4} mean; pitch {:.4} mean (too few azimuths for 1/rev)",
+                    mean[0], mean[1], mean[2]
+                ),
+            }
+        }
+        Err(_) => "mean and 1/rev not shown: the azimuth grid is not uniform".into(),
+    };
+    format!("{head}; {stats}")
 }

@@ -160,7 +160,8 @@ reference, value, tolerance and pass/fail."))]
     Verify(verify::VerifyArgs),
     /// Convert a flight record between the CSV triple and MCAP.
     #[command(after_long_help = prints!("Writes the converted record (STEM.meta.json, \
-STEM.airloads.csv, STEM.damper.csv, or FILE.mcap)."))]
+STEM.airloads.csv, STEM.damper.csv and, for a record with a blade motion, STEM.motion.csv; or \
+FILE.mcap)."))]
     Convert(convert::ConvertArgs),
     /// Print what a flight record holds.
     #[command(after_long_help = prints!("Writes nothing; prints to stdout."))]

@@ -1,7 +1,9 @@
-//! The CSV triple: `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (docs/formats.md).
+//! The CSV triple: `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (docs/formats.md),
+//! and the optional `STEM.motion.csv` (the measured rigid blade motion).
 //!
 //! Reading converts alternate units to SI (units.rs); writing is always SI with shortest
 //! round-trip number formatting, so CSV -> MCAP -> CSV gives back every value bit for bit.
+use super::motion::{MotionAssembler, MOTION_COLUMNS};
 use super::record::{AirloadAssembler, DamperSample, FlightMeta, FlightRecord, Loc};
 use super::units::{self, Quantity, Unit};
 use super::FlightError;
@@ -26,7 +28,106 @@ pub fn read_csv(stem: &Path) -> Result<FlightRecord, FlightError> {
     let rows = parse_airloads(open(&air_path)?, &air_path, &meta)?;
     let damp_path = with_suffix(stem, ".damper.csv");
     let (damper, locs) = parse_damper(open(&damp_path)?, &damp_path)?;
-    FlightRecord::from_rows(meta, rows, &air_path, damper, &locs, &damp_path)
+    let mut rec = FlightRecord::from_rows(meta, rows, &air_path, damper, &locs, &damp_path)?;
+    let motion_path = with_suffix(stem, ".motion.csv");
+    if motion_path.is_file() {
+        rec.motion = Some(parse_motion(
+            open(&motion_path)?,
+            &motion_path,
+            rec.azimuths_deg(),
+        )?);
+    }
+    Ok(rec)
+}
+
+/// Parses `STEM.motion.csv` against the airloads' azimuth grid `grid` [deg]. Every error names
+/// the file, the line and the column.
+pub(crate) fn parse_motion(
+    src: impl std::io::Read,
+    path: &Path,
+    grid: &[f64],
+) -> Result<super::BladeMotion, FlightError> {
+    let line_err = |line: u64, column: &str, msg: String| FlightError::Line {
+        path: path.to_path_buf(),
+        line,
+        msg: format!("column `{column}`: {msg}"),
+    };
+    let expected = MOTION_COLUMNS.join(",");
+    let mut rd = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(src);
+    let header = rd.headers().map_err(|e| csv_err(path, e))?.clone();
+    let mut idx = [usize::MAX; 5];
+    for (col, name) in header.iter().enumerate() {
+        let name = name.trim().trim_start_matches('\u{feff}');
+        let Some(k) = MOTION_COLUMNS.iter().position(|c| *c == name) else {
+            return Err(line_err(
+                1,
+                name,
+                format!("unexpected column (column {}); expected the header {expected} (angles in degrees)", col + 1),
+            ));
+        };
+        if idx[k] != usize::MAX {
+            return Err(line_err(1, name, "given twice".into()));
+        }
+        idx[k] = col;
+    }
+    if let Some(k) = idx.iter().position(|&i| i == usize::MAX) {
+        return Err(line_err(
+            1,
+            MOTION_COLUMNS[k],
+            format!("missing; expected the header {expected}"),
+        ));
+    }
+    let mut asm = MotionAssembler::new(grid);
+    let mut rec = csv::ByteRecord::new();
+    let mut last_line = 1;
+    loop {
+        match rd.read_byte_record(&mut rec) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => return Err(csv_err(path, e)),
+        }
+        let line = rec.position().map_or(0, |p| p.line());
+        last_line = line;
+        if rec.len() != header.len() {
+            // The first column the row lacks (or the one too many).
+            let column = header
+                .get(rec.len().min(header.len()))
+                .map(|c| format!("`{c}` missing"))
+                .unwrap_or_else(|| "an extra field beyond the header".into());
+            return Err(FlightError::Line {
+                path: path.to_path_buf(),
+                line,
+                msg: format!(
+                    "{} fields, expected {} ({expected}): column {column}",
+                    rec.len(),
+                    header.len()
+                ),
+            });
+        }
+        let f = |k: usize| field(&rec, idx[k], path, line, MOTION_COLUMNS[k]);
+        let rev = parse_rev(f(0)?, path, line)?;
+        let psi = parse_azimuth(f(1)?, path, line)?;
+        let v = [
+            parse_f64(f(2)?, path, line, MOTION_COLUMNS[2])?,
+            parse_f64(f(3)?, path, line, MOTION_COLUMNS[3])?,
+            parse_f64(f(4)?, path, line, MOTION_COLUMNS[4])?,
+        ];
+        asm.push(rev, psi, v)
+            .map_err(|e| line_err(line, e.column, e.msg))?;
+    }
+    asm.finish().map_err(|msg| FlightError::Line {
+        path: path.to_path_buf(),
+        line: last_line,
+        msg: if msg == "no motion rows" {
+            format!("no motion rows after the header; expected rows of {expected}")
+        } else {
+            format!("column `revolution`: {msg} (the last row)")
+        },
+    })
 }
 
 /// Column layout of a header: index of each required column and its unit.
@@ -385,8 +486,44 @@ pub(crate) fn damper_text(rec: &FlightRecord) -> String {
     }
 }
 
-/// Writes the triple atomically, file by file (each file is complete or absent).
+/// The motion CSV text [deg], or `None` for a record without motion.
+pub(crate) fn motion_text(rec: &FlightRecord) -> Option<String> {
+    let m = rec.motion.as_ref()?;
+    let az = m.azimuths_deg();
+    let rows = m
+        .revolutions()
+        .iter()
+        .enumerate()
+        .flat_map(move |(ir, &rev)| {
+            az.iter().enumerate().map(move |(ia, &psi)| {
+                let i = m.index(ir, ia);
+                [
+                    rev as f64,
+                    psi,
+                    m.flap_deg()[i],
+                    m.lag_deg()[i],
+                    m.pitch_deg()[i],
+                ]
+            })
+        });
+    Some(crate::io::csv_string(&MOTION_COLUMNS, rows))
+}
+
+/// Writes the triple atomically, file by file (each file is complete or absent), and
+/// `STEM.motion.csv` when the record has a motion; without one, a `STEM.motion.csv` already
+/// there is removed (else the stem would not read back as written).
 pub fn write_csv(rec: &FlightRecord, stem: &Path) -> Result<(), FlightError> {
+    let motion_path = with_suffix(stem, ".motion.csv");
+    match motion_text(rec) {
+        Some(text) => crate::io::write_atomic(&motion_path, text.as_bytes())?,
+        None if motion_path.is_file() => {
+            std::fs::remove_file(&motion_path).map_err(|source| FlightError::Io {
+                path: motion_path.clone(),
+                source,
+            })?
+        }
+        None => {}
+    }
     crate::io::write_atomic(
         &with_suffix(stem, ".airloads.csv"),
         airloads_text(rec).as_bytes(),

@@ -1,12 +1,15 @@
 //! The MCAP form of a flight record (docs/formats.md): channels `/rotor/meta` (one message),
 //! `/rotor/airloads` (one message per azimuth, arrays over stations), `/rotor/damper` (one message
 //! per sample); JSON message encoding, one JSON schema (encoding `jsonschema`) per channel;
-//! log time = (revolution * 360 + azimuth_deg) / Omega[deg/s], in nanoseconds.
+//! log time = (revolution * 360 + azimuth_deg) / Omega[deg/s], in nanoseconds. The optional
+//! `/rotor/motion` channel (one message per sample) carries the measured blade motion
+//! (`STEM.motion.csv` of the CSV form); it is written only for a record that has one.
 //!
 //! Streaming: the reader never holds the file. It feeds the sans-io linear reader of the `mcap`
 //! crate from the open file as it asks for bytes (at most one chunk buffered, bounded by a record
 //! length limit), and decodes each message as it comes, in file order, which for files written
 //! here is log-time order. Only the decoded values are kept: they are the record.
+use super::motion::MotionAssembler;
 use super::record::{AirloadAssembler, DamperSample, FlightMeta, FlightRecord, Loc};
 use super::FlightError;
 use ::mcap::records::{MessageHeader, Record};
@@ -19,9 +22,11 @@ use std::path::Path;
 pub const TOPIC_META: &str = "/rotor/meta";
 pub const TOPIC_AIRLOADS: &str = "/rotor/airloads";
 pub const TOPIC_DAMPER: &str = "/rotor/damper";
+pub const TOPIC_MOTION: &str = "/rotor/motion";
 pub const SCHEMA_META: &str = "rotorsim.FlightMeta";
 pub const SCHEMA_AIRLOADS: &str = "rotorsim.AirloadsAzimuth";
 pub const SCHEMA_DAMPER: &str = "rotorsim.DamperSample";
+pub const SCHEMA_MOTION: &str = "rotorsim.MotionSample";
 /// Log times may differ from (rev * 360 + psi) / Omega by this much (writers round differently).
 pub const LOG_TIME_TOLERANCE_NS: u64 = 1000;
 
@@ -88,6 +93,31 @@ pub const DAMPER_SCHEMA_JSON: &str = r#"{
     "damper_stroke_m": {"type": "number"}
   }
 }"#;
+
+/// JSON schema of `/rotor/motion` (optional channel).
+pub const MOTION_SCHEMA_JSON: &str = r#"{
+  "$schema": "https://json-schema.org/draft/2020-12/schema",
+  "title": "rotorsim.MotionSample",
+  "description": "Measured rigid motion of blade 1 on the airloads' azimuth grid [deg]: flap up positive, lag aft (against the rotation) positive, root pitch nose up positive.",
+  "type": "object",
+  "required": ["revolution", "azimuth_deg", "flap_deg", "lag_deg", "pitch_deg"],
+  "properties": {
+    "revolution": {"type": "integer", "minimum": 0},
+    "azimuth_deg": {"type": "number", "minimum": 0, "exclusiveMaximum": 360},
+    "flap_deg": {"type": "number"},
+    "lag_deg": {"type": "number"},
+    "pitch_deg": {"type": "number"}
+  }
+}"#;
+
+#[derive(Serialize, Deserialize)]
+struct MotionMsg {
+    revolution: u32,
+    azimuth_deg: f64,
+    flap_deg: f64,
+    lag_deg: f64,
+    pitch_deg: f64,
+}
 
 #[derive(Serialize)]
 struct AirloadsOut<'a> {
@@ -162,6 +192,10 @@ pub fn mcap_bytes(rec: &FlightRecord, path: &Path) -> Result<Vec<u8>, FlightErro
         let c_meta = add(SCHEMA_META, META_SCHEMA_JSON, TOPIC_META)?;
         let c_air = add(SCHEMA_AIRLOADS, AIRLOADS_SCHEMA_JSON, TOPIC_AIRLOADS)?;
         let c_damp = add(SCHEMA_DAMPER, DAMPER_SCHEMA_JSON, TOPIC_DAMPER)?;
+        let c_motion = match rec.motion {
+            Some(_) => add(SCHEMA_MOTION, MOTION_SCHEMA_JSON, TOPIC_MOTION)?,
+            None => 0,
+        };
 
         let n_st = rec.stations_r_over_r().len();
         let az = rec.azimuths_deg();
@@ -215,6 +249,37 @@ pub fn mcap_bytes(rec: &FlightRecord, path: &Path) -> Result<Vec<u8>, FlightErro
                 }
                 Ok(())
             };
+        // Motion samples (revolution, azimuth index), in log-time order.
+        let mut motion = rec
+            .motion
+            .iter()
+            .flat_map(|m| {
+                let n_az = m.azimuths_deg().len();
+                (0..m.revolutions().len() * n_az).map(move |i| (m, i, i / n_az, i % n_az))
+            })
+            .peekable();
+        let mut write_motion_until =
+            |w: &mut ::mcap::Writer<_>, limit: u64| -> Result<(), FlightError> {
+                while let Some(&(m, i, ir, ia)) = motion.peek() {
+                    let (rev, psi) = (m.revolutions()[ir], m.azimuths_deg()[ia]);
+                    let t = rec.log_time_ns(rev, psi);
+                    if t >= limit {
+                        break;
+                    }
+                    let msg = MotionMsg {
+                        revolution: rev,
+                        azimuth_deg: psi,
+                        flap_deg: m.flap_deg()[i],
+                        lag_deg: m.lag_deg()[i],
+                        pitch_deg: m.pitch_deg()[i],
+                    };
+                    let bytes = serde_json::to_vec(&msg).unwrap_or_default();
+                    w.write_to_known_channel(&header(c_motion, i as u32, t), &bytes)
+                        .map_err(e)?;
+                    motion.next();
+                }
+                Ok(())
+            };
         for (k, (ir, ia)) in (0..rec.revolutions().len())
             .flat_map(|ir| (0..az.len()).map(move |ia| (ir, ia)))
             .enumerate()
@@ -222,6 +287,7 @@ pub fn mcap_bytes(rec: &FlightRecord, path: &Path) -> Result<Vec<u8>, FlightErro
             let (rev, psi) = (rec.revolutions()[ir], az[ia]);
             let t = rec.log_time_ns(rev, psi);
             write_damper_until(&mut w, t)?;
+            write_motion_until(&mut w, t)?;
             let i0 = rec.index(ir, ia, 0);
             let msg = AirloadsOut {
                 revolution: rev,
@@ -240,6 +306,7 @@ pub fn mcap_bytes(rec: &FlightRecord, path: &Path) -> Result<Vec<u8>, FlightErro
                 .map_err(e)?;
         }
         write_damper_until(&mut w, u64::MAX)?;
+        write_motion_until(&mut w, u64::MAX)?;
         w.finish().map_err(e)?;
     }
     Ok(buf.into_inner())
@@ -257,6 +324,7 @@ enum Kind {
     Meta,
     Airloads,
     Damper,
+    Motion,
 }
 
 impl Kind {
@@ -265,6 +333,7 @@ impl Kind {
             TOPIC_META => Some(Kind::Meta),
             TOPIC_AIRLOADS => Some(Kind::Airloads),
             TOPIC_DAMPER => Some(Kind::Damper),
+            TOPIC_MOTION => Some(Kind::Motion),
             _ => None,
         }
     }
@@ -273,6 +342,7 @@ impl Kind {
             Kind::Meta => TOPIC_META,
             Kind::Airloads => TOPIC_AIRLOADS,
             Kind::Damper => TOPIC_DAMPER,
+            Kind::Motion => TOPIC_MOTION,
         }
     }
     fn schema(self) -> (&'static str, &'static str) {
@@ -280,6 +350,7 @@ impl Kind {
             Kind::Meta => (SCHEMA_META, META_SCHEMA_JSON),
             Kind::Airloads => (SCHEMA_AIRLOADS, AIRLOADS_SCHEMA_JSON),
             Kind::Damper => (SCHEMA_DAMPER, DAMPER_SCHEMA_JSON),
+            Kind::Motion => (SCHEMA_MOTION, MOTION_SCHEMA_JSON),
         }
     }
 }
@@ -369,7 +440,10 @@ pub fn read_mcap_from(
     let mut damper_locs = Vec::new();
     // (kind, message index, log time, revolution, azimuth), checked once Omega is known.
     let mut times: Vec<(Kind, u64, u64, u32, f64)> = Vec::new();
-    let mut seen = [false; 3];
+    // Motion rows (revolution, azimuth, [flap, lag, pitch] deg, message index), placed on the
+    // airloads' grid once that is known.
+    let mut motion_rows: Vec<(u32, f64, [f64; 3], u64)> = Vec::new();
+    let mut seen = [false; 4];
 
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| corrupt(e.to_string()))? {
@@ -501,6 +575,29 @@ pub fn read_mcap_from(
                                 });
                                 damper_locs.push(Loc::Message(index));
                             }
+                            Kind::Motion => {
+                                let m: MotionMsg =
+                                    serde_json::from_slice(&data).map_err(bad_json)?;
+                                if !(0.0..360.0).contains(&m.azimuth_deg) {
+                                    return Err(msg_err(format!(
+                                        "azimuth_deg {} is outside [0, 360)",
+                                        m.azimuth_deg
+                                    )));
+                                }
+                                times.push((
+                                    kind,
+                                    index,
+                                    header.log_time,
+                                    m.revolution,
+                                    m.azimuth_deg,
+                                ));
+                                motion_rows.push((
+                                    m.revolution,
+                                    m.azimuth_deg,
+                                    [m.flap_deg, m.lag_deg, m.pitch_deg],
+                                    index,
+                                ));
+                            }
                         }
                     }
                     _ => {}
@@ -547,5 +644,26 @@ pub fn read_mcap_from(
             });
         }
     }
-    FlightRecord::from_rows(meta, rows, path, damper, &damper_locs, path)
+    let mut rec = FlightRecord::from_rows(meta, rows, path, damper, &damper_locs, path)?;
+    if seen[Kind::Motion as usize] {
+        // Messages of a file not in log-time order are placed in order first.
+        if !motion_rows
+            .windows(2)
+            .all(|w| (w[0].0, w[0].1) <= (w[1].0, w[1].1))
+        {
+            motion_rows.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        }
+        let mut asm = MotionAssembler::new(rec.azimuths_deg());
+        for &(rev, psi, v, index) in &motion_rows {
+            asm.push(rev, psi, v).map_err(|e| FlightError::Message {
+                path: path.to_path_buf(),
+                channel: TOPIC_MOTION.into(),
+                index,
+                msg: format!("field `{}`: {}", e.column, e.msg),
+            })?;
+        }
+        let motion = asm.finish().map_err(|msg| chan_err(Kind::Motion, msg))?;
+        rec.motion = Some(motion);
+    }
+    Ok(rec)
 }

@@ -1,7 +1,8 @@
 //! Flight records (CSV triple and MCAP), unit conversion at the edges, airload replay.
 //!
 //! A [`FlightRecord`] holds the metadata, the airloads per azimuth at radial stations (SI, section
-//! frame of docs/formats.md) and the measured damper channel. [`FlightRecord::read`] accepts either
+//! frame of docs/formats.md), the measured damper channel and, optionally, the measured rigid blade
+//! motion ([`BladeMotion`]). [`FlightRecord::read`] accepts either
 //! form; [`FlightRecord::write_csv`] and [`FlightRecord::write_mcap`] write them atomically.
 //! [`AirloadReplay`] turns a record into a load provider for the rotor run.
 //! Format details, interpolation and root/tip treatment: docs/flight_records.md.
@@ -9,10 +10,12 @@ use std::path::PathBuf;
 
 pub mod csv;
 pub mod mcap;
+pub mod motion;
 pub mod record;
 pub mod replay;
 pub mod units;
 
+pub use motion::{BladeMotion, MotionSample, PeriodicMotion};
 pub use record::{ControlsDeg, DamperSample, DamperTrace, FlightMeta, FlightRecord};
 pub use replay::{AirloadReplay, ReplayMode, ReplayOptions, SectionLoads};
 

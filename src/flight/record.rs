@@ -1,4 +1,5 @@
 //! The flight record: metadata, airloads on an (revolution, azimuth, station) grid, damper channel.
+use super::motion::BladeMotion;
 use super::FlightError;
 use serde_json::{Map, Value};
 use std::path::{Path, PathBuf};
@@ -246,6 +247,10 @@ pub struct FlightRecord {
     chord: Vec<f64>,
     moment: Vec<f64>,
     damper: Vec<DamperSample>,
+    /// The measured rigid blade motion (optional `STEM.motion.csv` / MCAP channel
+    /// `/rotor/motion`), on the airloads' azimuth grid. Set it with [`FlightRecord::with_motion`],
+    /// which checks the grid (a motion assigned directly on another grid would not read back).
+    pub motion: Option<BladeMotion>,
 }
 
 /// Where a row came from, for error messages.
@@ -547,6 +552,7 @@ impl FlightRecord {
             chord: chord_n_per_m,
             moment: moment_n_m_per_m,
             damper: Vec::new(),
+            motion: None,
         };
         let mut damper = damper;
         check_damper(&mut damper, &[], Path::new("<flight record>"))?;
@@ -578,6 +584,7 @@ impl FlightRecord {
                     chord,
                     moment,
                     damper,
+                    motion: None,
                 });
             }
             Err(rows) => rows,
@@ -670,7 +677,27 @@ impl FlightRecord {
             chord,
             moment,
             damper,
+            motion: None,
         })
+    }
+
+    /// The record with `motion` attached; errors unless the motion's azimuth grid is the
+    /// airloads' (bit for bit).
+    pub fn with_motion(mut self, motion: Option<BladeMotion>) -> Result<Self, FlightError> {
+        if let Some(m) = &motion {
+            if m.azimuths_deg() != self.azimuths.as_slice() {
+                return Err(FlightError::Invalid {
+                    path: PathBuf::from("<flight record>"),
+                    msg: format!(
+                        "the blade motion's azimuth grid ({} azimuths) is not the airloads' ({} azimuths)",
+                        m.azimuths_deg().len(),
+                        self.azimuths.len()
+                    ),
+                });
+            }
+        }
+        self.motion = motion;
+        Ok(self)
     }
 
     /// Stations r/R, strictly increasing.
@@ -782,7 +809,8 @@ impl FlightRecord {
     }
 
     /// Reads a record: an MCAP file, a CSV stem (`flightdata/c8534like`), or any one of the
-    /// three CSV files of the triple.
+    /// three CSV files of the triple (or the optional `STEM.motion.csv`). A CSV stem's
+    /// `STEM.motion.csv` is read when it exists ([`FlightRecord::motion`]).
     pub fn read(path: &Path) -> Result<Self, FlightError> {
         let (rec, meta_file) = match resolve(path)? {
             Form::Mcap(p) => (super::mcap::read_mcap(&p)?, p),
@@ -801,19 +829,22 @@ impl FlightRecord {
     }
 
     /// The files [`FlightRecord::read`] reads for `path`: the MCAP file, or the CSV triple of
-    /// the stem (those that exist).
+    /// the stem (those that exist) and `STEM.motion.csv` when it exists.
     pub fn files(path: &Path) -> Result<Vec<PathBuf>, FlightError> {
         Ok(match resolve(path)? {
             Form::Mcap(p) => vec![p],
             Form::Csv(stem) => CSV_SUFFIXES
                 .iter()
+                .chain(&CSV_OPTIONAL_SUFFIXES)
                 .map(|suf| PathBuf::from(format!("{}{suf}", stem.to_string_lossy())))
                 .filter(|p| p.is_file())
                 .collect(),
         })
     }
 
-    /// Writes the CSV triple `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (SI).
+    /// Writes the CSV triple `STEM.meta.json`, `STEM.airloads.csv`, `STEM.damper.csv` (SI), and
+    /// `STEM.motion.csv` when the record has a motion (a `STEM.motion.csv` already there is
+    /// removed when it has none, so that the stem reads back as written).
     pub fn write_csv(&self, stem: &Path) -> Result<(), FlightError> {
         super::csv::write_csv(self, stem)
     }
@@ -822,6 +853,11 @@ impl FlightRecord {
     pub fn write_mcap(&self, path: &Path) -> Result<(), FlightError> {
         super::mcap::write_mcap(self, path)
     }
+}
+
+/// Revolutions missing between the first and the last of a strictly increasing list.
+pub fn missing_revolutions_of(sorted: &[u32]) -> Vec<u32> {
+    missing(sorted)
 }
 
 fn missing(sorted: &[u32]) -> Vec<u32> {
@@ -943,6 +979,8 @@ pub(crate) enum Form {
 
 /// Suffixes of the CSV triple.
 pub const CSV_SUFFIXES: [&str; 3] = [".meta.json", ".airloads.csv", ".damper.csv"];
+/// Suffixes of the optional CSV files of a record (read when they exist).
+pub const CSV_OPTIONAL_SUFFIXES: [&str; 1] = [".motion.csv"];
 
 /// Decides which form `path` names.
 pub(crate) fn resolve(path: &Path) -> Result<Form, FlightError> {
@@ -950,7 +988,7 @@ pub(crate) fn resolve(path: &Path) -> Result<Form, FlightError> {
     if s.ends_with(".mcap") {
         return Ok(Form::Mcap(path.to_path_buf()));
     }
-    for suf in CSV_SUFFIXES {
+    for suf in CSV_SUFFIXES.iter().chain(&CSV_OPTIONAL_SUFFIXES) {
         if let Some(stem) = s.strip_suffix(suf) {
             return Ok(Form::Csv(PathBuf::from(stem)));
         }

@@ -72,7 +72,7 @@ pub fn example_stem() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("flightdata/c8534like")
 }
 
-/// Every value of two records, bit for bit.
+/// Every value of two records, bit for bit (the blade motion included).
 pub fn assert_same_bits(a: &FlightRecord, b: &FlightRecord) {
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(a.revolutions(), b.revolutions());
@@ -89,4 +89,16 @@ pub fn assert_same_bits(a: &FlightRecord, b: &FlightRecord) {
         assert_eq!(x.stroke_m.map(f64::to_bits), y.stroke_m.map(f64::to_bits));
     }
     assert_eq!(a.meta, b.meta);
+    assert_eq!(
+        a.motion.is_some(),
+        b.motion.is_some(),
+        "motion present in one only"
+    );
+    if let (Some(x), Some(y)) = (&a.motion, &b.motion) {
+        assert_eq!(x.revolutions(), y.revolutions());
+        assert_eq!(bits(x.azimuths_deg()), bits(y.azimuths_deg()));
+        assert_eq!(bits(x.flap_deg()), bits(y.flap_deg()));
+        assert_eq!(bits(x.lag_deg()), bits(y.lag_deg()));
+        assert_eq!(bits(x.pitch_deg()), bits(y.pitch_deg()));
+    }
 }
