@@ -17,7 +17,7 @@
 //!
 //! The lift table (ML Mach numbers, NL angles of attack) comes first, then the drag table
 //! (MD, ND) and the moment table (MM, NM), each with its own Mach row. This is the layout of
-//! MBDyn's `read_c81_data` (libraries/libaerodc81 in MBDyn), `A30,6I2 / 7X,9F7.0 /
+//! MBDyn's `read_c81_data` (its c81data.cc), `A30,6I2 / 7X,9F7.0 /
 //! 10F7.0/(7X,9F7.0)`.
 //!
 //! Two leniencies, both needed by real tables:

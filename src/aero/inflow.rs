@@ -24,8 +24,8 @@
 //! - Drees, J. M. (1949), "A theory of airflow through rotors and its application to some
 //!   helicopter problems", J. Helicopter Association of Great Britain 3(2); linear inflow
 //!   `lambda_i = l0 (1 + kx r cos psi + ky r sin psi)`, kx = (4/3)(1 - cos chi - 1.8 mu^2) /
-//!   sin chi, ky = -2 mu, as quoted by Johnson, *Helicopter Theory* (1980) sec. 4.2.1 and
-//!   *Rotorcraft Aeromechanics* (2013) sec. 6.x.
+//!   sin chi, ky = -2 mu, as quoted by Johnson, *Helicopter Theory* (1980) and *Rotorcraft
+//!   Aeromechanics* (2013).
 //! - Pitt, D. M. and Peters, D. A. (1981), "Theoretical prediction of dynamic-inflow
 //!   derivatives", Vertica 5(1), 21-34; Peters, D. A. and HaQuang, N. (1988), "Dynamic inflow
 //!   for practical applications", J. American Helicopter Society 33(4), 64-68:
@@ -41,8 +41,8 @@
 //!   L = | 0              4/(1+cos chi)   0               |
 //!       | (15 pi/64) X   0               4 cos chi/(1+cos chi) |
 //! ```
-//! Pitt and Peters write L symmetric with negative moment diagonals against the aerodynamic
-//! roll and pitch moments (C_L right side down, C_M nose up). Here the moment "loads" are first
+//! The published form is written against the aerodynamic roll and pitch moments (C_L, C_M),
+//! with L symmetric and minus signs on the moment diagonals. Here the moment "loads" are first
 //! moments of thrust: a thrust moment toward the advancing side is a negative roll moment
 //! (cs = -C_L) and a thrust moment aft is a nose-down pitch moment (cc = -C_M). Substituting
 //! flips the sign of the moment columns of L: the diagonal becomes positive (more thrust on a
