@@ -165,8 +165,10 @@ impl Airfoil {
     /// Mach number `mach` (>= 0).
     ///
     /// - Thin: the thin-aerofoil fallback "2 pi alpha, no stall, no compressibility":
-    ///   `cl = a alpha` with alpha wrapped, `cd = cd0`, `cm = cm0`; Mach is ignored and nothing
-    ///   clamps.
+    ///   `cl = a alpha`, `cd = cd0`, `cm = cm0`; Mach is ignored and nothing clamps. In reversed
+    ///   flow (|alpha| > 90 deg) the plate meets the air trailing edge first: `cl = a (alpha -+
+    ///   pi)`, the lift of a flat plate at that incidence (the lift is perpendicular to the
+    ///   flow, so this is still upward for air from below).
     /// - Table: bilinear interpolation in (alpha in degrees, Mach) of each coefficient; outside
     ///   a table's alpha or Mach range the value at the edge is used and the matching counter
     ///   in `clamps` is incremented (once per query and edge).
@@ -176,7 +178,7 @@ impl Airfoil {
         let alpha = wrap_pi(alpha_rad);
         match self {
             Airfoil::Thin(t) => Coefficients {
-                cl: t.lift_slope_per_rad * alpha,
+                cl: t.lift_slope_per_rad * (alpha - PI * (alpha / PI).round()),
                 cd: t.cd0,
                 cm: t.cm0,
             },

@@ -3,3 +3,5 @@
 pub mod airfoil;
 pub mod c81;
 pub mod inflow;
+pub mod lifting_line;
+pub mod section;

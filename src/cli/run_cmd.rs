@@ -80,6 +80,13 @@ pub struct RunArgs {
     /// Writes <model>/blade<K>/ for every blade (docs/run.md).
     #[arg(long)]
     pub all_blades: bool,
+    /// Where the blade's airloads come from: measured (the record's, replayed), computed (a
+    /// lifting line with the deck's [aero] table and an inflow model, under the record's
+    /// controls: a prediction) or hybrid (the record's airloads plus the lifting line's
+    /// difference between the blade's motion and the record's measured blade motion).
+    /// docs/aerodynamics.md.
+    #[arg(long, default_value = "measured")]
+    pub airloads: String,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
@@ -113,6 +120,7 @@ impl RunArgs {
             newton: &self.newton,
             periodic: &self.periodic,
             model: &self.model,
+            airloads: &self.airloads,
         })?;
         Ok(job)
     }

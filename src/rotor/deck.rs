@@ -27,6 +27,107 @@ pub struct RotorSpec {
     /// The airframe under the hub (docs/rotor_deck.md); a deck with one runs the whole rotor.
     #[serde(default)]
     pub airframe: Option<AirframeTable>,
+    /// The blade's aerodynamics (docs/rotor_deck.md, "Aerodynamics"): what the lifting line of
+    /// `--airloads computed|hybrid` needs.
+    #[serde(default)]
+    pub aero: Option<AeroTable>,
+}
+
+/// The blade's aerodynamic description.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AeroTable {
+    /// Chord [m] (constant along the blade).
+    pub chord_m: f64,
+    /// Start of the aerofoil [m]: no airloads inboard.
+    pub cutout_r_m: f64,
+    /// Tip-loss factor B: no lift outboard of B R (1: none).
+    #[serde(default = "one_f64")]
+    pub tip_loss_factor: f64,
+    /// Inflow model: "uniform" (Glauert momentum), "drees" (linear) or "pitt-peters" (3-state
+    /// dynamic inflow).
+    #[serde(default = "default_inflow")]
+    pub inflow: String,
+    /// Aerofoils by radial segment, inboard first; none: the thin aerofoil (2 pi alpha).
+    #[serde(rename = "airfoil", default)]
+    pub airfoils: Vec<AirfoilSegment>,
+}
+
+/// One radial segment's aerofoil: a C81 table, or the thin aerofoil.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AirfoilSegment {
+    /// Outer end of the segment [m] (the last one covers the tip whatever its value).
+    pub r_end_m: f64,
+    /// C81 table file (relative paths: against the deck's folder); absent: thin aerofoil.
+    #[serde(default)]
+    pub c81: Option<String>,
+}
+
+fn one_f64() -> f64 {
+    1.0
+}
+
+fn default_inflow() -> String {
+    "drees".into()
+}
+
+impl AeroTable {
+    /// Positive chord, cut-out inside the blade, B in (0, 1], a known inflow model, segments
+    /// increasing; `Err((key, expected))`.
+    fn check(&self, radius_m: f64) -> Result<(), (String, String)> {
+        if !(self.chord_m.is_finite() && self.chord_m > 0.0) {
+            return Err((
+                "aero.chord_m".into(),
+                format!("expected a positive number, found {}", self.chord_m),
+            ));
+        }
+        if !(self.cutout_r_m.is_finite() && self.cutout_r_m >= 0.0 && self.cutout_r_m < radius_m) {
+            return Err((
+                "aero.cutout_r_m".into(),
+                format!(
+                    "expected a radius in [0, rotor.radius_m = {radius_m}), found {}",
+                    self.cutout_r_m
+                ),
+            ));
+        }
+        if !(self.tip_loss_factor > 0.0 && self.tip_loss_factor <= 1.0) {
+            return Err((
+                "aero.tip_loss_factor".into(),
+                format!(
+                    "expected a number in (0, 1], found {}",
+                    self.tip_loss_factor
+                ),
+            ));
+        }
+        if self
+            .inflow
+            .parse::<crate::aero::inflow::InflowModel>()
+            .is_err()
+        {
+            return Err((
+                "aero.inflow".into(),
+                format!(
+                    "expected \"uniform\", \"drees\" or \"pitt-peters\", found \"{}\"",
+                    self.inflow
+                ),
+            ));
+        }
+        let mut prev = f64::NEG_INFINITY;
+        for (i, a) in self.airfoils.iter().enumerate() {
+            if !(a.r_end_m.is_finite() && a.r_end_m > prev) {
+                return Err((
+                    format!("aero.airfoil[{i}].r_end_m"),
+                    format!(
+                        "expected radii increasing from segment to segment, found {}",
+                        a.r_end_m
+                    ),
+                ));
+            }
+            prev = a.r_end_m;
+        }
+        Ok(())
+    }
 }
 
 /// The airframe under the hub: a mass, spring and damper in each of the hub's directions that
@@ -731,6 +832,10 @@ impl RotorSpec {
         pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
         if let Some(a) = &self.airframe {
             a.check().map_err(|(k, what)| bad(&k, &what))?;
+        }
+        if let Some(a) = &self.aero {
+            a.check(self.rotor.radius_m)
+                .map_err(|(k, what)| bad(&k, &what))?;
         }
         if self.rotor.blades == 0 {
             return Err(bad("rotor.blades", "expected at least 1 blade"));

@@ -160,6 +160,7 @@ pub struct SimState {
     pub aux: Vec<f64>,
 }
 
+pub mod aero;
 pub mod blades;
 pub mod deck;
 
@@ -202,6 +203,8 @@ pub struct RunOptions {
     /// turns the cyclic and the airloads it sees; None for the single-blade run (its hub loads
     /// are then built from the blade by symmetry).
     pub blade_azimuth_deg: Option<f64>,
+    /// Where the airloads come from (docs/aerodynamics.md).
+    pub airloads: aero::AirloadSource,
 }
 
 impl Default for RunOptions {
@@ -214,6 +217,7 @@ impl Default for RunOptions {
             newton_rtol: sim::RTOL,
             perturbation_damping: true,
             blade_azimuth_deg: None,
+            airloads: aero::AirloadSource::Measured,
         }
     }
 }

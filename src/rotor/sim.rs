@@ -278,6 +278,60 @@ pub struct RotorSim {
     output_channels: bool,
     /// A blade of a whole-rotor run (its hub loads come from all blades, not by symmetry).
     in_whole_rotor: bool,
+    /// The lifting lines and their inflow (computed and hybrid airloads).
+    aero: Option<AeroRun>,
+}
+
+/// The rotor's aerodynamics in a run: what the lifting lines share, and the output stations.
+struct AeroRun {
+    source: super::aero::AirloadSource,
+    air: crate::aero::lifting_line::RotorAir,
+    shared: Arc<Mutex<crate::aero::lifting_line::AeroShared>>,
+    clamps: Arc<crate::aero::airfoil::ClampCounts>,
+    /// Blades of the rotor per blade modelled (the inflow's thrust).
+    scale: f64,
+    /// Solidity N c / (pi R) of blade 1's chord.
+    solidity: f64,
+    /// Whether the blades' airloads drive the inflow (computed) or it stays at the record's.
+    coupled: bool,
+    /// Output stations r/R (the record's) and radius [m].
+    stations: Vec<(f64, f64)>,
+    /// The record's airloads (the computed-minus-measured channels) and blade 1's azimuth ahead.
+    measured: AirloadReplay,
+    ahead_deg: f64,
+    /// A blade standing for N identical ones: its disk loads over the last revolution, per
+    /// step (NaN: not yet integrated), so that the rotor's are the sum at the N blades'
+    /// azimuths, `sum_k f(t - k T/N)` (exact on the periodic solution). Empty when every blade
+    /// is modelled or the steps per revolution are not a multiple of N.
+    history: Vec<crate::aero::inflow::DiskLoads>,
+    blades: usize,
+}
+
+/// Per output station: angle of attack, Mach, lift, drag and moment coefficients, inflow
+/// ratio, normal force and its difference from the record's.
+const AERO_STATION_CHANNELS: [&str; 8] = [
+    "aero_alpha_deg",
+    "aero_mach",
+    "aero_cl",
+    "aero_cd",
+    "aero_cm",
+    "aero_inflow_ratio",
+    "aero_normal_N_per_m",
+    "aero_normal_minus_measured_N_per_m",
+];
+
+/// Rotor channels of the aerodynamics (the rotor's thrust and power from the modelled blades
+/// times the rotor's blades per modelled blade).
+const AERO_ROTOR_CHANNELS: [&str; 4] = [
+    "rotor_thrust_N",
+    "rotor_power_W",
+    "rotor_CT_over_sigma",
+    "inflow_ratio_mean",
+];
+
+/// Station label of channel names: `r0.775`.
+pub fn station_label(r_over_r: f64) -> String {
+    format!("r{r_over_r:.3}")
 }
 
 /// Relief-valve cracking limits of Eq. (5) with the other chamber at `p_s`:
@@ -376,6 +430,30 @@ fn build_parts(
     };
     let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
     let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
+    // the lifting lines' shared state (computed and hybrid airloads); off in the statics
+    let source = opts.airloads;
+    let aero_active = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let aero_common = if source.aerodynamic() {
+        use crate::aero::inflow::Inflow;
+        let air = super::aero::rotor_air(spec, record)?;
+        let cond = super::aero::flight_condition(&air);
+        let (_, inflow_model) = super::aero::blade_geometry(spec, file)?;
+        // the inflow starts from (hybrid: stays at) the record's thrust and moments
+        let disk = super::aero::record_disk_loads(record, &air, spec.rotor.blades);
+        let mut inflow = Inflow::new(inflow_model, cond);
+        inflow.set_state(Inflow::steady(inflow_model, cond, &disk));
+        let shared = Arc::new(Mutex::new(crate::aero::lifting_line::AeroShared {
+            inflow,
+            points: vec![],
+        }));
+        Some((
+            air,
+            shared,
+            Arc::new(crate::aero::airfoil::ClampCounts::default()),
+        ))
+    } else {
+        None
+    };
     let physical = model_kind == DamperModel::Physical;
     struct Pending {
         prefix: String,
@@ -444,15 +522,58 @@ fn build_parts(
                 )?),
             },
         };
-        let load = super::transient::blade_load(
-            airloads,
-            &model,
-            &nm(names::BLADE),
-            bspec,
-            record,
-            opts.steps_per_rev,
-            opts.perturbation_damping,
-        )?;
+        let load: Box<dyn DistributedLoad> = match &aero_common {
+            None => super::transient::blade_load(
+                airloads,
+                &model,
+                &nm(names::BLADE),
+                bspec,
+                record,
+                opts.steps_per_rev,
+                opts.perturbation_damping,
+            )?,
+            // the lifting line's damping replaces the perturbation damping
+            Some((air, shared, clamps)) => {
+                use super::aero::{AirloadSource, ComputedLoad, HybridLoad};
+                let (geometry, _) = super::aero::blade_geometry(bspec, file)?;
+                let ahead = ahead_deg.to_radians();
+                let model_turn = if whole { ahead } else { 0.0 };
+                let line = crate::aero::lifting_line::LiftingLine::new(
+                    &model,
+                    &nm(names::BLADE),
+                    &geometry,
+                    *air,
+                    clamps.clone(),
+                    shared.clone(),
+                    k,
+                )?
+                .with_turn(ahead - model_turn);
+                if source == AirloadSource::Hybrid {
+                    let reference = super::aero::reference_motion(
+                        record,
+                        bspec,
+                        &model,
+                        &nm(names::BLADE),
+                        &line,
+                        ahead,
+                        model_turn,
+                    )?;
+                    Box::new(HybridLoad {
+                        measured: airloads,
+                        line,
+                        reference,
+                        t_ramp,
+                        active: aero_active.clone(),
+                    })
+                } else {
+                    Box::new(ComputedLoad {
+                        statics: airloads,
+                        line,
+                        active: aero_active.clone(),
+                    })
+                }
+            }
+        };
         model.add_distributed_load(&nm(names::BLADE), load)?;
         pending.push(Pending {
             prefix,
@@ -497,6 +618,7 @@ fn build_parts(
         })?;
     }
     st.set_rigid_rotation([0.0; 3], [0.0, 0.0, om]);
+    aero_active.store(true, Ordering::Relaxed);
     let hub = model.node_id(names::HUB)?;
     let airframe = match (&spec.airframe, whole) {
         (Some(a), true) => {
@@ -579,6 +701,41 @@ fn build_parts(
     solver.newton.rtol = opts.newton_rtol;
     solver.newton.method = opts.newton;
     solver.init_accelerations()?;
+    let aero = match aero_common {
+        None => None,
+        Some((air, shared, clamps)) => Some(AeroRun {
+            source,
+            air,
+            shared,
+            clamps,
+            scale: spec.rotor.blades as f64 / blades.len() as f64,
+            solidity: spec.aero.as_ref().map_or(f64::NAN, |a| {
+                spec.rotor.blades as f64 * a.chord_m / (std::f64::consts::PI * spec.rotor.radius_m)
+            }),
+            coupled: source == super::aero::AirloadSource::Computed,
+            stations: record
+                .stations_r_over_r()
+                .iter()
+                .map(|r| (*r, r * spec.rotor.radius_m))
+                .collect(),
+            measured: AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?,
+            ahead_deg: blades[0].2,
+            history: if blades.len() == 1
+                && spec.rotor.blades > 1
+                && opts.steps_per_rev.is_multiple_of(spec.rotor.blades)
+            {
+                let nan = crate::aero::inflow::DiskLoads {
+                    ct: f64::NAN,
+                    cs: f64::NAN,
+                    cc: f64::NAN,
+                };
+                vec![nan; opts.steps_per_rev]
+            } else {
+                vec![]
+            },
+            blades: spec.rotor.blades,
+        }),
+    };
     Ok(RotorSim {
         label: model_kind.name().to_string(),
         solver,
@@ -597,6 +754,7 @@ fn build_parts(
         t_ramp,
         output_channels: true,
         in_whole_rotor: whole || opts.blade_azimuth_deg.is_some(),
+        aero,
     })
 }
 
@@ -769,6 +927,102 @@ impl RotorSim {
     }
 }
 
+impl RotorSim {
+    /// After a converged step: the inflow driven by the rotor's airloads of that step.
+    fn advance_inflow(&mut self) {
+        let dpsi = self.omega * self.h;
+        let k = (self.solver.state.t / self.h).round() as i64;
+        let Some(a) = &mut self.aero else { return };
+        if !a.coupled {
+            return;
+        }
+        let Ok(mut sh) = a.shared.lock() else { return };
+        let n = a.history.len();
+        let disk = if n == 0 {
+            sh.rotor_airloads(&a.air, a.scale).disk
+        } else {
+            let own = sh.rotor_airloads(&a.air, 1.0).disk;
+            let i = k.rem_euclid(n as i64) as usize;
+            a.history[i] = own;
+            // the other blades sit k T/N behind: their loads are this blade's then
+            let step = n / a.blades;
+            let mut sum = crate::aero::inflow::DiskLoads::default();
+            for b in 0..a.blades {
+                let h = a.history[(i + n - b * step) % n];
+                // before a whole revolution is integrated: this blade's own loads
+                let h = if h.ct.is_nan() { own } else { h };
+                sum.ct += h.ct;
+                sum.cs += h.cs;
+                sum.cc += h.cc;
+            }
+            sum
+        };
+        sh.inflow.advance(dpsi, &disk);
+    }
+
+    /// Where the airloads come from.
+    pub fn airload_source(&self) -> super::aero::AirloadSource {
+        self.aero
+            .as_ref()
+            .map_or(super::aero::AirloadSource::Measured, |a| a.source)
+    }
+
+    /// Aerofoil-table queries clamped to a table's edge so far, in words (empty: none).
+    pub fn aero_clamps(&self) -> String {
+        self.aero
+            .as_ref()
+            .map_or(String::new(), |a| a.clamps.summary())
+    }
+
+    /// The rotor's channels, then per station of blade 1 (interpolated in radius between the
+    /// lifting line's points, as the last converged evaluation left them).
+    fn aero_channels(&self, a: &AeroRun, out: &mut [f64]) {
+        let Ok(sh) = a.shared.lock() else {
+            out.fill(f64::NAN);
+            return;
+        };
+        let l = sh.rotor_airloads(&a.air, a.scale);
+        out[0] = l.thrust_n;
+        out[1] = l.power_w;
+        out[2] = l.disk.ct / a.solidity;
+        out[3] = sh.inflow.state()[0];
+        let pts = &sh.points[0];
+        let t = self.solver.state.t;
+        let nr = AERO_ROTOR_CHANNELS.len();
+        let ns = AERO_STATION_CHANNELS.len();
+        for (j, (_, r_m)) in a.stations.iter().enumerate() {
+            let o = &mut out[nr + ns * j..nr + ns * (j + 1)];
+            // the bracketing points (increasing radius along the beam)
+            let k = pts.partition_point(|p| p.r_m < *r_m);
+            let (p0, p1) = match (k.checked_sub(1).and_then(|i| pts.get(i)), pts.get(k)) {
+                (Some(p0), Some(p1)) => (p0, p1),
+                (None, Some(p)) | (Some(p), None) => (p, p),
+                (None, None) => {
+                    o.fill(f64::NAN);
+                    continue;
+                }
+            };
+            let w = if p1.r_m > p0.r_m {
+                ((r_m - p0.r_m) / (p1.r_m - p0.r_m)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let lerp = |f: &dyn Fn(&crate::aero::lifting_line::PointRecord) -> f64| {
+                f(p0) + w * (f(p1) - f(p0))
+            };
+            o[0] = lerp(&|p| p.section.alpha_rad.to_degrees());
+            o[1] = lerp(&|p| p.section.mach);
+            o[2] = lerp(&|p| p.section.coefficients.cl);
+            o[3] = lerp(&|p| p.section.coefficients.cd);
+            o[4] = lerp(&|p| p.section.coefficients.cm);
+            o[5] = lerp(&|p| p.lambda_i);
+            o[6] = lerp(&|p| p.section.normal_n_per_m());
+            let m = a.measured.section_loads_ahead(t, *r_m, a.ahead_deg);
+            o[7] = o[6] - m.normal_N_per_m;
+        }
+    }
+}
+
 impl ForcedResponse for RotorSim {
     fn label(&self) -> &str {
         &self.label
@@ -818,6 +1072,7 @@ impl ForcedResponse for RotorSim {
                 t1 / self.period * 360.0
             )
         })?;
+        self.advance_inflow();
         Ok(())
     }
     fn channel_names(&self) -> Vec<String> {
@@ -836,6 +1091,13 @@ impl ForcedResponse for RotorSim {
             }
             v.push(AIRFRAME_STEP_TOLERANCE.to_string());
         }
+        if let Some(a) = &self.aero {
+            v.extend(AERO_ROTOR_CHANNELS.iter().map(|s| s.to_string()));
+            for (r, _) in &a.stations {
+                let l = station_label(*r);
+                v.extend(AERO_STATION_CHANNELS.iter().map(|s| format!("{s}_{l}")));
+            }
+        }
         v
     }
     fn channels(&self, out: &mut [f64]) {
@@ -847,9 +1109,16 @@ impl ForcedResponse for RotorSim {
         }
         if let Some(a) = &self.airframe {
             let n = 4 * a.dofs.len() + 1;
-            if out.len() - at == n {
+            if out.len() - at >= n {
                 self.airframe_channels(a, &mut out[at..at + n - 1]);
                 out[at + n - 1] = self.step_tol;
+            }
+            at += n;
+        }
+        if let Some(a) = &self.aero {
+            let n = AERO_ROTOR_CHANNELS.len() + AERO_STATION_CHANNELS.len() * a.stations.len();
+            if out.len() - at.min(out.len()) == n {
+                self.aero_channels(a, &mut out[at..]);
             }
         }
     }
@@ -870,9 +1139,16 @@ impl ForcedResponse for RotorSim {
     }
     fn save_state(&self) -> Option<super::SimState> {
         let snap = self.solver.snapshot();
+        let mut coords = snap.coords(&self.r0, 1.0 / self.omega);
+        // the inflow's states (coupled inflow), in units of R
+        if let Some(a) = self.aero.as_ref().filter(|a| a.coupled) {
+            if let Ok(sh) = a.shared.lock() {
+                coords.extend(sh.inflow.state().map(|l| l * a.air.radius_m));
+            }
+        }
         Some(super::SimState {
             t_s: snap.t_s,
-            coords: snap.coords(&self.r0, 1.0 / self.omega),
+            coords,
             solver: Some(snap),
             // the damper ends at the start of the step that ended here: the load channels of
             // the first sample after a restore need them
@@ -880,6 +1156,11 @@ impl ForcedResponse for RotorSim {
                 .parts
                 .iter()
                 .flat_map(|p| p.damper_x_start.iter().flatten().copied())
+                .chain(
+                    self.aero
+                        .iter()
+                        .flat_map(|a| a.history.iter().flat_map(|d| [d.ct, d.cs, d.cc])),
+                )
                 .collect(),
         })
     }
@@ -891,23 +1172,46 @@ impl ForcedResponse for RotorSim {
         };
         let mut snap = snap.clone();
         let n = crate::solver::snapshot::COORDS_PER_NODE * snap.nodes();
-        if s.coords.len() != n {
+        let inflow = self.aero.as_ref().filter(|a| a.coupled);
+        let extra = if inflow.is_some() { 3 } else { 0 };
+        if s.coords.len() != n + extra {
             anyhow::bail!(
-                "the saved state has {} coordinates, its structural state {n}",
+                "the saved state has {} coordinates, its structural state {n} and its inflow {extra}",
                 s.coords.len()
             );
         }
-        snap.set_coords(&self.r0, 1.0 / self.omega, &s.coords);
+        snap.set_coords(&self.r0, 1.0 / self.omega, &s.coords[..n]);
+        if let Some(a) = inflow {
+            if let Ok(mut sh) = a.shared.lock() {
+                let r = a.air.radius_m;
+                sh.inflow
+                    .set_state([s.coords[n] / r, s.coords[n + 1] / r, s.coords[n + 2] / r]);
+            }
+        }
         snap.t_s = s.t_s;
         self.solver
             .restore(&snap)
             .map_err(|e| anyhow::anyhow!("rotor model ({} damper): {e}", self.label))?;
+        if let Some(a) = &mut self.aero {
+            // the revolution of disk loads the state was saved with (else: none yet)
+            let h = &s.aux[(6 * self.parts.len()).min(s.aux.len())..];
+            let whole = h.len() == 3 * a.history.len();
+            for (i, d) in a.history.iter_mut().enumerate() {
+                let v = h.get(3 * i..3 * i + 3);
+                (d.ct, d.cs, d.cc) = match v {
+                    Some(v) if whole => (v[0], v[1], v[2]),
+                    _ => (f64::NAN, f64::NAN, f64::NAN),
+                };
+            }
+            // the lifting lines' records (output channels, inflow forcing) at the restored state
+            self.solver.refresh_distributed_loads();
+        }
         let np = self.parts.len();
         let travel = 2.0 * self.omega * self.h * self.parts[0].spec.rotor.radius_m;
         let back = exp_map([0.0, 0.0, -self.omega * self.h]);
         let state = &self.solver.state;
         for (k, p) in self.parts.iter_mut().enumerate() {
-            let saved: Option<[[f64; 3]; 2]> = (s.aux.len() == 6 * np).then(|| {
+            let saved: Option<[[f64; 3]; 2]> = (s.aux.len() >= 6 * np).then(|| {
                 std::array::from_fn(|e| std::array::from_fn(|c| s.aux[6 * k + 3 * e + c]))
             });
             // saved with this structural state: within a step's travel of the ends (a state

@@ -147,6 +147,7 @@ pub struct NamedOptions<'a> {
     pub newton: &'a str,
     pub periodic: &'a str,
     pub model: &'a str,
+    pub airloads: &'a str,
 }
 
 impl Default for NamedOptions<'_> {
@@ -157,6 +158,7 @@ impl Default for NamedOptions<'_> {
             newton: "modified",
             periodic: "shooting",
             model: "uh60a",
+            airloads: "measured",
         }
     }
 }
@@ -194,6 +196,8 @@ pub struct RunJob {
     /// airframe, all in one model (implied by an `[airframe]` and by per-blade
     /// differences in the deck or the overrides).
     pub all_blades: bool,
+    /// Where the airloads come from (docs/aerodynamics.md).
+    pub airloads: crate::rotor::aero::AirloadSource,
     /// Result folder.
     pub out: PathBuf,
 }
@@ -372,6 +376,7 @@ impl RunJob {
             newton: NewtonMethod::Modified,
             overrides: Vec::new(),
             all_blades: false,
+            airloads: crate::rotor::aero::AirloadSource::Measured,
             out: out.into(),
         }
     }
@@ -387,6 +392,7 @@ impl RunJob {
         self.periodic = parse_option("--periodic", n.periodic)?;
         self.check_tol()?;
         self.model = parse_option("--model", n.model)?;
+        self.airloads = parse_option("--airloads", n.airloads)?;
         Ok(())
     }
 
@@ -552,6 +558,25 @@ impl RunJob {
     ) -> anyhow::Result<()> {
         let Some(r) = rotor else { return Ok(()) };
         r.spec.check_record(record, &self.rotor)?;
+        if self.airloads.aerodynamic() {
+            if self.model != RotorModel::Uh60a {
+                bail!(
+                    "--airloads {}: the lifting line runs on the elastic blade model (--model uh60a), not --model {}",
+                    self.airloads.name(),
+                    self.model.name()
+                );
+            }
+            // the deck's aerodynamics and the record's air, checked before anything runs
+            crate::rotor::aero::blade_geometry(&r.spec, &self.rotor)?;
+            crate::rotor::aero::rotor_air(&r.spec, record)?;
+            if self.airloads == crate::rotor::aero::AirloadSource::Hybrid && record.motion.is_none()
+            {
+                bail!(
+                    "--airloads hybrid: the flight record {} has no measured blade motion (STEM.motion.csv, docs/formats.md)",
+                    self.flight.display()
+                );
+            }
+        }
         if self.model == RotorModel::Uh60a {
             let (ndof, nnz) = r.spec.size_estimate();
             let steps = (self.revs * self.steps_per_rev) as f64;
@@ -613,6 +638,7 @@ impl RunJob {
             // the delayed perturbation damping vanishes on the periodic solution: it only
             // speeds up marching, and its history would be part of the revolution map's state
             perturbation_damping: method == PeriodicMethod::March,
+            airloads: self.airloads,
             ..RunOptions::default()
         };
         let sdof_params = if sdof {

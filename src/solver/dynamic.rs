@@ -556,6 +556,19 @@ impl DynamicSolver {
             .force_scale(&self.model, &self.kin, &ctx, &mut self.res)
     }
 
+    /// Evaluates the distributed loads at the current state (providers that record what they
+    /// see, e.g. a lifting line, then hold the state's values).
+    pub fn refresh_distributed_loads(&mut self) {
+        let t = self.state.t;
+        self.state.kin(&mut self.kin);
+        if let Some(om) = self.frame_omega {
+            for k in self.kin.iter_mut() {
+                to_frame(k, om);
+            }
+        }
+        self.model.update_distributed_loads(t, &self.kin);
+    }
+
     /// Advance one step of size `h`. On error the state is left at the last converged step.
     pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
         let p = self.params;

@@ -36,6 +36,7 @@ pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result
             ("newton", Value::String(s)) => named.newton = s,
             ("periodic", Value::String(s)) => named.periodic = s,
             ("model", Value::String(s)) => named.model = s,
+            ("airloads", Value::String(s)) => named.airloads = s,
             ("revs", Value::Integer(i)) => job.revs = count(k, *i)?,
             ("steps_per_rev", Value::Integer(i)) => job.steps_per_rev = count(k, *i)?,
             ("substeps", Value::Integer(i)) => job.substeps = count(k, *i)?,

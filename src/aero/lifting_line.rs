@@ -1,0 +1,395 @@
+//! Blade-element lifting line on a beam: at every load point of the blade's beam the section's
+//! velocity relative to the air (the blade's own motion, elastic twist and flap and lag rates
+//! included, and the hub's, against the free stream and the induced inflow) gives the angle
+//! of attack, the Mach number and the airloads of [`super::section::blade_element`]
+//! (docs/aerodynamics.md).
+//!
+//! The rotor's blades share one [`AeroShared`]: the inflow state, read by every evaluation,
+//! and the record of the last evaluation at every load point, which at the end of a converged
+//! step holds the converged airloads (the rotor simulation integrates them into the disk loads
+//! that drive the inflow, and into the output channels).
+use super::airfoil::{Airfoil, ClampCounts};
+use super::inflow::{DiskLoads, Inflow};
+use super::section::{blade_element, Air, SectionAirloads};
+use crate::structure::beam::{SectionLoad, NPTS_M};
+use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
+use crate::structure::rotation::*;
+use std::sync::{Arc, Mutex};
+
+/// The rotor's air: density, speed of sound, free stream and the geometry the inflow is
+/// expressed in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RotorAir {
+    pub air: Air,
+    /// Rotor speed [rad/s] and radius [m] (the inflow's velocity scale Omega R).
+    pub omega_rad_s: f64,
+    pub radius_m: f64,
+    /// Velocity of the undisturbed air relative to the ground frame [m/s] (the hub's motion is
+    /// in the section velocities).
+    pub freestream_m_s: [f64; 3],
+    /// Centre of the disk [m] (the shaft on z): radius and azimuth of a point for the inflow.
+    pub center_m: [f64; 3],
+}
+
+impl RotorAir {
+    /// Radius over R and azimuth [rad] of `x` (azimuth from +x, counter-clockwise from above).
+    pub fn disk_position(&self, x: [f64; 3]) -> (f64, f64) {
+        let d = sub(x, self.center_m);
+        (d[0].hypot(d[1]) / self.radius_m, d[1].atan2(d[0]))
+    }
+    /// Air velocity at `x` [m/s]: free stream plus the induced inflow (down along -z).
+    pub fn air_velocity(&self, inflow: &Inflow, x: [f64; 3]) -> ([f64; 3], f64) {
+        let (r, psi) = self.disk_position(x);
+        let li = inflow.lambda_i(r, psi);
+        let w = li * self.omega_rad_s * self.radius_m;
+        (
+            [
+                self.freestream_m_s[0],
+                self.freestream_m_s[1],
+                self.freestream_m_s[2] - w,
+            ],
+            li,
+        )
+    }
+    /// Normalisation of the disk loads: `rho pi R^2 (Omega R)^2` [N].
+    pub fn thrust_scale_n(&self) -> f64 {
+        let vt = self.omega_rad_s * self.radius_m;
+        self.air.density_kg_m3 * std::f64::consts::PI * self.radius_m.powi(2) * vt * vt
+    }
+}
+
+/// One blade's aerodynamic geometry along its beam.
+#[derive(Clone, Debug)]
+pub struct BladeAero {
+    /// Radius of the beam's first point (`r = root_r_m + s_m`) [m].
+    pub root_r_m: f64,
+    /// Chord at radius r [m]: `(r_m, chord_m)` points, linear between, constant outside.
+    pub chord_m: Vec<(f64, f64)>,
+    /// Aerofoils by radial segment: `(r_end_m, aerofoil)`, increasing; the last covers the tip.
+    pub airfoils: Vec<(f64, Airfoil)>,
+    /// Aerodynamic root cut-out [m]: no airloads inboard of it.
+    pub cutout_r_m: f64,
+    /// Tip-loss factor B: no lift outboard of B R (1: none).
+    pub tip_loss_factor: f64,
+}
+
+impl BladeAero {
+    fn chord_at(&self, r: f64) -> f64 {
+        let c = &self.chord_m;
+        if c.is_empty() {
+            return 0.0;
+        }
+        if r <= c[0].0 {
+            return c[0].1;
+        }
+        for w in c.windows(2) {
+            if r <= w[1].0 {
+                let t = (r - w[0].0) / (w[1].0 - w[0].0);
+                return w[0].1 + t * (w[1].1 - w[0].1);
+            }
+        }
+        c[c.len() - 1].1
+    }
+    fn airfoil_at(&self, r: f64) -> usize {
+        self.airfoils
+            .iter()
+            .position(|(r_end, _)| r <= *r_end)
+            .unwrap_or(self.airfoils.len().saturating_sub(1))
+    }
+}
+
+/// What the last evaluation at a load point gave.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointRecord {
+    pub t_s: f64,
+    /// Radius [m] and quadrature weight [m] of the point.
+    pub r_m: f64,
+    pub weight_m: f64,
+    /// Disk position of the deformed point: r/R and azimuth [rad].
+    pub disk_r: f64,
+    pub psi_rad: f64,
+    /// Induced inflow ratio there (positive down).
+    pub lambda_i: f64,
+    pub section: SectionAirloads,
+    /// Force per span in the hub frame of the air [N/m] and the arm from the disk centre [m].
+    pub force_n_per_m: [f64; 3],
+    pub arm_m: [f64; 3],
+}
+
+/// State shared by the blades of a rotor: the inflow and every load point's last airloads.
+pub struct AeroShared {
+    pub inflow: Inflow,
+    /// Per blade of the model, per load point (element order, then quadrature order).
+    pub points: Vec<Vec<PointRecord>>,
+}
+
+/// Integrated airloads of the modelled blades.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RotorAirloads {
+    /// Thrust along +z [N], aerodynamic torque against the rotation [N m] and the power it
+    /// takes [W].
+    pub thrust_n: f64,
+    pub torque_nm: f64,
+    pub power_w: f64,
+    /// The disk loads as coefficients (the inflow's forcing).
+    pub disk: DiskLoads,
+}
+
+impl AeroShared {
+    /// The rotor's airloads: the sum over the modelled blades times `scale` (blades of the
+    /// rotor per blade modelled).
+    pub fn rotor_airloads(&self, air: &RotorAir, scale: f64) -> RotorAirloads {
+        let (mut t, mut q, mut cs, mut cc) = (0.0, 0.0, 0.0, 0.0);
+        for p in self.points.iter().flatten() {
+            let f = fmul(p.weight_m, p.force_n_per_m);
+            t += f[2];
+            q -= cross(p.arm_m, f)[2];
+            cs += f[2] * p.disk_r * p.psi_rad.sin();
+            cc += f[2] * p.disk_r * p.psi_rad.cos();
+        }
+        let n = air.thrust_scale_n();
+        RotorAirloads {
+            thrust_n: scale * t,
+            torque_nm: scale * q,
+            power_w: scale * q * air.omega_rad_s,
+            disk: DiskLoads {
+                ct: scale * t / n,
+                cs: scale * cs / n,
+                cc: scale * cc / n,
+            },
+        }
+    }
+}
+
+/// A pitch added to the sections' aerodynamic pitch, as a function of time [rad] (a blade
+/// model without a pitch degree of freedom, e.g. a verification blade on a flap hinge).
+pub type PitchLaw = Arc<dyn Fn(f64) -> f64 + Send + Sync>;
+
+/// Per load point of the beam: radius, chord, aerofoil, lift factor and quadrature weight.
+#[derive(Clone, Copy, Debug)]
+struct Station {
+    s_m: f64,
+    r_m: f64,
+    chord_m: f64,
+    airfoil: usize,
+    lift_factor: f64,
+    weight_m: f64,
+    /// Outside the aerofoil (inboard of the cut-out): no airloads.
+    active: bool,
+}
+
+/// The lifting line of one blade (a [`DistributedLoad`] on its beam).
+pub struct LiftingLine {
+    blade: usize,
+    rotor: RotorAir,
+    airfoils: Vec<Airfoil>,
+    clamps: Arc<ClampCounts>,
+    shared: Arc<Mutex<AeroShared>>,
+    /// Per element id: index of its first station (usize::MAX: not ours).
+    first: Vec<usize>,
+    stations: Vec<Station>,
+    pitch_law: Option<PitchLaw>,
+    /// From the model's frame to the hub frame of the air (a single-blade model of a blade
+    /// that sits ahead of the model's blade).
+    turn: Option<[[f64; 3]; 3]>,
+}
+
+impl LiftingLine {
+    /// The lifting line on beam `beam` of `model`, blade `blade` of `shared` (its point records
+    /// are sized here).
+    pub fn new(
+        model: &Model,
+        beam: &str,
+        geometry: &BladeAero,
+        rotor: RotorAir,
+        clamps: Arc<ClampCounts>,
+        shared: Arc<Mutex<AeroShared>>,
+        blade: usize,
+    ) -> anyhow::Result<Self> {
+        let ids = model
+            .beams
+            .get(beam)
+            .ok_or_else(|| anyhow::anyhow!("lifting line: model has no beam `{beam}`"))?;
+        if geometry.airfoils.is_empty() {
+            anyhow::bail!("lifting line: no aerofoil");
+        }
+        let n_el = ids.iter().map(|i| i + 1).max().unwrap_or(0);
+        let mut first = vec![usize::MAX; n_el];
+        let mut stations = Vec::with_capacity(ids.len() * NPTS_M);
+        let tip_r = geometry.tip_loss_factor * rotor.radius_m;
+        for &id in ids {
+            if let Element::Beam(b) = &model.elements[id] {
+                first[id] = stations.len();
+                for g in &b.gm {
+                    let r = geometry.root_r_m + g.s_m;
+                    stations.push(Station {
+                        s_m: g.s_m,
+                        r_m: r,
+                        chord_m: geometry.chord_at(r),
+                        airfoil: geometry.airfoil_at(r),
+                        lift_factor: if r <= tip_r { 1.0 } else { 0.0 },
+                        weight_m: g.wj,
+                        active: r >= geometry.cutout_r_m,
+                    });
+                }
+            }
+        }
+        {
+            let mut sh = shared
+                .lock()
+                .map_err(|_| anyhow::anyhow!("lifting line: shared state poisoned"))?;
+            if sh.points.len() <= blade {
+                sh.points.resize(blade + 1, Vec::new());
+            }
+            sh.points[blade] = stations
+                .iter()
+                .map(|s| PointRecord {
+                    r_m: s.r_m,
+                    weight_m: if s.active { s.weight_m } else { 0.0 },
+                    ..Default::default()
+                })
+                .collect();
+        }
+        Ok(LiftingLine {
+            blade,
+            rotor,
+            airfoils: geometry.airfoils.iter().map(|a| a.1.clone()).collect(),
+            clamps,
+            shared,
+            first,
+            stations,
+            pitch_law: None,
+            turn: None,
+        })
+    }
+
+    /// Adds `law(t)` to every section's aerodynamic pitch.
+    pub fn with_pitch_law(mut self, law: PitchLaw) -> Self {
+        self.pitch_law = Some(law);
+        self
+    }
+
+    /// The model's blade sits `ahead_rad` behind the blade it stands for: its kinematics are
+    /// turned forward by that azimuth before they meet the air.
+    pub fn with_turn(mut self, ahead_rad: f64) -> Self {
+        self.turn = (ahead_rad != 0.0).then(|| exp_map([0.0, 0.0, ahead_rad]));
+        self
+    }
+
+    /// Stations (load points) of the line.
+    pub fn stations(&self) -> usize {
+        self.stations.len()
+    }
+
+    /// The station of load point `p`, if it is one of the line's.
+    pub fn station(&self, p: &LoadPoint) -> Option<usize> {
+        let i0 = *self.first.get(p.element)?;
+        if i0 == usize::MAX {
+            return None;
+        }
+        (i0..i0 + NPTS_M).find(|&i| self.stations[i].s_m == p.s_m)
+    }
+
+    /// The airloads of station `i` with the section at `p` (its frame possibly pitched by the
+    /// pitch law): the section's airloads, the frame they are in, the inflow ratio.
+    fn airloads(
+        &self,
+        inflow: &Inflow,
+        i: usize,
+        p: &LoadPoint,
+    ) -> (SectionAirloads, [[f64; 3]; 3], f64) {
+        let st = &self.stations[i];
+        let (x, rp, v, w) = match &self.turn {
+            None => (p.x, p.r, p.v, p.w),
+            Some(t) => (mv(t, p.x), mm(t, &p.r), mv(t, p.v), mv(t, p.w)),
+        };
+        let r = match &self.pitch_law {
+            None => rp,
+            Some(law) => mm(&rp, &exp_map([law(p.t), 0.0, 0.0])),
+        };
+        // three-quarter chord: c/2 behind the quarter-chord reference line
+        let arm = mv(&r, [0.0, -0.5 * st.chord_m, 0.0]);
+        let v34 = add(v, cross(w, arm));
+        let (va, li) = self.rotor.air_velocity(inflow, x);
+        let u = mtv(&r, sub(va, v34));
+        let a = blade_element(
+            u,
+            st.chord_m,
+            &self.rotor.air,
+            &self.airfoils[st.airfoil],
+            &self.clamps,
+            st.lift_factor,
+        );
+        (a, r, li)
+    }
+
+    /// The airloads station `i` would see at the kinematics `p` (a reference motion), with
+    /// the current inflow, without recording them; in the section frame of `p`.
+    pub fn reference_airloads(&self, i: usize, p: &LoadPoint) -> SectionAirloads {
+        if !self.stations[i].active {
+            return SectionAirloads::default();
+        }
+        match self.shared.lock() {
+            Ok(sh) => {
+                let (mut a, r, _) = self.airloads(&sh.inflow, i, p);
+                // from the (pitch-law) frame the airloads were computed in to the frame of p
+                let rp = match &self.turn {
+                    None => p.r,
+                    Some(t) => mm(t, &p.r),
+                };
+                a.force_n_per_m = mtv(&rp, mv(&r, a.force_n_per_m));
+                a
+            }
+            Err(_) => SectionAirloads::default(),
+        }
+    }
+
+    /// Evaluates and records the airloads at `p`; the load in the section frame of `p`.
+    pub fn evaluate(&mut self, p: &LoadPoint) -> SectionLoad {
+        let Some(i) = self.station(p) else {
+            return SectionLoad::default();
+        };
+        let Ok(mut sh) = self.shared.lock() else {
+            return SectionLoad::default();
+        };
+        if !self.stations[i].active {
+            return SectionLoad {
+                follower: true,
+                ..Default::default()
+            };
+        }
+        let (a, r, li) = self.airloads(&sh.inflow, i, p);
+        // hub frame of the air
+        let f_hub = mv(&r, a.force_n_per_m);
+        let x = match &self.turn {
+            None => p.x,
+            Some(t) => mv(t, p.x),
+        };
+        let (disk_r, psi) = self.rotor.disk_position(x);
+        if let Some(rec) = sh.points[self.blade].get_mut(i) {
+            rec.t_s = p.t;
+            rec.disk_r = disk_r;
+            rec.psi_rad = psi;
+            rec.lambda_i = li;
+            rec.section = a;
+            rec.force_n_per_m = f_hub;
+            rec.arm_m = sub(x, self.rotor.center_m);
+        }
+        // in the section frame of p (the pitch law's frame and the turn undone)
+        let rp = match &self.turn {
+            None => p.r,
+            Some(t) => mm(t, &p.r),
+        };
+        SectionLoad {
+            force: mtv(&rp, f_hub),
+            moment: [a.moment_n_m_per_m, 0.0, 0.0],
+            follower: true,
+        }
+    }
+}
+
+impl DistributedLoad for LiftingLine {
+    fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
+        self.evaluate(p)
+    }
+}

@@ -1,0 +1,339 @@
+//! The rotor's aerodynamics in the forced response (docs/aerodynamics.md): where the airloads
+//! come from (`--airloads measured|computed|hybrid`), the air and free stream of the record,
+//! the blade's lifting line from the deck's `[aero]` table, and the hybrid load: the measured
+//! airloads plus the lifting line's difference between the blade's motion and a reference
+//! motion (the record's measured blade motion).
+use super::deck::RotorSpec;
+use crate::aero::airfoil::{Airfoil, ClampCounts, ThinAirfoil};
+use crate::aero::c81::C81Table;
+use crate::aero::inflow::{DiskLoads, FlightCondition, InflowModel};
+use crate::aero::lifting_line::{BladeAero, LiftingLine, RotorAir};
+use crate::aero::section::Air;
+use crate::flight::FlightRecord;
+use crate::structure::beam::SectionLoad;
+use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
+use crate::structure::rotation::*;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Where the blade's airloads come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AirloadSource {
+    /// The record's airloads replayed (no aerodynamic feedback).
+    #[default]
+    Measured,
+    /// The lifting line and the inflow with the record's controls: a prediction.
+    Computed,
+    /// Measured airloads plus the lifting line's difference between the blade's motion and the
+    /// record's measured motion.
+    Hybrid,
+}
+
+impl AirloadSource {
+    pub fn name(self) -> &'static str {
+        match self {
+            AirloadSource::Measured => "measured",
+            AirloadSource::Computed => "computed",
+            AirloadSource::Hybrid => "hybrid",
+        }
+    }
+    /// Whether the lifting line runs.
+    pub fn aerodynamic(self) -> bool {
+        self != AirloadSource::Measured
+    }
+}
+
+impl std::str::FromStr for AirloadSource {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "measured" => Ok(AirloadSource::Measured),
+            "computed" => Ok(AirloadSource::Computed),
+            "hybrid" => Ok(AirloadSource::Hybrid),
+            _ => Err(format!(
+                "unknown airload source `{s}` (expected measured, computed or hybrid)"
+            )),
+        }
+    }
+}
+
+/// The air of the record: density and speed of sound from its metadata, the free stream from
+/// its advance ratio and shaft tilt (`shaft_tilt_deg`, negative forward: the free stream then
+/// flows down through the disk), in the hub frame (x aft, where azimuth 0 points).
+pub fn rotor_air(spec: &RotorSpec, record: &FlightRecord) -> anyhow::Result<RotorAir> {
+    let meta = &record.meta;
+    let need = |v: Option<f64>, key: &str| {
+        v.filter(|x| x.is_finite() && *x > 0.0).ok_or_else(|| {
+            anyhow::anyhow!(
+                "the lifting line needs a positive `{key}` in the flight record's metadata"
+            )
+        })
+    };
+    let rho = need(meta.density_kg_m3, "density_kg_m3")?;
+    let a = need(meta.speed_of_sound_m_s, "speed_of_sound_m_s")?;
+    let mu = meta.advance_ratio.unwrap_or(0.0);
+    let tilt = match meta.raw.get("shaft_tilt_deg") {
+        None => 0.0,
+        Some(v) => v.as_f64().ok_or_else(|| {
+            anyhow::anyhow!("flight record metadata `shaft_tilt_deg`: expected a number, found {v}")
+        })?,
+    };
+    let om = spec.rotor.omega_rad_s;
+    let big_r = spec.rotor.radius_m;
+    let v = mu * om * big_r;
+    Ok(RotorAir {
+        air: Air {
+            density_kg_m3: rho,
+            speed_of_sound_m_s: a,
+        },
+        omega_rad_s: om,
+        radius_m: big_r,
+        freestream_m_s: [v, 0.0, v * tilt.to_radians().tan()],
+        center_m: [0.0; 3],
+    })
+}
+
+/// The flight condition of the inflow models: advance ratio and the free stream's flow down
+/// through the disk, over Omega R.
+pub fn flight_condition(air: &RotorAir) -> FlightCondition {
+    let vt = air.omega_rad_s * air.radius_m;
+    FlightCondition {
+        mu: air.freestream_m_s[0].hypot(air.freestream_m_s[1]) / vt,
+        lambda_free: -air.freestream_m_s[2] / vt,
+    }
+}
+
+/// The blade's aerodynamic geometry from the deck's `[aero]` (C81 files against the deck's
+/// folder) and its inflow model.
+pub fn blade_geometry(spec: &RotorSpec, file: &Path) -> anyhow::Result<(BladeAero, InflowModel)> {
+    let Some(a) = &spec.aero else {
+        anyhow::bail!(
+            "rotor deck {}: the lifting line needs an [aero] table (chord_m, cutout_r_m; docs/rotor_deck.md, \"Aerodynamics\")",
+            file.display()
+        );
+    };
+    let dir = file.parent().unwrap_or(Path::new(""));
+    let mut airfoils = Vec::with_capacity(a.airfoils.len().max(1));
+    for seg in &a.airfoils {
+        let foil = match &seg.c81 {
+            None => Airfoil::Thin(ThinAirfoil::default()),
+            Some(p) => Airfoil::Table(Arc::new(C81Table::from_file(&dir.join(p)).map_err(
+                |e| anyhow::anyhow!("rotor deck {}, aero.airfoil: {e}", file.display()),
+            )?)),
+        };
+        airfoils.push((seg.r_end_m, foil));
+    }
+    if airfoils.is_empty() {
+        airfoils.push((spec.rotor.radius_m, Airfoil::Thin(ThinAirfoil::default())));
+    }
+    let model = a
+        .inflow
+        .parse::<InflowModel>()
+        .map_err(|e| anyhow::anyhow!("rotor deck {}, aero.inflow: {e}", file.display()))?;
+    Ok((
+        BladeAero {
+            root_r_m: spec.blade.root_r_m,
+            chord_m: vec![(0.0, a.chord_m)],
+            airfoils,
+            cutout_r_m: a.cutout_r_m,
+            tip_loss_factor: a.tip_loss_factor,
+        },
+        model,
+    ))
+}
+
+/// The record's airloads as disk loads (revolution average): thrust and its first moments,
+/// `N` blades, normal force taken vertical (the inflow's forcing in the hybrid source).
+pub fn record_disk_loads(record: &FlightRecord, air: &RotorAir, blades: usize) -> DiskLoads {
+    let az = record.azimuths_deg();
+    let st = record.stations_r_over_r();
+    let revs = record.revolutions().len();
+    let big_r = air.radius_m;
+    let (mut t, mut cs, mut cc) = (0.0, 0.0, 0.0);
+    // trapezoid over the stations, mean over azimuths and revolutions
+    for i_rev in 0..revs {
+        for (i_az, psi) in az.iter().enumerate() {
+            let (s, c) = psi.to_radians().sin_cos();
+            for w in 0..st.len().saturating_sub(1) {
+                let (r0, r1) = (st[w], st[w + 1]);
+                let f0 = record.normal_n_per_m()[record.index(i_rev, i_az, w)];
+                let f1 = record.normal_n_per_m()[record.index(i_rev, i_az, w + 1)];
+                let dr = (r1 - r0) * big_r;
+                t += 0.5 * (f0 + f1) * dr;
+                let m = 0.5 * (f0 * r0 + f1 * r1) * dr;
+                cs += m * s;
+                cc += m * c;
+            }
+        }
+    }
+    let k = blades as f64 / (revs * az.len()).max(1) as f64 / air.thrust_scale_n();
+    DiskLoads {
+        ct: k * t,
+        cs: k * cs,
+        cc: k * cc,
+    }
+}
+
+/// The reference motion of the hybrid source: the record's measured rigid blade motion (flap,
+/// lag, pitch about the hinge), periodic over the revolution.
+pub struct ReferenceMotion {
+    motion: crate::flight::PeriodicMotion,
+    hinge_r_m: f64,
+    omega: f64,
+    /// The blade's azimuth ahead of blade 1 (where its motion is read) [rad].
+    ahead_rad: f64,
+    /// Azimuth of the model's blade at t = 0 [rad] (a whole rotor's blades are turned).
+    model_turn_rad: f64,
+    /// Per station of the lifting line: the load point's reference position and section frame.
+    points: Vec<([f64; 3], [[f64; 3]; 3])>,
+}
+
+impl ReferenceMotion {
+    /// The reference kinematics of station `i` at time t: the load point the blade would have
+    /// moving as the record says (hub frame of the model's blade).
+    fn point(&self, i: usize, p: &LoadPoint) -> LoadPoint {
+        let (x0, r0) = self.points[i];
+        let psi = self.omega * p.t;
+        let m = self.motion.at(psi + self.ahead_rad);
+        let rz = exp_map([0.0, 0.0, psi + self.model_turn_rad]);
+        let lag = exp_map([0.0, 0.0, -m.lag_rad]);
+        let flap = exp_map([0.0, -m.flap_rad, 0.0]);
+        let pitch = exp_map([m.pitch_rad, 0.0, 0.0]);
+        let lf = mm(&lag, &flap);
+        let e = [self.hinge_r_m, 0.0, 0.0];
+        let d = mv(&lf, sub(x0, e));
+        let x_rot = add(e, d);
+        // angular velocity relative to the turning frame (rotating axes)
+        let w_rel = add(
+            [0.0, 0.0, -m.lag_rate_rad_s],
+            mv(&lag, [0.0, -m.flap_rate_rad_s, 0.0]),
+        );
+        let w_pitch = mv(&lf, [m.pitch_rate_rad_s, 0.0, 0.0]);
+        let om = [0.0, 0.0, self.omega];
+        let v_rot = add(cross(om, x_rot), cross(w_rel, d));
+        LoadPoint {
+            t: p.t,
+            element: p.element,
+            s_m: p.s_m,
+            x: mv(&rz, x_rot),
+            r: mm(&rz, &mm(&lf, &mm(&pitch, &r0))),
+            v: mv(&rz, v_rot),
+            w: mv(&rz, add(om, add(w_rel, w_pitch))),
+        }
+    }
+}
+
+/// The hybrid blade load: the measured airloads plus `ramp(t)` times the lifting line's
+/// airloads at the blade's motion minus those at the reference motion (both with the same
+/// inflow), in the section frame.
+pub struct HybridLoad<M: DistributedLoad> {
+    pub measured: M,
+    pub line: LiftingLine,
+    pub reference: ReferenceMotion,
+    /// End of the cyclic ramp [s] (the difference ramps in with the measured harmonics).
+    pub t_ramp: f64,
+    pub active: Arc<AtomicBool>,
+}
+
+impl<M: DistributedLoad> DistributedLoad for HybridLoad<M> {
+    fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
+        let mut l = self.measured.eval(p);
+        if !self.active.load(Ordering::Relaxed) {
+            return l;
+        }
+        let Some(i) = self.line.station(p) else {
+            return l;
+        };
+        let a = self.line.evaluate(p);
+        let q = self.reference.point(i, p);
+        let r = self.line.reference_airloads(i, &q);
+        let w = super::expand::ramp(p.t, self.t_ramp);
+        for k in 0..3 {
+            l.force[k] += w * (a.force[k] - r.force_n_per_m[k]);
+        }
+        l.moment[0] += w * (a.moment[0] - r.moment_n_m_per_m);
+        l
+    }
+}
+
+/// The computed blade load: the lifting line alone once the dynamics run; the initial
+/// equilibrium is found under `statics` (the record's mean airloads, when it has them: a
+/// nearby start for the lag and flap under the rotor's drag and thrust).
+pub struct ComputedLoad<S: DistributedLoad> {
+    pub statics: S,
+    pub line: LiftingLine,
+    pub active: Arc<AtomicBool>,
+}
+
+impl<S: DistributedLoad> DistributedLoad for ComputedLoad<S> {
+    fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
+        if !self.active.load(Ordering::Relaxed) {
+            return self.statics.eval(p);
+        }
+        self.line.evaluate(p)
+    }
+}
+
+/// The reference motion for the lifting line `line` on beam `beam` of `model`.
+pub fn reference_motion(
+    record: &FlightRecord,
+    spec: &RotorSpec,
+    model: &Model,
+    beam: &str,
+    line: &LiftingLine,
+    ahead_rad: f64,
+    model_turn_rad: f64,
+) -> anyhow::Result<ReferenceMotion> {
+    let Some(motion) = &record.motion else {
+        anyhow::bail!(
+            "--airloads hybrid needs the record's measured blade motion (STEM.motion.csv, docs/formats.md); this record has none"
+        );
+    };
+    let om = spec.rotor.omega_rad_s;
+    let n_az = record.azimuths_deg().len();
+    let motion = motion
+        .periodic((n_az / 2).saturating_sub(1).min(10), om)
+        .map_err(|e| anyhow::anyhow!("the record's blade motion: {e}"))?;
+    let kin = model.reference_state();
+    let ids = model
+        .beams
+        .get(beam)
+        .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no beam `{beam}`"))?;
+    let mut points = vec![([0.0; 3], [[0.0; 3]; 3]); line.stations()];
+    for &ei in ids {
+        if let Element::Beam(b) = &model.elements[ei] {
+            let pts = b.load_points(&b.nodes.map(|i| kin[i]));
+            for (g, pt) in b.gm.iter().zip(&pts) {
+                let probe = LoadPoint {
+                    t: 0.0,
+                    element: ei,
+                    s_m: g.s_m,
+                    x: pt.0,
+                    r: pt.1,
+                    v: [0.0; 3],
+                    w: [0.0; 3],
+                };
+                if let Some(i) = line.station(&probe) {
+                    // along the hub's x axis (a whole rotor's blade is turned in the model)
+                    let back = exp_map([0.0, 0.0, -model_turn_rad]);
+                    points[i] = (mv(&back, pt.0), mm(&back, &pt.1));
+                }
+            }
+        }
+    }
+    Ok(ReferenceMotion {
+        motion,
+        hinge_r_m: spec.retention.hinge_r_m,
+        omega: om,
+        ahead_rad,
+        model_turn_rad,
+        points,
+    })
+}
+
+/// Counted table clamps of the run, in words (empty: none).
+pub fn clamp_warning(c: &ClampCounts) -> String {
+    c.summary()
+}
