@@ -184,6 +184,32 @@ fn print_summary(outcome: &RunOutcome) {
                         r.label, c.max_rel_error, c.channel, c.tolerance
                     );
                 }
+                if let (Some(a), Some(ct)) = (&r.airloads, r.channel("rotor_CT_over_sigma")) {
+                    let mean = ct.iter().sum::<f64>() / ct.len().max(1) as f64;
+                    outln!(
+                        "{:<22} {} airloads ({} inflow): thrust coefficient over solidity {:.4}{}",
+                        "",
+                        a.source,
+                        a.inflow,
+                        mean,
+                        a.record_ct_over_sigma
+                            .map(|v| format!(
+                                " (the record's {v:.4}{}; a plausibility comparison)",
+                                if a.record_synthetic {
+                                    ", SYNTHETIC"
+                                } else {
+                                    ""
+                                }
+                            ))
+                            .unwrap_or_default()
+                    );
+                }
+                if let Some(a) = r.airloads.as_ref().filter(|a| a.clamped_queries > 0) {
+                    outln!(
+                        "warning: {}: aerofoil tables clamped {} queries to their edges (not extrapolated): {}",
+                        r.label, a.clamped_queries, a.clamps
+                    );
+                }
                 if r.converged() && r.periodic.message.starts_with("warm start") {
                     outln!("note: {}: {}", r.label, r.periodic.message);
                 }

@@ -225,13 +225,20 @@ impl ReferenceMotion {
     }
 }
 
+/// The turn about the section axis from a section's frame to the frame the airloads are
+/// applied in (the deck's control-pitch frame: the rigid pitch), at a load point [rad].
+pub type PitchCorrection = Box<dyn Fn(&LoadPoint) -> f64 + Send>;
+
 /// The hybrid blade load: the measured airloads plus `ramp(t)` times the lifting line's
 /// airloads at the blade's motion minus those at the reference motion (both with the same
-/// inflow), in the section frame.
+/// inflow), in the section frame. With the deck's control-pitch airload frame the blade's
+/// sections meet the air at the rigid pitch, as the measured airloads are applied: the
+/// reference motion carries no elastic twist, so the difference is the flap and lag motion's.
 pub struct HybridLoad<M: DistributedLoad> {
     pub measured: M,
     pub line: LiftingLine,
     pub reference: ReferenceMotion,
+    pub pitch_correction: Option<PitchCorrection>,
     /// End of the cyclic ramp [s] (the difference ramps in with the measured harmonics).
     pub t_ramp: f64,
     pub active: Arc<AtomicBool>,
@@ -246,7 +253,19 @@ impl<M: DistributedLoad> DistributedLoad for HybridLoad<M> {
         let Some(i) = self.line.station(p) else {
             return l;
         };
-        let a = self.line.evaluate(p);
+        let a = match &self.pitch_correction {
+            None => self.line.evaluate(p),
+            Some(c) => {
+                let turn = exp_map([c(p), 0.0, 0.0]);
+                let pc = LoadPoint {
+                    r: mm(&p.r, &turn),
+                    ..*p
+                };
+                let mut a = self.line.evaluate(&pc);
+                a.force = mv(&turn, a.force);
+                a
+            }
+        };
         let q = self.reference.point(i, p);
         let r = self.line.reference_airloads(i, &q);
         let w = super::expand::ramp(p.t, self.t_ramp);
@@ -261,10 +280,14 @@ impl<M: DistributedLoad> DistributedLoad for HybridLoad<M> {
 /// The computed blade load: the lifting line alone once the dynamics run; the initial
 /// equilibrium is found under `statics` (the record's mean airloads, when it has them: a
 /// nearby start for the lag and flap under the rotor's drag and thrust).
+/// The lifting line takes over from them over the cyclic ramp (a gentle start: the blade's lag
+/// settles under the rotor's own drag without a step in its load).
 pub struct ComputedLoad<S: DistributedLoad> {
     pub statics: S,
     pub line: LiftingLine,
     pub active: Arc<AtomicBool>,
+    /// End of the hand-over [s].
+    pub t_ramp: f64,
 }
 
 impl<S: DistributedLoad> DistributedLoad for ComputedLoad<S> {
@@ -272,7 +295,18 @@ impl<S: DistributedLoad> DistributedLoad for ComputedLoad<S> {
         if !self.active.load(Ordering::Relaxed) {
             return self.statics.eval(p);
         }
-        self.line.evaluate(p)
+        let a = self.line.evaluate(p);
+        let w = super::expand::ramp(p.t, self.t_ramp);
+        if w >= 1.0 {
+            return a;
+        }
+        // both follower loads in the section frame
+        let s = self.statics.eval(p);
+        SectionLoad {
+            force: std::array::from_fn(|k| w * a.force[k] + (1.0 - w) * s.force[k]),
+            moment: std::array::from_fn(|k| w * a.moment[k] + (1.0 - w) * s.moment[k]),
+            follower: true,
+        }
     }
 }
 

@@ -78,6 +78,24 @@ impl ReliefRegulation {
 }
 
 /// One time-marching forced-response simulation of a rotor blade with one damper model.
+/// What a run with aerodynamics reports besides its channels.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct AirloadInfo {
+    /// "measured", "computed" or "hybrid".
+    pub source: String,
+    /// The inflow model ("uniform", "drees", "pitt-peters").
+    pub inflow: String,
+    /// The aerofoils, inboard first.
+    pub airfoils: Vec<String>,
+    /// Aerofoil-table queries clamped to a table's edge (never extrapolated), and where.
+    pub clamped_queries: u64,
+    pub clamps: String,
+    /// The record's thrust coefficient over solidity (its metadata), for comparison.
+    pub record_ct_over_sigma: Option<f64>,
+    /// Whether the record is synthetic (shown beside the comparison).
+    pub record_synthetic: bool,
+}
+
 pub trait ForcedResponse: Send {
     /// Model label: "linear", "nonlinear" or "physical".
     fn label(&self) -> &str;
@@ -137,6 +155,10 @@ pub trait ForcedResponse: Send {
         0.0
     }
     /// Which motion dominates a (complex) mode given in the coordinates of
+    /// The airloads' source, inflow and aerofoil-table clamps (None: replayed airloads only).
+    fn airload_info(&self) -> Option<AirloadInfo> {
+        None
+    }
     /// [`SimState::coords`]: "lag", "flap", "torsion", ... ("" when unknown).
     fn mode_label(&self, _re: &[f64], _im: &[f64]) -> String {
         String::new()

@@ -305,6 +305,10 @@ struct AeroRun {
     /// is modelled or the steps per revolution are not a multiple of N.
     history: Vec<crate::aero::inflow::DiskLoads>,
     blades: usize,
+    /// Blade 1's aerofoils by segment, in words.
+    airfoils: Vec<String>,
+    record_ct_over_sigma: Option<f64>,
+    record_synthetic: bool,
 }
 
 /// Per output station: angle of attack, Mach, lift, drag and moment coefficients, inflow
@@ -558,10 +562,20 @@ fn build_parts(
                         ahead,
                         model_turn,
                     )?;
+                    let pitch_correction: Option<super::aero::PitchCorrection> =
+                        match bspec.blade.airload_frame {
+                            AirloadFrame::Deformed => None,
+                            AirloadFrame::ControlPitch => {
+                                let c =
+                                    ControlPitch::new(bspec, controls, &model, &nm(names::BLADE))?;
+                                Some(Box::new(move |p: &LoadPoint| c.correction(p)))
+                            }
+                        };
                     Box::new(HybridLoad {
                         measured: airloads,
                         line,
                         reference,
+                        pitch_correction,
                         t_ramp,
                         active: aero_active.clone(),
                     })
@@ -570,6 +584,7 @@ fn build_parts(
                         statics: airloads,
                         line,
                         active: aero_active.clone(),
+                        t_ramp,
                     })
                 }
             }
@@ -700,6 +715,11 @@ fn build_parts(
     // finite-difference tangent stalls Newton near 1e-8 ||r_0|| at some valve events (measured).
     solver.newton.rtol = opts.newton_rtol;
     solver.newton.method = opts.newton;
+    if source.aerodynamic() {
+        // the lifting line's airloads depend on the velocities, which the iteration matrix
+        // does not differentiate: Newton contracts more slowly (a quasi-Newton method)
+        solver.newton.max_iterations = 50;
+    }
     solver.init_accelerations()?;
     let aero = match aero_common {
         None => None,
@@ -734,6 +754,14 @@ fn build_parts(
                 vec![]
             },
             blades: spec.rotor.blades,
+            airfoils: super::aero::blade_geometry(spec, file)?
+                .0
+                .airfoils
+                .iter()
+                .map(|(r, a)| format!("{} to r = {r} m", a.name()))
+                .collect(),
+            record_ct_over_sigma: record.meta.thrust_coefficient_over_solidity,
+            record_synthetic: record.meta.synthetic,
         }),
     };
     Ok(RotorSim {
@@ -1228,6 +1256,23 @@ impl ForcedResponse for RotorSim {
             };
         }
         Ok(())
+    }
+    fn airload_info(&self) -> Option<super::AirloadInfo> {
+        let a = self.aero.as_ref()?;
+        let inflow = a
+            .shared
+            .lock()
+            .map(|sh| sh.inflow.model().name().to_string())
+            .unwrap_or_default();
+        Some(super::AirloadInfo {
+            source: a.source.name().to_string(),
+            inflow,
+            airfoils: a.airfoils.clone(),
+            clamped_queries: a.clamps.total(),
+            clamps: a.clamps.summary(),
+            record_ct_over_sigma: a.record_ct_over_sigma,
+            record_synthetic: a.record_synthetic,
+        })
     }
     fn periodic_from_s(&self) -> f64 {
         self.t_ramp

@@ -87,6 +87,8 @@ pub struct ModelRun {
     pub blade_runs: Vec<ModelRun>,
     /// A rotor on an airframe: its equation of motion against the rotor's loads on it.
     pub airframe_check: Option<rotor::AirframeCheck>,
+    /// The airloads' source, inflow and aerofoil-table clamps (lifting-line runs).
+    pub airloads: Option<crate::rotor::AirloadInfo>,
 }
 
 /// One revolution kept along the way to the periodic solution.
@@ -505,6 +507,7 @@ pub fn drive_periodic(
         blade: None,
         blade_runs: Vec::new(),
         airframe_check: None,
+        airloads: sim.airload_info(),
     };
     loads::finish(&mut run, blades);
     // the sub-step envelope last, so the columns written before it keep their places

@@ -649,11 +649,36 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "channels": r.channel_names,
         "blades": blades_json(r),
         "airframe": airframe_json(r),
+        "airloads": airloads_json(r),
     })
 }
 
 /// A rotor on an airframe: per moving direction its motion (mean, half peak-to-peak,
 /// harmonics) and the momentum check of its equation of motion (null without an airframe).
+/// The lifting line's source, inflow, aerofoils and table clamps, with the rotor's thrust
+/// coefficient over solidity and power over the revolution beside the record's.
+fn airloads_json(r: &ModelRun) -> Value {
+    let Some(a) = &r.airloads else {
+        return Value::Null;
+    };
+    let mean = |c: &str| {
+        r.channel(c)
+            .map(|v| v.iter().sum::<f64>() / v.len().max(1) as f64)
+    };
+    json!({
+        "source": a.source,
+        "inflow": a.inflow,
+        "airfoils": a.airfoils,
+        "clamped_queries": a.clamped_queries,
+        "clamps": a.clamps,
+        "thrust_N_mean": mean("rotor_thrust_N"),
+        "power_W_mean": mean("rotor_power_W"),
+        "CT_over_sigma_mean": mean("rotor_CT_over_sigma"),
+        "record_CT_over_sigma": a.record_ct_over_sigma,
+        "record_synthetic": a.record_synthetic,
+    })
+}
+
 fn airframe_json(r: &ModelRun) -> Value {
     let Some(check) = &r.airframe_check else {
         return Value::Null;
