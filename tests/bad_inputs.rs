@@ -79,6 +79,17 @@ const RUN_R: &[&str] = &[
     "{T}/out",
 ];
 const EXPAND_R: &[&str] = &["expand", "--rotor", "{T}/r.toml"];
+const RUN_COMPUTED: &[&str] = &[
+    "run",
+    "--rotor",
+    "{T}/r.toml",
+    "--airloads",
+    "computed",
+    "--revs",
+    "3",
+    "--out",
+    "{T}/out",
+];
 const MODES_R: &[&str] = &[
     "modes",
     "--rotor",
@@ -230,6 +241,15 @@ const CASES: &[Case] = &[
     case("rotor airframe mode participation unsupported", rotor!("[damper]\nmodel", "[[airframe.mode]]\nfrequency_Hz = 3.0\ngeneralized_mass_kg = 2000.0\nparticipation = { x = 1.0, y = 0.5 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, airframe.mode[0].participation", "roll with y"]),
     case("rotor airframe mode direction twice", rotor!("[damper]\nmodel", "[[airframe.mode]]\nfrequency_Hz = 3.0\ngeneralized_mass_kg = 2000.0\nparticipation = { y = 1.0 }\n\n[[airframe.mode]]\nfrequency_Hz = 2.0\ngeneralized_mass_kg = 900.0\nparticipation = { roll = 1.0, y = 1.2 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, airframe.mode[1].participation", "y moves in an earlier mode"]),
     case("rotor airframe mode negative mass", rotor!("[damper]\nmodel", "[[airframe.mode]]\nfrequency_Hz = 3.0\ngeneralized_mass_kg = -2000.0\nparticipation = { z = 1.0 }\n\n[damper]\nmodel"), EXPAND_R, &["r.toml, airframe.mode[0].generalized_mass_kg", "positive"]),
+    case("rotor aero chord negative", rotor!("chord_m = 0.5273", "chord_m = -0.5"), RUN_COMPUTED, &["r.toml, aero.chord_m", "positive", "-0.5"]),
+    case("rotor aero inflow unknown", rotor!("inflow = \"drees\"", "inflow = \"vortex\""), RUN_COMPUTED, &["r.toml, aero.inflow", "pitt-peters", "vortex"]),
+    case("rotor aero tip loss above 1", rotor!("tip_loss_factor = 0.97", "tip_loss_factor = 1.2"), RUN_COMPUTED, &["r.toml, aero.tip_loss_factor", "(0, 1]"]),
+    case("rotor aero c81 missing", &[("r.toml", Repo(UH60A), &[("c81 = \"../data/airfoils/naca0012.c81\"", "c81 = \"no_such_table.c81\"")])], RUN_COMPUTED, &["r.toml, aero.airfoil", "no_such_table.c81", "cannot read"]),
+    case("rotor aero c81 malformed", &[("r.toml", Repo(UH60A), &[("c81 = \"../data/airfoils/naca0012.c81\"", "c81 = \"bad.c81\"")]), ("bad.c81", Text("BAD 0012                       2 2 2 2 2 2\n       0.0    0.5\n-10.0  -1.1   -1.0\n 10.0  1.1x   1.0\n       0.0    0.5\n-10.0  0.01   0.01\n 10.0  0.01   0.01\n       0.0    0.5\n-10.0  0.0    0.0\n 10.0  0.0    0.0\n"), &[])], RUN_COMPUTED, &["bad.c81 line 4", "columns", "1.1x"]),
+    case("run --airloads unknown", R, &["run", "--rotor", "{T}/r.toml", "--airloads", "cfd", "--revs", "3", "--out", "{T}/out"], &["--airloads", "cfd", "measured, computed or hybrid"]),
+    case("rotor aero unknown key", rotor!("chord_m = 0.5273", "chord_mm = 0.5273"), RUN_COMPUTED, &["r.toml", "chord_mm"]),
+    case("run --airloads hybrid without motion", &[("r.toml", Repo(UH60A), &[]), ("rec", Record("flightdata/c8534like"), &[])], &["run", "--rotor", "{T}/r.toml", "--flight", "{T}/rec", "--airloads", "hybrid", "--revs", "3", "--out", "{T}/out"], &["--airloads hybrid", "rec", "motion"]),
+    case("run --airloads computed on the rigid model", R, &["run", "--model", "rigid", "--rotor", "{T}/r.toml", "--airloads", "computed", "--revs", "3", "--out", "{T}/out"], &["--airloads computed", "--model uh60a", "--model rigid"]),
     // ---- damper decks (bench, diagnose, run --damper-deck) ----
     case("damper model unknown", damper!("model = \"physical\"", "model = \"magic\""), BENCH_D, &["d.toml", "model"]),
     case("damper linear c negative", damper!("c_N_s_per_m = 68000.0", "c_N_s_per_m = -68000.0"), BENCH_D, &["d.toml", "c_N_s_per_m"]),
@@ -397,6 +417,10 @@ fn absolutize(text: String) -> String {
     .replace(
         "deck = \"../../rotors/",
         &format!("deck = \"{}/", r.join("rotors").display()),
+    )
+    .replace(
+        "c81 = \"../data/",
+        &format!("c81 = \"{}/", r.join("data").display()),
     )
 }
 

@@ -501,6 +501,12 @@ impl Inflow {
         self.state[0] + r * (self.state[1] * s + self.state[2] * c)
     }
 
+    /// [`Inflow::lambda_i`] at the disk point `(x, y) / R` (x = r cos psi, y = r sin psi): the
+    /// same value without the trigonometry (the hot loop's form).
+    pub fn lambda_i_at(&self, x: f64, y: f64) -> f64 {
+        self.state[0] + self.state[1] * y + self.state[2] * x
+    }
+
     /// Advances by `dpsi` (= Omega dt, >= 0) under loads `l` held over the step.
     ///
     /// Uniform and Drees are quasi-steady: the state becomes the steady one for `l`. Pitt-Peters

@@ -37,10 +37,11 @@ impl RotorAir {
         let d = sub(x, self.center_m);
         (d[0].hypot(d[1]) / self.radius_m, d[1].atan2(d[0]))
     }
-    /// Air velocity at `x` [m/s]: free stream plus the induced inflow (down along -z).
+    /// Air velocity at `x` [m/s]: free stream plus the induced inflow (down along -z); and
+    /// the inflow ratio there.
     pub fn air_velocity(&self, inflow: &Inflow, x: [f64; 3]) -> ([f64; 3], f64) {
-        let (r, psi) = self.disk_position(x);
-        let li = inflow.lambda_i(r, psi);
+        let d = sub(x, self.center_m);
+        let li = inflow.lambda_i_at(d[0] / self.radius_m, d[1] / self.radius_m);
         let w = li * self.omega_rad_s * self.radius_m;
         (
             [
@@ -105,9 +106,9 @@ pub struct PointRecord {
     /// Radius [m] and quadrature weight [m] of the point.
     pub r_m: f64,
     pub weight_m: f64,
-    /// Disk position of the deformed point: r/R and azimuth [rad].
-    pub disk_r: f64,
-    pub psi_rad: f64,
+    /// Disk position of the deformed point over R: x = r cos(psi), y = r sin(psi).
+    pub disk_x: f64,
+    pub disk_y: f64,
     /// Induced inflow ratio there (positive down).
     pub lambda_i: f64,
     pub section: SectionAirloads,
@@ -144,8 +145,8 @@ impl AeroShared {
             let f = fmul(p.weight_m, p.force_n_per_m);
             t += f[2];
             q -= cross(p.arm_m, f)[2];
-            cs += f[2] * p.disk_r * p.psi_rad.sin();
-            cc += f[2] * p.disk_r * p.psi_rad.cos();
+            cs += f[2] * p.disk_y;
+            cc += f[2] * p.disk_x;
         }
         let n = air.thrust_scale_n();
         RotorAirloads {
@@ -365,11 +366,11 @@ impl LiftingLine {
             None => p.x,
             Some(t) => mv(t, p.x),
         };
-        let (disk_r, psi) = self.rotor.disk_position(x);
+        let d = sub(x, self.rotor.center_m);
         if let Some(rec) = sh.points[self.blade].get_mut(i) {
             rec.t_s = p.t;
-            rec.disk_r = disk_r;
-            rec.psi_rad = psi;
+            rec.disk_x = d[0] / self.rotor.radius_m;
+            rec.disk_y = d[1] / self.rotor.radius_m;
             rec.lambda_i = li;
             rec.section = a;
             rec.force_n_per_m = f_hub;

@@ -188,29 +188,62 @@ pub struct ReferenceMotion {
     model_turn_rad: f64,
     /// Per station of the lifting line: the load point's reference position and section frame.
     points: Vec<([f64; 3], [[f64; 3]; 3])>,
+    /// The blade's rigid motion at the last time asked (every station of an evaluation shares
+    /// it): time, shaft turn, lag-flap turn, pitch turn, relative angular velocity, pitch rate.
+    at: Option<RigidAt>,
+}
+
+#[derive(Clone, Copy)]
+struct RigidAt {
+    t: f64,
+    rz: [[f64; 3]; 3],
+    lf: [[f64; 3]; 3],
+    pitch: [[f64; 3]; 3],
+    w_rel: [f64; 3],
+    w_pitch: [f64; 3],
 }
 
 impl ReferenceMotion {
     /// The reference kinematics of station `i` at time t: the load point the blade would have
     /// moving as the record says (hub frame of the model's blade).
-    fn point(&self, i: usize, p: &LoadPoint) -> LoadPoint {
-        let (x0, r0) = self.points[i];
-        let psi = self.omega * p.t;
+    fn rigid_at(&mut self, t: f64) -> RigidAt {
+        if let Some(a) = self.at.filter(|a| a.t == t) {
+            return a;
+        }
+        let psi = self.omega * t;
         let m = self.motion.at(psi + self.ahead_rad);
-        let rz = exp_map([0.0, 0.0, psi + self.model_turn_rad]);
         let lag = exp_map([0.0, 0.0, -m.lag_rad]);
         let flap = exp_map([0.0, -m.flap_rad, 0.0]);
-        let pitch = exp_map([m.pitch_rad, 0.0, 0.0]);
         let lf = mm(&lag, &flap);
+        let a = RigidAt {
+            t,
+            rz: exp_map([0.0, 0.0, psi + self.model_turn_rad]),
+            lf,
+            pitch: exp_map([m.pitch_rad, 0.0, 0.0]),
+            // angular velocity relative to the turning frame (rotating axes)
+            w_rel: add(
+                [0.0, 0.0, -m.lag_rate_rad_s],
+                mv(&lag, [0.0, -m.flap_rate_rad_s, 0.0]),
+            ),
+            w_pitch: mv(&lf, [m.pitch_rate_rad_s, 0.0, 0.0]),
+        };
+        self.at = Some(a);
+        a
+    }
+
+    fn point(&mut self, i: usize, p: &LoadPoint) -> LoadPoint {
+        let (x0, r0) = self.points[i];
+        let RigidAt {
+            rz,
+            lf,
+            pitch,
+            w_rel,
+            w_pitch,
+            ..
+        } = self.rigid_at(p.t);
         let e = [self.hinge_r_m, 0.0, 0.0];
         let d = mv(&lf, sub(x0, e));
         let x_rot = add(e, d);
-        // angular velocity relative to the turning frame (rotating axes)
-        let w_rel = add(
-            [0.0, 0.0, -m.lag_rate_rad_s],
-            mv(&lag, [0.0, -m.flap_rate_rad_s, 0.0]),
-        );
-        let w_pitch = mv(&lf, [m.pitch_rate_rad_s, 0.0, 0.0]);
         let om = [0.0, 0.0, self.omega];
         let v_rot = add(cross(om, x_rot), cross(w_rel, d));
         LoadPoint {
@@ -225,38 +258,38 @@ impl ReferenceMotion {
     }
 }
 
-/// The turn about the section axis from a section's frame to the frame the airloads are
-/// applied in (the deck's control-pitch frame: the rigid pitch), at a load point [rad].
-pub type PitchCorrection = Box<dyn Fn(&LoadPoint) -> f64 + Send>;
-
 /// The hybrid blade load: the measured airloads plus `ramp(t)` times the lifting line's
 /// airloads at the blade's motion minus those at the reference motion (both with the same
 /// inflow), in the section frame. With the deck's control-pitch airload frame the blade's
 /// sections meet the air at the rigid pitch, as the measured airloads are applied: the
 /// reference motion carries no elastic twist, so the difference is the flap and lag motion's.
-pub struct HybridLoad<M: DistributedLoad> {
-    pub measured: M,
+pub struct HybridLoad {
+    /// The measured airloads; their frame (deformed or control-pitch) is the lifting line's.
+    pub measured: super::sim::BladeAirloads,
     pub line: LiftingLine,
     pub reference: ReferenceMotion,
-    pub pitch_correction: Option<PitchCorrection>,
+    /// Per station: the reference airloads at the time they were last computed (they depend
+    /// on time only, the hybrid inflow being fixed: once per step, not per iteration).
+    pub reference_cache: Vec<(f64, crate::aero::section::SectionAirloads)>,
     /// End of the cyclic ramp [s] (the difference ramps in with the measured harmonics).
     pub t_ramp: f64,
     pub active: Arc<AtomicBool>,
 }
 
-impl<M: DistributedLoad> DistributedLoad for HybridLoad<M> {
+impl DistributedLoad for HybridLoad {
     fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
-        let mut l = self.measured.eval(p);
+        let (mut l, d) = self.measured.eval_with_turn(p);
         if !self.active.load(Ordering::Relaxed) {
             return l;
         }
         let Some(i) = self.line.station(p) else {
             return l;
         };
-        let a = match &self.pitch_correction {
-            None => self.line.evaluate(p),
-            Some(c) => {
-                let turn = exp_map([c(p), 0.0, 0.0]);
+        let a = match d {
+            0.0 => self.line.evaluate(p),
+            d => {
+                let (sd, cd) = d.sin_cos();
+                let turn = [[1.0, 0.0, 0.0], [0.0, cd, -sd], [0.0, sd, cd]];
                 let pc = LoadPoint {
                     r: mm(&p.r, &turn),
                     ..*p
@@ -266,8 +299,17 @@ impl<M: DistributedLoad> DistributedLoad for HybridLoad<M> {
                 a
             }
         };
-        let q = self.reference.point(i, p);
-        let r = self.line.reference_airloads(i, &q);
+        let r = match self.reference_cache.get(i) {
+            Some((t, r)) if *t == p.t => *r,
+            _ => {
+                let q = self.reference.point(i, p);
+                let r = self.line.reference_airloads(i, &q);
+                if let Some(c) = self.reference_cache.get_mut(i) {
+                    *c = (p.t, r);
+                }
+                r
+            }
+        };
         let w = super::expand::ramp(p.t, self.t_ramp);
         for k in 0..3 {
             l.force[k] += w * (a.force[k] - r.force_n_per_m[k]);
@@ -364,6 +406,7 @@ pub fn reference_motion(
         ahead_rad,
         model_turn_rad,
         points,
+        at: None,
     })
 }
 

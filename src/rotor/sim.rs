@@ -42,6 +42,8 @@ struct ControlPitch {
     controls: Controls,
     /// Per model element id: (s_m, reference section pitch [rad]) at its load points.
     reference: std::collections::HashMap<usize, [(f64, f64); NPTS_M]>,
+    /// The commanded pitch at the last time asked (every load point of an evaluation shares it).
+    pitch_at: std::cell::Cell<(f64, f64)>,
 }
 
 impl ControlPitch {
@@ -70,6 +72,7 @@ impl ControlPitch {
             spec: spec.clone(),
             controls,
             reference,
+            pitch_at: std::cell::Cell::new((f64::NAN, 0.0)),
         })
     }
 
@@ -83,7 +86,15 @@ impl ControlPitch {
         });
         match reference {
             Some(theta_ref) => {
-                theta_ref + self.spec.pitch_rad(&self.controls, p.t) - section_pitch(&p.r)
+                let (t, pitch) = self.pitch_at.get();
+                let pitch = if t == p.t {
+                    pitch
+                } else {
+                    let pitch = self.spec.pitch_rad(&self.controls, p.t);
+                    self.pitch_at.set((p.t, pitch));
+                    pitch
+                };
+                theta_ref + pitch - section_pitch(&p.r)
             }
             // every load point of the blade was tabulated at construction (same model, same
             // quadrature); anything else is a bug, not input
@@ -109,6 +120,14 @@ pub fn section_pitch(r: &[[f64; 3]; 3]) -> f64 {
 
 impl DistributedLoad for BladeAirloads {
     fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
+        self.eval_with_turn(p).0
+    }
+}
+
+impl BladeAirloads {
+    /// The load, and the turn d about the section axis from the section's frame to the frame
+    /// the loads are applied in (0 in the deformed frame).
+    pub(crate) fn eval_with_turn(&mut self, p: &LoadPoint) -> (SectionLoad, f64) {
         let r = self.root_r_m + p.s_m;
         let m = self.mean.section_loads_ahead(p.t, r, self.ahead_deg);
         let w = ramp(p.t, self.t_ramp);
@@ -129,21 +148,20 @@ impl DistributedLoad for BladeAirloads {
         // d comes from the iterate of each residual evaluation, so the residual is exact; the
         // beam's tangent differentiates the frame R only and keeps a twist stiffness this load
         // lacks (a quasi-Newton tangent: 2.83 iterations/step, as in the deformed frame).
-        let (fy, fz) = match &self.control_pitch {
-            None => (-l.chord_N_per_m, l.normal_N_per_m),
-            Some(c) => {
-                let (sd, cd) = c.correction(p).sin_cos();
-                (
-                    -l.normal_N_per_m * sd - l.chord_N_per_m * cd,
-                    l.normal_N_per_m * cd - l.chord_N_per_m * sd,
-                )
-            }
-        };
-        SectionLoad {
-            force: [0.0, k * fy, k * fz],
-            moment: [k * l.moment_N_m_per_m, 0.0, 0.0],
-            follower: true,
-        }
+        let d = self.control_pitch.as_ref().map_or(0.0, |c| c.correction(p));
+        let (sd, cd) = d.sin_cos();
+        let (fy, fz) = (
+            -l.normal_N_per_m * sd - l.chord_N_per_m * cd,
+            l.normal_N_per_m * cd - l.chord_N_per_m * sd,
+        );
+        (
+            SectionLoad {
+                force: [0.0, k * fy, k * fz],
+                moment: [k * l.moment_N_m_per_m, 0.0, 0.0],
+                follower: true,
+            },
+            d,
+        )
     }
 }
 
@@ -562,20 +580,12 @@ fn build_parts(
                         ahead,
                         model_turn,
                     )?;
-                    let pitch_correction: Option<super::aero::PitchCorrection> =
-                        match bspec.blade.airload_frame {
-                            AirloadFrame::Deformed => None,
-                            AirloadFrame::ControlPitch => {
-                                let c =
-                                    ControlPitch::new(bspec, controls, &model, &nm(names::BLADE))?;
-                                Some(Box::new(move |p: &LoadPoint| c.correction(p)))
-                            }
-                        };
+                    let stations = line.stations();
                     Box::new(HybridLoad {
                         measured: airloads,
                         line,
                         reference,
-                        pitch_correction,
+                        reference_cache: vec![(f64::NAN, Default::default()); stations],
                         t_ramp,
                         active: aero_active.clone(),
                     })
