@@ -1196,6 +1196,7 @@ pub fn report_html(
         );
     }
     blade_loads(&mut rep, &runs);
+    airloads(&mut rep, &runs);
     whole_rotor(&mut rep, info, &runs);
     rep.heading(2, "Conventions");
     rep.paragraph("Azimuth: docs/formats.md, 0 over the tail, increasing with rotation; model time 0 is azimuth 0 of the reference blade. Damper force positive when it pushes its end points apart (Eq. 8), stroke positive in extension. The model's last revolution is interpolated (periodic linear interpolation) at the measured azimuths; the measurement is the record's damper channel averaged over its revolutions, azimuth by azimuth, never resampled. No time shift is applied to the comparison; the best shift is reported as evidence only. Details: docs/run.md.");
@@ -1291,6 +1292,123 @@ pub fn floquet_rows(runs: &[&ModelRun]) -> Vec<Vec<String>> {
 
 /// Radial distributions of the section loads, pitch-link and root loads vs azimuth, and the
 /// N/rev hub loads (docs/loads.md).
+/// Lifting-line runs: the computed normal force against the record's over azimuth at three
+/// stations and over radius at four azimuths, and the rotor's thrust.
+fn airloads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+    let with: Vec<&ModelRun> = runs
+        .iter()
+        .copied()
+        .filter(|r| r.airloads.is_some())
+        .collect();
+    let Some(first) = with.first() else { return };
+    let Some(a) = &first.airloads else { return };
+    rep.heading(2, "Airloads");
+    let ct = |r: &ModelRun| {
+        r.channel("rotor_CT_over_sigma")
+            .map(|v| v.iter().sum::<f64>() / v.len().max(1) as f64)
+    };
+    rep.paragraph(&format!(
+        "Airloads {} with the lifting line ({} inflow; {}). Thrust coefficient over solidity {}{}. The measured normal force is the record's{} (docs/aerodynamics.md).",
+        a.source,
+        a.inflow,
+        a.airfoils.join(", "),
+        with.iter()
+            .map(|r| format!("{} {:.4}", r.label, ct(r).unwrap_or(f64::NAN)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        a.record_ct_over_sigma
+            .map(|v| format!(" against the record's {v:.4} (a plausibility comparison)"))
+            .unwrap_or_default(),
+        if a.record_synthetic { ", SYNTHETIC" } else { "" },
+    ));
+    if a.clamped_queries > 0 {
+        rep.paragraph(&format!(
+            "Aerofoil tables clamped {} queries to their edges (not extrapolated): {}.",
+            a.clamped_queries, a.clamps
+        ));
+    }
+    // stations r/R of the normal-force channels
+    let prefix = "aero_normal_N_per_m_r";
+    let stations: Vec<(String, f64)> = first
+        .channel_names
+        .iter()
+        .filter_map(|c| {
+            let r = c.strip_prefix(prefix)?;
+            Some((r.to_string(), r.parse().ok()?))
+        })
+        .collect();
+    if stations.is_empty() {
+        return;
+    }
+    let normal = |r: &ModelRun, st: &str| -> Option<(Vec<f64>, Vec<f64>)> {
+        let c = r.channel(&format!("{prefix}{st}"))?;
+        let d = r.channel(&format!("aero_normal_minus_measured_N_per_m_r{st}"))?;
+        Some((c.to_vec(), c.iter().zip(d).map(|(c, d)| c - d).collect()))
+    };
+    let mut plots = vec![];
+    let n = stations.len();
+    for k in [n / 3, (2 * n) / 3, n.saturating_sub(2)] {
+        let (st, x) = &stations[k.min(n - 1)];
+        let mut p = Plot::new(
+            &format!("normal force at r/R = {x:.3}"),
+            "azimuth of blade 1 [deg]",
+            "normal force [N/m]",
+        )
+        .azimuth();
+        let mut measured_drawn = false;
+        for r in &with {
+            let Some((c, m)) = normal(r, st) else {
+                continue;
+            };
+            if !measured_drawn {
+                p = p.dashed("measured", &closed_x(&r.azimuth_deg), &closed(&m));
+                measured_drawn = true;
+            }
+            p = p.line(
+                &format!("{} ({})", r.label, a.source),
+                &closed_x(&r.azimuth_deg),
+                &closed(&c),
+            );
+        }
+        plots.push(p);
+    }
+    svg(
+        rep,
+        "The lifting line's normal force against the record's over the revolution, at three stations (blade 1, section frame).",
+        &plots,
+    );
+    let r = first;
+    let nr = r.azimuth_deg.len();
+    let xs: Vec<f64> = stations.iter().map(|s| s.1).collect();
+    let mut p = Plot::new(
+        &format!("{}: normal force over radius", r.label),
+        "r/R",
+        "normal force [N/m]",
+    );
+    for q in 0..4 {
+        let j = q * nr / 4;
+        let (mut c, mut m) = (vec![], vec![]);
+        for (st, _) in &stations {
+            if let Some((cv, mv)) = normal(r, st) {
+                c.push(cv[j]);
+                m.push(mv[j]);
+            }
+        }
+        let psi = r.azimuth_deg[j];
+        let colour = crate::report::plot::OTHER_COLOURS[q];
+        p = p
+            .line(&format!("computed, {psi:.0} deg"), &xs, &c)
+            .colour(colour)
+            .dashed(&format!("measured, {psi:.0} deg"), &xs, &m)
+            .colour(colour);
+    }
+    svg(
+        rep,
+        "The normal force over radius at four azimuths: the lifting line's (solid) and the record's (dashed).",
+        &[p],
+    );
+}
+
 fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     use crate::rotor::deck::SECTION_KINDS;
     let with: Vec<&ModelRun> = runs
