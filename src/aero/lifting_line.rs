@@ -32,11 +32,6 @@ pub struct RotorAir {
 }
 
 impl RotorAir {
-    /// Radius over R and azimuth [rad] of `x` (azimuth from +x, counter-clockwise from above).
-    pub fn disk_position(&self, x: [f64; 3]) -> (f64, f64) {
-        let d = sub(x, self.center_m);
-        (d[0].hypot(d[1]) / self.radius_m, d[1].atan2(d[0]))
-    }
     /// Air velocity at `x` [m/s]: free stream plus the induced inflow (down along -z); and
     /// the inflow ratio there.
     pub fn air_velocity(&self, inflow: &Inflow, x: [f64; 3]) -> ([f64; 3], f64) {

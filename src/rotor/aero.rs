@@ -4,7 +4,7 @@
 //! airloads plus the lifting line's difference between the blade's motion and a reference
 //! motion (the record's measured blade motion).
 use super::deck::RotorSpec;
-use crate::aero::airfoil::{Airfoil, ClampCounts, ThinAirfoil};
+use crate::aero::airfoil::{Airfoil, ThinAirfoil};
 use crate::aero::c81::C81Table;
 use crate::aero::inflow::{DiskLoads, FlightCondition, InflowModel};
 use crate::aero::lifting_line::{BladeAero, LiftingLine, RotorAir};
@@ -408,9 +408,4 @@ pub fn reference_motion(
         points,
         at: None,
     })
-}
-
-/// Counted table clamps of the run, in words (empty: none).
-pub fn clamp_warning(c: &ClampCounts) -> String {
-    c.summary()
 }
