@@ -189,17 +189,12 @@ impl Run {
     }
 }
 
-/// (mean, cos, sin) harmonics of one revolution sampled at k 2 pi / n.
+/// (mean, cos, sin) harmonics of one revolution sampled at k 2 pi / n (the library's fit).
 fn harmonics(x: &[f64]) -> (f64, f64, f64) {
-    let n = x.len() as f64;
-    let (mut a0, mut a1, mut b1) = (0.0, 0.0, 0.0);
-    for (k, v) in x.iter().enumerate() {
-        let psi = 2.0 * PI * k as f64 / n;
-        a0 += v / n;
-        a1 += 2.0 * v * psi.cos() / n;
-        b1 += 2.0 * v * psi.sin() / n;
-    }
-    (a0, a1, b1)
+    let n = x.len();
+    let psi: Vec<f64> = (0..n).map(|k| 360.0 * k as f64 / n as f64).collect();
+    let h = rotorsim::analysis::harmonics::harmonics(&psi, x, 1).unwrap();
+    (h[0].cos, h[1].cos, h[1].sin)
 }
 
 /// The classical closed form (Johnson, Helicopter Theory, sec. 5.5, for nu = 1, no offset, no

@@ -12,11 +12,12 @@
 //! differences.
 mod support;
 
+use rotorsim::analysis::harmonics::harmonics;
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::aero::AirloadSource;
 use rotorsim::run::job::{DamperChoice, RunJob};
+use rotorsim::run::summary::Stats;
 use rotorsim::run::{ModelRun, Silent};
-use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 /// The shipped record with the 1/rev of its normal force (per revolution and station) scaled
@@ -96,27 +97,6 @@ fn channel<'a>(r: &'a ModelRun, name: &str) -> &'a [f64] {
     &r.last_rev[i]
 }
 
-/// Amplitude of the 1/rev of a revolution sampled uniformly.
-fn one_per_rev(x: &[f64]) -> f64 {
-    let n = x.len() as f64;
-    let (mut a, mut b) = (0.0, 0.0);
-    for (k, v) in x.iter().enumerate() {
-        let psi = 2.0 * PI * k as f64 / n;
-        a += 2.0 * v * psi.cos() / n;
-        b += 2.0 * v * psi.sin() / n;
-    }
-    a.hypot(b)
-}
-
-fn peak_to_peak(x: &[f64]) -> f64 {
-    let (lo, hi) = x
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-            (l.min(*v), h.max(*v))
-        });
-    hi - lo
-}
-
 #[test]
 fn hybrid_airloads_condition_the_flapping() {
     let tmp = support::tmp("aero_hybrid");
@@ -126,7 +106,8 @@ fn hybrid_airloads_condition_the_flapping() {
     let m1 = run(&more, AirloadSource::Measured, &tmp.join("m1"));
     let h0 = run(&base, AirloadSource::Hybrid, &tmp.join("h0"));
     let h1 = run(&more, AirloadSource::Hybrid, &tmp.join("h1"));
-    let flap = |r: &ModelRun| one_per_rev(channel(r, "tip_flap_m"));
+    let flap =
+        |r: &ModelRun| harmonics(&r.azimuth_deg, channel(r, "tip_flap_m"), 1).unwrap()[1].amplitude;
     let dm = flap(&m1) / flap(&m0) - 1.0;
     let dh = flap(&h1) / flap(&h0) - 1.0;
     println!(
@@ -174,7 +155,7 @@ fn hybrid_airloads_condition_the_flapping() {
                 && !c.starts_with("check_"))
     }) {
         let (a, b) = (channel(&m0, name), channel(&h0, name));
-        let pp = peak_to_peak(a);
+        let pp = Stats::of(a).peak_to_peak;
         let d = a
             .iter()
             .zip(b)

@@ -495,6 +495,17 @@ pub fn read_mcap_from(
                         let bad_json = |e: serde_json::Error| {
                             msg_err(format!("does not match schema `{}`: {e}", kind.schema().0))
                         };
+                        // a sample's azimuth, checked, and its time stamp (every sampled channel)
+                        let log_time = header.log_time;
+                        let mut stamp = |revolution: u32, azimuth_deg: f64| {
+                            if !(0.0..360.0).contains(&azimuth_deg) {
+                                return Err(msg_err(format!(
+                                    "azimuth_deg {azimuth_deg} is outside [0, 360)"
+                                )));
+                            }
+                            times.push((kind, index, log_time, revolution, azimuth_deg));
+                            Ok(())
+                        };
                         match kind {
                             Kind::Meta => {
                                 if meta.is_some() {
@@ -523,24 +534,12 @@ pub fn read_mcap_from(
                                         m.moment.len()
                                     )));
                                 }
-                                if !(0.0..360.0).contains(&m.azimuth_deg) {
-                                    return Err(msg_err(format!(
-                                        "azimuth_deg {} is outside [0, 360)",
-                                        m.azimuth_deg
-                                    )));
-                                }
+                                stamp(m.revolution, m.azimuth_deg)?;
                                 if let Some(r) =
                                     m.r_over_r.iter().find(|&&r| !(r > 0.0 && r <= 1.0))
                                 {
                                     return Err(msg_err(format!("r_over_R {r} is outside (0, 1]")));
                                 }
-                                times.push((
-                                    kind,
-                                    index,
-                                    header.log_time,
-                                    m.revolution,
-                                    m.azimuth_deg,
-                                ));
                                 for k in 0..n {
                                     rows.push(
                                         m.revolution,
@@ -554,19 +553,7 @@ pub fn read_mcap_from(
                             Kind::Damper => {
                                 let m: DamperMsg =
                                     serde_json::from_slice(&data).map_err(bad_json)?;
-                                if !(0.0..360.0).contains(&m.azimuth_deg) {
-                                    return Err(msg_err(format!(
-                                        "azimuth_deg {} is outside [0, 360)",
-                                        m.azimuth_deg
-                                    )));
-                                }
-                                times.push((
-                                    kind,
-                                    index,
-                                    header.log_time,
-                                    m.revolution,
-                                    m.azimuth_deg,
-                                ));
+                                stamp(m.revolution, m.azimuth_deg)?;
                                 damper.push(DamperSample {
                                     revolution: m.revolution,
                                     azimuth_deg: m.azimuth_deg,
@@ -578,19 +565,7 @@ pub fn read_mcap_from(
                             Kind::Motion => {
                                 let m: MotionMsg =
                                     serde_json::from_slice(&data).map_err(bad_json)?;
-                                if !(0.0..360.0).contains(&m.azimuth_deg) {
-                                    return Err(msg_err(format!(
-                                        "azimuth_deg {} is outside [0, 360)",
-                                        m.azimuth_deg
-                                    )));
-                                }
-                                times.push((
-                                    kind,
-                                    index,
-                                    header.log_time,
-                                    m.revolution,
-                                    m.azimuth_deg,
-                                ));
+                                stamp(m.revolution, m.azimuth_deg)?;
                                 motion_rows.push((
                                     m.revolution,
                                     m.azimuth_deg,
