@@ -82,8 +82,11 @@ pub struct RunArgs {
     pub all_blades: bool,
     /// Where the blade's airloads come from: measured (the record's, replayed), computed (a
     /// lifting line with the deck's [aero] table and an inflow model, under the record's
-    /// controls: a prediction) or hybrid (the record's airloads plus the lifting line's
-    /// difference between the blade's motion and the record's measured blade motion).
+    /// controls: a prediction), hybrid (the record's airloads plus the lifting line's
+    /// difference between the blade's motion and the record's measured blade motion, or the
+    /// periodic solution's where the record has none) or hybrid-periodic (that difference
+    /// from the periodic solution under the measured airloads: the measured answer, with
+    /// aerodynamic damping of transients and in the Floquet multipliers).
     /// docs/aerodynamics.md.
     #[arg(long, default_value = "measured")]
     pub airloads: String,
@@ -189,7 +192,7 @@ fn print_summary(outcome: &RunOutcome) {
                     outln!(
                         "{:<22} {} airloads ({} inflow): thrust coefficient over solidity {:.4}{}",
                         "",
-                        a.source,
+                        a.source_text(),
                         a.inflow,
                         mean,
                         a.record_ct_over_sigma

@@ -2,7 +2,8 @@
 //! come from (`--airloads measured|computed|hybrid`), the air and free stream of the record,
 //! the blade's lifting line from the deck's `[aero]` table, and the hybrid load: the measured
 //! airloads plus the lifting line's difference between the blade's motion and a reference
-//! motion (the record's measured blade motion).
+//! motion (the record's measured blade motion, or the periodic solution under the measured
+//! airloads itself).
 use super::deck::RotorSpec;
 use crate::aero::airfoil::{Airfoil, ThinAirfoil};
 use crate::aero::c81::C81Table;
@@ -27,8 +28,13 @@ pub enum AirloadSource {
     /// The lifting line and the inflow with the record's controls: a prediction.
     Computed,
     /// Measured airloads plus the lifting line's difference between the blade's motion and the
-    /// record's measured motion.
+    /// record's measured motion (the periodic solution's where the record has none).
     Hybrid,
+    /// Measured airloads plus the lifting line's difference between the blade's motion and the
+    /// periodic solution under the measured airloads: the periodic answer is the measured
+    /// one, the aerodynamics act on transients and the Floquet stability.
+    #[serde(rename = "hybrid-periodic")]
+    HybridPeriodic,
 }
 
 impl AirloadSource {
@@ -37,11 +43,16 @@ impl AirloadSource {
             AirloadSource::Measured => "measured",
             AirloadSource::Computed => "computed",
             AirloadSource::Hybrid => "hybrid",
+            AirloadSource::HybridPeriodic => "hybrid-periodic",
         }
     }
     /// Whether the lifting line runs.
     pub fn aerodynamic(self) -> bool {
         self != AirloadSource::Measured
+    }
+    /// Whether the measured airloads are kept and the lifting line adds a difference.
+    pub fn hybrid(self) -> bool {
+        matches!(self, AirloadSource::Hybrid | AirloadSource::HybridPeriodic)
     }
 }
 
@@ -52,8 +63,9 @@ impl std::str::FromStr for AirloadSource {
             "measured" => Ok(AirloadSource::Measured),
             "computed" => Ok(AirloadSource::Computed),
             "hybrid" => Ok(AirloadSource::Hybrid),
+            "hybrid-periodic" => Ok(AirloadSource::HybridPeriodic),
             _ => Err(format!(
-                "unknown airload source `{s}` (expected measured, computed or hybrid)"
+                "unknown airload source `{s}` (expected measured, computed, hybrid or hybrid-periodic)"
             )),
         }
     }
@@ -258,6 +270,72 @@ impl ReferenceMotion {
     }
 }
 
+/// The lifting line's airloads along the periodic solution under the measured airloads, per
+/// station and step of the revolution: recorded while the run finds that solution (each step's
+/// last evaluation is at its converged state), then adopted as the hybrid's reference.
+pub struct PeriodicReference {
+    /// Per station, per step of the revolution: force per span (section frame of the load
+    /// applied) [N/m] and pitching moment per span [N m/m].
+    table: Vec<Vec<([f64; 3], f64)>>,
+    h_s: f64,
+    /// Recording (false) or adopted (true); the run flips it between the two solutions.
+    pub adopted: Arc<AtomicBool>,
+}
+
+impl PeriodicReference {
+    pub fn new(stations: usize, steps_per_rev: usize, h_s: f64, adopted: Arc<AtomicBool>) -> Self {
+        PeriodicReference {
+            // NaN until recorded: a step never recorded fails the run visibly, not silently
+            table: vec![vec![([f64::NAN; 3], f64::NAN); steps_per_rev]; stations],
+            h_s,
+            adopted,
+        }
+    }
+
+    /// Time t as a step of the revolution and the fraction to the next one.
+    fn slot(&self, t: f64) -> (usize, f64) {
+        let n = self.table.first().map_or(1, Vec::len).max(1);
+        let x = t / self.h_s;
+        let k = x.floor();
+        let f = x - k;
+        ((k as i64).rem_euclid(n as i64) as usize, f)
+    }
+
+    fn record(&mut self, i: usize, t: f64, a: &SectionLoad) {
+        let (k, f) = self.slot(t);
+        // only at the steps' own times (the loads of a step are evaluated at its end)
+        let k = match f {
+            f if f < 1e-6 => k,
+            f if f > 1.0 - 1e-6 => (k + 1) % self.table[i].len(),
+            _ => return,
+        };
+        if let Some(row) = self.table.get_mut(i) {
+            row[k] = (a.force, a.moment[0]);
+        }
+    }
+
+    /// The reference at time t (linear between steps: the steps' own times are exact).
+    fn at(&self, i: usize, t: f64) -> ([f64; 3], f64) {
+        let Some(row) = self.table.get(i) else {
+            return ([0.0; 3], 0.0);
+        };
+        let (k, f) = self.slot(t);
+        let (a, b) = (row[k], row[(k + 1) % row.len()]);
+        (
+            std::array::from_fn(|j| a.0[j] + f * (b.0[j] - a.0[j])),
+            a.1 + f * (b.1 - a.1),
+        )
+    }
+}
+
+/// The hybrid's reference motion.
+pub enum Reference {
+    /// The record's measured rigid blade motion.
+    Record(Box<ReferenceMotion>),
+    /// The periodic solution under the measured airloads.
+    Periodic(PeriodicReference),
+}
+
 /// The hybrid blade load: the measured airloads plus `ramp(t)` times the lifting line's
 /// airloads at the blade's motion minus those at the reference motion (both with the same
 /// inflow), in the section frame. With the deck's control-pitch airload frame the blade's
@@ -267,7 +345,7 @@ pub struct HybridLoad {
     /// The measured airloads; their frame (deformed or control-pitch) is the lifting line's.
     pub measured: super::sim::BladeAirloads,
     pub line: LiftingLine,
-    pub reference: ReferenceMotion,
+    pub reference: Reference,
     /// Per station: the reference airloads at the time they were last computed (they depend
     /// on time only, the hybrid inflow being fixed: once per step, not per iteration).
     pub reference_cache: Vec<(f64, crate::aero::section::SectionAirloads)>,
@@ -299,22 +377,31 @@ impl DistributedLoad for HybridLoad {
                 a
             }
         };
-        let r = match self.reference_cache.get(i) {
-            Some((t, r)) if *t == p.t => *r,
-            _ => {
-                let q = self.reference.point(i, p);
-                let r = self.line.reference_airloads(i, &q);
-                if let Some(c) = self.reference_cache.get_mut(i) {
-                    *c = (p.t, r);
+        let (rf, rm) = match &mut self.reference {
+            Reference::Periodic(r) => {
+                if !r.adopted.load(Ordering::Relaxed) {
+                    r.record(i, p.t, &a);
+                    return l;
                 }
-                r
+                r.at(i, p.t)
             }
+            Reference::Record(reference) => match self.reference_cache.get(i) {
+                Some((t, r)) if *t == p.t => (r.force_n_per_m, r.moment_n_m_per_m),
+                _ => {
+                    let q = reference.point(i, p);
+                    let r = self.line.reference_airloads(i, &q);
+                    if let Some(c) = self.reference_cache.get_mut(i) {
+                        *c = (p.t, r);
+                    }
+                    (r.force_n_per_m, r.moment_n_m_per_m)
+                }
+            },
         };
         let w = super::expand::ramp(p.t, self.t_ramp);
-        for k in 0..3 {
-            l.force[k] += w * (a.force[k] - r.force_n_per_m[k]);
+        for ((f, a), r) in l.force.iter_mut().zip(a.force).zip(rf) {
+            *f += w * (a - r);
         }
-        l.moment[0] += w * (a.moment[0] - r.moment_n_m_per_m);
+        l.moment[0] += w * (a.moment[0] - rm);
         l
     }
 }

@@ -27,6 +27,11 @@ pub const ROOT_CHANNELS: [&str; 6] = [
 
 pub const PITCH_LINK_CHANNEL: &str = "pitch_link_force_N";
 
+/// The elastomeric bearing's angles (its three revolute joints: lag about -z, flap about -y,
+/// pitch about +x of the hub frame, in that order from the hub), positive lag back, flap up,
+/// pitch nose up: the rigid blade motion a flight record's motion channels measure.
+pub const HINGE_CHANNELS: [&str; 3] = ["lag_hinge_rad", "flap_hinge_rad", "pitch_bearing_rad"];
+
 /// The damper's end nodes (hub end, blade end), their positions at the start of the last
 /// step and the force it applied over the step (positive along the blade end's line).
 #[derive(Clone, Copy, Debug)]
@@ -78,6 +83,8 @@ pub struct LoadChannels {
     /// The swashplate drive that carries the pitch link to the hub (whole rotor, for the
     /// loads on the hub).
     swash_drive: usize,
+    /// The bearing's lag, flap and pitch joints ([`HINGE_CHANNELS`]).
+    hinges: [usize; 3],
 }
 
 fn beam_ids<'a>(m: &'a Model, name: &str) -> anyhow::Result<&'a [usize]> {
@@ -155,6 +162,12 @@ impl LoadChannels {
         names_v.push(PITCH_LINK_CHANNEL.to_string());
         names_v.extend(ROOT_CHANNELS.iter().map(|s| s.to_string()));
         names_v.extend(ROOT_CHANNELS.iter().map(|s| format!("{CHECK_PREFIX}{s}")));
+        names_v.extend(HINGE_CHANNELS.iter().map(|s| s.to_string()));
+        let hinges = [
+            element(m, names::LAG)?,
+            element(m, names::FLAP)?,
+            element(m, names::PITCH)?,
+        ];
         let link_ids = beam_ids(m, "pitch_link")?;
         let half = 0.5 * spec.pitch_control.link_length_m;
         let link = Station {
@@ -206,6 +219,7 @@ impl LoadChannels {
             lam_off: loads::lambda_offsets(m),
             frame: [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]],
             swash_drive,
+            hinges,
         })
     }
 
@@ -348,6 +362,14 @@ impl LoadChannels {
             out[i..i + 3].copy_from_slice(&l.force);
             out[i + 3..i + 6].copy_from_slice(&l.moment);
             i += 6;
+        }
+        let kin = |n: Option<usize>| n.map_or_else(NodeKin::ground, |n| st.node_kin(n));
+        for &e in &self.hinges {
+            let Element::Joint(j) = &m.elements[e] else {
+                anyhow::bail!("element {e} is not a joint");
+            };
+            out[i] = j.angle(&kin(j.node_a), &kin(Some(j.node_b)));
+            i += 1;
         }
         Ok(())
     }

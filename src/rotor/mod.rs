@@ -77,12 +77,13 @@ impl ReliefRegulation {
     }
 }
 
-/// One time-marching forced-response simulation of a rotor blade with one damper model.
 /// What a run with aerodynamics reports besides its channels.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct AirloadInfo {
-    /// "measured", "computed" or "hybrid".
+    /// "measured", "computed", "hybrid" or "hybrid-periodic".
     pub source: String,
+    /// The hybrid's reference motion in words ("" for the other sources).
+    pub reference: String,
     /// The inflow model ("uniform", "drees", "pitt-peters").
     pub inflow: String,
     /// The aerofoils, inboard first.
@@ -96,6 +97,17 @@ pub struct AirloadInfo {
     pub record_synthetic: bool,
 }
 
+impl AirloadInfo {
+    /// The source with the hybrid's reference, in words.
+    pub fn source_text(&self) -> String {
+        match self.reference.as_str() {
+            "" => self.source.clone(),
+            r => format!("{} (reference: {r})", self.source),
+        }
+    }
+}
+
+/// One time-marching forced-response simulation of a rotor blade with one damper model.
 pub trait ForcedResponse: Send {
     /// Model label: "linear", "nonlinear" or "physical".
     fn label(&self) -> &str;
@@ -154,11 +166,19 @@ pub trait ForcedResponse: Send {
     fn periodic_from_s(&self) -> f64 {
         0.0
     }
-    /// Which motion dominates a (complex) mode given in the coordinates of
     /// The airloads' source, inflow and aerofoil-table clamps (None: replayed airloads only).
     fn airload_info(&self) -> Option<AirloadInfo> {
         None
     }
+    /// Hybrid airloads referenced to the periodic solution itself, not yet adopted: the run
+    /// first finds the periodic solution under the measured airloads.
+    fn reference_pending(&self) -> bool {
+        false
+    }
+    /// Adopts the revolution just integrated (from a periodic state) as the hybrid's
+    /// reference: from now on the lifting line's difference from it acts.
+    fn adopt_reference(&mut self) {}
+    /// Which motion dominates a (complex) mode given in the coordinates of
     /// [`SimState::coords`]: "lag", "flap", "torsion", ... ("" when unknown).
     fn mode_label(&self, _re: &[f64], _im: &[f64]) -> String {
         String::new()

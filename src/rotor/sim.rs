@@ -298,6 +298,8 @@ pub struct RotorSim {
     in_whole_rotor: bool,
     /// The lifting lines and their inflow (computed and hybrid airloads).
     aero: Option<AeroRun>,
+    /// The hybrid's periodic reference: whether adopted (None: no such reference).
+    reference_adopted: Option<Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// The rotor's aerodynamics in a run: what the lifting lines share, and the output stations.
@@ -455,6 +457,8 @@ fn build_parts(
     // the lifting lines' shared state (computed and hybrid airloads); off in the statics
     let source = opts.airloads;
     let aero_active = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    // the hybrid's periodic reference: recorded first, adopted once the run has found it
+    let reference_adopted = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let aero_common = if source.aerodynamic() {
         use crate::aero::inflow::Inflow;
         let air = super::aero::rotor_air(spec, record)?;
@@ -570,17 +574,26 @@ fn build_parts(
                     k,
                 )?
                 .with_turn(ahead - model_turn);
-                if source == AirloadSource::Hybrid {
-                    let reference = super::aero::reference_motion(
-                        record,
-                        bspec,
-                        &model,
-                        &nm(names::BLADE),
-                        &line,
-                        ahead,
-                        model_turn,
-                    )?;
+                if source.hybrid() {
                     let stations = line.stations();
+                    let reference = if source == AirloadSource::Hybrid && record.motion.is_some() {
+                        super::aero::Reference::Record(Box::new(super::aero::reference_motion(
+                            record,
+                            bspec,
+                            &model,
+                            &nm(names::BLADE),
+                            &line,
+                            ahead,
+                            model_turn,
+                        )?))
+                    } else {
+                        super::aero::Reference::Periodic(super::aero::PeriodicReference::new(
+                            stations,
+                            opts.steps_per_rev,
+                            period / opts.steps_per_rev as f64,
+                            reference_adopted.clone(),
+                        ))
+                    };
                     Box::new(HybridLoad {
                         measured: airloads,
                         line,
@@ -793,6 +806,9 @@ fn build_parts(
         output_channels: true,
         in_whole_rotor: whole || opts.blade_azimuth_deg.is_some(),
         aero,
+        reference_adopted: (source == super::aero::AirloadSource::HybridPeriodic
+            || (source == super::aero::AirloadSource::Hybrid && record.motion.is_none()))
+        .then_some(reference_adopted),
     })
 }
 
@@ -1267,6 +1283,16 @@ impl ForcedResponse for RotorSim {
         }
         Ok(())
     }
+    fn reference_pending(&self) -> bool {
+        self.reference_adopted
+            .as_ref()
+            .is_some_and(|a| !a.load(Ordering::Relaxed))
+    }
+    fn adopt_reference(&mut self) {
+        if let Some(a) = &self.reference_adopted {
+            a.store(true, Ordering::Relaxed);
+        }
+    }
     fn airload_info(&self) -> Option<super::AirloadInfo> {
         let a = self.aero.as_ref()?;
         let inflow = a
@@ -1276,6 +1302,11 @@ impl ForcedResponse for RotorSim {
             .unwrap_or_default();
         Some(super::AirloadInfo {
             source: a.source.name().to_string(),
+            reference: match (a.source.hybrid(), &self.reference_adopted) {
+                (false, _) => String::new(),
+                (true, None) => "the record's measured blade motion".into(),
+                (true, Some(_)) => "the periodic solution under the measured airloads".into(),
+            },
             inflow,
             airfoils: a.airfoils.clone(),
             clamped_queries: a.clamps.total(),

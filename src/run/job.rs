@@ -569,13 +569,6 @@ impl RunJob {
             // the deck's aerodynamics and the record's air, checked before anything runs
             crate::rotor::aero::blade_geometry(&r.spec, &self.rotor)?;
             crate::rotor::aero::rotor_air(&r.spec, record)?;
-            if self.airloads == crate::rotor::aero::AirloadSource::Hybrid && record.motion.is_none()
-            {
-                bail!(
-                    "--airloads hybrid: the flight record {} has no measured blade motion (STEM.motion.csv, docs/formats.md)",
-                    self.flight.display()
-                );
-            }
         }
         if self.model == RotorModel::Uh60a {
             let (ndof, nnz) = r.spec.size_estimate();

@@ -224,7 +224,66 @@ pub const MARCH_BEFORE_SHOOTING: usize = 2;
 /// Drives `sim` to its periodic solution (`o.method`), at most `o.max_revs` revolutions, and
 /// keeps the reported revolution: sampled at the start of each of its steps (azimuths 0,
 /// 360/N, ...), exactly one period of samples.
+///
+/// Hybrid airloads referenced to the periodic solution itself take two solutions: the one
+/// under the measured airloads (the lifting line recording along it), then, from it and with
+/// the lifting line's difference acting, the hybrid's, whose Floquet multipliers carry the
+/// aerodynamic damping (its periodic answer is the first one's, within the tolerance).
 pub fn drive_periodic(
+    sim: &mut dyn ForcedResponse,
+    model: DamperModel,
+    o: &PeriodicOptions,
+    progress: &dyn Fn(usize, Option<f64>),
+) -> anyhow::Result<ModelRun> {
+    if !sim.reference_pending() {
+        return drive_periodic_once(sim, model, o, progress);
+    }
+    let t_start = Instant::now();
+    let first = drive_periodic_once(sim, model, o, progress)?;
+    let (true, Some(start)) = (first.periodic.converged, first.periodic_state.as_ref()) else {
+        anyhow::bail!(
+            "{}: hybrid airloads need the periodic solution under the measured airloads as their reference, and it was not found: residual {:.2e} after {} revolutions, above the tolerance {:.0e} (more --revs, --periodic shooting)",
+            sim.label(),
+            first.periodic.residual,
+            first.revolutions,
+            o.tol
+        );
+    };
+    // the lifting line along the periodic solution, one clean revolution from its start
+    sim.restore_state(start)?;
+    let n = first.steps_per_rev;
+    let mut rev = Revolution::new(first.channel_names.len(), n);
+    integrate(
+        sim,
+        &mut rev,
+        &format!("{} model, hybrid reference", model.name()),
+    )?;
+    sim.adopt_reference();
+    sim.restore_state(start)?;
+    let second_opts = PeriodicOptions {
+        initial_state: None,
+        max_revs: o.max_revs.saturating_sub(first.revolutions + 1).max(2),
+        min_floquet_dirs: o.min_floquet_dirs.max(FLOQUET_REPORTED),
+        ..o.clone()
+    };
+    let before = first.revolutions + 1;
+    let mut run = drive_periodic_once(sim, model, &second_opts, &|p, r| progress(p + before, r))?;
+    run.revolutions += before;
+    run.periodic.revolutions_integrated += before;
+    run.periodic.marched_revolutions += first.periodic.marched_revolutions;
+    let note = format!(
+        "hybrid reference: the periodic solution under the measured airloads ({} revolutions, residual {:.2e}) and one revolution recording the lifting line along it",
+        first.revolutions, first.periodic.residual
+    );
+    run.periodic.message = match run.periodic.message.as_str() {
+        "" => note,
+        m => format!("{note}; {m}"),
+    };
+    run.wall_s = t_start.elapsed().as_secs_f64();
+    Ok(run)
+}
+
+fn drive_periodic_once(
     sim: &mut dyn ForcedResponse,
     model: DamperModel,
     o: &PeriodicOptions,
@@ -339,6 +398,10 @@ pub fn drive_periodic(
         if periodic && r <= o.tol {
             info.converged = true;
             if o.stop_early {
+                // periodic already: shooting only for the Floquet multipliers asked for
+                if shooting && o.min_floquet_dirs > 0 {
+                    shoot_from = start_state.clone();
+                }
                 break;
             }
         } else {
@@ -350,7 +413,7 @@ pub fn drive_periodic(
         }
     }
     info.marched_revolutions = periods;
-    if let (Some(st0), false) = (shoot_from, info.converged) {
+    if let Some(st0) = shoot_from.filter(|_| !info.converged || o.min_floquet_dirs > 0) {
         let end = sim
             .save_state()
             .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;

@@ -1309,7 +1309,7 @@ fn airloads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     };
     rep.paragraph(&format!(
         "Airloads {} with the lifting line ({} inflow; {}). Thrust coefficient over solidity {}{}. The measured normal force is the record's{} (docs/aerodynamics.md).",
-        a.source,
+        a.source_text(),
         a.inflow,
         a.airfoils.join(", "),
         with.iter()

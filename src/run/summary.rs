@@ -667,6 +667,7 @@ fn airloads_json(r: &ModelRun) -> Value {
     };
     json!({
         "source": a.source,
+        "hybrid_reference": a.reference,
         "inflow": a.inflow,
         "airfoils": a.airfoils,
         "clamped_queries": a.clamped_queries,
