@@ -16,5 +16,6 @@ pub mod report;
 pub mod rotor;
 pub mod run;
 pub mod solver;
+pub mod stability;
 pub mod structure;
 pub mod sweep;

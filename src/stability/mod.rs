@@ -1,0 +1,13 @@
+//! Ground-resonance stability: the mathematical core (no decks, no CLI).
+//!
+//! [`lag_rotor`] holds the reduced model of Coleman & Feingold (NACA TR-1351): rigid blades on
+//! lag hinges on a hub that moves in the plane with the airframe. It gives the
+//! constant-coefficient eigenvalues in multi-blade coordinates for an isotropic rotor
+//! ([`LagRotor::coleman_eigenvalues`]) and the Floquet characteristic exponents of the
+//! time-periodic equations in individual blade coordinates for any rotor
+//! ([`LagRotor::floquet`]), e.g. one lag damper inoperative (Hammond, JAHS 19(4), 1974).
+pub mod lag_rotor;
+
+pub use lag_rotor::{
+    AirframeAxis, LagBlade, LagRotor, Mode, ModeLabel, StabilityError, TimeResponse,
+};
