@@ -99,7 +99,7 @@ fn independent(r: &LagRotor, omega: f64) -> Vec<Complex<f64>> {
         (Complex::new(-cb, 0.0) - disc) / (2.0 * ib),
     ];
     out.extend(roots); // collective
-    if nb % 2 == 0 {
+    if nb.is_multiple_of(2) {
         out.extend(roots); // differential
     }
     for h in 2..=(nb - 1) / 2 {

@@ -519,7 +519,7 @@ impl LagRotor {
         };
         let (roots, _) = single(c_b, k_b)?;
         out.extend(roots.iter().map(|&l| (l, ModeLabel::CollectiveLag)));
-        if nb % 2 == 0 {
+        if nb.is_multiple_of(2) {
             out.extend(roots.iter().map(|&l| (l, ModeLabel::DifferentialLag)));
         }
         // Cyclic n >= 2 (N >= 5), reactionless: the cyclic equations without the hub terms.
@@ -952,24 +952,23 @@ impl Rk4 {
     }
 
     fn step(&mut self, sys: &mut PeriodicSystem, t: f64, h: f64, y: &mut [f64]) {
+        let axpy = |out: &mut [f64], y: &[f64], a: f64, k: &[f64]| {
+            for ((o, yi), ki) in out.iter_mut().zip(y).zip(k) {
+                *o = yi + a * ki;
+            }
+        };
         sys.set_time(t);
         sys.rhs_columns(y, &mut self.k1);
         sys.set_time(t + 0.5 * h);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + 0.5 * h * self.k1[i];
-        }
+        axpy(&mut self.tmp, y, 0.5 * h, &self.k1);
         sys.rhs_columns(&self.tmp, &mut self.k2);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + 0.5 * h * self.k2[i];
-        }
+        axpy(&mut self.tmp, y, 0.5 * h, &self.k2);
         sys.rhs_columns(&self.tmp, &mut self.k3);
         sys.set_time(t + h);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + h * self.k3[i];
-        }
+        axpy(&mut self.tmp, y, h, &self.k3);
         sys.rhs_columns(&self.tmp, &mut self.k4);
-        for i in 0..y.len() {
-            y[i] += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
         }
     }
 }
