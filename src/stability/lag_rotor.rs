@@ -25,16 +25,20 @@
 //!
 //! The zeroth-order terms `-(m e + S) Omega^2 u(psi_k)` cancel over identical blades; for
 //! dissimilar blade masses they are a 1/rev forcing (rotor imbalance), not part of the
-//! homogeneous perturbation equations, and are dropped. These are Johnson, "Rotorcraft
-//! Aeromechanics" (2013) eqs. 13.1-13.3 and Coleman & Feingold eqs. (1)-(3) with the
-//! opposite lag sign.
+//! homogeneous perturbation equations, and are dropped. The form (rotating lag frequency
+//! `nu^2 = (k_lag + e S Omega^2) / I`, coupling through `S` in the blade equations and
+//! `N/2 S` in the hub equations) is the classical one of Coleman & Feingold and of Johnson,
+//! "Rotorcraft Aeromechanics" (2013) ch. 13 (ground resonance); the derivation above is this
+//! module's own, checked against those forms (not against their printed equation numbers) and
+//! against Coleman's undamped result that the instability sits where the regressing lag
+//! frequency `(1 - nu) Omega` meets the airframe frequency (tests/stability_coleman.rs).
 //!
 //! # Multi-blade coordinates (isotropic rotor, N >= 3)
 //!
 //! `zeta_0 = 1/N sum zeta_k`, `zeta_nc = 2/N sum zeta_k cos n psi_k`,
 //! `zeta_ns = 2/N sum zeta_k sin n psi_k` (`1 <= n <= (N-1)/2`), `zeta_d = 1/N sum zeta_k (-1)^k`
 //! (N even). Substituting `zeta_k = zeta_nc cos n psi_k + zeta_ns sin n psi_k` gives, with
-//! `K = k_lag + e S Omega^2` (Johnson eq. 13.9):
+//! `K = k_lag + e S Omega^2`:
 //!
 //! `I (zeta_nc'' + 2 n Omega zeta_ns' - n^2 Omega^2 zeta_nc) + c (zeta_nc' + n Omega zeta_ns)
 //!  + K zeta_nc + [n = 1] S y'' = 0`
