@@ -99,7 +99,7 @@ fn independent(r: &LagRotor, omega: f64) -> Vec<Complex<f64>> {
         (Complex::new(-cb, 0.0) - disc) / (2.0 * ib),
     ];
     out.extend(roots); // collective
-    if nb % 2 == 0 {
+    if nb.is_multiple_of(2) {
         out.extend(roots); // differential
     }
     for h in 2..=(nb - 1) / 2 {
@@ -297,4 +297,47 @@ fn each_error_variant_once() {
     let e = r.time_response(20.0, &init, 10_000.0, 10.0).unwrap_err();
     assert!(matches!(e, StabilityError::Numerical(_)));
     assert!(msg(e).starts_with("numerical failure: time response is not finite at t = "));
+}
+
+/// Coleman & Feingold's classical result: without damping, an isotropic rotor on an isotropic
+/// support is unstable where the regressing lag frequency `(1 - nu) Omega` meets the support
+/// frequency `omega_b`, and neutrally stable well away from it.
+#[test]
+fn undamped_instability_at_the_regressing_lag_coincidence() {
+    let mut r = rotor(4, true, true);
+    for b in &mut r.blades {
+        b.damping_nms_per_rad = 0.0;
+        b.stiffness_nm_per_rad = 0.0;
+    }
+    let axis = AirframeAxis {
+        mass_kg: 5000.0,
+        stiffness_n_per_m: 1.0e6,
+        damping_ns_per_m: 0.0,
+    };
+    r.x = Some(axis.clone());
+    r.y = Some(axis);
+    let b = &r.blades[0];
+    let nu = (b.hinge_offset_m * b.first_moment_kg_m / b.inertia_kg_m2).sqrt();
+    let omega_b = (1.0e6 / (5000.0 + 4.0 * b.mass_kg)).sqrt();
+    let growth = |w: f64| {
+        let modes = r.coleman_eigenvalues(w).unwrap();
+        let scale = modes
+            .iter()
+            .map(|m| m.eigenvalue.norm())
+            .fold(0.0, f64::max);
+        let g = modes
+            .iter()
+            .map(|m| m.growth_rate_per_s)
+            .fold(f64::MIN, f64::max);
+        g / scale
+    };
+    let coincidence = omega_b / (1.0 - nu);
+    println!(
+        "undamped: nu {nu:.4}, coincidence {coincidence:.3} rad/s, growth/|lambda| there {:.3e}",
+        growth(coincidence)
+    );
+    assert!(growth(coincidence) > 1e-3);
+    for w in [0.4 * coincidence, 2.5 * coincidence] {
+        assert!(growth(w).abs() < 1e-9, "{w}: {}", growth(w));
+    }
 }

@@ -25,16 +25,20 @@
 //!
 //! The zeroth-order terms `-(m e + S) Omega^2 u(psi_k)` cancel over identical blades; for
 //! dissimilar blade masses they are a 1/rev forcing (rotor imbalance), not part of the
-//! homogeneous perturbation equations, and are dropped. These are Johnson, "Rotorcraft
-//! Aeromechanics" (2013) eqs. 13.1-13.3 and Coleman & Feingold eqs. (1)-(3) with the
-//! opposite lag sign.
+//! homogeneous perturbation equations, and are dropped. The form (rotating lag frequency
+//! `nu^2 = (k_lag + e S Omega^2) / I`, coupling through `S` in the blade equations and
+//! `N/2 S` in the hub equations) is the classical one of Coleman & Feingold and of Johnson,
+//! "Rotorcraft Aeromechanics" (2013) ch. 13 (ground resonance); the derivation above is this
+//! module's own, checked against those forms (not against their printed equation numbers) and
+//! against Coleman's undamped result that the instability sits where the regressing lag
+//! frequency `(1 - nu) Omega` meets the airframe frequency (tests/stability_coleman.rs).
 //!
 //! # Multi-blade coordinates (isotropic rotor, N >= 3)
 //!
 //! `zeta_0 = 1/N sum zeta_k`, `zeta_nc = 2/N sum zeta_k cos n psi_k`,
 //! `zeta_ns = 2/N sum zeta_k sin n psi_k` (`1 <= n <= (N-1)/2`), `zeta_d = 1/N sum zeta_k (-1)^k`
 //! (N even). Substituting `zeta_k = zeta_nc cos n psi_k + zeta_ns sin n psi_k` gives, with
-//! `K = k_lag + e S Omega^2` (Johnson eq. 13.9):
+//! `K = k_lag + e S Omega^2`:
 //!
 //! `I (zeta_nc'' + 2 n Omega zeta_ns' - n^2 Omega^2 zeta_nc) + c (zeta_nc' + n Omega zeta_ns)
 //!  + K zeta_nc + [n = 1] S y'' = 0`
@@ -519,7 +523,7 @@ impl LagRotor {
         };
         let (roots, _) = single(c_b, k_b)?;
         out.extend(roots.iter().map(|&l| (l, ModeLabel::CollectiveLag)));
-        if nb % 2 == 0 {
+        if nb.is_multiple_of(2) {
             out.extend(roots.iter().map(|&l| (l, ModeLabel::DifferentialLag)));
         }
         // Cyclic n >= 2 (N >= 5), reactionless: the cyclic equations without the hub terms.
@@ -952,24 +956,23 @@ impl Rk4 {
     }
 
     fn step(&mut self, sys: &mut PeriodicSystem, t: f64, h: f64, y: &mut [f64]) {
+        let axpy = |out: &mut [f64], y: &[f64], a: f64, k: &[f64]| {
+            for ((o, yi), ki) in out.iter_mut().zip(y).zip(k) {
+                *o = yi + a * ki;
+            }
+        };
         sys.set_time(t);
         sys.rhs_columns(y, &mut self.k1);
         sys.set_time(t + 0.5 * h);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + 0.5 * h * self.k1[i];
-        }
+        axpy(&mut self.tmp, y, 0.5 * h, &self.k1);
         sys.rhs_columns(&self.tmp, &mut self.k2);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + 0.5 * h * self.k2[i];
-        }
+        axpy(&mut self.tmp, y, 0.5 * h, &self.k2);
         sys.rhs_columns(&self.tmp, &mut self.k3);
         sys.set_time(t + h);
-        for i in 0..y.len() {
-            self.tmp[i] = y[i] + h * self.k3[i];
-        }
+        axpy(&mut self.tmp, y, h, &self.k3);
         sys.rhs_columns(&self.tmp, &mut self.k4);
-        for i in 0..y.len() {
-            y[i] += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
         }
     }
 }
