@@ -7,9 +7,10 @@
 //!
 //! Kinds, by the deck's tables: a model deck (`[[beam]]`, ...) runs each of its `[static]`,
 //! `[dynamic]` and `[modes]` analyses (docs/model_deck.md); a rotor deck (`[rotor]`): `expand`,
-//! `modes --rotor` and, with a `[damper]` table, a rigid (not on an airframe: that is the whole
-//! rotor) and an elastic `run` of 2 revolutions
-//! (docs/run.md); a damper deck (`[damper]` alone): `bench`; an actuator deck (`[actuator]`):
+//! `modes --rotor`, with an `[airframe]` a `stability` map (docs/stability.md), and, with a
+//! `[damper]` table, a rigid (not on an airframe: that is the whole rotor) and an elastic `run`
+//! of 2 revolutions (docs/run.md; not for an airframe deck without `[aero]`, a ground-resonance
+//! deck of no flight record's rotor); a damper deck (`[damper]` alone): `bench`; an actuator deck (`[actuator]`):
 //! the dynamic analysis of docs/examples/actuator_pitch_beam.toml with it as the device; a sweep
 //! plan (`[base]`/`[vary]`/`[[case]]`): `--emit-slurm` of the whole plan (every case checked) and
 //! a local sweep of its first case, 2 revolutions (docs/sweep.md); a flight record (CSV triple
@@ -166,7 +167,25 @@ fn jobs_for(deck: &Path, work: &Path, tag: &str) -> Result<Vec<Job>, String> {
                 Check::Status,
             ));
         }
-        if has("damper") && !has("hinge") {
+        if has("airframe") {
+            // ground resonance over a few speeds (docs/stability.md)
+            let o = out("stability");
+            v.push(job(
+                vec![
+                    "stability".into(),
+                    "--rotor".into(),
+                    s(deck),
+                    "--speeds".into(),
+                    "5:40:5".into(),
+                    "--out".into(),
+                    s(&o),
+                ],
+                Check::Folder(o),
+            ));
+        }
+        // a rotor on an airframe without aerodynamics is a ground-resonance deck: no flight
+        // record is of its rotor
+        if has("damper") && !has("hinge") && (has("aero") || !has("airframe")) {
             // a rotor on an airframe is the whole elastic rotor: the rigid reduction is one blade
             let models: &[&str] = if has("airframe") {
                 &["uh60a"]

@@ -68,6 +68,7 @@ pub mod inspect;
 pub mod modes;
 pub mod run_cmd;
 mod run_console;
+pub mod stability;
 pub mod static_cmd;
 pub mod sweep;
 pub mod verify;
@@ -147,6 +148,14 @@ paper figure 9-12 of each device."
 reference table, fan_comparison.csv (rotor deck)."
     ))]
     Modes(modes::ModesArgs),
+    /// Ground resonance of a rotor deck on its airframe over rotor speeds.
+    #[command(after_long_help = writes!(
+        "Writes DIR/: stability.csv (rotor_speed_rad_s, mode, frequency_Hz, damping_ratio, \
+growth_rate_per_s, method = coleman | floquet), stability.html (Coleman diagram, damping \
+against speed with the unstable ranges shaded, the reduced model) and summary.json. An unstable \
+rotor is a result: exit 0, marked UNSTABLE."
+    ))]
+    Stability(stability::StabilityArgs),
     /// Free decay of a hinged blade's lag hinge beside its linearised mode.
     #[command(after_long_help = writes!(
         "Writes DIR/: decay.csv (lag angle history: time_s, lag_angle_rad, lag_angle_deg) and \
@@ -242,5 +251,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => run_cmd::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Stability(a) => stability::run(a),
     }
 }

@@ -329,8 +329,8 @@ impl DamperDeck {
                     t,
                     "damper.linear",
                     "c_N_s_per_m",
-                    "a positive damping coefficient",
-                    positive,
+                    "a non-negative damping coefficient (0: an inoperative damper)",
+                    non_negative,
                 )?)
             }
         };

@@ -644,7 +644,59 @@ fn yes() -> bool {
     true
 }
 
+/// Mass moments of a blade about its lag hinge: what turns with the lag angle (the blade's
+/// section table and the retention outboard of the hinge, segments 2 and 3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LagMoments {
+    pub mass_kg: f64,
+    /// First moment about the hinge [kg m].
+    pub first_moment_kg_m: f64,
+    /// Second moment about the hinge [kg m^2].
+    pub inertia_kg_m2: f64,
+}
+
 impl RotorSpec {
+    /// The blade's [`LagMoments`]: trapezoid on a fine grid of the section table (piecewise
+    /// linear) from `blade.root_r_m` to the tip, plus retention segments 2 and 3 (uniform); the
+    /// root hardware (horn, damper lever) is left out. `deck_path`: where the section table's
+    /// path is relative to.
+    pub fn lag_moments(&self, deck_path: &std::path::Path) -> anyhow::Result<LagMoments> {
+        use crate::structure::section::SectionTable;
+        let e = self.retention.hinge_r_m;
+        let (r0, radius) = (self.blade.root_r_m, self.rotor.radius_m);
+        let csv = deck_path
+            .parent()
+            .unwrap_or(std::path::Path::new(""))
+            .join(&self.blade.sections_csv);
+        let table = SectionTable::from_csv(&csv)?;
+        let (mut m0, mut s1, mut i2) = (0.0, 0.0, 0.0);
+        let n = 4000;
+        let ds = (radius - r0) / n as f64;
+        for k in 0..=n {
+            let s = k as f64 * ds;
+            let w = if k == 0 || k == n { 0.5 * ds } else { ds };
+            let m = table.at(s).m;
+            let x = r0 + s - e;
+            m0 += w * m;
+            s1 += w * m * x;
+            i2 += w * m * x * x;
+        }
+        for (seg, a, b) in [
+            (&self.retention.segment2, e, self.retention.horn_r_m),
+            (&self.retention.segment3, self.retention.horn_r_m, r0),
+        ] {
+            let m = seg.section.m;
+            m0 += m * (b - a);
+            s1 += m * ((b - e).powi(2) - (a - e).powi(2)) / 2.0;
+            i2 += m * ((b - e).powi(3) - (a - e).powi(3)) / 3.0;
+        }
+        Ok(LagMoments {
+            mass_kg: m0,
+            first_moment_kg_m: s1,
+            inertia_kg_m2: i2,
+        })
+    }
+
     /// Unknowns and stored matrix entries of the expanded model, estimated as for a model deck
     /// (a cubic beam element adds 3 nodes of 6 dofs; a dozen joints and bodies beside them).
     pub fn size_estimate(&self) -> (f64, f64) {

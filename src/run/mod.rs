@@ -22,6 +22,7 @@ pub mod periodic;
 pub mod report;
 pub mod rotor;
 pub mod sdof;
+pub mod stability;
 pub mod summary;
 
 use crate::hydraulics::DamperModel;

@@ -91,36 +91,12 @@ impl SdofParams {
         record: &FlightRecord,
     ) -> anyhow::Result<Self> {
         use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
-        use crate::structure::section::SectionTable;
         // the record must be of this rotor, as the elastic model requires
         spec.check_record(record, deck_path)?;
         let e = spec.retention.hinge_r_m;
-        let (r0, radius) = (spec.blade.root_r_m, spec.rotor.radius_m);
-        let csv = deck_path
-            .parent()
-            .unwrap_or(std::path::Path::new(""))
-            .join(&spec.blade.sections_csv);
-        let table = SectionTable::from_csv(&csv)?;
-        // mass moments: trapezoid on a fine grid (the table is piecewise linear)
-        let (mut s1, mut i2) = (0.0, 0.0);
-        let n = 4000;
-        let ds = (radius - r0) / n as f64;
-        for k in 0..=n {
-            let s = k as f64 * ds;
-            let w = if k == 0 || k == n { 0.5 * ds } else { ds };
-            let m = table.at(s).m;
-            let x = r0 + s - e;
-            s1 += w * m * x;
-            i2 += w * m * x * x;
-        }
-        for (seg, a, b) in [
-            (&spec.retention.segment2, e, spec.retention.horn_r_m),
-            (&spec.retention.segment3, spec.retention.horn_r_m, r0),
-        ] {
-            let m = seg.section.m;
-            s1 += m * ((b - e).powi(2) - (a - e).powi(2)) / 2.0;
-            i2 += m * ((b - e).powi(3) - (a - e).powi(3)) / 3.0;
-        }
+        let radius = spec.rotor.radius_m;
+        let lm = spec.lag_moments(deck_path)?;
+        let (s1, i2) = (lm.first_moment_kg_m, lm.inertia_kg_m2);
         let replay = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
         let controls = crate::rotor::expand::Controls::from_record(&record.meta.controls_deg);
         let twist = crate::structure::kin::TimeTable {

@@ -1,0 +1,131 @@
+//! `rotorsim stability --rotor DECK --speeds A:B:STEP --out DIR`: ground resonance of a rotor
+//! deck on its airframe over rotor speeds (pipeline: src/run/stability.rs).
+use crate::hydraulics::DamperModel;
+use crate::io::OutDir;
+use crate::overrides::Override;
+use crate::rotor::RotorDeck;
+use crate::run::stability::{stability_map, write};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct StabilityArgs {
+    /// Rotor deck with an `[airframe]` (docs/rotor_deck.md); per-blade differences
+    /// (`[blades.K...]`, `--set blades.K...`) make the rotor anisotropic.
+    #[arg(long)]
+    pub rotor: PathBuf,
+    /// Rotor speeds [rad/s]: START:STOP:STEP (inclusive) or a comma-separated list, increasing.
+    #[arg(long)]
+    pub speeds: String,
+    /// Damper model linearised at each speed: linear, nonlinear or physical (default: the
+    /// deck's `damper.model`).
+    #[arg(long)]
+    pub damper: Option<String>,
+    /// Override a deck value by its dotted path before validation (repeatable), as for run.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
+    pub set: Vec<Override>,
+    /// Output directory (stability.csv, stability.html, summary.json).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn parse_set(s: &str) -> Result<Override, String> {
+    Override::parse(s).map_err(|e| format!("{e:#}"))
+}
+
+/// Most speeds of one map (each is an eigen-analysis or a Floquet integration).
+pub const MAX_SPEEDS: usize = 2000;
+
+/// `START:STOP:STEP` (inclusive) or `a,b,c`, in rad/s.
+pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
+    let bad = |m: &str| {
+        anyhow::anyhow!(
+            "--speeds `{s}`: {m} (expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30)"
+        )
+    };
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| bad(&format!("`{t}` is not a number")))
+    };
+    let v: Vec<f64> = if s.contains(':') {
+        let p: Vec<&str> = s.split(':').collect();
+        if p.len() != 3 {
+            return Err(bad("three fields needed"));
+        }
+        let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
+        if !(a.is_finite() && b.is_finite() && h.is_finite()) {
+            return Err(bad("START, STOP and STEP must be finite"));
+        }
+        if h <= 0.0 || b < a {
+            return Err(bad("STEP must be positive and STOP >= START"));
+        }
+        let n = ((b - a) / h + 1e-9).floor();
+        if n + 1.0 > MAX_SPEEDS as f64 {
+            return Err(bad(&format!(
+                "{n} speeds, beyond the {MAX_SPEEDS} a map may have; use a larger STEP"
+            )));
+        }
+        (0..=n as usize)
+            .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
+            .collect()
+    } else {
+        s.split(',').map(num).collect::<Result<_, _>>()?
+    };
+    crate::run::stability::check_speeds(&v).map_err(|e| bad(&format!("{e:#}")))?;
+    Ok(v)
+}
+
+pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
+    let speeds = parse_speeds(&args.speeds)?;
+    let deck = RotorDeck::from_file_with(&args.rotor, &args.set)?;
+    let model = match &args.damper {
+        Some(d) => d
+            .parse::<DamperModel>()
+            .map_err(|e| anyhow::anyhow!("--damper {d}: {e}"))?,
+        None => deck.damper()?.model,
+    };
+    let out = OutDir::create(&args.out, &deck.input_files())?;
+    let map = match stability_map(&deck, model, &speeds) {
+        Ok(m) => m,
+        Err(e) => {
+            out.mark_incomplete(&format!("{e:#}"))?;
+            return Err(e);
+        }
+    };
+    write(&map, &deck, &out)?;
+    out.finish()?;
+    let method = map.speeds.first().map_or("", |s| s.method.name());
+    outln!(
+        "rotorsim stability: {} ({} damper, {method}), {} speeds from {} to {} rad/s",
+        args.rotor.display(),
+        model.name(),
+        map.speeds.len(),
+        speeds[0],
+        speeds[speeds.len() - 1]
+    );
+    if map.unstable.is_empty() {
+        if let Some((z, mode, w)) = map.min_damping() {
+            outln!("stable: least damping ratio {z:.4} ({mode} at {w} rad/s)");
+        }
+    } else {
+        for u in &map.unstable {
+            outln!(
+                "UNSTABLE: {} from {:.3} to {:.3} rad/s, growth rate up to {:.4} 1/s",
+                u.mode,
+                u.from_rad_s,
+                u.to_rad_s,
+                u.max_growth_rate_per_s
+            );
+        }
+    }
+    for n in &map.notes {
+        outln!("note: {n}");
+    }
+    outln!(
+        "open: {}/stability.html (Coleman diagram, damping), {}/stability.csv",
+        args.out.display(),
+        args.out.display()
+    );
+    Ok(())
+}

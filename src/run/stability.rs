@@ -1,0 +1,660 @@
+//! Ground resonance of a rotor deck on its airframe (docs/stability.md): the deck's blades
+//! reduced to rigid blades on their lag hinges ([`crate::stability`]), each blade's damper
+//! linearised at the operating point, the airframe's in-plane directions under the hub, over a
+//! range of rotor speeds. Isotropic rotors: eigenvalues of the constant-coefficient equations
+//! in multi-blade (Coleman) coordinates; rotors whose blades differ: Floquet exponents of the
+//! periodic equations over one revolution.
+use crate::hydraulics::bench::harmonic_run;
+use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
+use crate::io::OutDir;
+use crate::report::html::{Banner, HtmlReport};
+use crate::report::plot::Plot;
+use crate::rotor::deck::{AirframeDof, RotorSpec};
+use crate::rotor::RotorDeck;
+use crate::stability::{AirframeAxis, LagBlade, LagRotor, Mode};
+use anyhow::{anyhow, bail};
+use std::f64::consts::PI;
+
+/// Stroke amplitude at which a damper is linearised [m]: a small perturbation about the
+/// operating point (zero mean stroke rate on the ground), 0.1 mm or about 0.03 deg of lag on
+/// a 0.175 m arm.
+pub const LINEARISATION_AMPLITUDE_M: f64 = 1e-4;
+
+/// Revolution steps of the Floquet integration (RK4; the multipliers converge as h^4).
+pub const FLOQUET_STEPS_PER_REV: usize = 512;
+
+/// How a speed's modes were found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    Coleman,
+    Floquet,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Coleman => "coleman",
+            Method::Floquet => "floquet",
+        }
+    }
+}
+
+/// A blade's damper linearised at one speed, moved to the lag hinge (`arm^2` times the
+/// stroke's values).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct LinearisedDamper {
+    /// Blade (1-based).
+    pub blade: usize,
+    /// Lag frequency in the rotating frame it was linearised at [rad/s].
+    pub frequency_rad_s: f64,
+    pub stiffness_nm_per_rad: f64,
+    pub damping_nms_per_rad: f64,
+}
+
+/// The modes at one rotor speed.
+#[derive(Clone, Debug)]
+pub struct SpeedModes {
+    pub omega_rad_s: f64,
+    pub method: Method,
+    pub modes: Vec<Mode>,
+    pub dampers: Vec<LinearisedDamper>,
+}
+
+/// A speed range where a mode grows (ends by linear interpolation of the growth rate between
+/// the speeds of the map; open ends at the map's first or last speed).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct UnstableRange {
+    pub mode: String,
+    pub from_rad_s: f64,
+    pub to_rad_s: f64,
+    pub max_growth_rate_per_s: f64,
+}
+
+/// A stability map over rotor speeds.
+#[derive(Clone, Debug)]
+pub struct StabilityMap {
+    pub damper: DamperModel,
+    pub blades: Vec<LagBlade>,
+    pub x: Option<AirframeAxis>,
+    pub y: Option<AirframeAxis>,
+    pub speeds: Vec<SpeedModes>,
+    pub unstable: Vec<UnstableRange>,
+    /// What the reduced model leaves out, in words.
+    pub notes: Vec<String>,
+}
+
+impl StabilityMap {
+    /// Least damping ratio over the map, its mode and speed.
+    pub fn min_damping(&self) -> Option<(f64, String, f64)> {
+        self.speeds
+            .iter()
+            .flat_map(|s| {
+                s.modes
+                    .iter()
+                    .map(move |m| (m.damping_ratio, m.label.to_string(), s.omega_rad_s))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+}
+
+/// The airframe's in-plane directions at the hub: x and y translations, and a roll or pitch
+/// about a centre off the hub plane as the hub translation it carries (`y = c theta`: mass
+/// `I / c^2`, and so the spring and damper). Returns (x, y, notes on what is left out).
+fn in_plane(
+    dofs: &[AirframeDof],
+    file: &str,
+) -> anyhow::Result<(Option<AirframeAxis>, Option<AirframeAxis>, Vec<String>)> {
+    let (mut x, mut y, mut notes) = (None, None, vec![]);
+    for d in dofs {
+        let axis = |s: f64| AirframeAxis {
+            mass_kg: d.mass * s,
+            stiffness_n_per_m: d.stiffness * s,
+            damping_ns_per_m: d.damping * s,
+        };
+        let (slot, a) = match (d.rotation, d.axis) {
+            (false, 0) => (&mut x, axis(1.0)),
+            (false, 1) => (&mut y, axis(1.0)),
+            (true, _) if d.center_z_m != 0.0 => {
+                let c2 = 1.0 / (d.center_z_m * d.center_z_m);
+                (if d.axis == 0 { &mut y } else { &mut x }, axis(c2))
+            }
+            _ => {
+                notes.push(format!(
+                    "airframe {} is not in the in-plane model (ground resonance couples the lag modes with the hub's in-plane motion)",
+                    d.name
+                ));
+                continue;
+            }
+        };
+        if slot.is_some() {
+            notes.push(format!(
+                "airframe {}: a second in-plane direction on the same hub axis, left out",
+                d.name
+            ));
+        } else {
+            *slot = Some(a);
+        }
+    }
+    if x.is_none() && y.is_none() {
+        bail!("rotor deck {file}: [airframe] has no in-plane direction: ground resonance needs the hub to move in x or y (add airframe.x and airframe.y with mass_kg, stiffness_N_per_m, damping_Ns_per_m, docs/rotor_deck.md)");
+    }
+    Ok((x, y, notes))
+}
+
+/// The damper of `deck` as `model` linearised at the rotating-frame frequency `w` [rad/s]
+/// and moved to the lag hinge: the linear dashpot exactly, the other models by their first
+/// harmonic at [`LINEARISATION_AMPLITUDE_M`] (the bench's K' and K''/w).
+fn linearise(
+    damper: &DamperDeck,
+    model: DamperModel,
+    arm_m: f64,
+    w: f64,
+) -> anyhow::Result<(f64, f64)> {
+    let a2 = arm_m * arm_m;
+    if model == DamperModel::Linear {
+        let c = damper
+            .linear_c_n_s_per_m
+            .ok_or_else(|| anyhow!("{}: no [damper.linear] table", damper.source))?;
+        return Ok((0.0, a2 * c));
+    }
+    let dev = damper.build(model, IntegratorOptions::default())?;
+    let r = harmonic_run(
+        dev.as_ref(),
+        w,
+        w * LINEARISATION_AMPLITUDE_M,
+        6,
+        256,
+        false,
+    )?;
+    Ok((
+        a2 * r.storage_stiffness_n_per_m,
+        a2 * r.loss_stiffness_n_per_m / w,
+    ))
+}
+
+/// One blade of `spec` with its damper linearised at `w`.
+fn blade(
+    spec: &RotorSpec,
+    deck_path: &std::path::Path,
+    damper: &DamperDeck,
+    model: DamperModel,
+    w: f64,
+) -> anyhow::Result<(LagBlade, (f64, f64))> {
+    let m = spec.lag_moments(deck_path)?;
+    let (k, c) = linearise(damper, model, spec.damper_attachment.arm_m, w)?;
+    Ok((
+        LagBlade {
+            mass_kg: m.mass_kg,
+            first_moment_kg_m: m.first_moment_kg_m,
+            inertia_kg_m2: m.inertia_kg_m2,
+            hinge_offset_m: spec.retention.hinge_r_m,
+            stiffness_nm_per_rad: spec.bearing.lag_k + k,
+            damping_nms_per_rad: spec.bearing.lag_c + c,
+        },
+        (k, c),
+    ))
+}
+
+/// The stability map of `deck` (its blades' own decks, per-blade differences applied) with
+/// damper model `model` at the rotor speeds `speeds_rad_s`.
+pub fn stability_map(
+    deck: &RotorDeck,
+    model: DamperModel,
+    speeds_rad_s: &[f64],
+) -> anyhow::Result<StabilityMap> {
+    let file = deck.path.display().to_string();
+    check_speeds(speeds_rad_s)?;
+    let Some(af) = &deck.spec.airframe else {
+        bail!("rotor deck {file} has no [airframe]: ground resonance is the rotor's lag modes coupled with the airframe under the hub; add [airframe] with x and y (mass_kg, stiffness_N_per_m, damping_Ns_per_m) or [[airframe.mode]] tables (docs/rotor_deck.md, \"The airframe under the hub\")");
+    };
+    let (x, y, mut notes) = in_plane(&af.dofs(), &file)?;
+    let n = deck.spec.rotor.blades;
+    let mut specs = Vec::with_capacity(n);
+    for k in 1..=n {
+        let b = deck.blade(k)?;
+        let damper = b.damper()?;
+        damper.require(model)?;
+        specs.push((b, damper));
+    }
+    notes.push("blades rigid on their lag hinges: no flap, no elastic bending; no aerodynamics (a rotor on the ground)".into());
+    let mut speeds = Vec::with_capacity(speeds_rad_s.len());
+    let mut nominal_blades = vec![];
+    for &om in speeds_rad_s {
+        // the damper linearised at the regressing lag's rotating-frame frequency: first the
+        // blade's own lag frequency, then (once) the coupled mode's
+        let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
+        let k0 = specs[0].0.spec.bearing.lag_k;
+        let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
+            / m0.inertia_kg_m2)
+            .sqrt();
+        let mut result = None;
+        for _ in 0..2 {
+            let w_lin = w.max(0.05 * om).max(0.1);
+            let mut blades = Vec::with_capacity(n);
+            let mut dampers = Vec::with_capacity(n);
+            // identical dampers are linearised once
+            let mut done: Vec<(usize, (f64, f64))> = vec![];
+            for (k, (b, d)) in specs.iter().enumerate() {
+                let same = done.iter().find(|(j, _)| {
+                    specs[*j].1 == *d
+                        && specs[*j].0.spec.damper_attachment.arm_m
+                            == b.spec.damper_attachment.arm_m
+                });
+                let (lb, kc) = match same {
+                    Some(&(_, kc)) => {
+                        let m = b.spec.lag_moments(&b.path)?;
+                        (
+                            LagBlade {
+                                mass_kg: m.mass_kg,
+                                first_moment_kg_m: m.first_moment_kg_m,
+                                inertia_kg_m2: m.inertia_kg_m2,
+                                hinge_offset_m: b.spec.retention.hinge_r_m,
+                                stiffness_nm_per_rad: b.spec.bearing.lag_k + kc.0,
+                                damping_nms_per_rad: b.spec.bearing.lag_c + kc.1,
+                            },
+                            kc,
+                        )
+                    }
+                    None => {
+                        let r = blade(&b.spec, &b.path, d, model, w_lin)
+                            .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?;
+                        done.push((k, r.1));
+                        r
+                    }
+                };
+                dampers.push(LinearisedDamper {
+                    blade: k + 1,
+                    frequency_rad_s: w_lin,
+                    stiffness_nm_per_rad: kc.0,
+                    damping_nms_per_rad: kc.1,
+                });
+                blades.push(lb);
+            }
+            let rotor = LagRotor {
+                blades,
+                x: x.clone(),
+                y: y.clone(),
+            };
+            rotor
+                .validate()
+                .map_err(|e| anyhow!("rotor deck {file}: the reduced lag model: {e}"))?;
+            let (method, modes) = if rotor.is_isotropic() && n >= 3 {
+                (Method::Coleman, rotor.coleman_eigenvalues(om))
+            } else {
+                (Method::Floquet, rotor.floquet(om, FLOQUET_STEPS_PER_REV))
+            };
+            let modes = modes
+                .map_err(|e| anyhow!("rotor deck {file}: {} at {om} rad/s: {e}", method.name()))?;
+            if let Some(r) = modes
+                .iter()
+                .find(|m| m.label == crate::stability::ModeLabel::RegressingLag)
+            {
+                w = (om - 2.0 * PI * r.frequency_hz).abs();
+            }
+            nominal_blades = rotor.blades.clone();
+            result = Some(SpeedModes {
+                omega_rad_s: om,
+                method,
+                modes,
+                dampers,
+            });
+            if model == DamperModel::Linear {
+                break; // frequency-independent
+            }
+        }
+        speeds.extend(result);
+    }
+    let unstable = unstable_ranges(&speeds);
+    Ok(StabilityMap {
+        damper: model,
+        blades: nominal_blades,
+        x,
+        y,
+        speeds,
+        unstable,
+        notes,
+    })
+}
+
+/// Speeds in rad/s: finite, non-negative, strictly increasing.
+pub fn check_speeds(s: &[f64]) -> anyhow::Result<()> {
+    if s.is_empty() {
+        bail!("--speeds: no rotor speed given");
+    }
+    if let Some(v) = s.iter().find(|v| !v.is_finite() || **v <= 0.0) {
+        bail!("--speeds: {v} rad/s is not a positive finite rotor speed");
+    }
+    if let Some(w) = s.windows(2).find(|w| w[1] <= w[0]) {
+        bail!(
+            "--speeds: {} rad/s after {} rad/s: the speeds must increase",
+            w[1],
+            w[0]
+        );
+    }
+    Ok(())
+}
+
+/// Contiguous speeds where a mode's growth rate is positive.
+fn unstable_ranges(speeds: &[SpeedModes]) -> Vec<UnstableRange> {
+    let mut labels: Vec<String> = vec![];
+    for s in speeds {
+        for m in &s.modes {
+            let l = m.label.to_string();
+            if !labels.contains(&l) {
+                labels.push(l);
+            }
+        }
+    }
+    let mut out = vec![];
+    for l in labels {
+        let g: Vec<(f64, f64)> = speeds
+            .iter()
+            .filter_map(|s| {
+                s.modes
+                    .iter()
+                    .filter(|m| m.label.to_string() == l)
+                    .map(|m| m.growth_rate_per_s)
+                    .max_by(f64::total_cmp)
+                    .map(|g| (s.omega_rad_s, g))
+            })
+            .collect();
+        let cross = |a: (f64, f64), b: (f64, f64)| a.0 + (b.0 - a.0) * a.1 / (a.1 - b.1);
+        let mut i = 0;
+        while i < g.len() {
+            if g[i].1 <= 0.0 {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i + 1 < g.len() && g[i + 1].1 > 0.0 {
+                i += 1;
+            }
+            let from = if start > 0 {
+                cross(g[start - 1], g[start])
+            } else {
+                g[start].0
+            };
+            let to = if i + 1 < g.len() {
+                cross(g[i], g[i + 1])
+            } else {
+                g[i].0
+            };
+            out.push(UnstableRange {
+                mode: l.clone(),
+                from_rad_s: from,
+                to_rad_s: to,
+                max_growth_rate_per_s: g[start..=i].iter().map(|p| p.1).fold(0.0, f64::max),
+            });
+            i += 1;
+        }
+    }
+    out
+}
+
+/// stability.csv: one row per speed and mode.
+pub fn csv(map: &StabilityMap) -> String {
+    let mut s = String::from(
+        "rotor_speed_rad_s,mode,frequency_Hz,damping_ratio,growth_rate_per_s,method\n",
+    );
+    for sp in &map.speeds {
+        for m in &sp.modes {
+            s.push_str(&format!(
+                "{},{},{},{},{},{}\n",
+                sp.omega_rad_s,
+                m.label,
+                m.frequency_hz,
+                m.damping_ratio,
+                m.growth_rate_per_s,
+                sp.method.name()
+            ));
+        }
+    }
+    s
+}
+
+/// summary.json: the reduced model, the unstable ranges and the least damping.
+pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
+    let blades: Vec<_> = map
+        .blades
+        .iter()
+        .map(|b| {
+            serde_json::json!({
+                "mass_kg": b.mass_kg,
+                "first_moment_kg_m": b.first_moment_kg_m,
+                "inertia_kg_m2": b.inertia_kg_m2,
+                "hinge_offset_m": b.hinge_offset_m,
+                "lag_stiffness_Nm_per_rad": b.stiffness_nm_per_rad,
+                "lag_damping_Nms_per_rad": b.damping_nms_per_rad,
+            })
+        })
+        .collect();
+    let axis = |a: &Option<AirframeAxis>| {
+        a.as_ref().map(|a| {
+            serde_json::json!({
+                "mass_kg": a.mass_kg,
+                "stiffness_N_per_m": a.stiffness_n_per_m,
+                "damping_Ns_per_m": a.damping_ns_per_m,
+            })
+        })
+    };
+    let min = map.min_damping();
+    serde_json::json!({
+        "rotor_deck": deck.path.display().to_string(),
+        "damper_model": map.damper.name(),
+        "linearisation_amplitude_m": LINEARISATION_AMPLITUDE_M,
+        "method": map.speeds.first().map(|s| s.method.name()),
+        "speeds_rad_s": map.speeds.iter().map(|s| s.omega_rad_s).collect::<Vec<_>>(),
+        "blades_at_last_speed": blades,
+        "airframe_x": axis(&map.x),
+        "airframe_y": axis(&map.y),
+        "stable": map.unstable.is_empty(),
+        "unstable": map.unstable,
+        "min_damping_ratio": min.as_ref().map(|m| m.0),
+        "min_damping_mode": min.as_ref().map(|m| m.1.clone()),
+        "min_damping_speed_rad_s": min.as_ref().map(|m| m.2),
+        "notes": map.notes,
+    })
+}
+
+/// stability.html: the Coleman diagram, damping versus speed with the unstable ranges shaded,
+/// the reduced model and the ranges.
+pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
+    let mut rep = HtmlReport::new("Ground resonance");
+    let method = map
+        .speeds
+        .first()
+        .map_or("", |s| s.method.name())
+        .to_string();
+    if map.unstable.is_empty() {
+        rep.banner(
+            Banner::Ok,
+            &format!(
+                "Stable over {:.3} to {:.3} rad/s ({} damper, {method}).",
+                map.speeds.first().map_or(f64::NAN, |s| s.omega_rad_s),
+                map.speeds.last().map_or(f64::NAN, |s| s.omega_rad_s),
+                map.damper.name()
+            ),
+        );
+    } else {
+        let ranges: Vec<String> = map
+            .unstable
+            .iter()
+            .map(|u| {
+                format!(
+                    "{} from {:.3} to {:.3} rad/s (growth rate up to {:.4} 1/s)",
+                    u.mode, u.from_rad_s, u.to_rad_s, u.max_growth_rate_per_s
+                )
+            })
+            .collect();
+        rep.banner(Banner::Bad, &format!("UNSTABLE: {}.", ranges.join("; ")));
+    }
+    rep.paragraph(&format!(
+        "Rotor deck {}: {} blades reduced to rigid blades on their lag hinges, each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's in-plane directions (docs/stability.md). Method: {method} ({}).",
+        deck.path.display(),
+        map.blades.len(),
+        map.damper.name(),
+        LINEARISATION_AMPLITUDE_M * 1e3,
+        if method == "coleman" {
+            "identical blades: constant-coefficient equations in multi-blade coordinates"
+        } else {
+            "blades differ: Floquet exponents of the periodic equations over one revolution"
+        }
+    ));
+    let label_order: Vec<String> = {
+        let mut v: Vec<String> = vec![];
+        for s in &map.speeds {
+            for m in &s.modes {
+                let l = m.label.to_string();
+                if !v.contains(&l) {
+                    v.push(l);
+                }
+            }
+        }
+        v
+    };
+    let series = |f: &dyn Fn(&Mode) -> f64, l: &str| -> (Vec<f64>, Vec<f64>) {
+        let mut xs = vec![];
+        let mut ys = vec![];
+        for s in &map.speeds {
+            for m in s.modes.iter().filter(|m| m.label.to_string() == l) {
+                xs.push(s.omega_rad_s);
+                ys.push(f(m));
+            }
+        }
+        (xs, ys)
+    };
+    let mut coleman = Plot::new(
+        "Frequencies in the fixed frame (Coleman diagram)",
+        "rotor speed [rad/s]",
+        "frequency [Hz]",
+    );
+    let mut damping = Plot::new(
+        "Damping ratio (unstable ranges shaded)",
+        "rotor speed [rad/s]",
+        "damping ratio [-]",
+    );
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for l in &label_order {
+        let (x, f) = series(&|m| m.frequency_hz, l);
+        coleman = coleman.points(l, &x, &f);
+        let (x, z) = series(&|m| m.damping_ratio, l);
+        for v in &z {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        damping = damping.points(l, &x, &z);
+    }
+    for u in &map.unstable {
+        damping = damping.band(
+            &format!("unstable: {}", u.mode),
+            &[u.from_rad_s, u.to_rad_s],
+            &[lo.min(0.0), hi],
+        );
+    }
+    let sp: Vec<f64> = map.speeds.iter().map(|s| s.omega_rad_s).collect();
+    let per_rev: Vec<f64> = sp.iter().map(|w| w / (2.0 * PI)).collect();
+    coleman = coleman.dashed("1/rev", &sp, &per_rev);
+    rep.heading(2, "Coleman diagram");
+    rep.svg(
+        "Frequencies of the coupled modes in the fixed frame against rotor speed.",
+        &coleman.to_svg(900, 500)?,
+    );
+    rep.heading(2, "Damping");
+    rep.svg(
+        "Damping ratio of each mode against rotor speed; negative is unstable.",
+        &damping.to_svg(900, 500)?,
+    );
+    if !map.unstable.is_empty() {
+        let rows: Vec<Vec<String>> = map
+            .unstable
+            .iter()
+            .map(|u| {
+                vec![
+                    u.mode.clone(),
+                    format!("{:.4}", u.from_rad_s),
+                    format!("{:.4}", u.to_rad_s),
+                    format!("{:.5}", u.max_growth_rate_per_s),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "mode",
+                "from [rad/s]",
+                "to [rad/s]",
+                "largest growth rate [1/s]",
+            ],
+            &rows,
+        );
+    }
+    rep.heading(2, "The reduced model");
+    let rows: Vec<Vec<String>> = map
+        .blades
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            vec![
+                format!("{}", k + 1),
+                format!("{:.2}", b.mass_kg),
+                format!("{:.2}", b.first_moment_kg_m),
+                format!("{:.2}", b.inertia_kg_m2),
+                format!("{:.4}", b.hinge_offset_m),
+                format!("{:.1}", b.stiffness_nm_per_rad),
+                format!("{:.1}", b.damping_nms_per_rad),
+            ]
+        })
+        .collect();
+    rep.paragraph(&format!(
+        "Blades at {:.3} rad/s (the damper's values depend on the frequency it is linearised at):",
+        sp.last().copied().unwrap_or(f64::NAN)
+    ));
+    rep.table(
+        &[
+            "blade",
+            "mass [kg]",
+            "first moment [kg m]",
+            "inertia [kg m^2]",
+            "hinge offset [m]",
+            "lag stiffness [N m/rad]",
+            "lag damping [N m s/rad]",
+        ],
+        &rows,
+    );
+    let axis = |n: &str, a: &Option<AirframeAxis>| {
+        a.as_ref().map(|a| {
+            vec![
+                n.to_string(),
+                format!("{:.1}", a.mass_kg),
+                format!("{:.1}", a.stiffness_n_per_m),
+                format!("{:.1}", a.damping_ns_per_m),
+            ]
+        })
+    };
+    let rows: Vec<Vec<String>> = [axis("x", &map.x), axis("y", &map.y)]
+        .into_iter()
+        .flatten()
+        .collect();
+    rep.table(
+        &[
+            "airframe",
+            "mass [kg]",
+            "stiffness [N/m]",
+            "damping [N s/m]",
+        ],
+        &rows,
+    );
+    rep.list(&map.notes);
+    Ok(rep.finish())
+}
+
+/// Writes stability.csv, stability.html and summary.json into `out`.
+pub fn write(map: &StabilityMap, deck: &RotorDeck, out: &OutDir) -> anyhow::Result<()> {
+    out.write("stability.csv", csv(map).as_bytes())?;
+    out.write("stability.html", html(map, deck)?.as_bytes())?;
+    out.write(
+        "summary.json",
+        serde_json::to_string_pretty(&summary_json(map, deck))?.as_bytes(),
+    )?;
+    Ok(())
+}
