@@ -4,7 +4,7 @@ use crate::hydraulics::DamperModel;
 use crate::io::OutDir;
 use crate::overrides::Override;
 use crate::rotor::RotorDeck;
-use crate::run::stability::{stability_map, write};
+use crate::run::stability::stability_map;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -21,6 +21,17 @@ pub struct StabilityArgs {
     /// deck's `damper.model`).
     #[arg(long)]
     pub damper: Option<String>,
+    /// Also march the whole multibody rotor on its airframe at these speeds [rad/s] (a list):
+    /// kicked along x, its growth rate fitted (method `time` in stability.csv).
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Velocity of the time-domain kick along x [m/s].
+    #[arg(long, default_value_t = 1e-4)]
+    pub kick_m_s: f64,
+    /// Simulated time of each time-domain run [s] (a growing one stops when the airframe
+    /// moves 10 mm); the fit starts at 10/28 of it.
+    #[arg(long, default_value_t = 28.0)]
+    pub time_duration_s: f64,
     /// Override a deck value by its dotted path before validation (repeatable), as for run.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
     pub set: Vec<Override>,
@@ -93,8 +104,66 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             return Err(e);
         }
     };
-    write(&map, &deck, &out)?;
+    let mut time = vec![];
+    if let Some(t) = &args.time {
+        let speeds: Vec<f64> = t
+            .split(',')
+            .map(|v| {
+                v.trim().parse::<f64>().map_err(|_| {
+                    anyhow::anyhow!(
+                        "--time `{t}`: `{v}` is not a number (expected rad/s, e.g. 25,27)"
+                    )
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+        crate::run::stability::check_speeds(&speeds)
+            .map_err(|e| anyhow::anyhow!("--time: {e:#}"))?;
+        if !(args.kick_m_s.is_finite() && args.kick_m_s > 0.0) {
+            anyhow::bail!(
+                "--kick-m-s {}: expected a positive velocity in m/s",
+                args.kick_m_s
+            );
+        }
+        if !(args.time_duration_s.is_finite() && args.time_duration_s > 0.0) {
+            anyhow::bail!(
+                "--time-duration-s {}: expected a positive time in s",
+                args.time_duration_s
+            );
+        }
+        for &w in &speeds {
+            outln!(
+                "time domain at {w} rad/s ({} s of motion)...",
+                args.time_duration_s
+            );
+            match crate::run::stability::time_check(
+                &args.rotor,
+                &args.set,
+                model,
+                w,
+                args.kick_m_s,
+                args.time_duration_s,
+                args.time_duration_s * 10.0 / 28.0,
+            ) {
+                Ok(c) => time.push(c),
+                Err(e) => {
+                    out.mark_incomplete(&format!("{e:#}"))?;
+                    return Err(e.context(format!("time domain at {w} rad/s")));
+                }
+            }
+        }
+    }
+    crate::run::stability::write_with_time(&map, &time, &deck, &out)?;
     out.finish()?;
+    for c in &time {
+        outln!(
+            "whole rotor at {} rad/s: growth rate {:+.5} 1/s, {:.4} Hz (airframe x after a {} m/s kick){}",
+            c.omega_rad_s,
+            c.growth_rate_per_s,
+            c.frequency_hz,
+            c.kick_m_s,
+            if c.growth_rate_per_s > 0.0 { ": UNSTABLE" } else { "" }
+        );
+    }
     let method = map.speeds.first().map_or("", |s| s.method.name());
     outln!(
         "rotorsim stability: {} ({} damper, {method}), {} speeds from {} to {} rad/s",

@@ -837,6 +837,33 @@ fn rel_twist(r_root: &[[f64; 3]; 3], r_tip: &[[f64; 3]; 3]) -> f64 {
 }
 
 impl RotorSim {
+    /// Kicks the airframe: adds `velocity_m_s` along the hub's `axis` (0: x, 1: y) to that
+    /// direction's node and everything it carries (the chain after it, the hub and the rotor),
+    /// a uniform translation velocity that every joint above the direction's own link admits,
+    /// then makes the accelerations consistent. Errors when the airframe does not move in that
+    /// direction.
+    pub fn kick_airframe(&mut self, axis: usize, velocity_m_s: f64) -> anyhow::Result<()> {
+        let a = self
+            .airframe
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("the rotor is not on an airframe"))?;
+        let k = a
+            .dofs
+            .iter()
+            .position(|d| !d.rotation && d.axis == axis)
+            .ok_or_else(|| anyhow::anyhow!("the airframe does not move along hub axis {axis}"))?;
+        let fixed: Vec<usize> = a.chain[..k].to_vec();
+        let st = &mut self.solver.state;
+        for i in 0..st.v.len() {
+            if !fixed.contains(&i) {
+                st.v[i][axis] += velocity_m_s;
+            }
+        }
+        self.solver
+            .init_accelerations()
+            .map_err(|e| anyhow::anyhow!("after the airframe kick: {e}"))
+    }
+
     /// The dynamic solver (model and state), e.g. for tests and diagnostics.
     pub fn solver(&self) -> &DynamicSolver {
         &self.solver

@@ -650,11 +650,299 @@ pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
 
 /// Writes stability.csv, stability.html and summary.json into `out`.
 pub fn write(map: &StabilityMap, deck: &RotorDeck, out: &OutDir) -> anyhow::Result<()> {
-    out.write("stability.csv", csv(map).as_bytes())?;
-    out.write("stability.html", html(map, deck)?.as_bytes())?;
+    write_with_time(map, &[], deck, out)
+}
+
+/// As [`write`], with the time-domain checks: rows of method `time` (mode `whole rotor`), a
+/// table and figure in the report, `time_checks` in summary.json.
+pub fn write_with_time(
+    map: &StabilityMap,
+    time: &[TimeCheck],
+    deck: &RotorDeck,
+    out: &OutDir,
+) -> anyhow::Result<()> {
+    let mut text = csv(map);
+    for c in time {
+        let w = 2.0 * PI * c.frequency_hz;
+        let zeta = -c.growth_rate_per_s / c.growth_rate_per_s.hypot(w);
+        text.push_str(&format!(
+            "{},whole rotor,{},{},{},time\n",
+            c.omega_rad_s, c.frequency_hz, zeta, c.growth_rate_per_s
+        ));
+    }
+    out.write("stability.csv", text.as_bytes())?;
+    let mut page = html(map, deck)?;
+    if !time.is_empty() {
+        let mut rep = HtmlReport::new("");
+        rep.heading(2, "Time domain: the whole rotor");
+        rep.paragraph(&format!(
+            "The whole multibody rotor on its airframe (every blade, its damper, the hub on the airframe's chain), in rotating equilibrium without airloads, kicked along x by {} m/s and marched {} s; the growth rate is the slope of ln|x| at the peaks of the airframe's x motion from {} s on, beside the {} analysis's least stable growth rate at the same speed.",
+            time[0].kick_m_s,
+            time[0].time_s.last().copied().unwrap_or(f64::NAN),
+            time[0].fit_from_s,
+            map.speeds.first().map_or("linear", |s| s.method.name())
+        ));
+        let mut rows = vec![];
+        let mut plot = Plot::new("Airframe x after the kick", "time [s]", "airframe x [m]");
+        for c in time {
+            let linear = map
+                .speeds
+                .iter()
+                .find(|s| s.omega_rad_s == c.omega_rad_s)
+                .and_then(|s| {
+                    s.modes
+                        .iter()
+                        .map(|m| m.growth_rate_per_s)
+                        .max_by(f64::total_cmp)
+                });
+            rows.push(vec![
+                format!("{}", c.omega_rad_s),
+                format!("{:+.5}", c.growth_rate_per_s),
+                format!("{:.4}", c.frequency_hz),
+                linear.map_or("-".into(), |g| format!("{g:+.5}")),
+                linear.map_or("-".into(), |g| {
+                    format!("{:.2}%", 100.0 * (c.growth_rate_per_s / g - 1.0).abs())
+                }),
+            ]);
+            plot = plot.line(
+                &format!("{} rad/s", c.omega_rad_s),
+                &c.time_s,
+                &c.airframe_x_m,
+            );
+        }
+        rep.table(
+            &[
+                "rotor speed [rad/s]",
+                "whole rotor growth rate [1/s]",
+                "frequency [Hz]",
+                "linear analysis [1/s]",
+                "difference",
+            ],
+            &rows,
+        );
+        rep.svg(
+            "The airframe's x motion after the kick.",
+            &plot.to_svg(900, 450)?,
+        );
+        // the section goes before the reduced model
+        let body = rep.finish();
+        let section = body
+            .split_once("<body>")
+            .map(|(_, b)| b)
+            .and_then(|b| b.rsplit_once("</body>").map(|(b, _)| b))
+            .unwrap_or("")
+            .to_string();
+        page = match page.find("<h2 id=\"the-reduced-model\"") {
+            Some(i) => format!("{}{}{}", &page[..i], section, &page[i..]),
+            None => page.replace("</body>", &format!("{section}</body>")),
+        };
+    }
+    out.write("stability.html", page.as_bytes())?;
+    let mut summary = summary_json(map, deck);
+    summary["time_checks"] = serde_json::Value::Array(
+        time.iter()
+            .map(|c| {
+                serde_json::json!({
+                    "rotor_speed_rad_s": c.omega_rad_s,
+                    "kick_m_s": c.kick_m_s,
+                    "duration_s": c.time_s.last(),
+                    "fit_from_s": c.fit_from_s,
+                    "growth_rate_per_s": c.growth_rate_per_s,
+                    "frequency_Hz": c.frequency_hz,
+                })
+            })
+            .collect(),
+    );
     out.write(
         "summary.json",
-        serde_json::to_string_pretty(&summary_json(map, deck))?.as_bytes(),
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
     )?;
     Ok(())
+}
+
+/// The whole multibody rotor on its airframe at one speed, kicked along the hub's x axis:
+/// its airframe x motion and the growth rate and frequency fitted to it.
+#[derive(Clone, Debug)]
+pub struct TimeCheck {
+    pub omega_rad_s: f64,
+    /// Velocity of the kick [m/s].
+    pub kick_m_s: f64,
+    pub time_s: Vec<f64>,
+    pub airframe_x_m: Vec<f64>,
+    /// Slope of ln|x| at its peaks over the fitted window [1/s].
+    pub growth_rate_per_s: f64,
+    /// From the spacing of the peaks of |x| in the window [Hz].
+    pub frequency_hz: f64,
+    /// Start of the fitted window [s] (the kick's faster modes have died out before it).
+    pub fit_from_s: f64,
+}
+
+/// A flight record of no airloads and no controls at `omega` for the rotor of `spec`: a
+/// rotor on the ground.
+fn ground_record(spec: &RotorSpec, omega: f64) -> anyhow::Result<crate::flight::FlightRecord> {
+    use crate::flight::record::FlightMeta;
+    let meta = serde_json::json!({
+        "synthetic": true,
+        "description": "no airloads: a rotor on the ground (rotorsim stability)",
+        "rotor_speed_rad_s": omega,
+        "radius_m": spec.rotor.radius_m,
+        "controls_deg": {"collective": 0.0, "lateral_cyclic": 0.0, "longitudinal_cyclic": 0.0},
+    });
+    let serde_json::Value::Object(raw) = meta else {
+        bail!("ground record metadata");
+    };
+    let meta = FlightMeta::from_json(raw, std::path::Path::new("<ground record>"))?;
+    let az = vec![0.0, 90.0, 180.0, 270.0];
+    let n = 2 * az.len();
+    // a record holds a damper channel: none was measured, zeros stand in (never compared)
+    let damper = az
+        .iter()
+        .map(|&a| crate::flight::record::DamperSample {
+            revolution: 0,
+            azimuth_deg: a,
+            force_N: 0.0,
+            stroke_m: None,
+        })
+        .collect();
+    Ok(crate::flight::FlightRecord::new(
+        meta,
+        vec![0.5, 1.0],
+        vec![0],
+        az,
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        damper,
+    )?)
+}
+
+/// Airframe motion up to which a kicked response is fitted [m]: small against the rotor, so
+/// that the lag angles stay small and the linear analysis applies (a growing response is
+/// stopped there).
+pub const TIME_FIT_MAX_M: f64 = 0.01;
+
+/// Growth rate and frequency of `x(t)` after `from_s` and before `|x|` first exceeds
+/// [`TIME_FIT_MAX_M`]. The frequency from the mean spacing of the peaks of `|x|`; the growth
+/// rate as the least-squares slope of `ln E / 2` against time over every sample, `E = x^2 +
+/// (x'/omega)^2` (x' by central differences): for a growing oscillation `E` grows smoothly,
+/// without the peaks' sampling of the cycle.
+pub fn fit_growth(t: &[f64], x: &[f64], from_s: f64) -> Option<(f64, f64)> {
+    let end = x
+        .iter()
+        .position(|v| v.abs() > TIME_FIT_MAX_M)
+        .unwrap_or(x.len());
+    // a decaying response ends where it meets the solver's noise: 1e-4 of its largest value
+    let top = x
+        .iter()
+        .zip(t)
+        .filter(|(_, ti)| **ti >= from_s)
+        .fold(0.0f64, |m, (v, _)| m.max(v.abs()));
+    let end = match x
+        .iter()
+        .zip(t)
+        .rposition(|(v, ti)| *ti >= from_s && v.abs() > 1e-4 * top)
+    {
+        Some(i) => end.min(i + 1),
+        None => end,
+    };
+    let (t, x) = (&t[..end], &x[..end]);
+    let peaks: Vec<f64> = (1..x.len().saturating_sub(1))
+        .filter(|&i| t[i] >= from_s && x[i].abs() > x[i - 1].abs() && x[i].abs() >= x[i + 1].abs())
+        .map(|i| t[i])
+        .collect();
+    if peaks.len() < 6 {
+        return None;
+    }
+    let f = 0.5 * (peaks.len() - 1) as f64 / (peaks[peaks.len() - 1] - peaks[0]);
+    let w = 2.0 * std::f64::consts::PI * f;
+    // whole cycles of the window, so that what is left of the cycle in E averages out
+    let (a, b) = (peaks[0], peaks[peaks.len() - 1]);
+    let pts: Vec<(f64, f64)> = (1..x.len() - 1)
+        .filter(|&i| t[i] >= a && t[i] <= b)
+        .map(|i| {
+            let v = (x[i + 1] - x[i - 1]) / (t[i + 1] - t[i - 1]);
+            (t[i], 0.5 * (x[i] * x[i] + (v / w) * (v / w)).ln())
+        })
+        .collect();
+    let n = pts.len() as f64;
+    let (mt, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(p, q), s| (p + s.0 / n, q + s.1 / n));
+    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |(p, q), s| {
+        (p + (s.0 - mt) * (s.1 - my), q + (s.0 - mt) * (s.0 - mt))
+    });
+    Some((sxy / sxx, f))
+}
+
+/// The time-domain check at `omega`: the deck at that speed (`sets` applied, e.g. a blade's
+/// damper), the whole multibody rotor on its airframe with damper model `model`, in rotating
+/// equilibrium without airloads, kicked along x by `kick_m_s` and marched `duration_s`; the
+/// growth rate fitted from `fit_from_s` on.
+pub fn time_check(
+    path: &std::path::Path,
+    sets: &[crate::overrides::Override],
+    model: DamperModel,
+    omega: f64,
+    kick_m_s: f64,
+    duration_s: f64,
+    fit_from_s: f64,
+) -> anyhow::Result<TimeCheck> {
+    let mut all = sets.to_vec();
+    all.push(crate::overrides::Override::parse(&format!(
+        "rotor.omega_rad_s={omega}"
+    ))?);
+    let deck = RotorDeck::from_file_with(path, &all)?;
+    if deck.spec.airframe.is_none() {
+        bail!(
+            "rotor deck {} has no [airframe]: nothing to kick",
+            path.display()
+        );
+    }
+    let n = deck.spec.rotor.blades;
+    let mut blades = Vec::with_capacity(n);
+    for k in 1..=n {
+        let b = deck.blade(k)?;
+        let d = b.damper()?;
+        blades.push((b, d));
+    }
+    let parts: Vec<(&RotorSpec, &DamperDeck)> = blades.iter().map(|(b, d)| (&b.spec, d)).collect();
+    let record = ground_record(&deck.spec, omega)?;
+    let opts = crate::rotor::RunOptions {
+        perturbation_damping: false,
+        ..Default::default()
+    };
+    let mut sim = crate::rotor::sim::build_rotor_sim(&parts, path, model, &record, &opts)?;
+    use crate::rotor::ForcedResponse;
+    sim.set_output_channels(false);
+    let names = sim.channel_names();
+    let ix = names
+        .iter()
+        .position(|c| c == "airframe_x_m")
+        .ok_or_else(|| anyhow!("the rotor has no airframe x channel"))?;
+    sim.kick_airframe(0, kick_m_s)?;
+    let steps = (duration_s / sim.time_step_s()).ceil() as usize;
+    let mut buf = vec![0.0; names.len()];
+    let (mut t, mut x) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
+    let t0 = sim.time_s();
+    for _ in 0..steps {
+        sim.step()?;
+        sim.channels(&mut buf);
+        t.push(sim.time_s() - t0);
+        x.push(buf[ix]);
+        if buf[ix].abs() > TIME_FIT_MAX_M {
+            break; // beyond what the fit uses
+        }
+    }
+    let (g, f) = fit_growth(&t, &x, fit_from_s).ok_or_else(|| {
+        anyhow!("the airframe x motion has too few peaks after {fit_from_s} s to fit a growth rate")
+    })?;
+    Ok(TimeCheck {
+        omega_rad_s: omega,
+        kick_m_s,
+        time_s: t,
+        airframe_x_m: x,
+        growth_rate_per_s: g,
+        frequency_hz: f,
+        fit_from_s,
+    })
 }
