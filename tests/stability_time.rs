@@ -7,7 +7,7 @@
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::overrides::Override;
 use rotorsim::rotor::RotorDeck;
-use rotorsim::run::stability::{stability_map, time_check};
+use rotorsim::run::stability::{stability_map, time_check, TimeOptions};
 use std::path::PathBuf;
 
 /// Does not hold yet: the whole rotor's growth rates differ from the reduced model's by up to
@@ -40,9 +40,7 @@ fn whole_rotor_growth_rates_match_floquet() {
                                 sets,
                                 DamperModel::Linear,
                                 s.omega_rad_s,
-                                1e-4,
-                                28.0,
-                                10.0,
+                                &TimeOptions::default(),
                             )
                             .unwrap();
                             (c, t0.elapsed().as_secs_f64())

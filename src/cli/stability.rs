@@ -32,6 +32,9 @@ pub struct StabilityArgs {
     /// moves 10 mm); the fit starts at 10/28 of it.
     #[arg(long, default_value_t = 28.0)]
     pub time_duration_s: f64,
+    /// Structural steps per revolution of the time-domain runs.
+    #[arg(long, default_value_t = 256)]
+    pub steps_per_rev: usize,
     /// Override a deck value by its dotted path before validation (repeatable), as for run.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
     pub set: Vec<Override>,
@@ -140,9 +143,12 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
                 &args.set,
                 model,
                 w,
-                args.kick_m_s,
-                args.time_duration_s,
-                args.time_duration_s * 10.0 / 28.0,
+                &crate::run::stability::TimeOptions {
+                    kick_m_s: args.kick_m_s,
+                    duration_s: args.time_duration_s,
+                    fit_from_s: args.time_duration_s * 10.0 / 28.0,
+                    steps_per_rev: args.steps_per_rev,
+                },
             ) {
                 Ok(c) => time.push(c),
                 Err(e) => {

@@ -874,19 +874,46 @@ pub fn fit_growth(t: &[f64], x: &[f64], from_s: f64) -> Option<(f64, f64)> {
     Some((sxy / sxx, f))
 }
 
+/// How the time-domain check runs.
+#[derive(Clone, Copy, Debug)]
+pub struct TimeOptions {
+    /// Velocity of the kick along x [m/s].
+    pub kick_m_s: f64,
+    /// Simulated time [s] (a growing response stops at [`TIME_FIT_MAX_M`]).
+    pub duration_s: f64,
+    /// Start of the fitted window [s].
+    pub fit_from_s: f64,
+    /// Structural steps per revolution.
+    pub steps_per_rev: usize,
+}
+
+impl Default for TimeOptions {
+    fn default() -> Self {
+        TimeOptions {
+            kick_m_s: 1e-4,
+            duration_s: 28.0,
+            fit_from_s: 10.0,
+            steps_per_rev: 256,
+        }
+    }
+}
+
 /// The time-domain check at `omega`: the deck at that speed (`sets` applied, e.g. a blade's
 /// damper), the whole multibody rotor on its airframe with damper model `model`, in rotating
-/// equilibrium without airloads, kicked along x by `kick_m_s` and marched `duration_s`; the
-/// growth rate fitted from `fit_from_s` on.
+/// equilibrium without airloads, kicked along x and marched ([`TimeOptions`]).
 pub fn time_check(
     path: &std::path::Path,
     sets: &[crate::overrides::Override],
     model: DamperModel,
     omega: f64,
-    kick_m_s: f64,
-    duration_s: f64,
-    fit_from_s: f64,
+    o: &TimeOptions,
 ) -> anyhow::Result<TimeCheck> {
+    let TimeOptions {
+        kick_m_s,
+        duration_s,
+        fit_from_s,
+        steps_per_rev,
+    } = *o;
     let mut all = sets.to_vec();
     all.push(crate::overrides::Override::parse(&format!(
         "rotor.omega_rad_s={omega}"
@@ -909,6 +936,7 @@ pub fn time_check(
     let record = ground_record(&deck.spec, omega)?;
     let opts = crate::rotor::RunOptions {
         perturbation_damping: false,
+        steps_per_rev,
         ..Default::default()
     };
     let mut sim = crate::rotor::sim::build_rotor_sim(&parts, path, model, &record, &opts)?;
