@@ -100,17 +100,16 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("--damper {d}: {e}"))?,
         None => deck.damper()?.model,
     };
-    let out = OutDir::create(&args.out, &deck.input_files())?;
-    let map = match stability_map(&deck, model, &speeds) {
-        Ok(m) => m,
-        Err(e) => {
-            out.mark_incomplete(&format!("{e:#}"))?;
-            return Err(e);
-        }
+    // --time: read and sized before the result folder exists
+    let time_opts = crate::run::stability::TimeOptions {
+        kick_m_s: args.kick_m_s,
+        duration_s: args.time_duration_s,
+        fit_from_s: args.time_duration_s * 7.0 / 20.0,
+        steps_per_rev: args.steps_per_rev,
     };
-    let mut time = vec![];
+    let mut time_speeds: Vec<f64> = vec![];
     if let Some(t) = &args.time {
-        let speeds: Vec<f64> = t
+        time_speeds = t
             .split(',')
             .map(|v| {
                 v.trim().parse::<f64>().map_err(|_| {
@@ -120,42 +119,31 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
                 })
             })
             .collect::<anyhow::Result<_>>()?;
-        crate::run::stability::check_speeds(&speeds)
+        crate::run::stability::check_speeds(&time_speeds)
             .map_err(|e| anyhow::anyhow!("--time: {e:#}"))?;
-        if !(args.kick_m_s.is_finite() && args.kick_m_s > 0.0) {
-            anyhow::bail!(
-                "--kick-m-s {}: expected a positive velocity in m/s",
-                args.kick_m_s
-            );
+        for &w in &time_speeds {
+            time_opts.check(w)?;
         }
-        if !(args.time_duration_s.is_finite() && args.time_duration_s > 0.0) {
-            anyhow::bail!(
-                "--time-duration-s {}: expected a positive time in s",
-                args.time_duration_s
-            );
+    }
+    let out = OutDir::create(&args.out, &deck.input_files())?;
+    let map = match stability_map(&deck, model, &speeds) {
+        Ok(m) => m,
+        Err(e) => {
+            out.mark_incomplete(&format!("{e:#}"))?;
+            return Err(e);
         }
-        for &w in &speeds {
-            outln!(
-                "time domain at {w} rad/s ({} s of motion)...",
-                args.time_duration_s
-            );
-            match crate::run::stability::time_check(
-                &args.rotor,
-                &args.set,
-                model,
-                w,
-                &crate::run::stability::TimeOptions {
-                    kick_m_s: args.kick_m_s,
-                    duration_s: args.time_duration_s,
-                    fit_from_s: args.time_duration_s * 7.0 / 20.0,
-                    steps_per_rev: args.steps_per_rev,
-                },
-            ) {
-                Ok(c) => time.push(c),
-                Err(e) => {
-                    out.mark_incomplete(&format!("{e:#}"))?;
-                    return Err(e.context(format!("time domain at {w} rad/s")));
-                }
+    };
+    let mut time = vec![];
+    for &w in &time_speeds {
+        outln!(
+            "time domain at {w} rad/s ({} s of motion)...",
+            args.time_duration_s
+        );
+        match crate::run::stability::time_check(&args.rotor, &args.set, model, w, &time_opts) {
+            Ok(c) => time.push(c),
+            Err(e) => {
+                out.mark_incomplete(&format!("{e:#}"))?;
+                return Err(e.context(format!("time domain at {w} rad/s")));
             }
         }
     }

@@ -874,6 +874,11 @@ pub fn fit_growth(t: &[f64], x: &[f64], from_s: f64) -> Option<(f64, f64)> {
     Some((sxy / sxx, f))
 }
 
+/// Most steps per revolution of a time-domain check.
+pub const MAX_TIME_STEPS_PER_REV: usize = 16384;
+/// Most structural steps of one time-domain check (about an hour of the whole rotor).
+pub const MAX_TIME_STEPS: f64 = 5e6;
+
 /// How the time-domain check runs.
 #[derive(Clone, Copy, Debug)]
 pub struct TimeOptions {
@@ -885,6 +890,35 @@ pub struct TimeOptions {
     pub fit_from_s: f64,
     /// Structural steps per revolution.
     pub steps_per_rev: usize,
+}
+
+impl TimeOptions {
+    /// The options at rotor speed `omega` [rad/s], sizes checked before anything is built or
+    /// allocated.
+    pub fn check(&self, omega: f64) -> anyhow::Result<()> {
+        let TimeOptions {
+            kick_m_s,
+            duration_s,
+            steps_per_rev,
+            ..
+        } = *self;
+        if !(kick_m_s.is_finite() && kick_m_s > 0.0) {
+            bail!("--kick-m-s {kick_m_s}: expected a positive velocity in m/s");
+        }
+        if !(duration_s.is_finite() && duration_s > 0.0) {
+            bail!("--time-duration-s {duration_s}: expected a positive time in s");
+        }
+        if !(8..=MAX_TIME_STEPS_PER_REV).contains(&steps_per_rev) {
+            bail!("--steps-per-rev {steps_per_rev}: expected 8 to {MAX_TIME_STEPS_PER_REV}");
+        }
+        let steps = duration_s * omega / (2.0 * PI) * steps_per_rev as f64;
+        if steps > MAX_TIME_STEPS {
+            bail!(
+                "--time-duration-s {duration_s} at {omega} rad/s and {steps_per_rev} steps per revolution is {steps:.3e} steps, beyond the {MAX_TIME_STEPS:.0e} a time-domain check may take; shorten it"
+            );
+        }
+        Ok(())
+    }
 }
 
 impl Default for TimeOptions {
@@ -916,6 +950,7 @@ pub fn time_check(
         fit_from_s,
         steps_per_rev,
     } = *o;
+    o.check(omega)?;
     let mut all = sets.to_vec();
     all.push(crate::overrides::Override::parse(&format!(
         "rotor.omega_rad_s={omega}"
