@@ -51,43 +51,13 @@ fn parse_set(s: &str) -> Result<Override, String> {
 /// Most speeds of one map (each is an eigen-analysis or a Floquet integration).
 pub const MAX_SPEEDS: usize = 2000;
 
-/// `START:STOP:STEP` (inclusive) or `a,b,c`, in rad/s.
+/// `START:STOP:STEP` (inclusive) or `a,b,c`, in rad/s, increasing.
 pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
-    let bad = |m: &str| {
-        anyhow::anyhow!(
-            "--speeds `{s}`: {m} (expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30)"
-        )
-    };
-    let num = |t: &str| {
-        t.trim()
-            .parse::<f64>()
-            .map_err(|_| bad(&format!("`{t}` is not a number")))
-    };
-    let v: Vec<f64> = if s.contains(':') {
-        let p: Vec<&str> = s.split(':').collect();
-        if p.len() != 3 {
-            return Err(bad("three fields needed"));
-        }
-        let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
-        if !(a.is_finite() && b.is_finite() && h.is_finite()) {
-            return Err(bad("START, STOP and STEP must be finite"));
-        }
-        if h <= 0.0 || b < a {
-            return Err(bad("STEP must be positive and STOP >= START"));
-        }
-        let n = ((b - a) / h + 1e-9).floor();
-        if n + 1.0 > MAX_SPEEDS as f64 {
-            return Err(bad(&format!(
-                "{n} speeds, beyond the {MAX_SPEEDS} a map may have; use a larger STEP"
-            )));
-        }
-        (0..=n as usize)
-            .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
-            .collect()
-    } else {
-        s.split(',').map(num).collect::<Result<_, _>>()?
-    };
-    crate::run::stability::check_speeds(&v).map_err(|e| bad(&format!("{e:#}")))?;
+    const EXPECTED: &str =
+        "expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30";
+    let v = super::modes::parse_range(s, EXPECTED, MAX_SPEEDS, "a map may have")?;
+    crate::run::stability::check_speeds(&v)
+        .map_err(|e| anyhow::anyhow!("--speeds `{s}`: {e:#} ({EXPECTED})"))?;
     Ok(v)
 }
 
