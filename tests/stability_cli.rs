@@ -2,7 +2,7 @@
 //! source's (data/stability/hammond1974.md), its map equals the lag-rotor analysis of the
 //! source's numbers written here, an unstable rotor is a result (exit 0, marked), and the
 //! outputs hold what the docs say.
-use rotorsim::stability::{AirframeAxis, LagBlade, LagRotor};
+use rotorsim::stability::LagRotor;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -28,35 +28,9 @@ fn stability(args: &[&str], out: &Path) -> (bool, String) {
     (o.status.success(), text)
 }
 
-/// The source's rotor (GR_rotor.mbd), blade `out` (0-based) without its damper.
+/// The source's rotor (data/stability/hammond1974.md), blade `out` (0-based) without its damper.
 fn source_rotor(out: Option<usize>) -> LagRotor {
-    let mut blades = vec![
-        LagBlade {
-            mass_kg: 94.9,
-            first_moment_kg_m: 289.1,
-            inertia_kg_m2: 1084.7,
-            hinge_offset_m: 0.3048,
-            stiffness_nm_per_rad: 0.0,
-            damping_nms_per_rad: 4067.5,
-        };
-        4
-    ];
-    if let Some(k) = out {
-        blades[k].damping_nms_per_rad = 0.0;
-    }
-    LagRotor {
-        blades,
-        x: Some(AirframeAxis {
-            mass_kg: 8026.6,
-            stiffness_n_per_m: 1_240_481.8,
-            damping_ns_per_m: 51_078.7,
-        }),
-        y: Some(AirframeAxis {
-            mass_kg: 3283.6,
-            stiffness_n_per_m: 1_240_481.8,
-            damping_ns_per_m: 25_539.3,
-        }),
-    }
+    support::hammond_rotor(out)
 }
 
 /// stability.csv rows: (speed, mode, frequency, damping ratio, growth rate, method).

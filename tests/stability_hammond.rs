@@ -2,39 +2,15 @@
 //! dampers working (Coleman sweep, checked by Floquet of the same rotor: the paper's figure
 //! is not available), and with blade 4's damper inoperative (Floquet growth rates against a
 //! log-decrement fit of the periodic system's time response).
-use rotorsim::stability::{AirframeAxis, LagBlade, LagRotor, Mode};
+use rotorsim::stability::{LagRotor, Mode};
 use std::f64::consts::PI;
+
+mod support;
 use std::time::Instant;
 
 /// data/stability/hammond1974.md (MBDyn tests/Hammond/GR_MBDyn/GR_rotor.mbd).
-fn hammond(inoperative: Option<usize>) -> LagRotor {
-    let mut blades = vec![
-        LagBlade {
-            mass_kg: 94.9,
-            first_moment_kg_m: 289.1,
-            inertia_kg_m2: 1084.7,
-            hinge_offset_m: 0.3048,
-            stiffness_nm_per_rad: 0.0,
-            damping_nms_per_rad: 4067.5,
-        };
-        4
-    ];
-    if let Some(k) = inoperative {
-        blades[k].damping_nms_per_rad = 0.0;
-    }
-    LagRotor {
-        blades,
-        x: Some(AirframeAxis {
-            mass_kg: 8026.6,
-            stiffness_n_per_m: 1_240_481.8,
-            damping_ns_per_m: 51_078.7,
-        }),
-        y: Some(AirframeAxis {
-            mass_kg: 3283.6,
-            stiffness_n_per_m: 1_240_481.8,
-            damping_ns_per_m: 25_539.3,
-        }),
-    }
+fn hammond(out: Option<usize>) -> LagRotor {
+    support::hammond_rotor(out)
 }
 
 /// No rotor speed range in the MBDyn folder: 1-40 rad/s brackets both regressing-lag /

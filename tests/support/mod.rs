@@ -55,3 +55,36 @@ pub const PHYSICAL_CHANNELS: [&str; 9] = [
     "q_valve0_m3_s",
     "q_valve1_m3_s",
 ];
+
+/// Hammond's 1974 ground-resonance rotor as the reduced lag model, from the source's numbers
+/// (data/stability/hammond1974.md); blade `inoperative` (0-based) without its lag damper.
+pub fn hammond_rotor(inoperative: Option<usize>) -> rotorsim::stability::LagRotor {
+    use rotorsim::stability::{AirframeAxis, LagBlade, LagRotor};
+    let mut blades = vec![
+        LagBlade {
+            mass_kg: 94.9,
+            first_moment_kg_m: 289.1,
+            inertia_kg_m2: 1084.7,
+            hinge_offset_m: 0.3048,
+            stiffness_nm_per_rad: 0.0,
+            damping_nms_per_rad: 4067.5,
+        };
+        4
+    ];
+    if let Some(k) = inoperative {
+        blades[k].damping_nms_per_rad = 0.0;
+    }
+    LagRotor {
+        blades,
+        x: Some(AirframeAxis {
+            mass_kg: 8026.6,
+            stiffness_n_per_m: 1_240_481.8,
+            damping_ns_per_m: 51_078.7,
+        }),
+        y: Some(AirframeAxis {
+            mass_kg: 3283.6,
+            stiffness_n_per_m: 1_240_481.8,
+            damping_ns_per_m: 25_539.3,
+        }),
+    }
+}
