@@ -191,3 +191,41 @@ fn hammond_deck_with_one_damper_out_is_unstable_and_a_result() {
     assert!(html.contains("UNSTABLE") && html.contains("unstable: regressing lag"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// The amplitude check through the command: amplitude.csv with its columns, the report's
+/// section, summary.json's statement; the result folder complete.
+#[test]
+fn the_amplitude_check_writes_its_table_section_and_statement() {
+    let out = support::tmp("stability_amplitude_cli");
+    let (ok, text) = stability(
+        &[
+            "--rotor",
+            repo("rotors/uh60a_airframe.toml").to_str().unwrap(),
+            "--speeds",
+            "20,27,34",
+            "--damper",
+            "physical",
+            "--amplitudes-m",
+            "1e-4,1e-3",
+        ],
+        &out,
+    );
+    assert!(ok, "{text}");
+    assert!(text.contains("amplitude check: at 27.000 rad/s"), "{text}");
+    let csv = std::fs::read_to_string(out.join("amplitude.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N"
+    );
+    assert_eq!(lines.count(), 2);
+    let html = std::fs::read_to_string(out.join("stability.html")).unwrap();
+    assert!(html.contains("Amplitude: where the linear analysis stops being true"));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let a = &s["amplitude_check"];
+    assert_eq!(a["rotor_speed_rad_s"], 27.0);
+    assert_eq!(a["points"].as_array().unwrap().len(), 2);
+    assert!(a["statement"].as_str().unwrap().contains("no limit cycle"));
+    assert!(!out.join("INCOMPLETE").exists());
+}

@@ -36,6 +36,15 @@ pub struct StabilityArgs {
     /// growth rate near a coalescence, 512 within 1%).
     #[arg(long, default_value_t = 512)]
     pub steps_per_rev: usize,
+    /// Nonlinear amplitude check: start the reduced rotor on its regressing lag mode at these
+    /// damper stroke amplitudes [m] (an increasing list; `default` for 0.1 to 30 mm), each
+    /// blade's damper a device with its valves live; growth rate against amplitude and the
+    /// limit cycles (amplitude.csv).
+    #[arg(long)]
+    pub amplitudes_m: Option<String>,
+    /// Rotor speed of the amplitude check [rad/s] (default: the deck's rotor.omega_rad_s).
+    #[arg(long)]
+    pub amplitude_at_rad_s: Option<f64>,
     /// Override a deck value by its dotted path before validation (repeatable), as for run.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
     pub set: Vec<Override>,
@@ -95,6 +104,39 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             time_opts.check(w)?;
         }
     }
+    // --amplitudes-m: read and checked before the result folder exists
+    let amplitude = match &args.amplitudes_m {
+        None => {
+            if args.amplitude_at_rad_s.is_some() {
+                anyhow::bail!("--amplitude-at-rad-s needs --amplitudes-m (the amplitudes to start from, or `default`)");
+            }
+            None
+        }
+        Some(a) => {
+            let amplitudes_m = if a.trim() == "default" {
+                crate::run::amplitude::DEFAULT_AMPLITUDES_M.to_vec()
+            } else {
+                a.split(',')
+                    .map(|v| {
+                        v.trim().parse::<f64>().map_err(|_| {
+                            anyhow::anyhow!("--amplitudes-m `{a}`: `{v}` is not a number (expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`)")
+                        })
+                    })
+                    .collect::<anyhow::Result<_>>()?
+            };
+            let w = args
+                .amplitude_at_rad_s
+                .unwrap_or(deck.spec.rotor.omega_rad_s);
+            if !(w.is_finite() && w > 0.0) {
+                anyhow::bail!("--amplitude-at-rad-s {w}: expected a positive rotor speed in rad/s");
+            }
+            crate::run::amplitude::check_amplitudes(
+                &amplitudes_m,
+                deck.spec.damper_attachment.arm_m,
+            )?;
+            Some((w, amplitudes_m))
+        }
+    };
     let out = OutDir::create(&args.out, &deck.input_files())?;
     let map = match stability_map(&deck, model, &speeds) {
         Ok(m) => m,
@@ -117,8 +159,32 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             }
         }
     }
-    crate::run::stability::write_with_time(&map, &time, &deck, &out)?;
+    let amp = match amplitude {
+        None => None,
+        Some((w, amplitudes_m)) => {
+            outln!(
+                "amplitude check at {w} rad/s ({} starts, {} damper)...",
+                amplitudes_m.len(),
+                model.name()
+            );
+            let opts = crate::run::amplitude::AmplitudeOptions {
+                amplitudes_m,
+                ..Default::default()
+            };
+            match crate::run::amplitude::amplitude_check(&deck, model, w, &opts) {
+                Ok(c) => Some(c),
+                Err(e) => {
+                    out.mark_incomplete(&format!("{e:#}"))?;
+                    return Err(e.context(format!("amplitude check at {w} rad/s")));
+                }
+            }
+        }
+    };
+    crate::run::stability::write_all(&map, &time, amp.as_ref(), &deck, &out)?;
     out.finish()?;
+    if let Some(c) = &amp {
+        outln!("amplitude check: {}", c.statement);
+    }
     for c in &time {
         outln!(
             "whole rotor at {} rad/s: growth rate {:+.5} 1/s, {:.4} Hz (airframe x after a {} m/s kick){}",

@@ -301,6 +301,12 @@ impl RotorDeck {
             (text, spec)
         } else {
             let text = crate::overrides::apply_all(&text, &file, &overrides, |t, ov| {
+                // the schema's message without its position in the generated text: the user
+                // wrote the value on the command line, which the caller names
+                if let Err(e) = toml::from_str::<deck::RotorSpec>(t) {
+                    let table = ov.key.rsplit_once('.').map_or("", |(t, _)| t);
+                    anyhow::bail!("rotor deck {file}, {table}: {}", e.message().trim_end());
+                }
                 deck::RotorSpec::parse(t, &file)?;
                 if ov.is_damper() {
                     DamperDeck::from_toml_str(t, &file)?;

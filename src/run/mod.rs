@@ -12,6 +12,7 @@
 //! Beside it, the pipelines of the other commands that write result folders: [`bench`] (the
 //! damper bench's sweep and replay outputs), [`decay`] (a hinged blade's lag free decay) and
 //! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check).
+pub mod amplitude;
 pub mod bench;
 pub mod decay;
 pub mod job;
@@ -75,6 +76,9 @@ pub struct ModelRun {
     pub timing: Timing,
     /// Wall time of the whole run of this model, construction included [s].
     pub wall_s: f64,
+    /// When the run began and ended (a whole rotor's blades share threads, so its wall time
+    /// spans its first blade's start to its last blade's end).
+    pub span: Option<(Instant, Instant)>,
     /// Wall time of building the simulation [s].
     pub build_s: f64,
     /// Equilibrium check of the blade loads (models with load channels).
@@ -565,6 +569,7 @@ fn drive_periodic_once(
         relief_regulation: sim.relief_regulation(),
         timing,
         wall_s: t_start.elapsed().as_secs_f64(),
+        span: None,
         build_s: 0.0,
         loads_check: None,
         blades,
@@ -732,6 +737,7 @@ where
             let mut run = drive_periodic(sim.as_mut(), model, opts, &cb)?;
             run.build_s = build_s;
             run.wall_s = t0.elapsed().as_secs_f64();
+            run.span = Some((t0, Instant::now()));
             Ok(run)
         })
         .map_err(|e| format!("{e:#}"));

@@ -147,7 +147,18 @@ pub fn combine(blades: Vec<ModelRun>) -> anyhow::Result<ModelRun> {
             relaxed_steps: t.relaxed_steps + s.relaxed_steps,
         }
     });
-    run.wall_s = blades.iter().map(|b| b.wall_s).fold(0.0, f64::max);
+    // the blades share threads: the rotor's wall time runs from its first blade's start to
+    // its last blade's end
+    let spans: Vec<_> = blades.iter().filter_map(|b| b.span).collect();
+    run.span = spans
+        .iter()
+        .map(|s| s.0)
+        .min()
+        .zip(spans.iter().map(|s| s.1).max());
+    run.wall_s = match run.span {
+        Some((a, b)) if spans.len() == blades.len() => (b - a).as_secs_f64(),
+        _ => blades.iter().map(|b| b.wall_s).fold(0.0, f64::max),
+    };
     run.build_s = blades.iter().map(|b| b.build_s).fold(0.0, f64::max);
     run.loads_check = blades
         .iter()

@@ -20,6 +20,21 @@ use std::f64::consts::PI;
 /// a 0.175 m arm.
 pub const LINEARISATION_AMPLITUDE_M: f64 = 1e-4;
 
+/// The devices' integrator on the linearisation bench: the L-stable SDIRK with the rotor
+/// run's 25 sub-steps. At the lag frequency a bench cycle of 256 steps makes RK4's sub-step
+/// (1.4e-4 s at 7 rad/s) so long against the chambers' rates that its own numerical damping
+/// shows: the physical damper's small-amplitude damping came out 222 N m s/rad where a
+/// converged integration (RK4 at 1.8e-5 s, or this) gives 39.
+pub const BENCH_INTEGRATOR: IntegratorOptions = IntegratorOptions {
+    scheme: crate::hydraulics::Scheme::Implicit,
+    substeps: 25,
+};
+
+/// Cycles of the linearisation's harmonic run (the first harmonic of the last one) and steps
+/// per cycle.
+pub const BENCH_CYCLES: usize = 3;
+pub const BENCH_STEPS_PER_CYCLE: usize = 128;
+
 /// Revolution steps of the Floquet integration (RK4; the multipliers converge as h^4).
 pub const FLOQUET_STEPS_PER_REV: usize = 512;
 
@@ -101,7 +116,7 @@ impl StabilityMap {
 /// The airframe's in-plane directions at the hub: x and y translations, and a roll or pitch
 /// about a centre off the hub plane as the hub translation it carries (`y = c theta`: mass
 /// `I / c^2`, and so the spring and damper). Returns (x, y, notes on what is left out).
-fn in_plane(
+pub(crate) fn in_plane(
     dofs: &[AirframeDof],
     file: &str,
 ) -> anyhow::Result<(Option<AirframeAxis>, Option<AirframeAxis>, Vec<String>)> {
@@ -151,6 +166,26 @@ fn linearise(
     arm_m: f64,
     w: f64,
 ) -> anyhow::Result<(f64, f64)> {
+    linearise_at(
+        damper,
+        model,
+        arm_m,
+        w,
+        LINEARISATION_AMPLITUDE_M,
+        BENCH_INTEGRATOR,
+    )
+}
+
+/// As [`linearise`], at the stroke amplitude `amplitude_m`: the damper's equivalent stiffness
+/// and damping at that amplitude (the bench's first harmonic), moved to the lag hinge.
+pub(crate) fn linearise_at(
+    damper: &DamperDeck,
+    model: DamperModel,
+    arm_m: f64,
+    w: f64,
+    amplitude_m: f64,
+    integrator: IntegratorOptions,
+) -> anyhow::Result<(f64, f64)> {
     let a2 = arm_m * arm_m;
     if model == DamperModel::Linear {
         let c = damper
@@ -158,13 +193,13 @@ fn linearise(
             .ok_or_else(|| anyhow!("{}: no [damper.linear] table", damper.source))?;
         return Ok((0.0, a2 * c));
     }
-    let dev = damper.build(model, IntegratorOptions::default())?;
+    let dev = damper.build(model, integrator)?;
     let r = harmonic_run(
         dev.as_ref(),
         w,
-        w * LINEARISATION_AMPLITUDE_M,
-        6,
-        256,
+        w * amplitude_m,
+        BENCH_CYCLES,
+        BENCH_STEPS_PER_CYCLE,
         false,
     )?;
     Ok((
@@ -661,6 +696,18 @@ pub fn write_with_time(
     deck: &RotorDeck,
     out: &OutDir,
 ) -> anyhow::Result<()> {
+    write_all(map, time, None, deck, out)
+}
+
+/// As [`write_with_time`], with the nonlinear amplitude check: amplitude.csv, its section in
+/// the report, `amplitude_check` in summary.json.
+pub fn write_all(
+    map: &StabilityMap,
+    time: &[TimeCheck],
+    amplitude: Option<&super::amplitude::AmplitudeCheck>,
+    deck: &RotorDeck,
+    out: &OutDir,
+) -> anyhow::Result<()> {
     let mut text = csv(map);
     for c in time {
         let w = 2.0 * PI * c.frequency_hz;
@@ -737,8 +784,19 @@ pub fn write_with_time(
             None => page.replace("</body>", &format!("{section}</body>")),
         };
     }
+    if let Some(a) = amplitude {
+        out.write("amplitude.csv", super::amplitude::csv(a).as_bytes())?;
+        let section = super::amplitude::html_section(a)?;
+        page = match page.find("<h2 id=\"the-reduced-model\"") {
+            Some(i) => format!("{}{}{}", &page[..i], section, &page[i..]),
+            None => page.replace("</body>", &format!("{section}</body>")),
+        };
+    }
     out.write("stability.html", page.as_bytes())?;
     let mut summary = summary_json(map, deck);
+    if let Some(a) = amplitude {
+        summary["amplitude_check"] = super::amplitude::json(a);
+    }
     summary["time_checks"] = serde_json::Value::Array(
         time.iter()
             .map(|c| {

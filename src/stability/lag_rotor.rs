@@ -226,7 +226,7 @@ impl TimeResponse {
     }
 }
 
-fn finite(field: impl Into<String>, value: f64) -> Result<()> {
+pub(super) fn finite(field: impl Into<String>, value: f64) -> Result<()> {
     if value.is_finite() {
         Ok(())
     } else {
@@ -237,7 +237,12 @@ fn finite(field: impl Into<String>, value: f64) -> Result<()> {
     }
 }
 
-fn range(field: impl Into<String>, value: f64, ok: bool, expected: &'static str) -> Result<()> {
+pub(super) fn range(
+    field: impl Into<String>,
+    value: f64,
+    ok: bool,
+    expected: &'static str,
+) -> Result<()> {
     let field = field.into();
     finite(field.clone(), value)?;
     if ok {
@@ -251,7 +256,7 @@ fn range(field: impl Into<String>, value: f64, ok: bool, expected: &'static str)
     }
 }
 
-fn check_omega(omega_rad_s: f64) -> Result<()> {
+pub(super) fn check_omega(omega_rad_s: f64) -> Result<()> {
     range(
         "omega_rad_s",
         omega_rad_s,
@@ -544,35 +549,7 @@ impl LagRotor {
             out.extend(l2.iter().map(|&l| (l, ModeLabel::DifferentialLag)));
         }
         // Cyclic n = 1 coupled to the hub: coordinates zeta_1c, zeta_1s, hubs.
-        let n = 2 + hubs.len();
-        let mut mm = Mat::<f64>::zeros(n, n);
-        let mut cm = Mat::<f64>::zeros(n, n);
-        let mut km = Mat::<f64>::zeros(n, n);
-        let mut weight = vec![nb as f64 / 2.0 * i_b; n];
-        for i in 0..2 {
-            mm[(i, i)] = i_b;
-            cm[(i, i)] = c_b;
-            km[(i, i)] = k_b - omega * omega * i_b;
-        }
-        cm[(0, 1)] = 2.0 * omega * i_b;
-        cm[(1, 0)] = -2.0 * omega * i_b;
-        km[(0, 1)] = c_b * omega;
-        km[(1, 0)] = -c_b * omega;
-        let half_n_s = nb as f64 / 2.0 * s_b;
-        for (j, hub) in hubs.iter().enumerate() {
-            let ih = 2 + j;
-            mm[(ih, ih)] = hub.mass_kg;
-            cm[(ih, ih)] = hub.damping;
-            km[(ih, ih)] = hub.stiffness;
-            weight[ih] = hub.mass_kg;
-            if hub.is_y {
-                mm[(0, ih)] = s_b;
-                mm[(ih, 0)] = half_n_s;
-            } else {
-                mm[(1, ih)] = -s_b;
-                mm[(ih, 1)] = -half_n_s;
-            }
-        }
+        let (mm, cm, km, weight) = self.cyclic_block(omega);
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
         for (j, &l) in lams.iter().enumerate() {
             let energy = |i: usize| weight[i] * u[(i, j)].norm() * u[(i, j)].norm();
@@ -608,6 +585,94 @@ impl LagRotor {
             out.push((l, best.1));
         }
         Ok(out)
+    }
+
+    /// The cyclic n = 1 equations coupled to the hub (isotropic rotor): mass, damping and
+    /// stiffness on `zeta_1c, zeta_1s`, then the hubs, and each coordinate's kinetic-energy
+    /// weight.
+    fn cyclic_block(&self, omega: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>, Vec<f64>) {
+        let nb = self.blades.len();
+        let b = &self.blades[0];
+        let (i_b, s_b, c_b) = (b.inertia_kg_m2, b.first_moment_kg_m, b.damping_nms_per_rad);
+        let k_b = b.stiffness_nm_per_rad + b.hinge_offset_m * s_b * omega * omega;
+        let hubs = self.hubs();
+        let n = 2 + hubs.len();
+        let mut mm = Mat::<f64>::zeros(n, n);
+        let mut cm = Mat::<f64>::zeros(n, n);
+        let mut km = Mat::<f64>::zeros(n, n);
+        let mut weight = vec![nb as f64 / 2.0 * i_b; n];
+        for i in 0..2 {
+            mm[(i, i)] = i_b;
+            cm[(i, i)] = c_b;
+            km[(i, i)] = k_b - omega * omega * i_b;
+        }
+        cm[(0, 1)] = 2.0 * omega * i_b;
+        cm[(1, 0)] = -2.0 * omega * i_b;
+        km[(0, 1)] = c_b * omega;
+        km[(1, 0)] = -c_b * omega;
+        let half_n_s = nb as f64 / 2.0 * s_b;
+        for (j, hub) in hubs.iter().enumerate() {
+            let ih = 2 + j;
+            mm[(ih, ih)] = hub.mass_kg;
+            cm[(ih, ih)] = hub.damping;
+            km[(ih, ih)] = hub.stiffness;
+            weight[ih] = hub.mass_kg;
+            if hub.is_y {
+                mm[(0, ih)] = s_b;
+                mm[(ih, 0)] = half_n_s;
+            } else {
+                mm[(1, ih)] = -s_b;
+                mm[(ih, 1)] = -half_n_s;
+            }
+        }
+        (mm, cm, km, weight)
+    }
+
+    /// A state (ordered as [`LagRotor::state_layout`], blade 1 at zero azimuth) on the least
+    /// damped Coleman mode labelled `label` of this isotropic rotor, scaled to a cyclic lag
+    /// amplitude of 1 rad ([`cyclic_amplitude`]): the start of a free response that holds
+    /// that mode alone. Only the coupled modes (regressing and progressive lag, airframe).
+    pub fn mode_state(&self, omega_rad_s: f64, label: ModeLabel) -> Result<Vec<f64>> {
+        let modes = self.coleman_eigenvalues(omega_rad_s)?;
+        let target = modes
+            .iter()
+            .filter(|m| m.label == label)
+            .max_by(|a, b| a.growth_rate_per_s.total_cmp(&b.growth_rate_per_s))
+            .ok_or_else(|| StabilityError::Numerical(format!("no {label} mode")))?;
+        let (mm, cm, km, _) = self.cyclic_block(omega_rad_s);
+        let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
+        let j = (0..lams.len())
+            .min_by(|&a, &b| {
+                (lams[a] - target.eigenvalue)
+                    .norm()
+                    .total_cmp(&(lams[b] - target.eigenvalue).norm())
+            })
+            .ok_or_else(|| StabilityError::Numerical("empty Coleman block".into()))?;
+        let (lam, nh) = (lams[j], self.hubs().len());
+        let q = |i: usize| u[(i, j)].re;
+        let v = |i: usize| (lam * u[(i, j)]).re;
+        let nb = self.blades.len();
+        let n = nb + nh;
+        let mut z = vec![0.0; 2 * n];
+        for k in 0..nb {
+            let (sn, cs) = (2.0 * PI * k as f64 / nb as f64).sin_cos();
+            z[k] = q(0) * cs + q(1) * sn;
+            z[n + k] = v(0) * cs - omega_rad_s * q(0) * sn + v(1) * sn + omega_rad_s * q(1) * cs;
+        }
+        for h in 0..nh {
+            z[nb + h] = q(2 + h);
+            z[n + nb + h] = v(2 + h);
+        }
+        let a = cyclic_amplitude(&z, nb, omega_rad_s, 0.0, lam.im.abs());
+        if !(a > 0.0 && a.is_finite()) {
+            return Err(StabilityError::Numerical(format!(
+                "the {label} mode has no cyclic lag motion"
+            )));
+        }
+        for x in &mut z {
+            *x /= a;
+        }
+        Ok(z)
     }
 
     /// Floquet characteristic exponents of the periodic equations in individual blade
@@ -818,7 +883,7 @@ fn resolve(
 }
 
 /// The periodic equations in individual blade coordinates, evaluated in place.
-struct PeriodicSystem {
+pub(super) struct PeriodicSystem {
     omega: f64,
     inertia: Vec<f64>,
     first_moment: Vec<f64>,
@@ -830,10 +895,16 @@ struct PeriodicSystem {
     sin: Vec<f64>,
     cos: Vec<f64>,
     force: Vec<f64>,
+    /// External lag moment on each blade [N m], linear in time over a step: `m0 + (t - t0)
+    /// slope` (a damper outside the linear equations, [`super::dampers`]); zero otherwise.
+    moment: Vec<f64>,
+    moment_start: Vec<f64>,
+    moment_slope: Vec<f64>,
+    moment_t0: f64,
 }
 
 impl PeriodicSystem {
-    fn new(rotor: &LagRotor, omega: f64) -> Self {
+    pub(super) fn new(rotor: &LagRotor, omega: f64) -> Self {
         let nb = rotor.blades.len();
         let b = &rotor.blades;
         PeriodicSystem {
@@ -852,6 +923,19 @@ impl PeriodicSystem {
             sin: vec![0.0; nb],
             cos: vec![0.0; nb],
             force: vec![0.0; nb],
+            moment: vec![0.0; nb],
+            moment_start: vec![0.0; nb],
+            moment_slope: vec![0.0; nb],
+            moment_t0: 0.0,
+        }
+    }
+
+    /// The external lag moments from `start` at `t0` to `end` at `t0 + h`.
+    pub(super) fn set_moments(&mut self, t0: f64, h: f64, start: &[f64], end: &[f64]) {
+        self.moment_t0 = t0;
+        for k in 0..self.moment.len() {
+            self.moment_start[k] = start[k];
+            self.moment_slope[k] = (end[k] - start[k]) / h;
         }
     }
 
@@ -860,6 +944,7 @@ impl PeriodicSystem {
             let (s, c) = (self.omega * t + self.phase[k]).sin_cos();
             self.sin[k] = s;
             self.cos[k] = c;
+            self.moment[k] = self.moment_start[k] + (t - self.moment_t0) * self.moment_slope[k];
         }
     }
 
@@ -883,7 +968,7 @@ impl PeriodicSystem {
         let (q, v) = z.split_at(n);
         dz[..n].copy_from_slice(v);
         for k in 0..nb {
-            self.force[k] = -(self.damping[k] * v[k] + self.stiffness[k] * q[k]);
+            self.force[k] = self.moment[k] - (self.damping[k] * v[k] + self.stiffness[k] * q[k]);
         }
         // Hub forces and the Schur complement of the (diagonal) blade inertia block:
         // (H - B^T D^-1 B) a_h = f_h - B^T D^-1 f_b.
@@ -936,7 +1021,7 @@ impl PeriodicSystem {
 }
 
 /// Classical RK4 with its stage buffers allocated once.
-struct Rk4 {
+pub(super) struct Rk4 {
     k1: Vec<f64>,
     k2: Vec<f64>,
     k3: Vec<f64>,
@@ -945,7 +1030,7 @@ struct Rk4 {
 }
 
 impl Rk4 {
-    fn new(len: usize) -> Self {
+    pub(super) fn new(len: usize) -> Self {
         Rk4 {
             k1: vec![0.0; len],
             k2: vec![0.0; len],
@@ -955,7 +1040,7 @@ impl Rk4 {
         }
     }
 
-    fn step(&mut self, sys: &mut PeriodicSystem, t: f64, h: f64, y: &mut [f64]) {
+    pub(super) fn step(&mut self, sys: &mut PeriodicSystem, t: f64, h: f64, y: &mut [f64]) {
         let axpy = |out: &mut [f64], y: &[f64], a: f64, k: &[f64]| {
             for ((o, yi), ki) in out.iter_mut().zip(y).zip(k) {
                 *o = yi + a * ki;
@@ -975,4 +1060,26 @@ impl Rk4 {
             *yi += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
         }
     }
+}
+
+/// Cyclic lag amplitude of state `z` at time `t` [rad]: `sqrt((z_1c^2 + z_1s^2 + (z_1c'^2 +
+/// z_1s'^2) / w^2) / 2)` with the multi-blade coordinates `z_1c = 2/N sum zeta_k cos psi_k`,
+/// `z_1s = 2/N sum zeta_k sin psi_k` (`psi_k = Omega t + 2 pi k / N`) and `w` the whirl's
+/// fixed-frame frequency. Constant over the cycle for a whirl of one frequency (circular or
+/// elliptic), so its logarithm grows at the mode's growth rate without the cycle's ripple;
+/// each blade's lag amplitude for a circular whirl.
+pub fn cyclic_amplitude(z: &[f64], blades: usize, omega: f64, t: f64, w: f64) -> f64 {
+    let n = z.len() / 2;
+    let (mut c, mut s, mut dc, mut ds) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..blades {
+        let (sn, cs) = (omega * t + 2.0 * PI * k as f64 / blades as f64).sin_cos();
+        let (q, v) = (z[k], z[n + k]);
+        c += q * cs;
+        s += q * sn;
+        dc += v * cs - omega * q * sn;
+        ds += v * sn + omega * q * cs;
+    }
+    let f = 2.0 / blades as f64;
+    let (c, s, dc, ds) = (f * c, f * s, f * dc, f * ds);
+    (0.5 * (c * c + s * s + (dc * dc + ds * ds) / (w * w))).sqrt()
 }

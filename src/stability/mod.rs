@@ -6,8 +6,13 @@
 //! ([`LagRotor::coleman_eigenvalues`]) and the Floquet characteristic exponents of the
 //! time-periodic equations in individual blade coordinates for any rotor
 //! ([`LagRotor::floquet`]), e.g. one lag damper inoperative (Hammond, JAHS 19(4), 1974).
+//! [`dampers`] integrates the same rotor with each damper as a device (its nonlinearity
+//! live), for the amplitude at which the linear analysis stops being true.
+pub mod dampers;
 pub mod lag_rotor;
 
+pub use dampers::{free_response_with_dampers, BladeDamper, DeviceResponse};
 pub use lag_rotor::{
-    AirframeAxis, LagBlade, LagRotor, Mode, ModeLabel, StabilityError, TimeResponse,
+    cyclic_amplitude, AirframeAxis, LagBlade, LagRotor, Mode, ModeLabel, StabilityError,
+    TimeResponse,
 };

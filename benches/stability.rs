@@ -1,0 +1,43 @@
+//! Benchmark: ground resonance on the UH-60A-like airframe deck with the physical damper, the
+//! linear map over 30 rotor speeds (the damper linearised on the bench at each) and one
+//! nonlinear amplitude check (the reduced rotor with four live dampers, started at the default
+//! eight stroke amplitudes, side by side on the cores).
+//!
+//! `cargo bench --bench stability`
+use criterion::{criterion_group, criterion_main, Criterion};
+use rotorsim::hydraulics::DamperModel;
+use rotorsim::rotor::RotorDeck;
+use rotorsim::run::amplitude::{amplitude_check, AmplitudeOptions};
+use rotorsim::run::stability::stability_map;
+use std::path::Path;
+
+fn deck() -> RotorDeck {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    RotorDeck::from_file_with(&root.join("rotors/uh60a_airframe.toml"), &[]).unwrap()
+}
+
+fn stability(c: &mut Criterion) {
+    let deck = deck();
+    let speeds: Vec<f64> = (1..=30).map(|k| 5.0 * k as f64).collect();
+    let mut g = c.benchmark_group("stability");
+    g.sample_size(10);
+    g.bench_function("map_30_speeds_physical", |b| {
+        b.iter(|| stability_map(&deck, DamperModel::Physical, &speeds).unwrap())
+    });
+    let om = deck.spec.rotor.omega_rad_s;
+    g.bench_function("amplitude_check_physical", |b| {
+        b.iter(|| {
+            amplitude_check(
+                &deck,
+                DamperModel::Physical,
+                om,
+                &AmplitudeOptions::default(),
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, stability);
+criterion_main!(benches);
