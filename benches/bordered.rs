@@ -106,6 +106,7 @@ fn lu(c: &mut Criterion) {
         for parallel in [false, true] {
             let mut b_lu = BorderedLu::new(n, &cp, &ri, &part).unwrap();
             b_lu.parallel = parallel;
+            b_lu.parallel_solve = parallel;
             let name = if parallel { "parallel" } else { "serial" };
             g.bench_function(format!("bordered_{name}/{blocks}"), |b| {
                 b.iter(|| {

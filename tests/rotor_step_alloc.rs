@@ -77,3 +77,49 @@ fn rotor_steps_do_not_allocate() {
         }
     }
 }
+
+/// The whole rotor on its airframe (one model, factored as a bordered LU of the blades): its
+/// steps without a refactorization do not allocate either, solves of the blocks included.
+#[test]
+fn airframe_steps_do_not_allocate() {
+    use rotorsim::hydraulics::DamperDeck;
+    use rotorsim::rotor::deck::RotorSpec;
+    use rotorsim::rotor::sim::build_rotor_sim;
+    let path = repo("rotors/uh60a_airframe.toml");
+    let deck = RotorDeck::from_file(&path).unwrap();
+    let blades: Vec<(RotorDeck, DamperDeck)> = (1..=deck.spec.rotor.blades)
+        .map(|k| {
+            let b = deck.blade(k).unwrap();
+            let d = b.damper().unwrap();
+            (b, d)
+        })
+        .collect();
+    let parts: Vec<(&RotorSpec, &DamperDeck)> = blades.iter().map(|(b, d)| (&b.spec, d)).collect();
+    let rec = FlightRecord::read(&repo("flightdata/c8534like")).unwrap();
+    assert_counting();
+    let opts = RunOptions {
+        newton: NewtonMethod::Modified,
+        ..RunOptions::default()
+    };
+    let mut sim = build_rotor_sim(&parts, &path, DamperModel::Physical, &rec, &opts).unwrap();
+    let mut ch = vec![0.0; sim.channel_names().len()];
+    for _ in 0..WARMUP {
+        sim.step().unwrap();
+    }
+    let mut plain = 0;
+    for _ in 0..256 {
+        let a0 = allocations();
+        let f0 = sim.timing().factorizations;
+        sim.step().unwrap();
+        sim.channels(&mut ch);
+        if sim.timing().factorizations == f0 {
+            plain += 1;
+            assert_eq!(
+                allocations() - a0,
+                0,
+                "a step without refactorization allocated"
+            );
+        }
+    }
+    assert!(plain > 100, "{plain} of 256 steps without refactorization");
+}

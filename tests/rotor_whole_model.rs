@@ -89,3 +89,47 @@ fn the_whole_rotor_at_rest_on_its_shaft_is_the_single_blade_turned() {
         .fold(0.0, f64::max);
     assert!(moved > 1e-3 * scale, "largest deflection {moved} m");
 }
+
+/// The whole rotor on its airframe is factored by parts: the hub and the airframe's chain are
+/// the border of a bordered LU, and its rotating equilibrium is the one LU's of the same model
+/// to the statics' tolerance.
+#[test]
+fn the_whole_rotor_on_its_airframe_is_factored_blade_by_blade() {
+    use rotorsim::solver::Assembler;
+    let path = support::root().join("rotors/uh60a_airframe.toml");
+    let deck = RotorDeck::from_file(&path).unwrap();
+    let opts = ExpandOptions {
+        controls: Controls {
+            th0_deg: 10.0,
+            th1c_deg: 2.0,
+            th1s_deg: -6.0,
+        },
+        table_revs: 1,
+        ..Default::default()
+    };
+    let n = deck.spec.rotor.blades;
+    let specs = vec![deck.spec.clone(); n];
+    let om = deck.spec.rotor.omega_rad_s;
+    let mut bordered = whole_rotor_model(&specs, &opts, &path).unwrap();
+    let border: Vec<&str> = bordered
+        .border_nodes
+        .iter()
+        .map(|&i| bordered.nodes[i].name.as_str())
+        .collect();
+    assert_eq!(border, ["hub", "airframe.x", "airframe.y"]);
+    // the dampers (step elements, which the run adds) are all that ties each blade's clamped
+    // damper mount on the hub to its blade: without them, two blocks a blade
+    assert_eq!(Assembler::new(&bordered).unwrap().bordered_blocks(), 2 * n);
+    let mut single = whole_rotor_model(&specs, &opts, &path).unwrap();
+    single.border_nodes.clear();
+    assert_eq!(Assembler::new(&single).unwrap().bordered_blocks(), 0);
+    let sb = equilibrium(&mut bordered, om);
+    let ss = equilibrium(&mut single, om);
+    let scale = deck.spec.rotor.radius_m;
+    let worst =
+        sb.x.iter()
+            .zip(&ss.x)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / scale))
+            .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "largest difference {worst:.2e} R");
+}

@@ -101,6 +101,7 @@ fn solves_as_a_dense_lu_does_with_a_residual_at_round_off() {
         let mut results = vec![];
         for parallel in [false, true] {
             lu.parallel = parallel;
+            lu.parallel_solve = parallel;
             lu.factor(&v).unwrap();
             let mut x = r.clone();
             lu.solve(&mut x);
@@ -127,6 +128,7 @@ fn a_solve_does_not_allocate() {
     let (cp, ri, v) = csc(&a);
     let mut lu = BorderedLu::new(n, &cp, &ri, &part).unwrap();
     lu.parallel = false;
+    lu.parallel_solve = false;
     lu.factor(&v).unwrap();
     let mut x = rhs(n, 8);
     assert_counting();

@@ -175,13 +175,22 @@ pub fn expanded_model(
 }
 
 /// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub,
-/// parsed (relative paths against `file`'s folder).
+/// parsed (relative paths against `file`'s folder). The hub and the airframe's chain are its
+/// border nodes: the blades meet only there, so the solver factors each blade on its own.
 pub fn whole_rotor_model(
     specs: &[RotorSpec],
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    parse_expanded(&super::expand::expand_rotor(specs, opts), file)
+    let mut model = parse_expanded(&super::expand::expand_rotor(specs, opts), file)?;
+    let airframe = format!("{}.", names::AIRFRAME);
+    model.border_nodes = (0..model.nodes.len())
+        .filter(|&i| {
+            let name = &model.nodes[i].name;
+            name == names::HUB || name.starts_with(&airframe)
+        })
+        .collect();
+    Ok(model)
 }
 
 /// A model deck expanded from the rotor deck `file`, parsed into a model (relative paths against

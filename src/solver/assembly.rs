@@ -1,5 +1,6 @@
 //! Global assembly: dof numbering, sparse pattern (built once), residual and tangent by seeded
 //! dual numbers, sparse LU (faer) with the symbolic factorisation done once.
+use super::bordered::{BorderedError, BorderedLu, Partition};
 use crate::structure::joint::Joint;
 use crate::structure::kin::{EvalCtx, NodeKin, Seed};
 use crate::structure::model::{Element, ElementError, ElementOutput, Model};
@@ -51,9 +52,7 @@ pub struct Assembler {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     pub values: Vec<f64>,
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
-    buf: MemBuffer,
+    lu: Lu,
     factored: bool,
     step_out: ElementOutput,
     /// Beam tangents from one 24-lane dual evaluation (true) or 24 single-lane ones (false);
@@ -64,6 +63,68 @@ pub struct Assembler {
     /// With `multilane`: beam tangents from the 24-lane dual evaluation (true) or from the
     /// closed form [`Beam::tangent`](crate::structure::Beam::tangent) (false, default).
     pub beam_tangent_dual: bool,
+}
+
+/// The factorization of the assembled matrix: one sparse LU, or the bordered LU of blocks that
+/// the model's border nodes separate (factored independently, in parallel).
+// One per assembler, never moved in a loop: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+enum Lu {
+    Single {
+        symbolic: SymbolicLu<usize>,
+        numeric: NumericLu<usize, f64>,
+        buf: MemBuffer,
+    },
+    Bordered(Box<BorderedLu>),
+}
+
+/// The blocks of the pattern that the unknowns of `border_nodes` separate: the connected
+/// components of the pattern without them. A component without node unknowns (the multipliers
+/// of a joint between border nodes) joins the border. `None` unless there are two blocks.
+fn border_partition(
+    n_nodes: usize,
+    border_nodes: &[usize],
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> Option<Partition> {
+    let ndof = col_ptr.len() - 1;
+    let mut border = vec![false; ndof];
+    for &n in border_nodes.iter().filter(|&&n| n < n_nodes) {
+        border[6 * n..6 * n + 6].fill(true);
+    }
+    // union-find over the unknowns off the border
+    let mut parent: Vec<usize> = (0..ndof).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for j in (0..ndof).filter(|&j| !border[j]) {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            if !border[i] {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut block_of = vec![usize::MAX; ndof];
+    let mut blocks: Vec<Vec<usize>> = vec![];
+    for d in (0..ndof).filter(|&d| !border[d]) {
+        let r = root(&mut parent, d);
+        if block_of[r] == usize::MAX {
+            block_of[r] = blocks.len();
+            blocks.push(vec![]);
+        }
+        blocks[block_of[r]].push(d);
+    }
+    let nl6 = 6 * n_nodes;
+    let (blocks, lone): (Vec<_>, Vec<_>) = blocks.into_iter().partition(|b| b[0] < nl6);
+    let mut border: Vec<usize> = (0..ndof).filter(|&d| border[d]).collect();
+    border.extend(lone.into_iter().flatten());
+    border.sort_unstable();
+    (blocks.len() >= 2).then_some(Partition { blocks, border })
 }
 
 /// Residual of one built-in element in scalar `T`; `k` holds the element's nodes in order.
@@ -183,7 +244,47 @@ impl Assembler {
         };
         let elem_pos = elem_dofs.iter().map(block).collect();
         let step_pos = step_dofs.iter().map(block).collect();
-        let sym = SymbolicSparseColMatRef::new_checked(ndof, ndof, &col_ptr, None, &row_idx);
+        let lu = match border_partition(n_nodes, &model.border_nodes, &col_ptr, &row_idx) {
+            Some(part) => {
+                let mut b =
+                    BorderedLu::new(ndof, &col_ptr, &row_idx, &part).map_err(|e| match e {
+                        BorderedError::Linear(l) => l,
+                        // the blocks are the pattern's components: they cannot couple
+                        BorderedError::Partition(p) => unreachable!("derived partition: {p}"),
+                    })?;
+                // Blocks factored in parallel, but not inside a pool: a sweep's cases already
+                // fill the cores, and a join there may run a whole other case first. Solves
+                // one block after the other: rayon's queue allocates on a hand-off now and
+                // then, and a block's solve gained nothing from one (docs/performance.md).
+                b.parallel = rayon::current_thread_index().is_none();
+                b.parallel_solve = false;
+                Lu::Bordered(Box::new(b))
+            }
+            None => Self::single_lu(ndof, &col_ptr, &row_idx)?,
+        };
+        let nnz = row_idx.len();
+        Ok(Assembler {
+            n_nodes,
+            ndof,
+            elem_dofs,
+            lam_start,
+            elem_pos,
+            step_pos,
+            col_ptr,
+            row_idx,
+            values: vec![0.0; nnz],
+            lu,
+            factored: false,
+            step_out: ElementOutput::default(),
+            multilane: true,
+            joint_tangent_dual: false,
+            beam_tangent_dual: false,
+        })
+    }
+
+    /// The symbolic analysis of one sparse LU of the whole pattern.
+    fn single_lu(ndof: usize, col_ptr: &[usize], row_idx: &[usize]) -> Result<Lu, LinearError> {
+        let sym = SymbolicSparseColMatRef::new_checked(ndof, ndof, col_ptr, None, row_idx);
         // Fill-reducing column ordering (COLAMD) once, here; supernodal numeric factorization:
         // on the rotor's banded pattern (half-bandwidth ~57) its dense kernels beat the
         // simplicial left-looking LU faer picks by its flop heuristic (docs/performance.md).
@@ -196,27 +297,20 @@ impl Assembler {
         let req = symbolic
             .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let nnz = row_idx.len();
         let buf = MemBuffer::try_new(req).map_err(|_| LinearError::OutOfMemory { ndof })?;
-        Ok(Assembler {
-            n_nodes,
-            ndof,
-            elem_dofs,
-            lam_start,
-            elem_pos,
-            step_pos,
-            col_ptr,
-            row_idx,
-            values: vec![0.0; nnz],
+        Ok(Lu::Single {
             symbolic,
             numeric: NumericLu::new(),
             buf,
-            factored: false,
-            step_out: ElementOutput::default(),
-            multilane: true,
-            joint_tangent_dual: false,
-            beam_tangent_dual: false,
         })
+    }
+
+    /// The number of blocks of the bordered LU (0: one LU of the whole matrix).
+    pub fn bordered_blocks(&self) -> usize {
+        match &self.lu {
+            Lu::Single { .. } => 0,
+            Lu::Bordered(b) => b.blocks(),
+        }
     }
 
     pub fn nnz(&self) -> usize {
@@ -480,18 +574,34 @@ impl Assembler {
 
     /// Numeric LU of the assembled matrix (symbolic analysis reused).
     pub fn factor(&mut self) -> Result<(), LinearError> {
-        let sym = SymbolicSparseColMatRef::new_checked(
-            self.ndof,
-            self.ndof,
-            &self.col_ptr,
-            None,
-            &self.row_idx,
-        );
-        let a = SparseColMatRef::new(sym, &self.values);
-        let stack = MemStack::new(&mut self.buf);
-        self.symbolic
-            .factorize_numeric_lu(&mut self.numeric, a, Par::Seq, stack, Default::default())
-            .map_err(|e| LinearError::of_lu(e, self.ndof))?;
+        self.factored = false;
+        match &mut self.lu {
+            Lu::Single {
+                symbolic,
+                numeric,
+                buf,
+            } => {
+                let sym = SymbolicSparseColMatRef::new_checked(
+                    self.ndof,
+                    self.ndof,
+                    &self.col_ptr,
+                    None,
+                    &self.row_idx,
+                );
+                let a = SparseColMatRef::new(sym, &self.values);
+                let stack = MemStack::new(buf);
+                symbolic
+                    .factorize_numeric_lu(numeric, a, Par::Seq, stack, Default::default())
+                    .map_err(|e| LinearError::of_lu(e, self.ndof))?;
+            }
+            Lu::Bordered(lu) => lu.factor(&self.values).map_err(|e| match e {
+                LinearError::Singular(s) => LinearError::Singular(format!(
+                    "{s} (bordered LU of {} blocks coupled through the border nodes' unknowns)",
+                    lu.blocks()
+                )),
+                other => other,
+            })?,
+        }
         self.factored = true;
         Ok(())
     }
@@ -499,10 +609,68 @@ impl Assembler {
     /// Solve in place with the last factorisation.
     pub fn solve(&mut self, rhs: &mut [f64]) {
         assert!(self.factored);
-        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        let stack = MemStack::new(&mut self.buf);
-        let n = rhs.len();
-        let m = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, stack);
+        match &mut self.lu {
+            Lu::Single {
+                symbolic,
+                numeric,
+                buf,
+            } => {
+                let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
+                let stack = MemStack::new(buf);
+                let n = rhs.len();
+                let m = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                lu.solve_in_place_with_conj(Conj::No, m, Par::Seq, stack);
+            }
+            Lu::Bordered(lu) => lu.solve(rhs),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::border_partition;
+
+    /// CSC of the symmetric pattern of the dense element blocks `elems` (and the diagonal).
+    fn pattern(ndof: usize, elems: &[Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
+        let mut cols: Vec<Vec<usize>> = (0..ndof).map(|i| vec![i]).collect();
+        for d in elems {
+            for &j in d {
+                cols[j].extend(d);
+            }
+        }
+        let (mut cp, mut ri) = (vec![0], vec![]);
+        for c in &mut cols {
+            c.sort_unstable();
+            c.dedup();
+            ri.extend(c.iter());
+            cp.push(ri.len());
+        }
+        (cp, ri)
+    }
+
+    #[test]
+    fn blocks_are_the_components_off_the_border() {
+        // nodes 0 (border), 1-2 and 3 (blocks); a joint 0-1 (multipliers 24, 25) goes with
+        // its block, a joint on the border node alone (multiplier 26) to the border
+        let node = |n: usize| (6 * n..6 * n + 6).collect::<Vec<_>>();
+        let joint = |a: usize, b: usize, l: &[usize]| [node(a), node(b), l.to_vec()].concat();
+        let elems = vec![
+            joint(0, 1, &[24, 25]),
+            [node(1), node(2)].concat(),
+            [node(0), node(3)].concat(),
+            [node(0), vec![26]].concat(),
+        ];
+        let (cp, ri) = pattern(27, &elems);
+        let p = border_partition(4, &[0], &cp, &ri).expect("two blocks");
+        assert_eq!(p.blocks.len(), 2);
+        assert_eq!(
+            p.blocks[0],
+            [(6..18).collect::<Vec<_>>(), vec![24, 25]].concat()
+        );
+        assert_eq!(p.blocks[1], node(3));
+        assert_eq!(p.border, [node(0), vec![26]].concat());
+        // without a border, or one block only: one LU
+        assert!(border_partition(4, &[], &cp, &ri).is_none());
+        assert!(border_partition(4, &[3], &cp, &ri).is_none());
     }
 }

@@ -69,20 +69,23 @@ struct Block {
     symbolic: SymbolicLu<usize>,
     numeric: NumericLu<usize, f64>,
     buf: MemBuffer,
-    /// B_k: (local row, border column, global position).
+    /// B_k: (local row, column of `bcols`, global position).
     b: Vec<(usize, usize, usize)>,
+    /// The border columns B_k has entries in (a blade meets the hub, not the whole border).
+    bcols: Vec<usize>,
     /// C_k: (border row, local column, global position), and its values at the last factor.
     c: Vec<(usize, usize, usize)>,
     cv: Vec<f64>,
-    /// W_k = A_k^-1 B_k, column-major n_k x n_border.
+    /// W_k = A_k^-1 B_k over `bcols`, column-major n_k x bcols.len().
     w: Vec<f64>,
     /// Right-hand side and solution of the block.
     x: Vec<f64>,
 }
 
 impl Block {
-    fn factor(&mut self, values: &[f64], nb: usize) -> Result<(), LinearError> {
+    fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
         let n = self.dofs.len();
+        let nb = self.bcols.len();
         for (v, &p) in self.values.iter_mut().zip(&self.src) {
             *v = values[p];
         }
@@ -137,8 +140,10 @@ pub struct BorderedLu {
     perm_inv: Vec<usize>,
     buf: MemBuffer,
     xb: Vec<f64>,
-    /// Factor and solve the blocks in parallel (rayon) or one after the other.
+    /// Factor the blocks in parallel (rayon) or one after the other.
     pub parallel: bool,
+    /// Solve the blocks in parallel (rayon) or one after the other.
+    pub parallel_solve: bool,
     factored: bool,
 }
 
@@ -214,6 +219,14 @@ impl BorderedLu {
         let mut blocks = Vec::with_capacity(nblocks);
         for (k, dofs) in blocks_dofs.into_iter().enumerate() {
             let nk = dofs.len();
+            let mut bk = std::mem::take(&mut b[k]);
+            let mut bcols: Vec<usize> = bk.iter().map(|e| e.1).collect();
+            bcols.sort_unstable();
+            bcols.dedup();
+            for e in &mut bk {
+                e.1 = bcols.binary_search(&e.1).expect("border column of B_k");
+            }
+            let nbk = bcols.len();
             let mut cp = vec![0usize; nk + 1];
             let mut ri = Vec::new();
             let mut src = Vec::new();
@@ -236,7 +249,7 @@ impl BorderedLu {
                 factorize_symbolic_lu(sym, params).map_err(|e| LinearError::of_faer(e, nk))?;
             let req = StackReq::any_of(&[
                 symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-                symbolic.solve_in_place_scratch::<f64>(nb.max(1), Par::Seq),
+                symbolic.solve_in_place_scratch::<f64>(nbk.max(1), Par::Seq),
             ]);
             let buf = MemBuffer::try_new(req)
                 .map_err(|_| BorderedError::Linear(LinearError::OutOfMemory { ndof: nk }))?;
@@ -250,10 +263,11 @@ impl BorderedLu {
                 symbolic,
                 numeric: NumericLu::new(),
                 buf,
-                b: std::mem::take(&mut b[k]),
+                b: bk,
+                bcols,
                 cv: vec![0.0; c[k].len()],
                 c: std::mem::take(&mut c[k]),
-                w: vec![0.0; nk * nb],
+                w: vec![0.0; nk * nbk],
                 x: vec![0.0; nk],
             });
         }
@@ -274,6 +288,7 @@ impl BorderedLu {
             buf,
             xb: vec![0.0; nb],
             parallel: true,
+            parallel_solve: true,
             factored: false,
         })
     }
@@ -283,12 +298,17 @@ impl BorderedLu {
         self.n
     }
 
+    /// Number of diagonal blocks.
+    pub fn blocks(&self) -> usize {
+        self.blocks.len()
+    }
+
     /// Numeric factorization of the matrix with `values` on the pattern of [`Self::new`].
     pub fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
         self.factored = false;
         let nb = self.border.len();
         let block = |(k, b): (usize, &mut Block)| {
-            b.factor(values, nb).map_err(|e| match e {
+            b.factor(values).map_err(|e| match e {
                 LinearError::Singular(s) => LinearError::Singular(format!("block {k}: {s}")),
                 other => other,
             })
@@ -311,8 +331,8 @@ impl BorderedLu {
             let nk = blk.dofs.len();
             for &(a, i, p) in &blk.c {
                 let v = values[p];
-                for b in 0..nb {
-                    self.schur[a + b * nb] -= v * blk.w[i + b * nk];
+                for (m, &b) in blk.bcols.iter().enumerate() {
+                    self.schur[a + b * nb] -= v * blk.w[i + m * nk];
                 }
             }
         }
@@ -353,7 +373,7 @@ impl BorderedLu {
             }
             b.solve();
         };
-        if self.parallel {
+        if self.parallel_solve {
             self.blocks.par_iter_mut().for_each(fill_and_solve);
         } else {
             self.blocks.iter_mut().for_each(fill_and_solve);
@@ -378,8 +398,8 @@ impl BorderedLu {
             let nk = blk.dofs.len();
             for (i, &g) in blk.dofs.iter().enumerate() {
                 let mut x = blk.x[i];
-                for b in 0..nb {
-                    x -= blk.w[i + b * nk] * self.xb[b];
+                for (m, &b) in blk.bcols.iter().enumerate() {
+                    x -= blk.w[i + m * nk] * self.xb[b];
                 }
                 rhs[g] = x;
             }

@@ -671,6 +671,8 @@ impl DynamicSolver {
                     self.assemble_at(t, t_n, &lam_hat, &ctx, true, (it, rn))?;
                     assembled = true;
                 }
+                // a failed factorization leaves none to reuse
+                self.have_factor = false;
                 self.asm.factor().map_err(|source| NewtonError::Linear {
                     t,
                     iteration: it,

@@ -183,6 +183,9 @@ pub struct Model {
     elem_names: HashMap<String, usize>,
     /// Beam name -> element indices in order along the beam.
     pub beams: HashMap<String, Vec<usize>>,
+    /// Nodes whose unknowns couple otherwise separate parts (a hub between blades): the solver
+    /// factors the parts as blocks of a bordered LU with these as the border. Empty: one LU.
+    pub border_nodes: Vec<usize>,
 }
 
 impl Default for Model {
@@ -231,6 +234,7 @@ impl Model {
             node_names: HashMap::new(),
             elem_names: HashMap::new(),
             beams: HashMap::new(),
+            border_nodes: vec![],
         }
     }
 
