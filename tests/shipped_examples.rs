@@ -13,7 +13,7 @@
 //! deck of no flight record's rotor); a damper deck (`[damper]` alone): `bench`; an actuator deck (`[actuator]`):
 //! the dynamic analysis of docs/examples/actuator_pitch_beam.toml with it as the device; a sweep
 //! plan (`[base]`/`[vary]`/`[[case]]`): `--emit-slurm` of the whole plan (every case checked) and
-//! a local sweep of its first case, 2 revolutions (docs/sweep.md); a flight record (CSV triple
+//! a local sweep of its first case, 2 revolutions (a stability case: its map) (docs/sweep.md); a flight record (CSV triple
 //! or MCAP): `inspect`.
 //!
 //! Time: 24 s wall in release on 2 cores shared with other builds (load ~5), two runs at a time
@@ -270,8 +270,11 @@ fn jobs_for(deck: &Path, work: &Path, tag: &str) -> Result<Vec<Job>, String> {
                 cases.truncate(1);
             }
         }
+        // a run case 2 revolutions (a stability case is a map: no revolutions)
         if let Some(toml::Value::Table(b)) = p.get_mut("base") {
-            b.insert("revs".into(), toml::Value::Integer(2));
+            if !b.contains_key("stability_speeds") {
+                b.insert("revs".into(), toml::Value::Integer(2));
+            }
         }
         let plan = work.join(format!("{tag}-plan.toml"));
         std::fs::write(&plan, toml::to_string(&p).unwrap()).unwrap();

@@ -383,3 +383,71 @@ fn a_case_that_fails_at_run_time_names_the_deck_key_and_value() {
         .contains("in deck rotors/uh60a.toml"));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A stability sweep: each case is the ground-resonance map of its deck values; sweep.csv's
+/// least damping ratio equals the map's computed directly (the library call the command
+/// makes), and an option of a run is refused in a stability case before anything runs.
+#[test]
+fn a_stability_sweep_tables_each_cases_least_damping() {
+    let dir = tmp("sweep_stability");
+    let plan = dir.join("plan.toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        &plan,
+        "[base]\nrotor = \"rotors/uh60a_airframe.toml\"\ndamper = \"linear\"\nstability_speeds = \"20:34:2\"\n\n[vary]\n\"damper.linear.c_N_s_per_m\" = [0.0, 68000.0]\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    ok(&sweep(
+        &[plan.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        &[],
+    ));
+    let rows = table(&out);
+    let col = |name: &str| rows[0].iter().position(|c| c == name).unwrap();
+    let (z, stable, status) = (col("min_damping_ratio"), col("stable"), col("status"));
+    assert_eq!(rows.len(), 3);
+    let speeds: Vec<f64> = (0..8).map(|k| 20.0 + 2.0 * k as f64).collect();
+    for (row, c) in rows[1..].iter().zip(["0", "68000"]) {
+        assert_eq!(row[status], "ok");
+        let set = rotorsim::overrides::Override::parse(&format!("damper.linear.c_N_s_per_m={c}"))
+            .unwrap();
+        let deck = rotorsim::rotor::RotorDeck::from_file_with(
+            &root().join("rotors/uh60a_airframe.toml"),
+            &[set],
+        )
+        .unwrap();
+        let map = rotorsim::run::stability::stability_map(
+            &deck,
+            rotorsim::hydraulics::DamperModel::Linear,
+            &speeds,
+        )
+        .unwrap();
+        let (want, _, _) = map.min_damping().unwrap();
+        let got: f64 = row[z].parse().unwrap();
+        assert_eq!(got, want, "c = {c}");
+        assert_eq!(row[stable], map.unstable.is_empty().to_string());
+    }
+    // the damper adds damping to the least damped mode
+    let least = |r: &Vec<String>| r[z].parse::<f64>().unwrap();
+    assert!(least(&rows[2]) > least(&rows[1]), "{rows:?}");
+
+    std::fs::write(
+        &plan,
+        "[base]\nrotor = \"rotors/uh60a_airframe.toml\"\nstability_speeds = \"20:34:2\"\nrevs = 3\n\n[vary]\n\"damper.linear.c_N_s_per_m\" = [0.0]\n",
+    )
+    .unwrap();
+    let o = sweep(
+        &[
+            plan.to_str().unwrap(),
+            "--out",
+            dir.join("bad").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("revs") && e.contains("not an option of a stability case"),
+        "{e}"
+    );
+}

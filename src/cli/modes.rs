@@ -192,66 +192,20 @@ pub fn run(args: ModesArgs) -> anyhow::Result<()> {
 
 /// Parse `START:STOP:STEP` (inclusive, rounded to the step) or `a,b,c`.
 pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
-    let v = parse_range(
+    let v = crate::run::ranges::parse_range(
+        "--speeds",
         s,
         "expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0",
         MAX_SPEEDS,
         "a fan plot may have (each is a static solve and an eigen-analysis)",
     )?;
     if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-        return Err(range_error(
+        return Err(crate::run::ranges::range_error(
+            "--speeds",
             s,
             "fractions must be finite and non-negative",
             "expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0",
         ));
-    }
-    Ok(v)
-}
-
-fn range_error(s: &str, m: &str, expected: &str) -> anyhow::Error {
-    anyhow::anyhow!("--speeds `{s}`: {m} ({expected})")
-}
-
-/// `--speeds`: `START:STOP:STEP` (inclusive, rounded to the step) or a list `a,b,c`, at most
-/// `max` values (`what`: who takes them, for the message); `expected` says the form in the
-/// messages. Ranges must have a positive step and STOP >= START; the caller checks the values.
-pub fn parse_range(s: &str, expected: &str, max: usize, what: &str) -> anyhow::Result<Vec<f64>> {
-    let bad = |m: &str| range_error(s, m, expected);
-    let num = |t: &str| {
-        t.trim()
-            .parse::<f64>()
-            .map_err(|_| bad(&format!("`{t}` is not a number")))
-    };
-    let v: Vec<f64> = if s.contains(':') {
-        let p: Vec<&str> = s.split(':').collect();
-        if p.len() != 3 {
-            return Err(bad("three fields needed"));
-        }
-        let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
-        if !(a.is_finite() && b.is_finite() && h.is_finite()) {
-            return Err(bad("START, STOP and STEP must be finite"));
-        }
-        if h <= 0.0 || b < a {
-            return Err(bad("STEP must be positive and STOP >= START"));
-        }
-        let n = ((b - a) / h + 1e-9).floor();
-        if n >= max as f64 {
-            return Err(bad(&format!(
-                "{} speeds, beyond the {max} {what}; use a larger STEP",
-                crate::solver::budget::count(n + 1.0)
-            )));
-        }
-        (0..=n as usize)
-            .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
-            .collect()
-    } else {
-        s.split(',').map(num).collect::<Result<_, _>>()?
-    };
-    if v.is_empty() {
-        return Err(bad("no speed given"));
-    }
-    if v.len() > max {
-        return Err(bad(&format!("{} speeds, beyond the {max} {what}", v.len())));
     }
     Ok(v)
 }

@@ -57,21 +57,8 @@ fn parse_set(s: &str) -> Result<Override, String> {
     Override::parse(s).map_err(|e| format!("{e:#}"))
 }
 
-/// Most speeds of one map (each is an eigen-analysis or a Floquet integration).
-pub const MAX_SPEEDS: usize = 2000;
-
-/// `START:STOP:STEP` (inclusive) or `a,b,c`, in rad/s, increasing.
-pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
-    const EXPECTED: &str =
-        "expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30";
-    let v = super::modes::parse_range(s, EXPECTED, MAX_SPEEDS, "a map may have")?;
-    crate::run::stability::check_speeds(&v)
-        .map_err(|e| anyhow::anyhow!("--speeds `{s}`: {e:#} ({EXPECTED})"))?;
-    Ok(v)
-}
-
 pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
-    let speeds = parse_speeds(&args.speeds)?;
+    let speeds = crate::run::stability::parse_speeds("--speeds", &args.speeds)?;
     let deck = RotorDeck::from_file_with(&args.rotor, &args.set)?;
     let model = match &args.damper {
         Some(d) => d
@@ -139,7 +126,14 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
     };
     let out = OutDir::create(&args.out, &deck.input_files())?;
     let map = match stability_map(&deck, model, &speeds) {
-        Ok(m) => m,
+        Ok(mut m) => {
+            m.overrides = args
+                .set
+                .iter()
+                .map(|o| (o.key.clone(), o.value_text()))
+                .collect();
+            m
+        }
         Err(e) => {
             out.mark_incomplete(&format!("{e:#}"))?;
             return Err(e);

@@ -20,6 +20,7 @@ pub mod loads;
 pub mod mcap_out;
 pub mod outputs;
 pub mod periodic;
+pub mod ranges;
 pub mod report;
 pub mod rotor;
 pub mod sdof;

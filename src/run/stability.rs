@@ -97,6 +97,8 @@ pub struct StabilityMap {
     pub unstable: Vec<UnstableRange>,
     /// What the reduced model leaves out, in words.
     pub notes: Vec<String>,
+    /// The deck values overridden (`--set`, a sweep case's), as (key, value) for summary.json.
+    pub overrides: Vec<(String, String)>,
 }
 
 impl StabilityMap {
@@ -349,7 +351,21 @@ pub fn stability_map(
         speeds,
         unstable,
         notes,
+        overrides: Vec::new(),
     })
+}
+
+/// Most speeds of one map (each is an eigen-analysis or a Floquet integration).
+pub const MAX_SPEEDS: usize = 2000;
+
+/// Rotor speeds of a map given as `name` (an option or a plan key): `START:STOP:STEP`
+/// (inclusive) or `a,b,c`, in rad/s, increasing.
+pub fn parse_speeds(name: &str, s: &str) -> anyhow::Result<Vec<f64>> {
+    const EXPECTED: &str =
+        "expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30";
+    let v = super::ranges::parse_range(name, s, EXPECTED, MAX_SPEEDS, "a map may have")?;
+    check_speeds(&v).map_err(|e| anyhow!("{name} `{s}`: {e:#} ({EXPECTED})"))?;
+    Ok(v)
 }
 
 /// Speeds in rad/s: finite, non-negative, strictly increasing.
@@ -476,6 +492,10 @@ pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
     let min = map.min_damping();
     serde_json::json!({
         "rotor_deck": deck.path.display().to_string(),
+        "rotor": deck.path.display().to_string(),
+        "options": {
+            "overrides": map.overrides.iter().map(|(k, v)| serde_json::json!({"key": k, "value": v})).collect::<Vec<_>>(),
+        },
         "damper_model": map.damper.name(),
         "linearisation_amplitude_m": LINEARISATION_AMPLITUDE_M,
         "method": map.speeds.first().map(|s| s.method.name()),

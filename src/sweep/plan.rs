@@ -25,6 +25,8 @@ pub const RUN_OPTIONS: &[(&str, OptionType)] = &[
     ("substeps", OptionType::Count),
     ("scheme", OptionType::Text),
     ("newton", OptionType::Text),
+    // a ground-resonance map instead of a run (`rotorsim stability --speeds`)
+    ("stability_speeds", OptionType::Text),
 ];
 
 /// Cases a plan may hold. Each case is a run of seconds at least, its settings and its folder

@@ -9,6 +9,62 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use toml::Value;
 
+/// Options a stability case may set besides deck values.
+const STABILITY_OPTIONS: &[&str] = &["stability_speeds", "rotor", "damper"];
+
+/// A case with `stability_speeds`: the ground-resonance map of its rotor deck (its deck values
+/// applied) with its damper model over those speeds, as `rotorsim stability` makes it.
+struct StabilityCase {
+    deck: crate::rotor::RotorDeck,
+    model: crate::hydraulics::DamperModel,
+    speeds: Vec<f64>,
+}
+
+fn stability_case(case: &Case) -> Option<anyhow::Result<StabilityCase>> {
+    let Some(Value::String(speeds)) = case.option("stability_speeds") else {
+        return None;
+    };
+    Some((|| {
+        for (k, v) in &case.settings {
+            if !k.contains('.') && !STABILITY_OPTIONS.contains(&k.as_str()) {
+                bail!(
+                    "case {}: `{k} = {v}` is not an option of a stability case (those are {})",
+                    case.id,
+                    STABILITY_OPTIONS.join(", ")
+                );
+            }
+        }
+        let speeds = crate::run::stability::parse_speeds(
+            &format!("case {}: stability_speeds", case.id),
+            speeds,
+        )?;
+        let rotor = match case.option("rotor") {
+            Some(Value::String(r)) => PathBuf::from(r),
+            _ => PathBuf::from(job::DEFAULT_ROTOR),
+        };
+        let deck = crate::rotor::RotorDeck::from_file_with(&rotor, &case.overrides())?;
+        if deck.spec.airframe.is_none() {
+            bail!(
+                "case {}: rotor deck {} has no [airframe]: a stability case needs the airframe under the hub (docs/stability.md)",
+                case.id,
+                rotor.display()
+            );
+        }
+        let model = match case.option("damper") {
+            Some(Value::String(d)) => d
+                .parse::<crate::hydraulics::DamperModel>()
+                .map_err(|e| anyhow!("case {}: damper `{d}`: {e}", case.id))?,
+            _ => deck.damper()?.model,
+        };
+        deck.damper()?.require(model)?;
+        Ok(StabilityCase {
+            deck,
+            model,
+            speeds,
+        })
+    })())
+}
+
 /// The run of `case` into `out`, starting from the periodic states of the result folder
 /// `initial` when given. The plan has checked the settings' names and types.
 pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunJob> {
@@ -75,9 +131,31 @@ impl CaseRunner for JobRunner {
             };
             r.map_err(|e| anyhow!(e))
         };
+        if let Some(c) = stability_case(case) {
+            return c.map(|_| ());
+        }
         job_of(case, Path::new("unused"), None)?.check_with(&record)
     }
     fn run(&self, case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<()> {
+        if let Some(c) = stability_case(case) {
+            let c = c?;
+            let dir = crate::io::OutDir::create(out, &c.deck.input_files())?;
+            return match crate::run::stability::stability_map(&c.deck, c.model, &c.speeds) {
+                Ok(mut map) => {
+                    map.overrides = case
+                        .overrides()
+                        .iter()
+                        .map(|o| (o.key.clone(), o.value_text()))
+                        .collect();
+                    crate::run::stability::write(&map, &c.deck, &dir)?;
+                    Ok(dir.finish()?)
+                }
+                Err(e) => {
+                    dir.mark_incomplete(&format!("{e:#}"))?;
+                    Err(e)
+                }
+            };
+        }
         job_of(case, out, initial)?.execute(&Silent).map(|_| ())
     }
 }

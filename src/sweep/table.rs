@@ -23,6 +23,11 @@ pub const METRICS: &[&str] = &[
     "root_mx_half_p2p_Nm",
     "root_my_half_p2p_Nm",
     "root_mz_half_p2p_Nm",
+    // stability cases (a ground-resonance map each)
+    "min_damping_ratio",
+    "min_damping_mode",
+    "min_damping_speed_rad_s",
+    "stable",
 ];
 
 /// Metrics plotted in sweep.html (numeric ones): axis label (engineering units) and the scale
@@ -57,6 +62,11 @@ const PLOTTED: &[(&str, &str, f64)] = &[
         "root_mz_half_p2p_Nm",
         "root moment mz half peak-to-peak [kN m]",
         1e-3,
+    ),
+    (
+        "min_damping_ratio",
+        "least damping ratio over the speeds [-]",
+        1.0,
     ),
 ];
 
@@ -123,6 +133,28 @@ pub fn rows(plan: &Plan, dir: &Path, states: &[CaseState]) -> Vec<Row> {
                     .map(|f| f.to_string_lossy().into_owned())
             })
             .unwrap_or_default();
+        if s["min_damping_ratio"].is_number() {
+            // a stability case: its map's least damping ratio, where, and whether stable
+            let mut metrics = vec![String::new(); METRICS.len()];
+            let n = METRICS.len();
+            metrics[n - 4] = num(&s["min_damping_ratio"]);
+            metrics[n - 3] = s["min_damping_mode"].as_str().unwrap_or("").to_string();
+            metrics[n - 2] = num(&s["min_damping_speed_rad_s"]);
+            metrics[n - 1] = num(&s["stable"]);
+            out.push(Row {
+                case_id: c.id.clone(),
+                varied: varied.clone(),
+                model: s["damper_model"].as_str().unwrap_or("").to_string(),
+                status: if matches!(state, CaseState::Done) {
+                    "ok"
+                } else {
+                    "failed"
+                }
+                .into(),
+                metrics,
+            });
+            continue;
+        }
         let Some(models) = s["models"].as_object() else {
             out.push(empty("failed"));
             continue;
@@ -152,6 +184,11 @@ pub fn rows(plan: &Plan, dir: &Path, states: &[CaseState]) -> Vec<Row> {
                 hp("root_mx_Nm"),
                 hp("root_my_Nm"),
                 hp("root_mz_Nm"),
+                // the stability columns
+                String::new(),
+                String::new(),
+                String::new(),
+                String::new(),
             ];
             out.push(Row {
                 case_id: c.id.clone(),

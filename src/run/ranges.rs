@@ -1,0 +1,57 @@
+//! Ranges of values given as text: `START:STOP:STEP` or a list (rotor speeds of `modes`,
+//! `stability` and a sweep's stability maps).
+
+/// The error for `name`'s value `s`: what is wrong (`m`) and the form expected.
+pub fn range_error(name: &str, s: &str, m: &str, expected: &str) -> anyhow::Error {
+    anyhow::anyhow!("{name} `{s}`: {m} ({expected})")
+}
+
+/// `name` (an option or a plan key): `START:STOP:STEP` (inclusive, rounded to the step) or a list `a,b,c`, at most
+/// `max` values (`what`: who takes them, for the message); `expected` says the form in the
+/// messages. Ranges must have a positive step and STOP >= START; the caller checks the values.
+pub fn parse_range(
+    name: &str,
+    s: &str,
+    expected: &str,
+    max: usize,
+    what: &str,
+) -> anyhow::Result<Vec<f64>> {
+    let bad = |m: &str| range_error(name, s, m, expected);
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| bad(&format!("`{t}` is not a number")))
+    };
+    let v: Vec<f64> = if s.contains(':') {
+        let p: Vec<&str> = s.split(':').collect();
+        if p.len() != 3 {
+            return Err(bad("three fields needed"));
+        }
+        let (a, b, h) = (num(p[0])?, num(p[1])?, num(p[2])?);
+        if !(a.is_finite() && b.is_finite() && h.is_finite()) {
+            return Err(bad("START, STOP and STEP must be finite"));
+        }
+        if h <= 0.0 || b < a {
+            return Err(bad("STEP must be positive and STOP >= START"));
+        }
+        let n = ((b - a) / h + 1e-9).floor();
+        if n >= max as f64 {
+            return Err(bad(&format!(
+                "{} speeds, beyond the {max} {what}; use a larger STEP",
+                crate::solver::budget::count(n + 1.0)
+            )));
+        }
+        (0..=n as usize)
+            .map(|k| ((a + k as f64 * h) * 1e9).round() / 1e9)
+            .collect()
+    } else {
+        s.split(',').map(num).collect::<Result<_, _>>()?
+    };
+    if v.is_empty() {
+        return Err(bad("no speed given"));
+    }
+    if v.len() > max {
+        return Err(bad(&format!("{} speeds, beyond the {max} {what}", v.len())));
+    }
+    Ok(v)
+}
