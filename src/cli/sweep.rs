@@ -210,7 +210,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         let merged = sweep::table::write(&plan, out)?;
         let (ok, np, failed, not_run) = sweep::table::counts(&merged.rows);
         outln!(
-            "rows: {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}  plots: {}",
+            "rows: {ok} ok (periodic, or a stability map), {np} NOT periodic, {failed} failed, {not_run} not run; table: {}  plots: {}",
             out.join("sweep.csv").display(),
             out.join("sweep.html").display()
         );
@@ -239,7 +239,7 @@ fn merge(dir: &Path) -> anyhow::Result<()> {
     }
     let (ok, np, failed, not_run) = sweep::table::counts(&merged.rows);
     outln!(
-        "merged {} case(s): rows {ok} periodic, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}",
+        "merged {} case(s): rows {ok} ok, {np} NOT periodic, {failed} failed, {not_run} not run; table: {}",
         plan.cases.len(),
         dir.join("sweep.csv").display()
     );
