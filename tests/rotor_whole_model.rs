@@ -27,11 +27,9 @@ fn equilibrium(model: &mut Model, omega: f64) -> State {
     st
 }
 
-#[test]
-fn the_whole_rotor_at_rest_on_its_shaft_is_the_single_blade_turned() {
-    let path = support::root().join("rotors/uh60a.toml");
-    let deck = RotorDeck::from_file(&path).unwrap();
-    let opts = ExpandOptions {
+/// Expansion options with collective and cyclic pitch (the swashplate shared by the blades).
+fn pitched() -> ExpandOptions {
+    ExpandOptions {
         controls: Controls {
             th0_deg: 10.0,
             th1c_deg: 2.0,
@@ -39,7 +37,14 @@ fn the_whole_rotor_at_rest_on_its_shaft_is_the_single_blade_turned() {
         },
         table_revs: 1,
         ..Default::default()
-    };
+    }
+}
+
+#[test]
+fn the_whole_rotor_at_rest_on_its_shaft_is_the_single_blade_turned() {
+    let path = support::root().join("rotors/uh60a.toml");
+    let deck = RotorDeck::from_file(&path).unwrap();
+    let opts = pitched();
     let n = deck.spec.rotor.blades;
     let specs = vec![deck.spec.clone(); n];
     let text = expand_rotor(&specs, &opts);
@@ -98,15 +103,7 @@ fn the_whole_rotor_on_its_airframe_is_factored_blade_by_blade() {
     use rotorsim::solver::Assembler;
     let path = support::root().join("rotors/uh60a_airframe.toml");
     let deck = RotorDeck::from_file(&path).unwrap();
-    let opts = ExpandOptions {
-        controls: Controls {
-            th0_deg: 10.0,
-            th1c_deg: 2.0,
-            th1s_deg: -6.0,
-        },
-        table_revs: 1,
-        ..Default::default()
-    };
+    let opts = pitched();
     let n = deck.spec.rotor.blades;
     let specs = vec![deck.spec.clone(); n];
     let om = deck.spec.rotor.omega_rad_s;

@@ -9,7 +9,7 @@
 //! depends on `F_m`: a fixed point, solved to round-off in a few iterations (the damper's
 //! stroke moves by `h^2 arm^2 / I` per newton of force change, tiny at these steps).
 use super::lag_rotor::{
-    check_omega, finite, range, LagRotor, PeriodicSystem, Result, Rk4, StabilityError, TimeResponse,
+    check_omega, range, LagRotor, PeriodicSystem, Result, Rk4, StabilityError, TimeResponse,
 };
 use crate::hydraulics::Device;
 
@@ -63,31 +63,7 @@ pub fn free_response_with_dampers(
         range(format!("dampers[{k}].arm_m"), d.arm_m, d.arm_m > 0.0, "> 0")?;
     }
     let m = rotor.state_len();
-    if initial.len() != m {
-        return Err(StabilityError::StateLength {
-            got: initial.len(),
-            expected: m,
-            layout: rotor.state_layout(),
-        });
-    }
-    for (i, v) in initial.iter().enumerate() {
-        finite(format!("initial[{i}]"), *v)?;
-    }
-    range("dt_s", dt_s, dt_s > 0.0, "> 0")?;
-    range("t_end_s", t_end_s, t_end_s >= 0.0, ">= 0")?;
-    let steps_f = (t_end_s / dt_s).ceil();
-    range(
-        "t_end_s / dt_s",
-        steps_f,
-        steps_f <= 1e7,
-        "<= 10^7 steps (the history is kept in memory)",
-    )?;
-    let steps = steps_f as usize;
-    let h = if steps > 0 {
-        t_end_s / steps as f64
-    } else {
-        0.0
-    };
+    let (steps, h) = rotor.response_steps(initial, t_end_s, dt_s)?;
     let mut sys = PeriodicSystem::new(rotor, omega_rad_s);
     let mut rk = Rk4::new(m);
     let mut y = initial.to_vec();

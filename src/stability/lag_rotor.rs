@@ -226,7 +226,7 @@ impl TimeResponse {
     }
 }
 
-pub(super) fn finite(field: impl Into<String>, value: f64) -> Result<()> {
+fn finite(field: impl Into<String>, value: f64) -> Result<()> {
     if value.is_finite() {
         Ok(())
     } else {
@@ -757,18 +757,15 @@ impl LagRotor {
         Ok(y)
     }
 
-    /// Free response of the periodic equations from `initial` (ordered as
-    /// [`LagRotor::state_layout`]) at `t = 0` (blade 1 at zero azimuth) to `t_end_s`, RK4 with
-    /// the uniform step `t_end_s / ceil(t_end_s / dt_s)` (<= `dt_s`, landing on `t_end_s`).
-    pub fn time_response(
+    /// The uniform steps of a free response from `initial` to `t_end_s` of at most `dt_s`
+    /// (`t_end_s / ceil(t_end_s / dt_s)`, landing on `t_end_s`): their count and length, the
+    /// state and sizes checked.
+    pub(super) fn response_steps(
         &self,
-        omega_rad_s: f64,
         initial: &[f64],
         t_end_s: f64,
         dt_s: f64,
-    ) -> Result<TimeResponse> {
-        self.validate()?;
-        check_omega(omega_rad_s)?;
+    ) -> Result<(usize, f64)> {
         let m = self.state_len();
         if initial.len() != m {
             return Err(StabilityError::StateLength {
@@ -795,6 +792,23 @@ impl LagRotor {
         } else {
             0.0
         };
+        Ok((steps, h))
+    }
+
+    /// Free response of the periodic equations from `initial` (ordered as
+    /// [`LagRotor::state_layout`]) at `t = 0` (blade 1 at zero azimuth) to `t_end_s`, RK4 with
+    /// the uniform step `t_end_s / ceil(t_end_s / dt_s)` (<= `dt_s`, landing on `t_end_s`).
+    pub fn time_response(
+        &self,
+        omega_rad_s: f64,
+        initial: &[f64],
+        t_end_s: f64,
+        dt_s: f64,
+    ) -> Result<TimeResponse> {
+        self.validate()?;
+        check_omega(omega_rad_s)?;
+        let m = self.state_len();
+        let (steps, h) = self.response_steps(initial, t_end_s, dt_s)?;
         let mut sys = PeriodicSystem::new(self, omega_rad_s);
         let mut ws = Rk4::new(m);
         let mut time_s = Vec::with_capacity(steps + 1);
