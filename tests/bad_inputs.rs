@@ -177,7 +177,7 @@ macro_rules! record {
 const CASES: &[Case] = &[
     // ---- results that are not what they claim, aborts, vague messages ----
     case("modes rotor speed far beyond nominal", &[], &["modes", "--rotor", "{R}/rotors/tm4760.toml", "--speeds", "1e6", "--count", "4", "--out", "{T}/out"], &["--speeds", "tm4760.toml", "rotor.omega_rad_s", "beyond sense"]),
-    case("modes speed list of 1e18 entries", &[], &["modes", "--rotor", "{R}/rotors/tm4760.toml", "--speeds", "0:1e9:1e-9", "--out", "{T}/out"], &["--speeds", "1.00e18 speeds", "10000"]),
+    case("modes speed list of 1e18 entries", &[], &["modes", "--rotor", "{R}/rotors/tm4760.toml", "--speeds", "0:1e9:1e-9", "--out", "{T}/out"], &["--speeds", "1.00e18 values", "10000"]),
     case("modes model deck of 200000 elements", cant!("elements = 8", "elements = 200000"), MODES_M, &["m.toml", "elements = 200000", "memory"]),
     case("modes rotor deck of 200000 elements", rotor!("elements = 13 ", "elements = 200000 "), MODES_R, &["r.toml", "blade.elements = 200000", "memory"]),
     case("decay duration 1e9 s", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--duration-s", "1e9", "--out", "{T}/out"], &["tm4760.toml", "--duration-s 1e9", "memory"]),

@@ -75,18 +75,7 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
     };
     let mut time_speeds: Vec<f64> = vec![];
     if let Some(t) = &args.time {
-        time_speeds = t
-            .split(',')
-            .map(|v| {
-                v.trim().parse::<f64>().map_err(|_| {
-                    anyhow::anyhow!(
-                        "--time `{t}`: `{v}` is not a number (expected rad/s, e.g. 25,27)"
-                    )
-                })
-            })
-            .collect::<anyhow::Result<_>>()?;
-        crate::run::stability::check_speeds(&time_speeds)
-            .map_err(|e| anyhow::anyhow!("--time: {e:#}"))?;
+        time_speeds = crate::run::stability::parse_speeds("--time", t)?;
         for &w in &time_speeds {
             time_opts.check(w)?;
         }
@@ -103,13 +92,13 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             let amplitudes_m = if a.trim() == "default" {
                 crate::run::amplitude::DEFAULT_AMPLITUDES_M.to_vec()
             } else {
-                a.split(',')
-                    .map(|v| {
-                        v.trim().parse::<f64>().map_err(|_| {
-                            anyhow::anyhow!("--amplitudes-m `{a}`: `{v}` is not a number (expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`)")
-                        })
-                    })
-                    .collect::<anyhow::Result<_>>()?
+                crate::run::ranges::parse_range(
+                    "--amplitudes-m",
+                    a,
+                    "expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`",
+                    crate::run::amplitude::MAX_AMPLITUDES,
+                    "an amplitude check may have",
+                )?
             };
             let w = args
                 .amplitude_at_rad_s

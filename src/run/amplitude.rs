@@ -24,6 +24,8 @@ pub const DEFAULT_AMPLITUDES_M: [f64; 8] = [1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 2e-2, 
 /// [`super::stability::BENCH_INTEGRATOR`]): at tens of millimetres of stroke at the lag
 /// frequency the flows make the chambers too stiff for RK4's sub-steps.
 pub const INTEGRATOR: IntegratorOptions = super::stability::BENCH_INTEGRATOR;
+/// Most starts of one amplitude check (each a time-domain run of four live dampers).
+pub const MAX_AMPLITUDES: usize = 200;
 /// Largest lag angle of a start [rad]: the reduced model is linear in the lag angle.
 pub const MAX_LAG_RAD: f64 = 0.35;
 
@@ -100,19 +102,7 @@ pub struct AmplitudeCheck {
 
 /// Amplitudes: finite, positive, increasing, and a lag angle the reduced model holds.
 pub fn check_amplitudes(a: &[f64], arm_m: f64) -> anyhow::Result<()> {
-    if a.is_empty() {
-        bail!("--amplitudes-m: no amplitude given");
-    }
-    if let Some(v) = a.iter().find(|v| !v.is_finite() || **v <= 0.0) {
-        bail!("--amplitudes-m: {v} m is not a positive finite stroke amplitude");
-    }
-    if let Some(w) = a.windows(2).find(|w| w[1] <= w[0]) {
-        bail!(
-            "--amplitudes-m: {} m after {} m: the amplitudes must increase",
-            w[1],
-            w[0]
-        );
-    }
+    super::ranges::check_increasing("--amplitudes-m", a, "m", "stroke amplitude")?;
     let top = a[a.len() - 1];
     if top / arm_m > MAX_LAG_RAD {
         bail!(

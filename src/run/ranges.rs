@@ -1,5 +1,5 @@
-//! Ranges of values given as text: `START:STOP:STEP` or a list (rotor speeds of `modes`,
-//! `stability` and a sweep's stability maps).
+//! Values given as text: `START:STOP:STEP` or a list (rotor speeds of `modes`, `stability`
+//! and a sweep's stability maps; the amplitude check's stroke amplitudes), and their checks.
 
 /// The error for `name`'s value `s`: what is wrong (`m`) and the form expected.
 pub fn range_error(name: &str, s: &str, m: &str, expected: &str) -> anyhow::Error {
@@ -37,7 +37,7 @@ pub fn parse_range(
         let n = ((b - a) / h + 1e-9).floor();
         if n >= max as f64 {
             return Err(bad(&format!(
-                "{} speeds, beyond the {max} {what}; use a larger STEP",
+                "{} values, beyond the {max} {what}; use a larger STEP",
                 crate::solver::budget::count(n + 1.0)
             )));
         }
@@ -48,10 +48,29 @@ pub fn parse_range(
         s.split(',').map(num).collect::<Result<_, _>>()?
     };
     if v.is_empty() {
-        return Err(bad("no speed given"));
+        return Err(bad("no value given"));
     }
     if v.len() > max {
-        return Err(bad(&format!("{} speeds, beyond the {max} {what}", v.len())));
+        return Err(bad(&format!("{} values, beyond the {max} {what}", v.len())));
     }
     Ok(v)
+}
+
+/// `name`'s values (`unit`, each a `noun`): at least one, each finite and positive, strictly
+/// increasing.
+pub fn check_increasing(name: &str, v: &[f64], unit: &str, noun: &str) -> anyhow::Result<()> {
+    if v.is_empty() {
+        anyhow::bail!("{name}: no {noun} given");
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite() || **x <= 0.0) {
+        anyhow::bail!("{name}: {x} {unit} is not a positive finite {noun}");
+    }
+    if let Some(w) = v.windows(2).find(|w| w[1] <= w[0]) {
+        anyhow::bail!(
+            "{name}: {} {unit} after {} {unit}: the values must increase",
+            w[1],
+            w[0]
+        );
+    }
+    Ok(())
 }

@@ -241,7 +241,7 @@ pub fn stability_map(
     speeds_rad_s: &[f64],
 ) -> anyhow::Result<StabilityMap> {
     let file = deck.path.display().to_string();
-    check_speeds(speeds_rad_s)?;
+    check_speeds("speeds", speeds_rad_s)?;
     let Some(af) = &deck.spec.airframe else {
         bail!("rotor deck {file} has no [airframe]: ground resonance is the rotor's lag modes coupled with the airframe under the hub; add [airframe] with x and y (mass_kg, stiffness_N_per_m, damping_Ns_per_m) or [[airframe.mode]] tables (docs/rotor_deck.md, \"The airframe under the hub\")");
     };
@@ -364,26 +364,13 @@ pub fn parse_speeds(name: &str, s: &str) -> anyhow::Result<Vec<f64>> {
     const EXPECTED: &str =
         "expected START:STOP:STEP in rad/s, e.g. 5:40:0.5, or an increasing list 10,20,30";
     let v = super::ranges::parse_range(name, s, EXPECTED, MAX_SPEEDS, "a map may have")?;
-    check_speeds(&v).map_err(|e| anyhow!("{name} `{s}`: {e:#} ({EXPECTED})"))?;
+    check_speeds(name, &v).map_err(|e| anyhow!("{e:#} ({EXPECTED})"))?;
     Ok(v)
 }
 
-/// Speeds in rad/s: finite, non-negative, strictly increasing.
-pub fn check_speeds(s: &[f64]) -> anyhow::Result<()> {
-    if s.is_empty() {
-        bail!("--speeds: no rotor speed given");
-    }
-    if let Some(v) = s.iter().find(|v| !v.is_finite() || **v <= 0.0) {
-        bail!("--speeds: {v} rad/s is not a positive finite rotor speed");
-    }
-    if let Some(w) = s.windows(2).find(|w| w[1] <= w[0]) {
-        bail!(
-            "--speeds: {} rad/s after {} rad/s: the speeds must increase",
-            w[1],
-            w[0]
-        );
-    }
-    Ok(())
+/// Speeds `name` in rad/s: finite, positive, strictly increasing.
+pub fn check_speeds(name: &str, s: &[f64]) -> anyhow::Result<()> {
+    super::ranges::check_increasing(name, s, "rad/s", "rotor speed")
 }
 
 /// Contiguous speeds where a mode's growth rate is positive.
