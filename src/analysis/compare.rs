@@ -132,6 +132,19 @@ fn ptp(v: &[f64]) -> f64 {
     hi - lo
 }
 
+/// Least-squares slope of the points `(x, y)` (a growth rate from `(t, ln A)`); NaN for fewer
+/// than two distinct `x`.
+pub fn slope(pts: &[(f64, f64)]) -> f64 {
+    let n = pts.len() as f64;
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(p, q), s| (p + s.0 / n, q + s.1 / n));
+    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |(p, q), s| {
+        (p + (s.0 - mx) * (s.1 - my), q + (s.0 - mx) * (s.0 - mx))
+    });
+    sxy / sxx
+}
+
 /// Compares `model` (one revolution) with `measured`, on the measured azimuths, with harmonics
 /// up to `n_harmonics`/rev.
 pub fn compare(

@@ -228,18 +228,6 @@ impl Blades {
     }
 }
 
-/// Least-squares slope of `y` against `x`.
-fn slope(pts: &[(f64, f64)]) -> f64 {
-    let n = pts.len() as f64;
-    let (mx, my) = pts
-        .iter()
-        .fold((0.0, 0.0), |(p, q), s| (p + s.0 / n, q + s.1 / n));
-    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |(p, q), s| {
-        (p + (s.0 - mx) * (s.1 - my), q + (s.0 - mx) * (s.0 - mx))
-    });
-    sxy / sxx
-}
-
 /// The amplitude check of `deck` (per-blade differences applied) with damper model `model`
 /// at rotor speed `omega` [rad/s].
 pub fn amplitude_check(
@@ -318,7 +306,7 @@ pub fn amplitude_check(
         if fit.len() < 16 {
             bail!("the amplitude check at {a} m of stroke, {omega} rad/s: the response left the reduced model's range (lag beyond {:.0} deg) before a cycle was fitted", 2.0 * MAX_LAG_RAD.to_degrees());
         }
-        let g = slope(&fit);
+        let g = crate::analysis::compare::slope(&fit);
         let mean_ln = fit.iter().map(|p| p.1).sum::<f64>() / fit.len() as f64;
         let amp = mean_ln.exp();
         let (_, at, kc) = blades.equivalent(model, omega, amp, Some(w_rot(&mode)))?;

@@ -929,14 +929,7 @@ pub fn fit_growth(t: &[f64], x: &[f64], from_s: f64) -> Option<(f64, f64)> {
             (t[i], 0.5 * (x[i] * x[i] + (v / w) * (v / w)).ln())
         })
         .collect();
-    let n = pts.len() as f64;
-    let (mt, my) = pts
-        .iter()
-        .fold((0.0, 0.0), |(p, q), s| (p + s.0 / n, q + s.1 / n));
-    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |(p, q), s| {
-        (p + (s.0 - mt) * (s.1 - my), q + (s.0 - mt) * (s.0 - mt))
-    });
-    Some((sxy / sxx, f))
+    Some((crate::analysis::compare::slope(&pts), f))
 }
 
 /// Most steps per revolution of a time-domain check.
