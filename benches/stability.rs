@@ -1,19 +1,25 @@
 //! Benchmark: ground resonance on the UH-60A-like airframe deck with the physical damper, the
 //! linear map over 30 rotor speeds (the damper linearised on the bench at each) and one
 //! nonlinear amplitude check (the reduced rotor with four live dampers, started at the default
-//! eight stroke amplitudes, side by side on the cores).
+//! eight stroke amplitudes, side by side on the cores); air resonance in hover on the
+//! UH-60A-like hover deck, 30 speeds, physical damper.
 //!
 //! `cargo bench --bench stability`
 use criterion::{criterion_group, criterion_main, Criterion};
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::RotorDeck;
+use rotorsim::run::air_resonance::{air_resonance_map, HoverOptions};
 use rotorsim::run::amplitude::{amplitude_check, AmplitudeOptions};
 use rotorsim::run::stability::stability_map;
 use std::path::Path;
 
-fn deck() -> RotorDeck {
+fn deck_named(name: &str) -> RotorDeck {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    RotorDeck::from_file_with(&root.join("rotors/uh60a_airframe.toml"), &[]).unwrap()
+    RotorDeck::from_file_with(&root.join("rotors").join(name), &[]).unwrap()
+}
+
+fn deck() -> RotorDeck {
+    deck_named("uh60a_airframe.toml")
 }
 
 fn stability(c: &mut Criterion) {
@@ -32,6 +38,19 @@ fn stability(c: &mut Criterion) {
                 DamperModel::Physical,
                 om,
                 &AmplitudeOptions::default(),
+            )
+            .unwrap()
+        })
+    });
+    let hover = deck_named("uh60a_hover.toml");
+    let hover_speeds: Vec<f64> = (0..30).map(|k| 15.0 + 20.0 * k as f64 / 29.0).collect();
+    g.bench_function("hover_map_30_speeds_physical", |b| {
+        b.iter(|| {
+            air_resonance_map(
+                &hover,
+                DamperModel::Physical,
+                &hover_speeds,
+                &HoverOptions::default(),
             )
             .unwrap()
         })

@@ -25,6 +25,7 @@ fn r(i: f64, k: f64, c: f64) -> Option<AirframeRotation> {
         inertia: i,
         stiffness: k,
         damping: c,
+        center_z_m: 0.0,
     })
 }
 
@@ -211,5 +212,25 @@ fn the_airframe_example_is_the_shipped_deck_on_an_airframe() {
     for d in a.dofs() {
         assert!((d.frequency_hz() - 15.0).abs() < 1e-3, "{d:?}");
         assert!((d.damping_ratio() - 0.02).abs() < 1e-4, "{d:?}");
+    }
+}
+
+/// The shipped hover example is the shipped deck, unchanged, with a free-flight airframe after
+/// it whose rotations turn about the centre of gravity 1.7 m below the hub.
+#[test]
+fn the_hover_example_is_the_shipped_deck_on_a_free_airframe() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("rotors");
+    let base = std::fs::read_to_string(root.join("uh60a.toml")).unwrap();
+    let with = std::fs::read_to_string(root.join("uh60a_hover.toml")).unwrap();
+    assert!(
+        with.starts_with(&base),
+        "rotors/uh60a_hover.toml must begin with rotors/uh60a.toml"
+    );
+    let deck = rotorsim::rotor::RotorDeck::from_file(&root.join("uh60a_hover.toml")).unwrap();
+    let dofs = deck.spec.airframe.expect("an [airframe]").dofs();
+    assert_eq!(dofs.len(), 4);
+    for d in dofs {
+        assert!((d.frequency_hz() - 0.05).abs() < 1e-3, "{d:?}");
+        assert_eq!(d.center_z_m, if d.rotation { -1.7 } else { 0.0 });
     }
 }

@@ -229,3 +229,65 @@ fn the_amplitude_check_writes_its_table_section_and_statement() {
     assert!(a["statement"].as_str().unwrap().contains("no limit cycle"));
     assert!(!out.join("INCOMPLETE").exists());
 }
+
+/// Air resonance in hover on the shipped hover deck: every group of modes the model has is
+/// labelled, the summary carries the hover state and its momentum theory closes, and the
+/// report says what was run.
+#[test]
+fn hover_map_on_the_shipped_deck() {
+    let out = support::tmp("stability-hover");
+    let (ok, text) = stability(
+        &[
+            "--rotor",
+            repo("rotors/uh60a_hover.toml").to_str().unwrap(),
+            "--hover",
+            "--speeds",
+            "20,27",
+            "--damper",
+            "linear",
+        ],
+        &out,
+    );
+    assert!(ok, "{text}");
+    assert!(text.contains(", hover (linear damper, coleman)"), "{text}");
+    let r = rows(&out);
+    for label in [
+        "regressing lag",
+        "progressive lag",
+        "collective lag",
+        "differential lag",
+        "regressing flap",
+        "progressive flap",
+        "collective flap",
+        "differential flap",
+    ] {
+        assert!(
+            r.iter().any(|x| x.1 == label && x.0 == 27.0),
+            "{label} missing: {r:?}"
+        );
+    }
+    assert!(r.iter().all(|x| x.5 == "coleman"));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["condition"], "hover");
+    let h = &s["hover"];
+    let radius: f64 = 8.1786;
+    for st in h["states"].as_array().unwrap() {
+        let (t, vi) = (
+            st["thrust_n"].as_f64().unwrap(),
+            st["induced_velocity_m_s"].as_f64().unwrap(),
+        );
+        assert!(t > 0.0 && st["coning_deg"].as_f64().unwrap() > 0.0, "{st}");
+        let momentum = (t / (2.0 * 1.225 * std::f64::consts::PI * radius * radius)).sqrt();
+        assert!(
+            (vi - momentum).abs() < 1e-9 * momentum,
+            "{vi} vs {momentum}"
+        );
+    }
+    assert_eq!(h["options"]["collective_deg"], 8.0);
+    let html = std::fs::read_to_string(out.join("stability.html")).unwrap();
+    assert!(html.contains("Air resonance in hover") && html.contains("Hover equilibrium"));
+    // the least damping over the map is the csv's
+    let min = r.iter().map(|x| x.3).fold(f64::INFINITY, f64::min);
+    assert_eq!(s["min_damping_ratio"].as_f64().unwrap(), min);
+}

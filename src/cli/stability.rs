@@ -45,6 +45,22 @@ pub struct StabilityArgs {
     /// Rotor speed of the amplitude check [rad/s] (default: the deck's rotor.omega_rad_s).
     #[arg(long)]
     pub amplitude_at_rad_s: Option<f64>,
+    /// Air resonance in hover instead of ground resonance: rigid blades that lag and flap,
+    /// quasi-steady aerodynamics (the deck's `[aero]`), on the airframe's x, y, roll and pitch.
+    #[arg(long)]
+    pub hover: bool,
+    /// Hover: blade pitch at 0.75 R [deg] (the deck's twist about it).
+    #[arg(long, default_value_t = 8.0)]
+    pub collective_deg: f64,
+    /// Hover: air density [kg/m^3] (sea-level standard by default).
+    #[arg(long, default_value_t = 1.225)]
+    pub density_kg_m3: f64,
+    /// Hover: speed of sound [m/s] (the aerofoil tables' Mach number).
+    #[arg(long, default_value_t = 340.3)]
+    pub speed_of_sound_m_s: f64,
+    /// Hover: strips per blade from the hinge to the tip (mass and aerodynamics).
+    #[arg(long, default_value_t = crate::run::air_resonance::DEFAULT_STRIPS)]
+    pub strips: usize,
     /// Override a deck value by its dotted path before validation (repeatable), as for run.
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
     pub set: Vec<Override>,
@@ -113,8 +129,25 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             Some((w, amplitudes_m))
         }
     };
+    let hover = crate::run::air_resonance::HoverOptions {
+        collective_deg: args.collective_deg,
+        density_kg_m3: args.density_kg_m3,
+        speed_of_sound_m_s: args.speed_of_sound_m_s,
+        strips: args.strips,
+    };
+    if args.hover {
+        hover.check()?;
+        if args.time.is_some() || args.amplitudes_m.is_some() {
+            anyhow::bail!("--hover: the time-domain check (--time) and the amplitude check (--amplitudes-m) are for ground resonance; run them without --hover");
+        }
+    }
     let out = OutDir::create(&args.out, &deck.input_files())?;
-    let map = match stability_map(&deck, model, &speeds) {
+    let result = if args.hover {
+        crate::run::air_resonance::air_resonance_map(&deck, model, &speeds, &hover)
+    } else {
+        stability_map(&deck, model, &speeds)
+    };
+    let map = match result {
         Ok(mut m) => {
             m.overrides = args
                 .set
@@ -180,8 +213,9 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
     }
     let method = map.speeds.first().map_or("", |s| s.method.name());
     outln!(
-        "rotorsim stability: {} ({} damper, {method}), {} speeds from {} to {} rad/s",
+        "rotorsim stability: {}{} ({} damper, {method}), {} speeds from {} to {} rad/s",
         args.rotor.display(),
+        if args.hover { ", hover" } else { "" },
         model.name(),
         map.speeds.len(),
         speeds[0],

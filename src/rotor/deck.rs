@@ -132,7 +132,7 @@ impl AeroTable {
 
 /// The airframe under the hub: a mass, spring and damper in each of the hub's directions that
 /// move (any subset of x, y, z, roll, pitch; the others are rigid), in the fixed frame.
-/// Roll and pitch turn about the hub centre.
+/// Roll and pitch turn about a centre on the shaft (`center_z_m` above the hub; 0 by default).
 #[derive(Clone, Debug, Default, Deserialize, serde::Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AirframeTable {
@@ -204,6 +204,10 @@ pub struct AirframeRotation {
     pub stiffness: f64,
     #[serde(default, rename = "damping_Nms_per_rad")]
     pub damping: f64,
+    /// Height of the rotation's centre above the hub [m] (0: the hub centre; negative: below
+    /// it, e.g. the airframe's centre of gravity).
+    #[serde(default)]
+    pub center_z_m: f64,
 }
 
 /// One moving direction of the airframe, in the order x, y, z, roll, pitch.
@@ -378,7 +382,7 @@ impl AirframeTable {
                 mass: v.inertia,
                 stiffness: v.stiffness,
                 damping: v.damping,
-                center_z_m: 0.0,
+                center_z_m: v.center_z_m,
             })
         };
         if !self.mode.is_empty() {
@@ -461,6 +465,12 @@ impl AirframeTable {
                         format!("expected {what}, found {v}"),
                     ));
                 }
+            }
+            if !d.center_z_m.is_finite() {
+                return Err((
+                    format!("airframe.{}.center_z_m", d.name),
+                    format!("expected a finite height in m, found {}", d.center_z_m),
+                ));
             }
         }
         Ok(())

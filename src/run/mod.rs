@@ -12,6 +12,7 @@
 //! Beside it, the pipelines of the other commands that write result folders: [`bench`] (the
 //! damper bench's sweep and replay outputs), [`decay`] (a hinged blade's lag free decay) and
 //! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check).
+pub mod air_resonance;
 pub mod amplitude;
 pub mod bench;
 pub mod decay;

@@ -99,6 +99,8 @@ pub struct StabilityMap {
     pub notes: Vec<String>,
     /// The deck values overridden (`--set`, a sweep case's), as (key, value) for summary.json.
     pub overrides: Vec<(String, String)>,
+    /// Air resonance in hover ([`super::air_resonance`]); `None` on the ground.
+    pub hover: Option<super::air_resonance::HoverReport>,
 }
 
 impl StabilityMap {
@@ -162,7 +164,7 @@ pub(crate) fn in_plane(
 /// The damper of `deck` as `model` linearised at the rotating-frame frequency `w` [rad/s]
 /// and moved to the lag hinge: the linear dashpot exactly, the other models by their first
 /// harmonic at [`LINEARISATION_AMPLITUDE_M`] (the bench's K' and K''/w).
-fn linearise(
+pub(crate) fn linearise(
     damper: &DamperDeck,
     model: DamperModel,
     arm_m: f64,
@@ -352,6 +354,7 @@ pub fn stability_map(
         unstable,
         notes,
         overrides: Vec::new(),
+        hover: None,
     })
 }
 
@@ -374,7 +377,7 @@ pub fn check_speeds(name: &str, s: &[f64]) -> anyhow::Result<()> {
 }
 
 /// Contiguous speeds where a mode's growth rate is positive.
-fn unstable_ranges(speeds: &[SpeedModes]) -> Vec<UnstableRange> {
+pub(crate) fn unstable_ranges(speeds: &[SpeedModes]) -> Vec<UnstableRange> {
     let mut labels: Vec<String> = vec![];
     for s in speeds {
         for m in &s.modes {
@@ -495,6 +498,8 @@ pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
         "min_damping_ratio": min.as_ref().map(|m| m.0),
         "min_damping_mode": min.as_ref().map(|m| m.1.clone()),
         "min_damping_speed_rad_s": min.as_ref().map(|m| m.2),
+        "condition": if map.hover.is_some() { "hover" } else { "ground" },
+        "hover": map.hover,
         "notes": map.notes,
     })
 }
@@ -502,7 +507,11 @@ pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
 /// stability.html: the Coleman diagram, damping versus speed with the unstable ranges shaded,
 /// the reduced model and the ranges.
 pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
-    let mut rep = HtmlReport::new("Ground resonance");
+    let mut rep = HtmlReport::new(if map.hover.is_some() {
+        "Air resonance in hover"
+    } else {
+        "Ground resonance"
+    });
     let method = map
         .speeds
         .first()
@@ -531,18 +540,31 @@ pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
             .collect();
         rep.banner(Banner::Bad, &format!("UNSTABLE: {}.", ranges.join("; ")));
     }
-    rep.paragraph(&format!(
-        "Rotor deck {}: {} blades reduced to rigid blades on their lag hinges, each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's in-plane directions (docs/stability.md). Method: {method} ({}).",
-        deck.path.display(),
-        map.blades.len(),
-        map.damper.name(),
-        LINEARISATION_AMPLITUDE_M * 1e3,
-        if method == "coleman" {
-            "identical blades: constant-coefficient equations in multi-blade coordinates"
-        } else {
-            "blades differ: Floquet exponents of the periodic equations over one revolution"
-        }
-    ));
+    let how = if method == "coleman" {
+        "identical blades: constant-coefficient equations in multi-blade coordinates"
+    } else {
+        "blades differ: Floquet exponents of the periodic equations over one revolution"
+    };
+    let _ = match &map.hover {
+        None => rep.paragraph(&format!(
+            "Rotor deck {}: {} blades reduced to rigid blades on their lag hinges, each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's in-plane directions (docs/stability.md). Method: {method} ({how}).",
+            deck.path.display(),
+            map.blades.len(),
+            map.damper.name(),
+            LINEARISATION_AMPLITUDE_M * 1e3,
+        )),
+        Some(h) => rep.paragraph(&format!(
+            "Rotor deck {}: {} blades reduced to rigid blades on coincident lag and flap hinges ({} strips each), quasi-steady aerodynamics in hover at a collective of {} deg at 0.75 R, air density {} kg/m^3 (Lock number {:.2}), each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's directions under the hub (docs/stability.md). Method: {method} ({how}).",
+            deck.path.display(),
+            map.blades.len(),
+            h.options.strips,
+            h.options.collective_deg,
+            h.options.density_kg_m3,
+            h.lock_number,
+            map.damper.name(),
+            LINEARISATION_AMPLITUDE_M * 1e3,
+        )),
+    };
     let label_order: Vec<String> = {
         let mut v: Vec<String> = vec![];
         for s in &map.speeds {
@@ -677,15 +699,66 @@ pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
         .into_iter()
         .flatten()
         .collect();
-    rep.table(
-        &[
-            "airframe",
-            "mass [kg]",
-            "stiffness [N/m]",
-            "damping [N s/m]",
-        ],
-        &rows,
-    );
+    if !rows.is_empty() {
+        rep.table(
+            &[
+                "airframe",
+                "mass [kg]",
+                "stiffness [N/m]",
+                "damping [N s/m]",
+            ],
+            &rows,
+        );
+    }
+    if let Some(h) = &map.hover {
+        let rows: Vec<Vec<String>> = h
+            .airframe
+            .iter()
+            .map(|(n, m, k, c, z)| {
+                vec![
+                    n.clone(),
+                    format!("{m:.1}"),
+                    format!("{k:.1}"),
+                    format!("{c:.1}"),
+                    format!("{z:.3}"),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "airframe",
+                "mass [kg] or inertia [kg m^2]",
+                "stiffness [N/m or N m/rad]",
+                "damping [N s/m or N m s/rad]",
+                "centre above the hub [m]",
+            ],
+            &rows,
+        );
+        rep.heading(2, "Hover equilibrium");
+        let rows: Vec<Vec<String>> = h
+            .states
+            .iter()
+            .map(|s| {
+                vec![
+                    format!("{:.3}", s.omega_rad_s),
+                    format!("{:.0}", s.thrust_n),
+                    format!("{:.3}", s.induced_velocity_m_s),
+                    format!("{:.3}", s.coning_deg),
+                    format!("{:.3}", s.lag_deg),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "rotor speed [rad/s]",
+                "thrust [N]",
+                "induced velocity [m/s]",
+                "coning [deg]",
+                "lag [deg]",
+            ],
+            &rows,
+        );
+    }
     rep.list(&map.notes);
     Ok(rep.finish())
 }

@@ -148,6 +148,13 @@ pub enum ModeLabel {
     AirframeY,
     CollectiveLag,
     DifferentialLag,
+    /// Air resonance (flap and the airframe's rotations, [`super::air_rotor`]).
+    RegressingFlap,
+    ProgressiveFlap,
+    CollectiveFlap,
+    DifferentialFlap,
+    AirframeRoll,
+    AirframePitch,
     /// Floquet mode of a rotor with fewer than 3 blades: no Coleman reference, frequency is
     /// the principal value in `[0, Omega/2]`.
     Unresolved,
@@ -162,6 +169,12 @@ impl ModeLabel {
             ModeLabel::AirframeY => "airframe y",
             ModeLabel::CollectiveLag => "collective lag",
             ModeLabel::DifferentialLag => "differential lag",
+            ModeLabel::RegressingFlap => "regressing flap",
+            ModeLabel::ProgressiveFlap => "progressive flap",
+            ModeLabel::CollectiveFlap => "collective flap",
+            ModeLabel::DifferentialFlap => "differential flap",
+            ModeLabel::AirframeRoll => "airframe roll",
+            ModeLabel::AirframePitch => "airframe pitch",
             ModeLabel::Unresolved => "unresolved",
         }
     }
@@ -187,7 +200,7 @@ pub struct Mode {
 }
 
 impl Mode {
-    fn new(label: ModeLabel, eigenvalue: c64) -> Self {
+    pub(super) fn new(label: ModeLabel, eigenvalue: c64) -> Self {
         let norm = eigenvalue.re.hypot(eigenvalue.im);
         Mode {
             label,
@@ -838,7 +851,11 @@ impl LagRotor {
 
 /// Eigenvalues and eigenvectors (displacement rows first) of
 /// `A = [[0, I], [-M^-1 K, -M^-1 C]]`.
-fn eigen_pairs(mm: &Mat<f64>, cm: &Mat<f64>, km: &Mat<f64>) -> Result<(Vec<c64>, Mat<c64>)> {
+pub(super) fn eigen_pairs(
+    mm: &Mat<f64>,
+    cm: &Mat<f64>,
+    km: &Mat<f64>,
+) -> Result<(Vec<c64>, Mat<c64>)> {
     use faer::linalg::solvers::Solve;
     let n = mm.nrows();
     let lu = mm.partial_piv_lu();
@@ -864,7 +881,7 @@ fn eigen_pairs(mm: &Mat<f64>, cm: &Mat<f64>, km: &Mat<f64>) -> Result<(Vec<c64>,
 /// Match multipliers to reference exponents (nearest `lambda T` in the log plane, imaginary
 /// part modulo `2 pi`; greedy over all pairs, closest first) and resolve each exponent's
 /// imaginary part to the multiple of `Omega` nearest its reference.
-fn resolve(
+pub(super) fn resolve(
     refs: &[(c64, ModeLabel, bool)],
     mu: &[c64],
     period: f64,
