@@ -5,7 +5,19 @@
 //! matrix `H = S^T Y`; its eigenvectors `z` give the Ritz vectors `S z`. A multiplier `mu` of a
 //! mode `e^{s t}` is `e^{s T}`: `s T = ln|mu| + i arg(mu)`, so the frequency is known modulo
 //! 1/rev (reported in [0, 1/2] /rev) and the damping ratio follows from that frequency.
+//!
+//! A Ritz pair is an eigenpair of `M` only as far as span(S) contains the mode. Its residual
+//! `||M v - mu v|| / ||v||` with `v = S z`, `M v = Y z` (no further period) bounds the distance
+//! of `mu` to an eigenvalue of `M` for a normal `M` (Bauer-Fike; Saad, Numerical Methods for
+//! Large Eigenvalue Problems, 2011, Th. 3.6); a multiplier whose residual exceeds
+//! [`RELIABLE_RESIDUAL`] of its magnitude is marked unreliable. The bound is a guarantee
+//! only for a normal `M`; the Ritz value is often closer than its residual (see
+//! docs/periodic.md for the UH-60A run).
 use faer::Mat;
+
+/// Largest residual `||M v - mu v|| / ||v||`, relative to `|mu|`, of a multiplier reported as
+/// reliable: for a normal `M` an eigenvalue then lies within 1% of `mu`.
+pub const RELIABLE_RESIDUAL: f64 = 1e-2;
 
 /// One Floquet multiplier with its mode.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -22,6 +34,16 @@ pub struct Multiplier {
     /// Which motion dominates the mode (the simulation's label, e.g. "lag").
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub mode: String,
+    /// `||M v - mu v|| / ||v||` of the Ritz pair (NaN when not computed).
+    #[serde(default = "nan")]
+    pub residual: f64,
+    /// Whether `residual` is at most [`RELIABLE_RESIDUAL`] x `magnitude`.
+    #[serde(default)]
+    pub reliable: bool,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 impl Multiplier {
@@ -41,7 +63,16 @@ impl Multiplier {
             frequency_per_rev: arg / (2.0 * std::f64::consts::PI),
             damping_ratio,
             mode: String::new(),
+            residual: f64::NAN,
+            reliable: false,
         }
+    }
+
+    /// Sets the residual and whether it is small enough.
+    pub fn with_residual(mut self, r: f64) -> Self {
+        self.residual = r;
+        self.reliable = r <= RELIABLE_RESIDUAL * self.magnitude;
+        self
     }
 }
 
@@ -54,7 +85,7 @@ pub struct RitzPair {
 }
 
 /// Ritz pairs of `M` on span(`s`) from `y = M s` (`s` orthonormal), least damped first (largest
-/// |mu|); complex pairs give one entry (Im >= 0).
+/// |mu|); complex pairs give one entry (Im >= 0), with its residual (module docs).
 pub fn ritz_pairs(s: &[Vec<f64>], y: &[Vec<f64>]) -> Vec<RitzPair> {
     let k = s.len();
     if k == 0 {
@@ -71,15 +102,27 @@ pub fn ritz_pairs(s: &[Vec<f64>], y: &[Vec<f64>]) -> Vec<RitzPair> {
         .map(|j| {
             let l = lam.column_vector()[j];
             let (mut vr, mut vi) = (vec![0.0; n], vec![0.0; n]);
-            for (i, si) in s.iter().enumerate() {
+            let (mut mr, mut mi) = (vec![0.0; n], vec![0.0; n]);
+            for (i, (si, yi)) in s.iter().zip(y).enumerate() {
                 let z = u[(i, j)];
-                for (p, v) in si.iter().enumerate() {
+                for (p, (v, w)) in si.iter().zip(yi).enumerate() {
                     vr[p] += z.re * v;
                     vi[p] += z.im * v;
+                    mr[p] += z.re * w;
+                    mi[p] += z.im * w;
                 }
             }
+            // M v - mu v, complex
+            let r2: f64 = (0..n)
+                .map(|p| {
+                    let dr = mr[p] - (l.re * vr[p] - l.im * vi[p]);
+                    let di = mi[p] - (l.re * vi[p] + l.im * vr[p]);
+                    dr * dr + di * di
+                })
+                .sum();
+            let v2 = dot(&vr, &vr) + dot(&vi, &vi);
             RitzPair {
-                multiplier: Multiplier::new(l.re, l.im),
+                multiplier: Multiplier::new(l.re, l.im).with_residual((r2 / v2).sqrt()),
                 vector_re: vr,
                 vector_im: vi,
             }
@@ -131,5 +174,27 @@ mod tests {
             (p[0].multiplier.frequency_per_rev - 0.4 / (2.0 * std::f64::consts::PI)).abs() < 1e-14
         );
         assert!((p[1].multiplier.re - 0.2).abs() < 1e-14);
+        // span(S) is invariant: exact eigenpairs
+        assert!(p
+            .iter()
+            .all(|q| q.multiplier.residual < 1e-14 && q.multiplier.reliable));
+    }
+
+    /// A subspace that misses part of a mode: `M = diag(0.98, 0.5)` on span of
+    /// `s = (cos a, sin a)`. The Ritz value is `0.98 c^2 + 0.5 s^2` and its residual is
+    /// `|M s - mu s| = 0.48 |c s|` (the component of `M s` normal to `s`).
+    #[test]
+    fn ritz_value_of_a_subspace_that_misses_the_mode_carries_its_residual() {
+        for a in [1e-5f64, 0.2] {
+            let (c, sn) = (a.cos(), a.sin());
+            let s = vec![vec![c, sn]];
+            let y = vec![vec![0.98 * c, 0.5 * sn]];
+            let p = ritz_pairs(&s, &y);
+            let mu = 0.98 * c * c + 0.5 * sn * sn;
+            assert!((p[0].multiplier.re - mu).abs() < 1e-15);
+            let r = 0.48 * (c * sn).abs();
+            assert!((p[0].multiplier.residual - r).abs() < 1e-15 * (1.0 + r));
+            assert_eq!(p[0].multiplier.reliable, a < 0.1);
+        }
     }
 }

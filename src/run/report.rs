@@ -1180,7 +1180,7 @@ pub fn report_html(
     );
     let frows = floquet_rows(&runs);
     if !frows.is_empty() {
-        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode.");
+        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode. A multiplier is the eigenvalue of a subspace of the monodromy matrix; its residual ||M v - mu v|| / ||v|| says how far the subspace holds the mode, and one above 1% of |mu| is marked not reliable: the subspace does not guarantee it to 1% (its value is often closer than its residual, but nothing says so).");
         rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
         rep.table(
             &[
@@ -1191,6 +1191,8 @@ pub fn report_html(
                 "decay per rev |mu|",
                 "frequency [/rev, mod 1]",
                 "damping ratio [-]",
+                "residual ||M v - mu v|| / ||v||",
+                "reliable",
             ],
             &frows,
         );
@@ -1284,6 +1286,8 @@ pub fn floquet_rows(runs: &[&ModelRun]) -> Vec<Vec<String>> {
                 format!("{:.4}", m.magnitude),
                 freq,
                 zeta,
+                format!("{:.1e}", m.residual),
+                if m.reliable { "yes" } else { "NO" }.into(),
             ]);
         }
     }
