@@ -27,6 +27,14 @@ pub struct DecayArgs {
     /// Newton method: `modified` (stored factorization) or `full`.
     #[arg(long, default_value = "modified", value_parser = ["modified", "full"])]
     pub newton: String,
+    /// Spectral radius at infinite frequency of the generalized-alpha integrator, in [0, 1]
+    /// (1: no numerical damping; lower damps the elastic modes the release excites sooner).
+    #[arg(long, default_value_t = 0.9, allow_negative_numbers = true)]
+    pub rho_inf: f64,
+    /// Newton tolerance, relative to the residual of the zero-acceleration predictor, in (0, 1)
+    /// (docs/validation_tm4760.md, "Integrator settings and their cost").
+    #[arg(long, default_value_t = 1e-8)]
+    pub newton_rtol: f64,
     /// Output directory (decay.csv, decay_summary.csv).
     #[arg(long)]
     pub out: PathBuf,
@@ -52,6 +60,8 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         } else {
             NewtonMethod::Modified
         },
+        rho_inf: args.rho_inf,
+        newton_rtol: args.newton_rtol,
         ..Default::default()
     };
     if let Some(r) = args.rpm {
@@ -63,6 +73,8 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         match k {
             "time_step" => "--step-s",
             "duration" => "--duration-s",
+            "rho_inf" => "--rho-inf",
+            "newton_rtol" => "--newton-rtol",
             _ => "--rpm",
         }
         .to_string()
@@ -80,13 +92,15 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
     out.finish()?;
     let n = r.lag_rad.len();
     outln!(
-        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton): {:.3} iterations and {:.4} \
-         factorizations per step",
+        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton, rho_inf {}, rtol {:e}): {:.3} \
+         iterations and {:.4} factorizations per step",
         r.omega_rad_s * 30.0 / std::f64::consts::PI,
         opts.time_step_s,
         n,
         args.frame,
         args.newton,
+        opts.rho_inf,
+        opts.newton_rtol,
         r.newton_iterations as f64 / n as f64,
         r.factorizations as f64 / n as f64
     );

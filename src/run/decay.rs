@@ -66,6 +66,21 @@ impl DecayRunOptions {
             pos(om, "omega")?;
         }
         pos(self.time_step_s, "time_step")?;
+        if !(0.0..=1.0).contains(&self.rho_inf) {
+            anyhow::bail!(
+                "{}: expected a number in [0, 1] (the integrator's spectral radius at infinite \
+                 frequency), got {}",
+                what("rho_inf"),
+                self.rho_inf
+            );
+        }
+        if !(self.newton_rtol > 0.0 && self.newton_rtol < 1.0) {
+            anyhow::bail!(
+                "{}: expected a number in (0, 1) (relative to the predictor's residual), got {}",
+                what("newton_rtol"),
+                self.newton_rtol
+            );
+        }
         pos(self.duration_s, "duration")?;
         let need = self.analyse_from_s + 20.0 * self.time_step_s;
         if self.duration_s < need {
