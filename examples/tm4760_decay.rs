@@ -107,7 +107,7 @@ fn main() -> anyhow::Result<()> {
         omega_rad_s: om,
         lag_eq_rad: sim.lag_eq_rad,
         lag_rad: x,
-        modal,
+        modal: Some(modal),
         fit,
         log_decrement: ld,
         newton_iterations: s.total_iterations,
