@@ -186,6 +186,7 @@ const CASES: &[Case] = &[
     case("decay rho_inf above 1", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rho-inf", "1.5", "--out", "{T}/out"], &["--rho-inf", "expected a number in [0, 1]", "got 1.5"]),
     case("decay rho_inf NaN", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rho-inf", "nan", "--out", "{T}/out"], &["--rho-inf", "expected a number in [0, 1]", "got NaN"]),
     case("decay Newton tolerance zero", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--newton-rtol", "0", "--out", "{T}/out"], &["--newton-rtol", "expected a number in (0, 1)", "got 0"]),
+    case("decay Newton correction tolerance negative", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--newton-xtol=-1e-9", "--out", "{T}/out"], &["--newton-xtol", "expected a number in (0, 1)", "got -0.000000001"]),
     case("decay Newton tolerance 2", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--newton-rtol", "2", "--out", "{T}/out"], &["--newton-rtol", "expected a number in (0, 1)", "got 2"]),
     case("rigid run record radius 10x the deck's", record!("\"radius_m\": 8.178", "\"radius_m\": 0.8178"), RUN_FLIGHT, &["radius_m = 0.8178", "rotor.radius_m = 8.1786", "uh60a.toml"]),
     case("elastic run record radius 10x the deck's", record!("\"radius_m\": 8.178", "\"radius_m\": 81.78"), &["run", "--flight", "{T}/rec", "--revs", "3", "--out", "{T}/out"], &["radius_m = 81.78", "rotor.radius_m"]),

@@ -35,6 +35,10 @@ pub struct DecayArgs {
     /// (docs/validation_tm4760.md, "Integrator settings and their cost").
     #[arg(long, default_value_t = 1e-8)]
     pub newton_rtol: f64,
+    /// Newton correction tolerance, relative to the model's size, in (0, 1): a step also ends
+    /// once its largest correction is below it and the residual at its round-off floor.
+    #[arg(long, default_value_t = 1e-9)]
+    pub newton_xtol: f64,
     /// Skip the linearised lag mode (its static solve and eigen analysis, more than half of a
     /// 2000-step run): decay_summary.csv then has the decay's estimates only.
     #[arg(long)]
@@ -66,6 +70,7 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         },
         rho_inf: args.rho_inf,
         newton_rtol: args.newton_rtol,
+        newton_xtol: args.newton_xtol,
         modal: !args.no_modal,
         ..Default::default()
     };
@@ -80,6 +85,7 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
             "duration" => "--duration-s",
             "rho_inf" => "--rho-inf",
             "newton_rtol" => "--newton-rtol",
+            "newton_xtol" => "--newton-xtol",
             _ => "--rpm",
         }
         .to_string()
@@ -97,7 +103,7 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
     out.finish()?;
     let n = r.lag_rad.len();
     outln!(
-        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton, rho_inf {}, rtol {:e}): {:.3} \
+        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton, rho_inf {}, rtol {:e}, xtol {:e}): {:.3} \
          iterations and {:.4} factorizations per step",
         r.omega_rad_s * 30.0 / std::f64::consts::PI,
         opts.time_step_s,
@@ -106,6 +112,7 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         args.newton,
         opts.rho_inf,
         opts.newton_rtol,
+        opts.newton_xtol,
         r.newton_iterations as f64 / n as f64,
         r.factorizations as f64 / n as f64
     );
