@@ -1,6 +1,6 @@
 //! Free decay of the TM-4760 blade's lag hinge (rotors/tm4760.toml, docs/validation_tm4760.md):
 //! `cargo run --release --example tm4760_decay -- [STEP_S] [frame|inertial] [modified|full] [END_S] [RTOL] [RHO_INF]`
-//! (defaults 0.005 frame modified 6 1e-8 0.9). Prints the linearised rigid lag mode, the decay's damped
+//! (defaults 0.005 frame modified 6 1e-8 0.9; the correction tolerance is the decay's, 1e-9). Prints the linearised rigid lag mode, the decay's damped
 //! frequency and damping ratio (linear-prediction fit and log decrement over t >= 1 s), the
 //! Newton iterations and factorizations per step and the CPU cost per step of this thread, and
 //! writes the lag angle history to `tm4760_decay.csv` in the current folder.
@@ -107,7 +107,7 @@ fn main() -> anyhow::Result<()> {
         omega_rad_s: om,
         lag_eq_rad: sim.lag_eq_rad,
         lag_rad: x,
-        modal,
+        modal: Some(modal),
         fit,
         log_decrement: ld,
         newton_iterations: s.total_iterations,

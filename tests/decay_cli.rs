@@ -94,3 +94,40 @@ fn decay_bad_input_names_the_flag() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn decay_without_the_mode_marches_the_same_history() {
+    let deck = root().join("rotors/tm4760.toml");
+    let run = |name: &str, extra: &[&str]| {
+        let out = tmp(name);
+        let o = out.to_str().unwrap();
+        let mut args = vec![
+            "--rotor",
+            deck.to_str().unwrap(),
+            "--duration-s",
+            "1.5",
+            "--out",
+            o,
+        ];
+        args.extend_from_slice(extra);
+        let r = decay(&args);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let hist = std::fs::read_to_string(out.join("decay.csv")).unwrap();
+        let sum = std::fs::read_to_string(out.join("decay_summary.csv")).unwrap();
+        let _ = std::fs::remove_dir_all(&out);
+        (hist, sum)
+    };
+    let (h_with, s_with) = run("decay_cli_modal", &[]);
+    let (h_without, s_without) = run("decay_cli_no_modal", &["--no-modal"]);
+    assert_eq!(h_with, h_without, "the mode changed the march");
+    assert!(s_with.contains("linearised_modal,"), "{s_with}");
+    assert!(!s_without.contains("linearised_modal"), "{s_without}");
+    // the decay's own estimates are those of the run with the mode
+    let rows = |s: &str| -> Vec<String> {
+        s.lines()
+            .filter(|l| !l.starts_with("linearised_modal"))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(rows(&s_with), rows(&s_without));
+}

@@ -27,6 +27,22 @@ pub struct DecayArgs {
     /// Newton method: `modified` (stored factorization) or `full`.
     #[arg(long, default_value = "modified", value_parser = ["modified", "full"])]
     pub newton: String,
+    /// Spectral radius at infinite frequency of the generalized-alpha integrator, in [0, 1]
+    /// (1: no numerical damping; lower damps the elastic modes the release excites sooner).
+    #[arg(long, default_value_t = 0.9, allow_negative_numbers = true)]
+    pub rho_inf: f64,
+    /// Newton tolerance, relative to the residual of the zero-acceleration predictor, in (0, 1)
+    /// (docs/validation_tm4760.md, "Integrator settings and their cost").
+    #[arg(long, default_value_t = 1e-8)]
+    pub newton_rtol: f64,
+    /// Newton correction tolerance, relative to the model's size, in (0, 1): a step also ends
+    /// once its largest correction is below it and the residual at its round-off floor.
+    #[arg(long, default_value_t = 1e-9)]
+    pub newton_xtol: f64,
+    /// Skip the linearised lag mode (its static solve and eigen analysis, more than half of a
+    /// 2000-step run): decay_summary.csv then has the decay's estimates only.
+    #[arg(long)]
+    pub no_modal: bool,
     /// Output directory (decay.csv, decay_summary.csv).
     #[arg(long)]
     pub out: PathBuf,
@@ -52,6 +68,10 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         } else {
             NewtonMethod::Modified
         },
+        rho_inf: args.rho_inf,
+        newton_rtol: args.newton_rtol,
+        newton_xtol: args.newton_xtol,
+        modal: !args.no_modal,
         ..Default::default()
     };
     if let Some(r) = args.rpm {
@@ -63,6 +83,9 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         match k {
             "time_step" => "--step-s",
             "duration" => "--duration-s",
+            "rho_inf" => "--rho-inf",
+            "newton_rtol" => "--newton-rtol",
+            "newton_xtol" => "--newton-xtol",
             _ => "--rpm",
         }
         .to_string()
@@ -80,13 +103,16 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
     out.finish()?;
     let n = r.lag_rad.len();
     outln!(
-        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton): {:.3} iterations and {:.4} \
-         factorizations per step",
+        "{:.2} rpm, h = {} s, {} steps ({} frame, {} Newton, rho_inf {}, rtol {:e}, xtol {:e}): {:.3} \
+         iterations and {:.4} factorizations per step",
         r.omega_rad_s * 30.0 / std::f64::consts::PI,
         opts.time_step_s,
         n,
         args.frame,
         args.newton,
+        opts.rho_inf,
+        opts.newton_rtol,
+        opts.newton_xtol,
         r.newton_iterations as f64 / n as f64,
         r.factorizations as f64 / n as f64
     );
@@ -94,7 +120,9 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         Some((f, z)) => outln!("{name:<18} {f:>10.5} Hz  damping ratio {z:.5}"),
         None => outln!("{name:<18} not found (too few peaks after 1 s)"),
     };
-    show("linearised modal", Some(r.modal));
+    if let Some(m) = r.modal {
+        show("linearised modal", Some(m));
+    }
     show("damped-sine fit", r.fit);
     show("log decrement", r.log_decrement);
     outln!("wrote {}", args.out.display());

@@ -16,9 +16,33 @@ pub struct DynamicArgs {
     /// also plots.svg and one SVG per paper figure 9-12 of each device).
     #[arg(long)]
     pub out: PathBuf,
+    /// Spectral radius at infinite frequency of the generalized-alpha integrator, in [0, 1]
+    /// (default: the deck's `dynamic.rho_inf`).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rho_inf: Option<f64>,
+    /// Newton tolerance, relative to the residual of the step's predictor, in (0, 1)
+    /// (default 1e-9).
+    #[arg(long)]
+    pub newton_rtol: Option<f64>,
 }
 
 pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
+    if let Some(r) = args.rho_inf {
+        if !(0.0..=1.0).contains(&r) {
+            anyhow::bail!(
+                "--rho-inf: expected a number in [0, 1] (the integrator's spectral radius at \
+                 infinite frequency), got {r}"
+            );
+        }
+    }
+    if let Some(r) = args.newton_rtol {
+        if !(r > 0.0 && r < 1.0) {
+            anyhow::bail!(
+                "--newton-rtol: expected a number in (0, 1) (relative to the predictor's \
+                 residual), got {r}"
+            );
+        }
+    }
     // Refused before the model is built when beyond sense: 3 Newton iterations a step is
     // typical (docs/performance.md); kept samples: the time and a channel a node at least.
     let (deck, mut model) = load_deck_within(&args.deck, |d| {
@@ -48,6 +72,7 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
     if !(h > 0.0 && t_end > 0.0) {
         anyhow::bail!("deck {file}, dynamic: time_step_s and end_time_s must be positive");
     }
+    let rho_inf = args.rho_inf.unwrap_or(dy.rho_inf);
     if !(0.0..=1.0).contains(&dy.rho_inf) {
         anyhow::bail!(
             "deck {file}, dynamic.rho_inf: must be in [0, 1], got {}",
@@ -70,8 +95,11 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
     if let Some(om) = dy.initial_omega_rad_s {
         st.set_rigid_rotation([0.0; 3], om);
     }
-    let mut solver = DynamicSolver::new(model, st, h, dy.rho_inf)?;
+    let mut solver = DynamicSolver::new(model, st, h, rho_inf)?;
     solver.newton.max_iterations = dy.max_iterations;
+    if let Some(r) = args.newton_rtol {
+        solver.newton.rtol = r;
+    }
     solver.init_accelerations()?;
     let header = solver.sensor_header();
     let hs: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
@@ -121,7 +149,8 @@ pub fn run(args: DynamicArgs) -> anyhow::Result<()> {
         "steps": solver.steps,
         "newton_iterations": solver.total_iterations,
         "wall_time_s": elapsed,
-        "rho_inf": dy.rho_inf,
+        "rho_inf": rho_inf,
+        "newton_rtol": solver.newton.rtol,
         "complete": failure.is_none(),
         "error": failure.as_ref().map(|e| e.to_string()),
         "hydraulics": hydraulics,
