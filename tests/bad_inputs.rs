@@ -263,7 +263,7 @@ const CASES: &[Case] = &[
     case("stability --amplitudes-m not a number", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--amplitudes-m", "1e-3,big", "--out", "{T}/out"], &["--amplitudes-m", "`big` is not a number"]),
     case("stability --amplitudes-m beyond the model", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--amplitudes-m", "0.2", "--out", "{T}/out"], &["--amplitudes-m", "deg of lag", "damper arm"]),
     case("stability --amplitude-at-rad-s alone", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--amplitude-at-rad-s", "27", "--out", "{T}/out"], &["--amplitude-at-rad-s", "needs --amplitudes-m"]),
-    case("stability --hover with --time", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--hover", "--time", "25", "--out", "{T}/out"], &["--hover", "--time", "ground resonance"]),
+    case("stability --hover with --time", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--hover", "--time", "25", "--out", "{T}/out"], &["--hover", "--time", "ground resonance", "--amplitudes-m, runs in hover"]),
     case("stability --hover --collective-deg out of range", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--hover", "--collective-deg", "45", "--out", "{T}/out"], &["--collective-deg 45", "-30 and 30 deg"]),
     case("stability --hover --density-kg-m3 zero", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--hover", "--density-kg-m3", "0", "--out", "{T}/out"], &["--density-kg-m3 0", "air density"]),
     case("stability --hover --strips too few", R, &["stability", "--rotor", "{T}/r.toml", "--speeds", "10:20:5", "--hover", "--strips", "2", "--out", "{T}/out"], &["--strips 2", "8 to 2000"]),

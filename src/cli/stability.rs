@@ -137,8 +137,8 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
     };
     if args.hover {
         hover.check()?;
-        if args.time.is_some() || args.amplitudes_m.is_some() {
-            anyhow::bail!("--hover: the time-domain check (--time) and the amplitude check (--amplitudes-m) are for ground resonance; run them without --hover");
+        if args.time.is_some() {
+            anyhow::bail!("--hover: the whole rotor's time domain (--time) is for ground resonance; run it without --hover (the amplitude check, --amplitudes-m, runs in hover)");
         }
     }
     let out = OutDir::create(&args.out, &deck.input_files())?;
@@ -185,6 +185,7 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
             );
             let opts = crate::run::amplitude::AmplitudeOptions {
                 amplitudes_m,
+                hover: args.hover.then_some(hover),
                 ..Default::default()
             };
             match crate::run::amplitude::amplitude_check(&deck, model, w, &opts) {

@@ -202,7 +202,7 @@ pub fn air_blade(
 
 /// The airframe's directions under the hub as the air-resonance model's coordinates (x, y,
 /// roll, pitch; a vertical direction is left out, with a note).
-fn body(deck: &RotorDeck) -> anyhow::Result<(Vec<BodyDof>, Vec<String>)> {
+pub(crate) fn body(deck: &RotorDeck) -> anyhow::Result<(Vec<BodyDof>, Vec<String>)> {
     let file = deck.path.display();
     let Some(af) = &deck.spec.airframe else {
         bail!("rotor deck {file} has no [airframe]: air resonance is the rotor's lag and flap modes coupled with the airframe's roll and pitch under the hub; add [airframe] with roll and pitch (inertia_kg_m2, stiffness_Nm_per_rad, damping_Nms_per_rad) or [[airframe.mode]] tables (docs/rotor_deck.md, \"The airframe under the hub\")");

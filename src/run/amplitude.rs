@@ -1,16 +1,18 @@
-//! The nonlinear amplitude check of ground resonance (docs/stability.md): the reduced rotor
-//! of the stability map on its airframe at one speed, each blade's damper a device (relief and
+//! The nonlinear amplitude check of ground or air resonance (docs/stability.md): the reduced
+//! rotor of the stability map on its airframe at one speed (in hover, the air-resonance
+//! model linearised about its hover equilibrium), each blade's damper a device (relief and
 //! check valves live), started on the regressing lag mode at a series of stroke amplitudes.
 //! Each start gives a growth rate in the time domain; beside it the growth rate the damper's
 //! equivalent stiffness and damping at that amplitude predict (the bench's first harmonic),
 //! and the linearised map's at 0.1 mm. Where the time-domain growth rate changes sign between
 //! two amplitudes there is a limit cycle.
+use super::air_resonance::HoverOptions;
 use super::stability::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::rotor::RotorDeck;
 use crate::stability::{
-    cyclic_amplitude, free_response_with_dampers, AirframeAxis, BladeDamper, LagBlade, LagRotor,
-    Mode, ModeLabel,
+    cyclic_amplitude, free_response_with_dampers, AirRotor, AirframeAxis, BladeDamper, BodyDof,
+    Hover, LagBlade, LagRotor, Mode, ModeLabel,
 };
 use anyhow::{anyhow, bail};
 use rayon::prelude::*;
@@ -39,6 +41,8 @@ pub struct AmplitudeOptions {
     pub cycles: usize,
     /// Steps per revolution (RK4 on the blades, the devices sub-stepped inside each).
     pub steps_per_rev: usize,
+    /// In hover (the air-resonance model, [`super::air_resonance`]) rather than on the ground.
+    pub hover: Option<super::air_resonance::HoverOptions>,
 }
 
 impl Default for AmplitudeOptions {
@@ -47,6 +51,7 @@ impl Default for AmplitudeOptions {
             amplitudes_m: DEFAULT_AMPLITUDES_M.to_vec(),
             cycles: 4,
             steps_per_rev: 256,
+            hover: None,
         }
     }
 }
@@ -116,21 +121,80 @@ pub fn check_amplitudes(a: &[f64], arm_m: f64) -> anyhow::Result<()> {
 
 /// A rotor with its dampers' equivalent values, its regressing lag mode, and each blade's
 /// (stiffness, damping) at the hinge.
-type Equivalent = (LagRotor, Mode, Vec<(f64, f64)>);
+type Equivalent = (Reduced, Mode, Vec<(f64, f64)>);
+
+/// The reduced rotor of the check: on the ground (lag only) or in hover (lag, flap, air).
+#[derive(Clone, Debug)]
+enum Reduced {
+    Lag(LagRotor),
+    Air(Box<AirRotor>, Box<Hover>),
+}
+
+impl Reduced {
+    fn blades(&self) -> usize {
+        match self {
+            Reduced::Lag(r) => r.blades.len(),
+            Reduced::Air(r, _) => r.blades.len(),
+        }
+    }
+    fn modes(&self, om: f64) -> anyhow::Result<Vec<Mode>> {
+        let fl = super::stability::FLOQUET_STEPS_PER_REV;
+        Ok(match self {
+            Reduced::Lag(r) if r.is_isotropic() && r.blades.len() >= 3 => {
+                r.coleman_eigenvalues(om)?
+            }
+            Reduced::Lag(r) => r.floquet(om, fl)?,
+            Reduced::Air(r, _) if r.is_isotropic() => r.coleman_eigenvalues(om)?.1,
+            Reduced::Air(r, _) => r.floquet(om, fl)?.1,
+        })
+    }
+    /// The regressing lag mode's state of this rotor (the mean rotor's when blades differ).
+    fn mode_state(&self, om: f64) -> anyhow::Result<Vec<f64>> {
+        let l = ModeLabel::RegressingLag;
+        Ok(match self {
+            Reduced::Lag(r) if r.is_isotropic() => r.mode_state(om, l)?,
+            Reduced::Lag(r) => r.mean_rotor().mode_state(om, l)?,
+            Reduced::Air(r, h) if r.is_isotropic() => r.mode_state(h, l)?,
+            Reduced::Air(r, _) => {
+                let m = r.blend_to_mean(0.0);
+                m.mode_state(&m.hover(om)?, l)?
+            }
+        })
+    }
+    fn respond(
+        &self,
+        om: f64,
+        dampers: &mut [BladeDamper],
+        z: &[f64],
+        t_end: f64,
+        dt: f64,
+    ) -> anyhow::Result<crate::stability::DeviceResponse> {
+        Ok(match self {
+            Reduced::Lag(r) => {
+                free_response_with_dampers(r, om, dampers, z, t_end, dt, 2.0 * MAX_LAG_RAD)?
+            }
+            Reduced::Air(r, h) => {
+                r.response_with_dampers(h, dampers, z, t_end, dt, 2.0 * MAX_LAG_RAD)?
+            }
+        })
+    }
+}
 
 struct Blades {
     decks: Vec<(RotorDeck, DamperDeck)>,
     x: Option<AirframeAxis>,
     y: Option<AirframeAxis>,
+    /// In hover: the options, the airframe's coordinates and the rotor's radius.
+    hover: Option<(HoverOptions, Vec<BodyDof>, f64)>,
 }
 
 impl Blades {
-    fn of(deck: &RotorDeck, model: DamperModel) -> anyhow::Result<Self> {
+    fn of(
+        deck: &RotorDeck,
+        model: DamperModel,
+        hover: Option<HoverOptions>,
+    ) -> anyhow::Result<Self> {
         let file = deck.path.display().to_string();
-        let Some(af) = &deck.spec.airframe else {
-            bail!("rotor deck {file} has no [airframe]: ground resonance is the rotor's lag modes coupled with the airframe under the hub; add [airframe] with x and y (mass_kg, stiffness_N_per_m, damping_Ns_per_m) (docs/rotor_deck.md, \"The airframe under the hub\")");
-        };
-        let (x, y, _) = in_plane(&af.dofs(), &file)?;
         let mut decks = Vec::new();
         for k in 1..=deck.spec.rotor.blades {
             let b = deck.blade(k)?;
@@ -138,12 +202,53 @@ impl Blades {
             d.require(model)?;
             decks.push((b, d));
         }
-        Ok(Blades { decks, x, y })
+        if let Some(h) = hover {
+            h.check()?;
+            let (body, _) = super::air_resonance::body(deck)?;
+            return Ok(Blades {
+                decks,
+                x: None,
+                y: None,
+                hover: Some((h, body, deck.spec.rotor.radius_m)),
+            });
+        }
+        let Some(af) = &deck.spec.airframe else {
+            bail!("rotor deck {file} has no [airframe]: ground resonance is the rotor's lag modes coupled with the airframe under the hub; add [airframe] with x and y (mass_kg, stiffness_N_per_m, damping_Ns_per_m) (docs/rotor_deck.md, \"The airframe under the hub\")");
+        };
+        let (x, y, _) = in_plane(&af.dofs(), &file)?;
+        Ok(Blades {
+            decks,
+            x,
+            y,
+            hover: None,
+        })
     }
 
     /// The rotor with each blade's damper replaced by `kc(blade)` (stiffness, damping at the
-    /// hinge) on top of its lag bearing.
-    fn rotor(&self, kc: &[(f64, f64)]) -> anyhow::Result<LagRotor> {
+    /// hinge) on top of its lag bearing; in hover, about its hover equilibrium at `om`.
+    fn rotor(&self, kc: &[(f64, f64)], om: f64) -> anyhow::Result<Reduced> {
+        if let Some((opts, body, radius)) = &self.hover {
+            let mut blades = Vec::with_capacity(self.decks.len());
+            let mut airfoils = vec![];
+            for ((b, _), &kc) in self.decks.iter().zip(kc) {
+                let (ab, foils) = super::air_resonance::air_blade(&b.spec, &b.path, opts, kc)?;
+                blades.push(ab);
+                airfoils = foils;
+            }
+            let r = AirRotor {
+                blades,
+                body: body.clone(),
+                air: crate::aero::section::Air {
+                    density_kg_m3: opts.density_kg_m3,
+                    speed_of_sound_m_s: opts.speed_of_sound_m_s,
+                },
+                airfoils,
+                radius_m: *radius,
+            };
+            r.validate()?;
+            let h = r.hover(om)?;
+            return Ok(Reduced::Air(Box::new(r), Box::new(h)));
+        }
         let mut blades = Vec::with_capacity(self.decks.len());
         for ((b, _), &(k, c)) in self.decks.iter().zip(kc) {
             let m = b.spec.lag_moments(&b.path)?;
@@ -156,11 +261,11 @@ impl Blades {
                 damping_nms_per_rad: b.spec.bearing.lag_c + c,
             });
         }
-        Ok(LagRotor {
+        Ok(Reduced::Lag(LagRotor {
             blades,
             x: self.x.clone(),
             y: self.y.clone(),
-        })
+        }))
     }
 
     /// The rotor with its dampers' equivalent values at stroke amplitude `a`, linearised at
@@ -209,13 +314,10 @@ impl Blades {
                     .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?,
                 });
             }
-            let rotor = self.rotor(&kc)?;
-            let modes = if rotor.is_isotropic() && rotor.blades.len() >= 3 {
-                rotor.coleman_eigenvalues(om)
-            } else {
-                rotor.floquet(om, super::stability::FLOQUET_STEPS_PER_REV)
-            }
-            .map_err(|e| anyhow!("the reduced lag model at {om} rad/s: {e}"))?;
+            let rotor = self.rotor(&kc, om)?;
+            let modes = rotor
+                .modes(om)
+                .map_err(|e| anyhow!("the reduced model at {om} rad/s: {e:#}"))?;
             let mode = modes
                 .into_iter()
                 .filter(|m| m.label == ModeLabel::RegressingLag)
@@ -246,28 +348,23 @@ pub fn amplitude_check(
             super::stability::MAX_TIME_STEPS_PER_REV
         );
     }
-    let blades = Blades::of(deck, model)?;
+    let blades = Blades::of(deck, model, o.hover)?;
     let arm = blades.decks[0].0.spec.damper_attachment.arm_m;
     check_amplitudes(&o.amplitudes_m, arm)?;
     let (_, linearised, _) = blades.equivalent(model, omega, LINEARISATION_AMPLITUDE_M, None)?;
     let w_rot = |m: &Mode| (omega - 2.0 * PI * m.frequency_hz).abs();
     let w_lin = w_rot(&linearised);
-    let bare = blades.rotor(&vec![(0.0, 0.0); blades.decks.len()])?;
-    let nb = bare.blades.len();
+    let bare = blades.rotor(&vec![(0.0, 0.0); blades.decks.len()], omega)?;
+    let nb = bare.blades();
     let dt = 2.0 * PI / omega / o.steps_per_rev as f64;
     // the starts are independent: side by side on the cores
     let start = |a: f64| -> anyhow::Result<AmplitudePoint> {
         let (eq, mode, _) = blades
             .equivalent(model, omega, a, Some(w_lin))
             .map_err(|e| anyhow!("the damper's equivalent values at {a} m of stroke: {e:#}"))?;
-        let shape_rotor = if eq.is_isotropic() {
-            eq.clone()
-        } else {
-            eq.mean_rotor()
-        };
-        let mut z = shape_rotor
-            .mode_state(omega, ModeLabel::RegressingLag)
-            .map_err(|e| anyhow!("the regressing lag mode at {omega} rad/s: {e}"))?;
+        let mut z = eq
+            .mode_state(omega)
+            .map_err(|e| anyhow!("the regressing lag mode at {omega} rad/s: {e:#}"))?;
         for v in &mut z {
             *v *= a / arm;
         }
@@ -281,16 +378,9 @@ pub fn amplitude_check(
         let wf = (2.0 * PI * mode.frequency_hz).max(1e-6);
         let period = 2.0 * PI / wf;
         let t_end = o.cycles.max(2) as f64 * period;
-        let r = free_response_with_dampers(
-            &bare,
-            omega,
-            &mut dampers,
-            &z,
-            t_end,
-            dt,
-            2.0 * MAX_LAG_RAD,
-        )
-        .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {omega} rad/s: {e}"))?;
+        let r = bare
+            .respond(omega, &mut dampers, &z, t_end, dt)
+            .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {omega} rad/s: {e}"))?;
         let resp = &r.response;
         let env: Vec<(f64, f64)> = resp
             .time_s

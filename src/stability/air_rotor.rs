@@ -36,6 +36,7 @@
 //! `t = 0` (constant coefficients in hover), eigenvalues in the fixed frame. Others: Floquet
 //! multipliers over one revolution (RK4), matched to the mean isotropic rotor's Coleman
 //! eigenvalues by the continuation of [`super::lag_rotor`].
+use super::dampers::{BladeDamper, DeviceResponse};
 use super::lag_rotor::{eigen_pairs, resolve, Mode, ModeLabel, Result, StabilityError};
 use crate::aero::airfoil::{Airfoil, ClampCounts};
 use crate::aero::section::{blade_element, Air};
@@ -291,7 +292,7 @@ impl AirRotor {
         2 + self.body.len()
     }
 
-    /// Coordinates of the whole rotor: `[zeta_1, beta_1, ..., zeta_N, beta_N, airframe...]`.
+    /// Coordinates of the whole rotor: `[zeta_1, ..., zeta_N, beta_1, ..., beta_N, airframe...]`.
     pub fn coordinate_count(&self) -> usize {
         2 * self.blades.len() + self.body.len()
     }
@@ -716,7 +717,7 @@ impl AirRotor {
         let nb = self.blades.len();
         let nl = self.local_len();
         let mut out = [Mat::<f64>::zeros(n, n), Mat::zeros(n, n), Mat::zeros(n, n)];
-        let map = |k: usize, i: usize| if i < 2 { 2 * k + i } else { 2 * nb + i - 2 };
+        let map = |k: usize, i: usize| if i < 2 { i * nb + k } else { 2 * nb + i - 2 };
         let mut buf = [vec![0.0; nl * nl], vec![0.0; nl * nl], vec![0.0; nl * nl]];
         for (k, s) in series.iter().enumerate() {
             buf.iter_mut()
@@ -759,7 +760,7 @@ impl AirRotor {
     }
 
     /// The multi-blade transformation `q = T(t) m` and its time derivatives, for blade
-    /// coordinates `[zeta_k, beta_k]` and multi-blade ones `[zeta_0, zeta_1c, zeta_1s, ...,
+    /// coordinates `[zeta_1..N, beta_1..N]` and multi-blade ones `[zeta_0, zeta_1c, zeta_1s, ...,
     /// zeta_d, beta_0, ...]` (the airframe's unchanged).
     fn mbc(&self, omega: f64, t: f64) -> [Mat<f64>; 3] {
         let nb = self.blades.len();
@@ -768,7 +769,7 @@ impl AirRotor {
         for k in 0..nb {
             let psi = omega * t + 2.0 * PI * k as f64 / nb as f64;
             for d in 0..2 {
-                let row = 2 * k + d;
+                let row = d * nb + k;
                 for c in 0..nb {
                     let col = d * nb + c;
                     let (v, vd, vdd) = if c == 0 {
@@ -965,6 +966,215 @@ impl AirRotor {
         Ok((h, modes))
     }
 
+    /// A state `[q, q']` (blade 1 at zero azimuth) on the least damped Coleman mode labelled
+    /// `label` of this isotropic rotor about the hover `h`, scaled to a cyclic lag amplitude of
+    /// 1 rad ([`super::cyclic_amplitude`]).
+    pub fn mode_state(&self, h: &Hover, label: ModeLabel) -> Result<Vec<f64>> {
+        let all = self.coleman_all(h)?;
+        let target = all
+            .iter()
+            .filter(|(l, lb)| *lb == label && l.im >= 0.0)
+            .max_by(|a, b| a.0.re.total_cmp(&b.0.re))
+            .ok_or_else(|| StabilityError::Numerical(format!("no {label} mode")))?
+            .0;
+        let [mm, cm, km] = self.coleman_matrices(h, 0.0)?;
+        let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
+        let j = (0..lams.len())
+            .min_by(|&a, &b| {
+                (lams[a] - target)
+                    .norm()
+                    .total_cmp(&(lams[b] - target).norm())
+            })
+            .ok_or_else(|| StabilityError::Numerical("no Coleman eigenvalue".into()))?;
+        let lam = lams[j];
+        let n = self.coordinate_count();
+        let [tt, td, _] = self.mbc(h.omega_rad_s, 0.0);
+        let m: Vec<f64> = (0..n).map(|i| u[(i, j)].re).collect();
+        let md: Vec<f64> = (0..n).map(|i| (lam * u[(i, j)]).re).collect();
+        let mut z = vec![0.0; 2 * n];
+        for i in 0..n {
+            for c in 0..n {
+                z[i] += tt[(i, c)] * m[c];
+                z[n + i] += td[(i, c)] * m[c] + tt[(i, c)] * md[c];
+            }
+        }
+        let a = super::cyclic_amplitude(&z, self.blades.len(), h.omega_rad_s, 0.0, lam.im.abs());
+        if !(a > 0.0 && a.is_finite()) {
+            return Err(StabilityError::Numerical(format!(
+                "the {label} mode has no cyclic lag motion"
+            )));
+        }
+        z.iter_mut().for_each(|v| *v /= a);
+        Ok(z)
+    }
+
+    /// Free response of the linearised equations about the hover `h` with `dampers[k]` on
+    /// blade `k` (its lag spring and damper in `self` without the damper), from `initial`
+    /// (`[q, q']`, blade 1 at zero azimuth) to `t_end_s` in RK4 steps of at most `dt_s`. The
+    /// damper sees the lag perturbation's stroke `arm * zeta`; over a step its moment is its
+    /// time-averaged force held constant, solved by the fixed point of
+    /// [`super::free_response_with_dampers`]. `stop_lag_rad`: the response ends once a
+    /// blade's lag perturbation exceeds it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn response_with_dampers(
+        &self,
+        h: &Hover,
+        dampers: &mut [BladeDamper],
+        initial: &[f64],
+        t_end_s: f64,
+        dt_s: f64,
+        stop_lag_rad: f64,
+    ) -> Result<DeviceResponse> {
+        use faer::linalg::solvers::Solve;
+        let nb = self.blades.len();
+        let n = self.coordinate_count();
+        let m2 = 2 * n;
+        if dampers.len() != nb || initial.len() != m2 {
+            return Err(StabilityError::Numerical(format!(
+                "{} dampers and {} states for {nb} blades and {m2} states",
+                dampers.len(),
+                initial.len()
+            )));
+        }
+        if !(dt_s > 0.0 && t_end_s >= 0.0 && (t_end_s / dt_s) <= 1e7) {
+            return Err(StabilityError::OutOfRange {
+                field: "t_end_s / dt_s".into(),
+                value: t_end_s / dt_s,
+                expected: "0 ..= 10^7 steps, dt_s > 0",
+            });
+        }
+        let steps = (t_end_s / dt_s).ceil() as usize;
+        let hh = if steps > 0 {
+            t_end_s / steps as f64
+        } else {
+            0.0
+        };
+        let series = self.all_series(h);
+        let omega = h.omega_rad_s;
+        // at time t: -M^-1 K, -M^-1 C and M^-1 on the lag coordinates
+        let ops = |t: f64| -> Result<(Mat<f64>, Mat<f64>, Mat<f64>)> {
+            let [m, c, k] = self.matrices_at(&series, omega, t);
+            let lu = m.partial_piv_lu();
+            let e = Mat::<f64>::from_fn(n, nb, |i, j| f64::from(u8::from(i == j)));
+            let (a, b, g) = (lu.solve(&k), lu.solve(&c), lu.solve(&e));
+            if (0..n).any(|i| (0..n).any(|j| !a[(i, j)].is_finite() || !b[(i, j)].is_finite())) {
+                return Err(StabilityError::Numerical(format!(
+                    "singular mass matrix at t = {t} s"
+                )));
+            }
+            Ok((a, b, g))
+        };
+        let deriv = |o: &(Mat<f64>, Mat<f64>, Mat<f64>), y: &[f64], f: &[f64], out: &mut [f64]| {
+            for i in 0..n {
+                out[i] = y[n + i];
+                let mut acc = 0.0;
+                for j in 0..n {
+                    acc -= o.0[(i, j)] * y[j] + o.1[(i, j)] * y[n + j];
+                }
+                for (j, fj) in f.iter().enumerate() {
+                    acc += o.2[(i, j)] * fj;
+                }
+                out[n + i] = acc;
+            }
+        };
+        let mut y = initial.to_vec();
+        let mut trial = vec![0.0; m2];
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
+            vec![0.0; m2],
+            vec![0.0; m2],
+            vec![0.0; m2],
+            vec![0.0; m2],
+            vec![0.0; m2],
+        );
+        let mut fm: Vec<f64> = dampers.iter().map(|d| d.device.committed_force()).collect();
+        let mut fm_new = fm.clone();
+        let mut fm_prev = fm.clone();
+        let mut moment = vec![0.0; nb];
+        let mut time_s = vec![0.0];
+        let mut states = y.clone();
+        let mut force_n = Vec::with_capacity(steps * nb);
+        let mut max_iterations = 0;
+        let mut o0 = ops(0.0)?;
+        for step in 0..steps {
+            let t = step as f64 * hh;
+            let (o1, o2) = (ops(t + 0.5 * hh)?, ops(t + hh)?);
+            for k in 0..nb {
+                let f = fm[k];
+                fm[k] = if step > 0 { 2.0 * f - fm_prev[k] } else { f };
+                fm_prev[k] = f;
+            }
+            let mut converged = false;
+            let mut change = f64::INFINITY;
+            for it in 1..=super::dampers::MAX_COUPLING_ITERATIONS {
+                for k in 0..nb {
+                    moment[k] = dampers[k].arm_m * fm[k];
+                }
+                deriv(&o0, &y, &moment, &mut k1);
+                (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k1[i]);
+                deriv(&o1, &tmp, &moment, &mut k2);
+                (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k2[i]);
+                deriv(&o1, &tmp, &moment, &mut k3);
+                (0..m2).for_each(|i| tmp[i] = y[i] + hh * k3[i]);
+                deriv(&o2, &tmp, &moment, &mut k4);
+                for i in 0..m2 {
+                    trial[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+                }
+                let mut scale = 1.0f64;
+                change = 0.0;
+                for (k, d) in dampers.iter_mut().enumerate() {
+                    let (d_i, d_f) = (d.arm_m * y[k], d.arm_m * trial[k]);
+                    let f = d.device.trial_step(t, hh, d_i, d_f).map_err(|e| {
+                        StabilityError::Numerical(format!(
+                            "the damper of blade {} at t = {t:.6} s: {e}",
+                            k + 1
+                        ))
+                    })?;
+                    fm_new[k] = f.force_mean;
+                    scale = scale.max(d.device.force_scale()).max(f.force_mean.abs());
+                    change = change.max((f.force_mean - fm[k]).abs());
+                }
+                fm.copy_from_slice(&fm_new);
+                if change <= super::dampers::COUPLING_TOL * scale {
+                    max_iterations = max_iterations.max(it);
+                    converged = true;
+                    break;
+                }
+            }
+            if !converged {
+                return Err(StabilityError::Numerical(format!(
+                    "damper coupling did not converge at t = {t:.6} s: {} iterations, last force change {change:.3e} N (a shorter step: more steps per revolution)",
+                    super::dampers::MAX_COUPLING_ITERATIONS
+                )));
+            }
+            if trial.iter().any(|v| !v.is_finite()) {
+                return Err(StabilityError::Numerical(format!(
+                    "time response is not finite at t = {:.6} s",
+                    t + hh
+                )));
+            }
+            for d in dampers.iter_mut() {
+                d.device.commit();
+            }
+            y.copy_from_slice(&trial);
+            force_n.extend_from_slice(&fm);
+            time_s.push(t + hh);
+            states.extend_from_slice(&y);
+            o0 = o2;
+            if y[..nb].iter().any(|z| z.abs() > stop_lag_rad) {
+                break;
+            }
+        }
+        Ok(DeviceResponse {
+            response: super::TimeResponse {
+                time_s,
+                states,
+                state_len: m2,
+            },
+            force_n,
+            max_iterations,
+        })
+    }
+
     /// The monodromy matrix over one revolution about the hover `h` (RK4, column-major
     /// `2n x 2n`, state `[q, q']`).
     pub fn monodromy(&self, h: &Hover, steps_per_rev: usize) -> Result<Vec<f64>> {
@@ -1029,7 +1239,7 @@ impl AirRotor {
 
     /// The isotropic rotor with each blade the mean of the blades, and the blend `mean + s
     /// (actual - mean)`.
-    fn blend_to_mean(&self, s: f64) -> AirRotor {
+    pub fn blend_to_mean(&self, s: f64) -> AirRotor {
         let nb = self.blades.len() as f64;
         let b0 = &self.blades[0];
         let mut mean = b0.clone();
