@@ -174,7 +174,8 @@ impl Reduced {
                 free_response_with_dampers(r, om, dampers, z, t_end, dt, 2.0 * MAX_LAG_RAD)?
             }
             Reduced::Air(r, h) => {
-                r.response_with_dampers(h, dampers, z, t_end, dt, 2.0 * MAX_LAG_RAD)?
+                let steps_per_rev = (2.0 * PI / om / dt).round() as usize;
+                r.response_with_dampers(h, dampers, z, t_end, steps_per_rev, 2.0 * MAX_LAG_RAD)?
             }
         })
     }

@@ -1010,11 +1010,13 @@ impl AirRotor {
 
     /// Free response of the linearised equations about the hover `h` with `dampers[k]` on
     /// blade `k` (its lag spring and damper in `self` without the damper), from `initial`
-    /// (`[q, q']`, blade 1 at zero azimuth) to `t_end_s` in RK4 steps of at most `dt_s`. The
-    /// damper sees the lag perturbation's stroke `arm * zeta`; over a step its moment is its
-    /// time-averaged force held constant, solved by the fixed point of
-    /// [`super::free_response_with_dampers`]. `stop_lag_rad`: the response ends once a
-    /// blade's lag perturbation exceeds it.
+    /// (`[q, q']`, blade 1 at zero azimuth), RK4 at `steps_per_rev` steps per revolution
+    /// until `t_end_s` is reached (the last step ends at or just after it). The damper sees the
+    /// lag perturbation's stroke `arm * zeta`; over a step its moment is its time-averaged
+    /// force held constant, solved by the fixed point of [`super::free_response_with_dampers`].
+    /// `stop_lag_rad`: the response ends once a blade's lag perturbation exceeds it. The
+    /// equations' operators at the revolution's half steps are computed once, so the steps do
+    /// not allocate (beyond the history they return).
     #[allow(clippy::too_many_arguments)]
     pub fn response_with_dampers(
         &self,
@@ -1022,7 +1024,7 @@ impl AirRotor {
         dampers: &mut [BladeDamper],
         initial: &[f64],
         t_end_s: f64,
-        dt_s: f64,
+        steps_per_rev: usize,
         stop_lag_rad: f64,
     ) -> Result<DeviceResponse> {
         use faer::linalg::solvers::Solve;
@@ -1036,34 +1038,34 @@ impl AirRotor {
                 initial.len()
             )));
         }
-        if !(dt_s > 0.0 && t_end_s >= 0.0 && (t_end_s / dt_s) <= 1e7) {
+        let omega = h.omega_rad_s;
+        let hh = 2.0 * PI / omega / steps_per_rev.max(1) as f64;
+        let steps_f = (t_end_s / hh).ceil();
+        if !((16..=1_000_000).contains(&steps_per_rev) && t_end_s >= 0.0 && steps_f <= 1e7) {
             return Err(StabilityError::OutOfRange {
-                field: "t_end_s / dt_s".into(),
-                value: t_end_s / dt_s,
-                expected: "0 ..= 10^7 steps, dt_s > 0",
+                field: "t_end_s, steps_per_rev".into(),
+                value: steps_f,
+                expected: "16 ..= 10^6 steps per revolution, at most 10^7 steps",
             });
         }
-        let steps = (t_end_s / dt_s).ceil() as usize;
-        let hh = if steps > 0 {
-            t_end_s / steps as f64
-        } else {
-            0.0
-        };
+        let steps = steps_f as usize;
         let series = self.all_series(h);
-        let omega = h.omega_rad_s;
-        // at time t: -M^-1 K, -M^-1 C and M^-1 on the lag coordinates
-        let ops = |t: f64| -> Result<(Mat<f64>, Mat<f64>, Mat<f64>)> {
+        // at the revolution's half steps: -M^-1 K, -M^-1 C and M^-1 on the lag coordinates
+        let e = Mat::<f64>::from_fn(n, nb, |i, j| f64::from(u8::from(i == j)));
+        let mut table = Vec::with_capacity(2 * steps_per_rev);
+        for i in 0..2 * steps_per_rev {
+            let t = 0.5 * hh * i as f64;
             let [m, c, k] = self.matrices_at(&series, omega, t);
             let lu = m.partial_piv_lu();
-            let e = Mat::<f64>::from_fn(n, nb, |i, j| f64::from(u8::from(i == j)));
             let (a, b, g) = (lu.solve(&k), lu.solve(&c), lu.solve(&e));
             if (0..n).any(|i| (0..n).any(|j| !a[(i, j)].is_finite() || !b[(i, j)].is_finite())) {
                 return Err(StabilityError::Numerical(format!(
                     "singular mass matrix at t = {t} s"
                 )));
             }
-            Ok((a, b, g))
-        };
+            table.push((a, b, g));
+        }
+        let at = |half_steps: usize| &table[half_steps % (2 * steps_per_rev)];
         let deriv = |o: &(Mat<f64>, Mat<f64>, Mat<f64>), y: &[f64], f: &[f64], out: &mut [f64]| {
             for i in 0..n {
                 out[i] = y[n + i];
@@ -1090,14 +1092,15 @@ impl AirRotor {
         let mut fm_new = fm.clone();
         let mut fm_prev = fm.clone();
         let mut moment = vec![0.0; nb];
-        let mut time_s = vec![0.0];
-        let mut states = y.clone();
+        let mut time_s = Vec::with_capacity(steps + 1);
+        let mut states = Vec::with_capacity((steps + 1) * m2);
+        time_s.push(0.0);
+        states.extend_from_slice(&y);
         let mut force_n = Vec::with_capacity(steps * nb);
         let mut max_iterations = 0;
-        let mut o0 = ops(0.0)?;
         for step in 0..steps {
             let t = step as f64 * hh;
-            let (o1, o2) = (ops(t + 0.5 * hh)?, ops(t + hh)?);
+            let (o0, o1, o2) = (at(2 * step), at(2 * step + 1), at(2 * step + 2));
             for k in 0..nb {
                 let f = fm[k];
                 fm[k] = if step > 0 { 2.0 * f - fm_prev[k] } else { f };
@@ -1109,13 +1112,13 @@ impl AirRotor {
                 for k in 0..nb {
                     moment[k] = dampers[k].arm_m * fm[k];
                 }
-                deriv(&o0, &y, &moment, &mut k1);
+                deriv(o0, &y, &moment, &mut k1);
                 (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k1[i]);
-                deriv(&o1, &tmp, &moment, &mut k2);
+                deriv(o1, &tmp, &moment, &mut k2);
                 (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k2[i]);
-                deriv(&o1, &tmp, &moment, &mut k3);
+                deriv(o1, &tmp, &moment, &mut k3);
                 (0..m2).for_each(|i| tmp[i] = y[i] + hh * k3[i]);
-                deriv(&o2, &tmp, &moment, &mut k4);
+                deriv(o2, &tmp, &moment, &mut k4);
                 for i in 0..m2 {
                     trial[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
                 }
@@ -1159,7 +1162,6 @@ impl AirRotor {
             force_n.extend_from_slice(&fm);
             time_s.push(t + hh);
             states.extend_from_slice(&y);
-            o0 = o2;
             if y[..nb].iter().any(|z| z.abs() > stop_lag_rad) {
                 break;
             }
