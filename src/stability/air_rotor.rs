@@ -358,7 +358,7 @@ impl AirRotor {
                     s.lift_factor >= 0.0,
                     ">= 0",
                 )?;
-                if s.airfoil >= self.airfoils.len().max(1) && s.width_m > 0.0 {
+                if s.airfoil >= self.airfoils.len() && s.width_m > 0.0 {
                     return Err(StabilityError::OutOfRange {
                         field: g("airfoil"),
                         value: s.airfoil as f64,
@@ -402,14 +402,14 @@ impl AirRotor {
     ) -> f64 {
         let nl = self.local_len();
         out[..nl].iter_mut().for_each(|v| *v = 0.0);
-        let (mut x, mut y, mut xd, mut yd, mut xdd, mut ydd) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut xd, mut yd, mut xdd, mut ydd) = (0.0, 0.0, 0.0, 0.0);
         let (mut ph, mut phd, mut phdd, mut th, mut thd, mut thdd) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         let (mut cr, mut cp) = ([0.0; 3], [0.0; 3]);
         for (i, d) in self.body.iter().enumerate() {
             let (q, qd, qdd) = (z[2 + i], zd[2 + i], zdd[2 + i]);
             match d.axis {
-                BodyAxis::X => (x, xd, xdd) = (q, qd, qdd),
-                BodyAxis::Y => (y, yd, ydd) = (q, qd, qdd),
+                BodyAxis::X => (xd, xdd) = (qd, qdd),
+                BodyAxis::Y => (yd, ydd) = (qd, qdd),
                 BodyAxis::Roll => {
                     (ph, phd, phdd) = (q, qd, qdd);
                     cr = [0.0, 0.0, d.center_z_m];
@@ -434,11 +434,7 @@ impl AirRotor {
         rdd = madd(&rdd, &mm(&rx0, &ry2), thd * thd);
         rdd = madd(&rdd, &mm(&rx0, &ry1), thdd);
         let neg = |v: [f64; 3]| scale(-1.0, v);
-        let p_h = add(
-            add([x, y, 0.0], add(cr, neg(mv(&rx0, cr)))),
-            add(cp, neg(mv(&ry0, cp))),
-        );
-        let _ = p_h; // positions enter through the Jacobians only (no gravity)
+        // the hub's position itself does not enter (no gravity): its rates do
         let pd_h = add(
             [xd, yd, 0.0],
             add(neg(scale(phd, mv(&rx1, cr))), neg(scale(thd, mv(&ry1, cp)))),
