@@ -36,7 +36,7 @@
 //! `t = 0` (constant coefficients in hover), eigenvalues in the fixed frame. Others: Floquet
 //! multipliers over one revolution (RK4), matched to the mean isotropic rotor's Coleman
 //! eigenvalues by the continuation of [`super::lag_rotor`].
-use super::dampers::{BladeDamper, DeviceResponse};
+use super::dampers::{coupled_step, BladeDamper, DeviceResponse, StepForces};
 use super::lag_rotor::{eigen_pairs, resolve, Mode, ModeLabel, Result, StabilityError};
 use crate::aero::airfoil::{Airfoil, ClampCounts};
 use crate::aero::section::{blade_element, Air};
@@ -1084,10 +1084,7 @@ impl AirRotor {
             vec![0.0; m2],
             vec![0.0; m2],
         );
-        let mut fm: Vec<f64> = dampers.iter().map(|d| d.device.committed_force()).collect();
-        let mut fm_new = fm.clone();
-        let mut fm_prev = fm.clone();
-        let mut moment = vec![0.0; nb];
+        let mut forces = StepForces::new(dampers);
         let mut time_s = Vec::with_capacity(steps + 1);
         let mut states = Vec::with_capacity((steps + 1) * m2);
         time_s.push(0.0);
@@ -1097,65 +1094,30 @@ impl AirRotor {
         for step in 0..steps {
             let t = step as f64 * hh;
             let (o0, o1, o2) = (at(2 * step), at(2 * step + 1), at(2 * step + 2));
-            for k in 0..nb {
-                let f = fm[k];
-                fm[k] = if step > 0 { 2.0 * f - fm_prev[k] } else { f };
-                fm_prev[k] = f;
-            }
-            let mut converged = false;
-            let mut change = f64::INFINITY;
-            for it in 1..=super::dampers::MAX_COUPLING_ITERATIONS {
-                for k in 0..nb {
-                    moment[k] = dampers[k].arm_m * fm[k];
-                }
-                deriv(o0, &y, &moment, &mut k1);
-                (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k1[i]);
-                deriv(o1, &tmp, &moment, &mut k2);
-                (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k2[i]);
-                deriv(o1, &tmp, &moment, &mut k3);
-                (0..m2).for_each(|i| tmp[i] = y[i] + hh * k3[i]);
-                deriv(o2, &tmp, &moment, &mut k4);
-                for i in 0..m2 {
-                    trial[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
-                let mut scale = 1.0f64;
-                change = 0.0;
-                for (k, d) in dampers.iter_mut().enumerate() {
-                    let (d_i, d_f) = (d.arm_m * y[k], d.arm_m * trial[k]);
-                    let f = d.device.trial_step(t, hh, d_i, d_f).map_err(|e| {
-                        StabilityError::Numerical(format!(
-                            "the damper of blade {} at t = {t:.6} s: {e}",
-                            k + 1
-                        ))
-                    })?;
-                    fm_new[k] = f.force_mean;
-                    scale = scale.max(d.device.force_scale()).max(f.force_mean.abs());
-                    change = change.max((f.force_mean - fm[k]).abs());
-                }
-                fm.copy_from_slice(&fm_new);
-                if change <= super::dampers::COUPLING_TOL * scale {
-                    max_iterations = max_iterations.max(it);
-                    converged = true;
-                    break;
-                }
-            }
-            if !converged {
-                return Err(StabilityError::Numerical(format!(
-                    "damper coupling did not converge at t = {t:.6} s: {} iterations, last force change {change:.3e} N (a shorter step: more steps per revolution)",
-                    super::dampers::MAX_COUPLING_ITERATIONS
-                )));
-            }
-            if trial.iter().any(|v| !v.is_finite()) {
-                return Err(StabilityError::Numerical(format!(
-                    "time response is not finite at t = {:.6} s",
-                    t + hh
-                )));
-            }
-            for d in dampers.iter_mut() {
-                d.device.commit();
-            }
+            let it = coupled_step(
+                dampers,
+                &mut forces,
+                step == 0,
+                t,
+                hh,
+                &y,
+                &mut trial,
+                |moment, trial| {
+                    deriv(o0, &y, moment, &mut k1);
+                    (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k1[i]);
+                    deriv(o1, &tmp, moment, &mut k2);
+                    (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k2[i]);
+                    deriv(o1, &tmp, moment, &mut k3);
+                    (0..m2).for_each(|i| tmp[i] = y[i] + hh * k3[i]);
+                    deriv(o2, &tmp, moment, &mut k4);
+                    for i in 0..m2 {
+                        trial[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+                    }
+                },
+            )?;
+            max_iterations = max_iterations.max(it);
             y.copy_from_slice(&trial);
-            force_n.extend_from_slice(&fm);
+            force_n.extend_from_slice(&forces.mean);
             time_s.push(t + hh);
             states.extend_from_slice(&y);
             if y[..nb].iter().any(|z| z.abs() > stop_lag_rad) {

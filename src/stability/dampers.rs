@@ -36,6 +36,95 @@ pub const MAX_COUPLING_ITERATIONS: usize = 30;
 /// Relative change of the damper force at which a step's coupling has converged.
 pub const COUPLING_TOL: f64 = 1e-9;
 
+/// Forces of the dampers over one step: the last step's and the one before (the start of the
+/// fixed point), and the iteration's.
+pub(super) struct StepForces {
+    pub mean: Vec<f64>,
+    prev: Vec<f64>,
+    next: Vec<f64>,
+    moment: Vec<f64>,
+}
+
+impl StepForces {
+    pub(super) fn new(dampers: &[BladeDamper]) -> Self {
+        let f: Vec<f64> = dampers.iter().map(|d| d.device.committed_force()).collect();
+        StepForces {
+            prev: f.clone(),
+            next: f.clone(),
+            moment: vec![0.0; f.len()],
+            mean: f,
+        }
+    }
+}
+
+/// One step of a free response with the dampers as devices (module docs): the step's moments
+/// `arm * F_m` held constant, `advance(moments, trial)` integrating the blades from the
+/// accepted state `y` (lag perturbations first) to `trial`, the devices' trial steps giving
+/// the next `F_m`, to [`COUPLING_TOL`]; the devices committed on success. Returns the
+/// iterations taken.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn coupled_step(
+    dampers: &mut [BladeDamper],
+    forces: &mut StepForces,
+    first: bool,
+    t: f64,
+    h: f64,
+    y: &[f64],
+    trial: &mut [f64],
+    mut advance: impl FnMut(&[f64], &mut [f64]),
+) -> Result<usize> {
+    let nb = dampers.len();
+    // the force extrapolated from the last two steps starts the fixed point
+    for k in 0..nb {
+        let f = forces.mean[k];
+        forces.mean[k] = if first { f } else { 2.0 * f - forces.prev[k] };
+        forces.prev[k] = f;
+    }
+    let mut change = f64::INFINITY;
+    for it in 1..=MAX_COUPLING_ITERATIONS {
+        for ((m, d), f) in forces
+            .moment
+            .iter_mut()
+            .zip(dampers.iter())
+            .zip(&forces.mean)
+        {
+            *m = d.arm_m * f;
+        }
+        advance(&forces.moment, trial);
+        let mut scale = 1.0f64;
+        change = 0.0;
+        for (k, d) in dampers.iter_mut().enumerate() {
+            let (d_i, d_f) = (d.arm_m * y[k], d.arm_m * trial[k]);
+            let f = d.device.trial_step(t, h, d_i, d_f).map_err(|e| {
+                StabilityError::Numerical(format!(
+                    "the damper of blade {} at t = {t:.6} s: {e}",
+                    k + 1
+                ))
+            })?;
+            forces.next[k] = f.force_mean;
+            scale = scale.max(d.device.force_scale()).max(f.force_mean.abs());
+            change = change.max((f.force_mean - forces.mean[k]).abs());
+        }
+        forces.mean.copy_from_slice(&forces.next);
+        if change <= COUPLING_TOL * scale {
+            if trial.iter().any(|v| !v.is_finite()) {
+                return Err(StabilityError::Numerical(format!(
+                    "time response is not finite at t = {:.6} s",
+                    t + h
+                )));
+            }
+            // the last trial (its stroke from the accepted state) is the step taken
+            for d in dampers.iter_mut() {
+                d.device.commit();
+            }
+            return Ok(it);
+        }
+    }
+    Err(StabilityError::Numerical(format!(
+        "damper coupling did not converge at t = {t:.6} s: {MAX_COUPLING_ITERATIONS} iterations, last force change {change:.3e} N (a shorter step: more steps per revolution)"
+    )))
+}
+
 /// Free response of `rotor` (its blades' stiffness and damping without the dampers, i.e. the
 /// lag bearing's) with `dampers[k]` on blade `k`, from `initial` (ordered as
 /// [`LagRotor::state_layout`], blade 1 at zero azimuth) at `t = 0` to `t_end_s`, RK4 steps of
@@ -68,10 +157,7 @@ pub fn free_response_with_dampers(
     let mut rk = Rk4::new(m);
     let mut y = initial.to_vec();
     let mut trial = vec![0.0; m];
-    let mut fm: Vec<f64> = dampers.iter().map(|d| d.device.committed_force()).collect();
-    let mut fm_new = fm.clone();
-    let mut fm_prev = fm.clone();
-    let mut moment = vec![0.0; nb];
+    let mut forces = StepForces::new(dampers);
     let mut time_s = Vec::with_capacity(steps + 1);
     let mut states = Vec::with_capacity((steps + 1) * m);
     let mut force_n = Vec::with_capacity(steps * nb);
@@ -80,59 +166,23 @@ pub fn free_response_with_dampers(
     let mut max_iterations = 0;
     for step in 0..steps {
         let t = step as f64 * h;
-        // the force extrapolated from the last two steps starts the fixed point
-        for k in 0..nb {
-            let f = fm[k];
-            fm[k] = if step > 0 { 2.0 * f - fm_prev[k] } else { f };
-            fm_prev[k] = f;
-        }
-        let mut converged = false;
-        let mut change = f64::INFINITY;
-        for it in 1..=MAX_COUPLING_ITERATIONS {
-            for k in 0..nb {
-                moment[k] = dampers[k].arm_m * fm[k];
-            }
-            sys.set_moments(t, h, &moment, &moment);
-            trial.copy_from_slice(&y);
-            rk.step(&mut sys, t, h, &mut trial);
-            let mut scale = 1.0f64;
-            change = 0.0;
-            for (k, d) in dampers.iter_mut().enumerate() {
-                let (d_i, d_f) = (d.arm_m * y[k], d.arm_m * trial[k]);
-                let f = d.device.trial_step(t, h, d_i, d_f).map_err(|e| {
-                    StabilityError::Numerical(format!(
-                        "the damper of blade {} at t = {t:.6} s: {e}",
-                        k + 1
-                    ))
-                })?;
-                fm_new[k] = f.force_mean;
-                scale = scale.max(d.device.force_scale()).max(f.force_mean.abs());
-                change = change.max((f.force_mean - fm[k]).abs());
-            }
-            fm.copy_from_slice(&fm_new);
-            if change <= COUPLING_TOL * scale {
-                max_iterations = max_iterations.max(it);
-                converged = true;
-                break;
-            }
-        }
-        if !converged {
-            return Err(StabilityError::Numerical(format!(
-                "damper coupling did not converge at t = {t:.6} s: {MAX_COUPLING_ITERATIONS} iterations, last force change {change:.3e} N (a shorter step: more steps per revolution)"
-            )));
-        }
-        if trial.iter().any(|v| !v.is_finite()) {
-            return Err(StabilityError::Numerical(format!(
-                "time response is not finite at t = {:.6} s",
-                t + h
-            )));
-        }
-        // the last trial (its stroke from the accepted state) is the step taken
-        for d in dampers.iter_mut() {
-            d.device.commit();
-        }
+        let it = coupled_step(
+            dampers,
+            &mut forces,
+            step == 0,
+            t,
+            h,
+            &y,
+            &mut trial,
+            |moment, trial| {
+                sys.set_moments(t, h, moment, moment);
+                trial.copy_from_slice(&y);
+                rk.step(&mut sys, t, h, trial);
+            },
+        )?;
+        max_iterations = max_iterations.max(it);
         y.copy_from_slice(&trial);
-        force_n.extend_from_slice(&fm);
+        force_n.extend_from_slice(&forces.mean);
         time_s.push(t + h);
         states.extend_from_slice(&y);
         if y[..nb].iter().any(|z| z.abs() > stop_lag_rad) {
