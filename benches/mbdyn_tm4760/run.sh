@@ -32,7 +32,7 @@ skip() {
     echo "benches/mbdyn_tm4760: skipped: $*"
     exit 0
 }
-MBDYN=${MBDYN:-$(command -v mbdyn || true)}
+MBDYN=$(command -v "${MBDYN:-mbdyn}" || true)
 [ -n "$MBDYN" ] && [ -x "$MBDYN" ] || skip "no MBDyn (set MBDYN to the mbdyn executable or put mbdyn on PATH)"
 [ -n "${TM4760_BLK:-}" ] && [ -f "$TM4760_BLK" ] || skip "no tm4760.blk (set TM4760_BLK to MBDyn's tests/rbk/tm4760/tm4760.blk)"
 command -v python3 >/dev/null || skip "no python3"
