@@ -78,8 +78,13 @@ fn main() -> anyhow::Result<()> {
             let path = Path::new(&dir).join(format!("{}.json", cp.id));
             std::fs::write(path, serde_json::to_string_pretty(&o.diagnosis)?)?;
         }
-        let s = blind::score(&cp, &o.diagnosis);
         let wall = t0.elapsed().as_secs_f64();
+        // g*, the truth's own held-out gain (the detectability rule), outside the timing
+        let best = (!cp.effects.is_empty())
+            .then(|| blind::effect_size(&cp, cycles, rate).map(|e| e.2))
+            .transpose()
+            .map_err(anyhow::Error::msg)?;
+        let s = blind::score(&cp, &o.diagnosis, best);
         let row = blind::csv_row(&cp, &s, wall);
         println!("{row}");
         writeln!(csv, "{row}")?;

@@ -613,17 +613,32 @@ pub struct Score {
     pub exact: bool,
     pub hidden_among_named: bool,
     pub gain: f64,
+    /// g*: the held-out gain of the truth model itself, the best a diagnosis can reach
+    /// ([`effect_size`]); None on no-effect campaigns.
+    pub best_gain: Option<f64>,
+    /// g* below [`DETECTABLE_GAIN`]: the hidden effect is smaller than the noise reveals.
+    pub sub_noise: bool,
+    /// The held-out gain a named cause must reach: `min(0.3, 0.8 g*)` ([`required_gain`]).
+    pub gain_required: f64,
     /// Every truth parameter the named cause fitted.
     pub params: Vec<ParamScore>,
 }
 
-pub fn score(cp: &Campaign, d: &Diagnosis) -> Score {
-    let sheet = Sheet::nominal();
-    let named: Vec<&str> = if d.cause == "none" {
-        vec![]
-    } else {
-        d.cause.split('+').collect()
-    };
+/// Held-out gain below which a hidden effect is sub-noise, and the gain a named cause must
+/// reach where the effect is large enough.
+pub const DETECTABLE_GAIN: f64 = 0.3;
+
+/// The gain a named cause must reach on a campaign whose truth reaches `best_gain`:
+/// `min(0.3, 0.8 g*)` (0.3 on no-effect data, where nothing should be named).
+pub fn required_gain(best_gain: Option<f64>) -> f64 {
+    best_gain.map_or(DETECTABLE_GAIN, |g| DETECTABLE_GAIN.min(0.8 * g))
+}
+
+/// (exact, hidden among named) of the causes `named` (empty: none) on campaign `cp`. Exact: the
+/// hidden effects, no more, no fewer. Among: every hidden effect is named or nested in a named
+/// cause. On a sub-noise campaign naming none or exactly the hidden effect counts as both, and
+/// naming anything else as neither.
+pub fn name_score(cp: &Campaign, named: &[&str], sub_noise: bool) -> (bool, bool) {
     let exact = if cp.effects.is_empty() {
         named.is_empty()
     } else {
@@ -636,11 +651,31 @@ pub fn score(cp: &Campaign, d: &Diagnosis) -> Score {
                 .iter()
                 .all(|n| cp.effects.iter().any(|e| e.exact_names().contains(n)))
     };
+    if sub_noise {
+        let correct = named.is_empty() || exact;
+        return (correct, correct);
+    }
     let among = !cp.effects.is_empty()
         && cp
             .effects
             .iter()
             .all(|e| named.iter().any(|n| e.family_names().contains(n)));
+    (exact, among)
+}
+
+/// Scores a diagnosis under the detectability rule: on a sub-noise campaign (`best_gain`, g*,
+/// below [`DETECTABLE_GAIN`]) naming none or exactly the hidden effect is correct and naming any
+/// other effect is a miss; elsewhere the named causes must be the hidden ones.
+pub fn score(cp: &Campaign, d: &Diagnosis, best_gain: Option<f64>) -> Score {
+    let sheet = Sheet::nominal();
+    let named: Vec<&str> = if d.cause == "none" {
+        vec![]
+    } else {
+        d.cause.split('+').collect()
+    };
+    let best_gain = best_gain.filter(|_| !cp.effects.is_empty());
+    let sub_noise = best_gain.is_some_and(|g| g < DETECTABLE_GAIN);
+    let (exact, among) = name_score(cp, &named, sub_noise);
     let mut params = Vec::new();
     for e in &cp.effects {
         for (p, truth) in e.truth_parameters(&sheet) {
@@ -674,6 +709,9 @@ pub fn score(cp: &Campaign, d: &Diagnosis) -> Score {
         exact,
         hidden_among_named: among,
         gain: d.gain,
+        best_gain,
+        sub_noise,
+        gain_required: required_gain(best_gain),
         params,
     }
 }
@@ -683,7 +721,9 @@ pub const PARAM_SLOTS: usize = 4;
 
 /// The CSV header of docs/diagnosis_blind_suite.csv.
 pub fn csv_header() -> String {
-    let mut h = String::from("id,kind,hidden,magnitudes,named,exact,hidden_among_named,gain");
+    let mut h = String::from(
+        "id,kind,hidden,magnitudes,named,exact,hidden_among_named,gain,best_gain,sub_noise,gain_required",
+    );
     for i in 1..=PARAM_SLOTS {
         h.push_str(&format!(
             ",param{i},true{i},fitted{i},interval_lo{i},interval_hi{i},covered{i}"
@@ -703,7 +743,7 @@ pub fn csv_row(cp: &Campaign, s: &Score, wall_s: f64) -> String {
         .collect::<Vec<_>>()
         .join("; ");
     let mut row = format!(
-        "{},{},{},\"{}\",{},{},{},{:.4}",
+        "{},{},{},\"{}\",{},{},{},{:.4},{},{},{:.4}",
         cp.id,
         if cp.flight { "flight" } else { "bench" },
         cp.hidden(),
@@ -712,6 +752,9 @@ pub fn csv_row(cp: &Campaign, s: &Score, wall_s: f64) -> String {
         s.exact,
         s.hidden_among_named,
         s.gain,
+        s.best_gain.map_or(String::new(), |g| format!("{g:.4}")),
+        s.sub_noise,
+        s.gain_required,
     );
     for i in 0..PARAM_SLOTS {
         match s.params.get(i) {
@@ -741,6 +784,10 @@ pub struct Rates {
     pub none_on_no_effect: usize,
     pub named: usize,
     pub min_gain_named: f64,
+    /// Named campaigns whose gain reaches its required gain ([`required_gain`]).
+    pub gain_met: usize,
+    /// Campaigns with an effect below the noise (g* < 0.3).
+    pub sub_noise: usize,
     pub scored_params: usize,
     pub covered: usize,
 }
@@ -760,9 +807,11 @@ impl Rates {
                 r.exact += s.exact as usize;
                 r.among += s.hidden_among_named as usize;
             }
+            r.sub_noise += s.sub_noise as usize;
             if s.named != "none" {
                 r.named += 1;
                 r.min_gain_named = r.min_gain_named.min(s.gain);
+                r.gain_met += (s.gain >= s.gain_required) as usize;
             }
             for c in s.params.iter().filter_map(|p| p.covered) {
                 r.scored_params += 1;
@@ -786,17 +835,19 @@ impl std::fmt::Display for Rates {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "exact name {}/{} ({:.1}%), hidden among named {}/{} ({:.1}%), none on no-effect data {}/{}, min held-out gain where named {:.3} ({} named), 95% intervals cover the truth {}/{} ({:.1}%)",
+            "exact name {}/{} ({:.1}%), hidden among named {}/{} ({:.1}%) ({} sub-noise), none on no-effect data {}/{}, held-out gain at least min(0.3, 0.8 g*) where named {}/{} (lowest gain {:.3}), 95% intervals cover the truth {}/{} ({:.1}%)",
             self.exact,
             self.with_effect,
             100.0 * self.exact_rate(),
             self.among,
             self.with_effect,
             100.0 * self.among_rate(),
+            self.sub_noise,
             self.none_on_no_effect,
             self.no_effect,
-            self.min_gain_named,
+            self.gain_met,
             self.named,
+            self.min_gain_named,
             self.covered,
             self.scored_params,
             100.0 * self.coverage()
