@@ -336,6 +336,13 @@ impl LoadChannels {
         damper: &DamperStep,
         out: &mut [f64],
     ) -> anyhow::Result<()> {
+        if out.len() != self.names.len() {
+            anyhow::bail!(
+                "{} load channel values asked for, {} channels",
+                out.len(),
+                self.names.len()
+            );
+        }
         let ctx = eval_ctx(m, st);
         let mut data = self
             .scratch
