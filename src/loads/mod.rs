@@ -81,6 +81,26 @@ pub struct SectionComponents {
 }
 
 impl Section {
+    /// The section's pitch about its own axis e1 relative to the plane normal to `up` (a
+    /// unit vector; the shaft axis for a blade) [rad], nose up positive: the angle
+    /// `atan2(e2 . up, e3 . up)` by which the section frame is turned about e1 from the frame
+    /// whose second axis lies in that plane (docs/loads.md, "unpitched blade frame"). For a
+    /// frame `Rz(-zeta) Ry(-beta) Rx(theta)` of the plane's axes it is theta, whatever the
+    /// lag zeta and flap beta.
+    pub fn pitch_about(&self, up: [f64; 3]) -> f64 {
+        let f = &self.frame;
+        let e2 = [f[0][1], f[1][1], f[2][1]];
+        let e3 = [f[0][2], f[1][2], f[2][2]];
+        dot(e2, up).atan2(dot(e3, up))
+    }
+
+    /// The components in the unpitched blade frame: the section frame turned back about e1
+    /// by [`Section::pitch_about`] `up`, so that its second axis lies in the plane normal to
+    /// `up` (docs/loads.md).
+    pub fn unpitched_components(&self, up: [f64; 3]) -> SectionComponents {
+        self.components().turned_back(self.pitch_about(up))
+    }
+
     pub fn components(&self) -> SectionComponents {
         let l = self.load.in_frame(&self.frame);
         SectionComponents {
@@ -90,6 +110,25 @@ impl Section {
             torsion_nm: l.moment[0],
             flap_nm: -l.moment[1],
             chord_nm: l.moment[2],
+        }
+    }
+}
+
+impl SectionComponents {
+    /// The same load in the frame turned by `-theta` about e1 (e1' = e1,
+    /// e2' = cos(theta) e2 - sin(theta) e3, e3' = sin(theta) e2 + cos(theta) e3): a section
+    /// pitched nose up by theta seen from the frame without that pitch. Axial force and
+    /// torsion are unchanged.
+    pub fn turned_back(&self, theta: f64) -> SectionComponents {
+        let (s, c) = theta.sin_cos();
+        SectionComponents {
+            axial_n: self.axial_n,
+            shear_chord_n: c * self.shear_chord_n - s * self.shear_flap_n,
+            shear_flap_n: s * self.shear_chord_n + c * self.shear_flap_n,
+            torsion_nm: self.torsion_nm,
+            // flap = -M . e2, chord = M . e3
+            flap_nm: c * self.flap_nm + s * self.chord_nm,
+            chord_nm: c * self.chord_nm - s * self.flap_nm,
         }
     }
 }

@@ -1,7 +1,9 @@
 //! Blade load channels of the rotor model (docs/loads.md): section loads at the `[outputs]`
-//! stations, the pitch-link load, the blade root loads at the hub centre (rotating hub frame)
-//! and, for the run-time equilibrium check, the same root loads from the applied and inertial
-//! loads of the blade system and the pitch-link reaction.
+//! stations (deformed section frame, and the unpitched blade frame), the pitch-link load, the
+//! blade root loads at the hub centre (rotating hub frame), the bearing's joint angles and the
+//! moments its joints carry about their axes, and, for the run-time equilibrium check, the
+//! same root loads from the applied and inertial loads of the blade system and the pitch-link
+//! reaction.
 use super::deck::{RotorSpec, SECTION_KINDS};
 use super::expand::names;
 use crate::loads::{self, Resultant};
@@ -32,6 +34,34 @@ pub const PITCH_LINK_CHANNEL: &str = "pitch_link_force_N";
 /// pitch nose up: the rigid blade motion a flight record's motion channels measure.
 pub const HINGE_CHANNELS: [&str; 3] = ["lag_hinge_rad", "flap_hinge_rad", "pitch_bearing_rad"];
 
+/// The moment each of the bearing's joints carries about its own axis (its spring and damper,
+/// `k psi + c psi'`), in the order and with the signs of [`HINGE_CHANNELS`]: what the blade's
+/// side exerts on the hub's side, positive when it resists a positive angle (docs/loads.md).
+pub const HINGE_MOMENT_CHANNELS: [&str; 3] = [
+    "lag_hinge_moment_Nm",
+    "flap_hinge_moment_Nm",
+    "pitch_bearing_moment_Nm",
+];
+
+/// Infix of the section channels in the unpitched blade frame
+/// (`flap_moment_unpitched_r0.05_Nm`, docs/loads.md).
+pub const UNPITCHED: &str = "unpitched";
+
+/// The section kinds that differ between the deformed section frame and the unpitched blade
+/// frame (both share e1: torsion and axial force are the same in both).
+pub const UNPITCHED_KINDS: [&str; 4] = ["flap_moment", "chord_moment", "shear_flap", "shear_chord"];
+
+/// Name of section channel `kind` (with `unit`) at r/R `x`, in the deformed section frame
+/// (`unpitched` false: `flap_moment_r0.50_Nm`) or the unpitched blade frame
+/// (`flap_moment_unpitched_r0.50_Nm`).
+pub fn section_channel(kind: &str, unit: &str, x: f64, unpitched: bool) -> String {
+    if unpitched {
+        format!("{kind}_{UNPITCHED}_r{x:.2}_{unit}")
+    } else {
+        format!("{kind}_r{x:.2}_{unit}")
+    }
+}
+
 /// The damper's end nodes (hub end, blade end), their positions at the start of the last
 /// step and the force it applied over the step (positive along the blade end's line).
 #[derive(Clone, Copy, Debug)]
@@ -60,6 +90,8 @@ pub struct LoadChannels {
     stations: Vec<Station>,
     /// Indices into [`SECTION_KINDS`] written at every station.
     kinds: Vec<usize>,
+    /// Of those, the ones also written in the unpitched blade frame ([`UNPITCHED_KINDS`]).
+    unpitched_kinds: Vec<usize>,
     names: Vec<String>,
     link: Station,
     hub: usize,
@@ -152,17 +184,30 @@ impl LoadChannels {
             .iter()
             .filter_map(|k| SECTION_KINDS.iter().position(|c| c.0 == k))
             .collect();
+        let unpitched_kinds: Vec<usize> = kinds
+            .iter()
+            .copied()
+            .filter(|&k| UNPITCHED_KINDS.contains(&SECTION_KINDS[k].0))
+            .collect();
         let mut names_v = vec![];
         for (_, x) in spec.load_stations() {
             for &k in &kinds {
                 let (kind, unit) = SECTION_KINDS[k];
-                names_v.push(format!("{kind}_r{x:.2}_{unit}"));
+                names_v.push(section_channel(kind, unit, x, false));
             }
         }
         names_v.push(PITCH_LINK_CHANNEL.to_string());
         names_v.extend(ROOT_CHANNELS.iter().map(|s| s.to_string()));
         names_v.extend(ROOT_CHANNELS.iter().map(|s| format!("{CHECK_PREFIX}{s}")));
         names_v.extend(HINGE_CHANNELS.iter().map(|s| s.to_string()));
+        // added channels follow the original ones, so that their order is kept
+        names_v.extend(HINGE_MOMENT_CHANNELS.iter().map(|s| s.to_string()));
+        for (_, x) in spec.load_stations() {
+            for &k in &unpitched_kinds {
+                let (kind, unit) = SECTION_KINDS[k];
+                names_v.push(section_channel(kind, unit, x, true));
+            }
+        }
         let hinges = [
             element(m, names::LAG)?,
             element(m, names::FLAP)?,
@@ -206,6 +251,7 @@ impl LoadChannels {
         Ok(LoadChannels {
             stations,
             kinds,
+            unpitched_kinds,
             names: names_v,
             link,
             hub,
@@ -290,6 +336,13 @@ impl LoadChannels {
         damper: &DamperStep,
         out: &mut [f64],
     ) -> anyhow::Result<()> {
+        if out.len() != self.names.len() {
+            anyhow::bail!(
+                "{} load channel values asked for, {} channels",
+                out.len(),
+                self.names.len()
+            );
+        }
         let ctx = eval_ctx(m, st);
         let mut data = self
             .scratch
@@ -305,32 +358,44 @@ impl LoadChannels {
             let d = b.densities_with(&k, &ip.rg, &ctx);
             data.push(ElemData { elem: e, k, ip, d });
         }
+        let xh = st.x[self.hub];
+        let rh = mm(&quat_to_arr(&st.q[self.hub]), &self.frame);
+        // the shaft axis: the unpitched blade frame's second axis is normal to it
+        let up = [rh[0][2], rh[1][2], rh[2][2]];
+        // the unpitched section channels come last
+        let mut iu = out.len() - self.stations.len() * self.unpitched_kinds.len();
         let mut i = 0;
-        for (s, &j) in self.stations.iter().zip(&self.station_beam) {
-            let e = &data[j];
-            let Element::Beam(b) = &m.elements[e.elem] else {
-                anyhow::bail!("element {} is not a beam", e.elem);
-            };
-            let c = loads::section_from(b, &e.k, &e.ip, &e.d, s.s_m).components();
-            let all = [
+        let all = |c: &loads::SectionComponents| {
+            [
                 c.flap_nm,
                 c.chord_nm,
                 c.torsion_nm,
                 c.shear_flap_n,
                 c.shear_chord_n,
                 c.axial_n,
-            ];
+            ]
+        };
+        for (s, &j) in self.stations.iter().zip(&self.station_beam) {
+            let e = &data[j];
+            let Element::Beam(b) = &m.elements[e.elem] else {
+                anyhow::bail!("element {} is not a beam", e.elem);
+            };
+            let sec = loads::section_from(b, &e.k, &e.ip, &e.d, s.s_m);
+            let c = all(&sec.components());
             for &k in &self.kinds {
-                out[i] = all[k];
+                out[i] = c[k];
                 i += 1;
+            }
+            let u = all(&sec.unpitched_components(up));
+            for &k in &self.unpitched_kinds {
+                out[iu] = u[k];
+                iu += 1;
             }
         }
         out[i] = loads::section(m, st, &ctx, self.link.elem, self.link.s_m)?
             .components()
             .axial_n;
         i += 1;
-        let xh = st.x[self.hub];
-        let rh = mm(&quat_to_arr(&st.q[self.hub]), &self.frame);
         // what the blade system exerts on the hub, about the hub centre, from this sample's
         // data of the retention's first element
         let root = self.root(m, st, &ctx, &data[0])?;
@@ -364,12 +429,13 @@ impl LoadChannels {
             i += 6;
         }
         let kin = |n: Option<usize>| n.map_or_else(NodeKin::ground, |n| st.node_kin(n));
-        for &e in &self.hinges {
+        for (q, &e) in self.hinges.iter().enumerate() {
             let Element::Joint(j) = &m.elements[e] else {
                 anyhow::bail!("element {e} is not a joint");
             };
-            out[i] = j.angle(&kin(j.node_a), &kin(Some(j.node_b)));
-            i += 1;
+            let (a, b) = (kin(j.node_a), kin(Some(j.node_b)));
+            out[i + q] = j.angle(&a, &b);
+            out[i + 3 + q] = j.axis_moment(&a, &b);
         }
         Ok(())
     }

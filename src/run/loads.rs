@@ -98,13 +98,15 @@ pub fn finish(run: &mut ModelRun, blades: Option<usize>) {
     }
 }
 
-/// Whether `name` is a blade load channel (section, pitch link, root or hub).
+/// Whether `name` is a blade load channel (section in either frame, pitch link, root, bearing
+/// moments or hub).
 pub fn is_load_channel(name: &str) -> bool {
     use crate::rotor::deck::SECTION_KINDS;
-    SECTION_KINDS
-        .iter()
-        .any(|(k, _)| name.starts_with(&format!("{k}_r")))
-        || name == crate::rotor::loads::PITCH_LINK_CHANNEL
+    use crate::rotor::loads::{HINGE_MOMENT_CHANNELS, UNPITCHED};
+    SECTION_KINDS.iter().any(|(k, _)| {
+        name.starts_with(&format!("{k}_r")) || name.starts_with(&format!("{k}_{UNPITCHED}_r"))
+    }) || name == crate::rotor::loads::PITCH_LINK_CHANNEL
+        || HINGE_MOMENT_CHANNELS.contains(&name)
         || ROOT_CHANNELS.contains(&name)
         || HUB_CHANNELS.contains(&name)
         || super::rotor::HUB_ROTATING_CHANNELS.contains(&name)

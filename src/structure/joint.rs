@@ -500,6 +500,19 @@ impl Joint {
         }
     }
 
+    /// The moment the joint transmits about its free z axis: its own spring and damper,
+    /// `k psi + c psi'` (psi the unwrapped [`Joint::angle`], psi' the relative angular velocity
+    /// about the axis), what node B's side exerts on node A's side about +z (B receives
+    /// `-m z`); the constraint moments are normal to the axis. Zero for a joint without them,
+    /// with a prescribed angle, or a bushing (whose springs act on six axes).
+    pub fn axis_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>) -> f64 {
+        if !self.has_spring() {
+            return 0.0;
+        }
+        let z = mv(&mm(&a.r, &self.qa), [0.0, 0.0, 1.0]);
+        self.spring_moment(a, b, z)
+    }
+
     /// Spring/damper moment `k psi + c z . (w_B - w_A)` about the joint axis `z`.
     fn spring_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>, z: V3<f64>) -> f64 {
         self.angle(a, b) * self.spring_nm_per_rad + dot(z, sub(b.w, a.w)) * self.damper_nms_per_rad
