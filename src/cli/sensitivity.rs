@@ -203,13 +203,24 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         errln!("note: {n}");
     }
     let report = &out.report;
+    let fallbacks = out
+        .setup
+        .params
+        .iter()
+        .filter(|p| p.low_round + p.high_round > 0)
+        .count();
     outln!(
-        "sensitivity: {} case(s), {} run now ({} warm-started), {} already complete, {} failed, {jobs} at once, wall {:.1} s",
+        "sensitivity: {} case(s), {} run now ({} warm-started), {} already complete, {} failed{}, {jobs} at once, wall {:.1} s",
         report.total,
         report.ran.len(),
         report.warm_started,
         report.skipped.len(),
         report.failed().len(),
+        if fallbacks > 0 {
+            format!(" ({fallbacks} side(s) run again nearer the nominal value: fallback below)")
+        } else {
+            String::new()
+        },
         t0.elapsed().as_secs_f64()
     );
     for (id, r) in &report.ran {

@@ -250,7 +250,13 @@ pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<
                     Err(e) => {
                         refused.push(format!("x{f}"));
                         if why.is_empty() {
-                            why = first_line(&e);
+                            // the deck's reason, without the override and file it names
+                            let line = first_line(&e);
+                            let at = format!("{}: ", t.key);
+                            why = match line.find(&at) {
+                                Some(i) => line[i + at.len()..].to_string(),
+                                None => line,
+                            };
                         }
                     }
                 }
