@@ -653,8 +653,7 @@ pub fn html(t: &Sensitivity) -> String {
         .map(|r| {
             let p = &r.param;
             vec![
-                p.name(),
-                p.unit(),
+                format!("{} [{}]", p.name(), p.unit()),
                 short(p.target.nominal),
                 short(p.low),
                 short(p.high),
@@ -666,8 +665,7 @@ pub fn html(t: &Sensitivity) -> String {
         .collect();
     h.table(
         &[
-            "key",
-            "unit",
+            "key [unit]",
             "nominal",
             "low",
             "high",
