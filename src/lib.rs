@@ -15,6 +15,7 @@ pub mod periodic;
 pub mod report;
 pub mod rotor;
 pub mod run;
+pub mod sensitivity;
 pub mod solver;
 pub mod stability;
 pub mod structure;

@@ -17,8 +17,18 @@ fn rotorsim(args: &[&str]) -> std::process::Output {
 #[test]
 fn every_help_says_what_the_command_writes_and_the_exit_status() {
     for cmd in [
-        "run", "bench", "diagnose", "static", "dynamic", "modes", "verify", "convert", "inspect",
-        "expand", "sweep",
+        "run",
+        "bench",
+        "diagnose",
+        "static",
+        "dynamic",
+        "modes",
+        "verify",
+        "convert",
+        "inspect",
+        "expand",
+        "sweep",
+        "sensitivity",
     ] {
         let o = rotorsim(&[cmd, "--help"]);
         assert!(o.status.success(), "{cmd}");

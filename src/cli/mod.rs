@@ -68,6 +68,7 @@ pub mod inspect;
 pub mod modes;
 pub mod run_cmd;
 mod run_console;
+pub mod sensitivity;
 pub mod stability;
 pub mod static_cmd;
 pub mod sweep;
@@ -201,6 +202,14 @@ sweep.csv (one row per case and damper model) and sweep.html; --emit-slurm FILE 
 sbatch array script only."
     ))]
     Sweep(sweep::SweepArgs),
+    /// Sensitivity of the outputs to every value the rotor deck labels ASSUMED (and --vary).
+    #[command(after_long_help = writes!(
+        "Writes DIR/: sensitivity.csv (one row per parameter: its low, nominal and high value, \
+each output at them and the swing), sensitivity.html (a tornado chart and a ranking per output), \
+summary.json, sensitivity_plan.toml (the sweep plan of the cases) and what `rotorsim sweep` \
+writes: plan.json, cases/<id>/ (a run folder per case), sweep.csv, sweep.html."
+    ))]
+    Sensitivity(sensitivity::SensitivityArgs),
 }
 
 pub fn main() -> ExitCode {
@@ -251,6 +260,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => run_cmd::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Sensitivity(a) => sensitivity::run(a),
         Command::Stability(a) => stability::run(a),
     }
 }

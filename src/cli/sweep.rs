@@ -58,7 +58,7 @@ pub enum SweepCommand {
 }
 
 /// A count of at least 1 (`--jobs`, `--shards`, `--cpus-per-task`): 0 would silently mean 1.
-fn at_least_one(s: &str) -> Result<usize, String> {
+pub(crate) fn at_least_one(s: &str) -> Result<usize, String> {
     match s.trim().parse::<usize>() {
         Ok(n) if n >= 1 => Ok(n),
         Ok(_) => Err("expected a whole number of at least 1, found 0".into()),
@@ -107,7 +107,7 @@ impl SweepProgress for Console {
     }
 }
 
-fn env_shard() -> anyhow::Result<Option<(usize, usize)>> {
+pub(crate) fn env_shard() -> anyhow::Result<Option<(usize, usize)>> {
     match (
         std::env::var("SLURM_ARRAY_TASK_ID"),
         std::env::var("SLURM_ARRAY_TASK_COUNT"),
@@ -119,7 +119,7 @@ fn env_shard() -> anyhow::Result<Option<(usize, usize)>> {
     }
 }
 
-fn default_jobs() -> usize {
+pub(crate) fn default_jobs() -> usize {
     std::env::var("SLURM_CPUS_PER_TASK")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -254,7 +254,7 @@ fn merge(dir: &Path) -> anyhow::Result<()> {
 
 /// Checks every case before any runs, with a progress bar on a terminal, otherwise a line
 /// every few seconds when checking takes long (a plan of many cases).
-fn check_with_progress(
+pub(crate) fn check_with_progress(
     plan: &Plan,
     runner: &JobRunner,
     jobs: usize,

@@ -84,6 +84,9 @@ pub enum SeriesKind {
     Rings,
     /// A shaded rectangle over the bounding box of the series' points (a band, e.g. noise).
     Band,
+    /// Horizontal bars from x = 0 to each x on a categorical y axis, side by side (top to
+    /// bottom) with the plot's other horizontal bar series in each row (a tornado chart).
+    HBars,
 }
 
 /// One named data series.
@@ -261,6 +264,11 @@ impl Plot {
         self.push(name, x, y, SeriesKind::Bars)
     }
 
+    /// Horizontal bars from x = 0 (rows of a categorical y axis: a tornado chart).
+    pub fn hbars(self, name: &str, x: &[f64], y: &[f64]) -> Self {
+        self.push(name, x, y, SeriesKind::HBars)
+    }
+
     pub fn dots(self, name: &str, x: &[f64], y: &[f64]) -> Self {
         self.push(name, x, y, SeriesKind::Dots)
     }
@@ -369,6 +377,14 @@ impl Plot {
         if self.series.iter().any(|s| s.kind == SeriesKind::Bars) && xr.0.is_finite() {
             yr = (yr.0.min(0.0), yr.1.max(0.0));
             xr = (xr.0 - 0.5 * sx.abs(), xr.1 + 0.5 * sx.abs());
+        }
+        let hbars = self.series.iter().any(|s| s.kind == SeriesKind::HBars);
+        if hbars && xr.0.is_finite() {
+            // bars start at 0, and none of them should touch the frame
+            xr = (xr.0.min(0.0), xr.1.max(0.0));
+            let span = xr.1 - xr.0;
+            let span = if span > 0.0 { span } else { 1.0 };
+            xr = (xr.0 - 0.05 * span, xr.1 + 0.05 * span);
         }
         if !xr.0.is_finite() {
             return Err(PlotError::NoData(self.title.clone()));
@@ -495,6 +511,13 @@ impl Plot {
             .count()
             .max(1);
         let mut jbar = 0usize;
+        let nhbars = self
+            .series
+            .iter()
+            .filter(|s| s.kind == SeriesKind::HBars)
+            .count()
+            .max(1);
+        let mut jhbar = 0usize;
         let (sx, sy) = (self.x_scale, self.y_scale);
         let fy = |y: f64| {
             if ncat > 0 {
@@ -573,6 +596,17 @@ impl Plot {
                         }))
                         .map_err(|e| err(&e))?;
                 }
+                SeriesKind::HBars => {
+                    // row height 1 in data units: 0.8 of it shared by the series, first on top
+                    let bh = 0.8 / nhbars as f64;
+                    let top = 0.4 - jhbar as f64 * bh;
+                    jhbar += 1;
+                    chart
+                        .draw_series(pts.into_iter().map(|(x, y)| {
+                            Rectangle::new([(0.0, y + top), (x, y + top - bh)], color.filled())
+                        }))
+                        .map_err(|e| err(&e))?;
+                }
             }
         }
         if lw > 0 {
@@ -613,7 +647,7 @@ impl Plot {
                         [(x0, y - 5), (x1, y + 5)],
                         color.mix(0.12).filled(),
                     )),
-                    SeriesKind::Bars => legend_area.draw(&Rectangle::new(
+                    SeriesKind::Bars | SeriesKind::HBars => legend_area.draw(&Rectangle::new(
                         [(x0 + 4, y - 5), (x1 - 4, y + 5)],
                         color.filled(),
                     )),
