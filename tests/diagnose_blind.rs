@@ -389,8 +389,8 @@ fn detectability_rule_scores_sub_noise_campaigns_and_the_required_gain() {
         .iter()
         .find(|c| c.effects.is_empty())
         .expect("a no-effect campaign");
-    assert_eq!(name_score(clean, &[], false).0, true);
-    assert_eq!(name_score(clean, &["seal_friction"], false).0, false);
+    assert!(name_score(clean, &[], false).0);
+    assert!(!name_score(clean, &["seal_friction"], false).0);
     // required gain: min(0.3, 0.8 g*)
     assert_eq!(required_gain(None), 0.3);
     assert_eq!(required_gain(Some(0.9)), 0.3);
