@@ -1,7 +1,7 @@
 //! `rotorsim sensitivity --rotor DECK --out DIR`: every value the deck labels ASSUMED (and any
 //! `--vary KEY=LOW:HIGH`) moved over its range through the sweep engine (pipeline:
 //! src/sensitivity/, docs/sensitivity.md).
-use super::sweep::{at_least_one, check_with_progress, default_jobs, env_shard};
+use super::sweep::{check_with_progress, default_jobs, env_shard, BatchArgs};
 use crate::sensitivity::{self, table::OUTPUTS, SensitivityOptions, Vary};
 use crate::sweep::{self, Case, JobRunner, SweepOptions, SweepProgress};
 use anyhow::{bail, Context};
@@ -39,34 +39,14 @@ pub struct SensitivityArgs {
     /// `damper.model`).
     #[arg(long)]
     pub damper: Option<String>,
-    /// Cases run at once, at least 1 (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
-    #[arg(long, value_parser = at_least_one)]
-    pub jobs: Option<usize>,
-    /// Run only shard K of N of the cases (K from 0 to N-1; default from SLURM_ARRAY_TASK_ID
-    /// and SLURM_ARRAY_TASK_COUNT). Run the command again without a shard when all have ended:
-    /// it finds the cases complete and writes the tables.
-    #[arg(long, value_name = "K/N")]
-    pub shard: Option<String>,
-    /// Run again the cases that failed in an earlier run into DIR.
-    #[arg(long)]
-    pub retry_failed: bool,
+    #[command(flatten)]
+    pub batch: BatchArgs,
     /// Start the cases of each warm-start group of 3 from its seed's periodic state (the
     /// nominal case and the seeds start cold). Faster, but a warm-started case's Floquet
     /// multipliers, the lag damping among them, can differ from a cold run's well beyond its
     /// periodicity tolerance: by default every case starts cold, as a plain `rotorsim run`.
     #[arg(long)]
     pub warm_start: bool,
-    /// Write an sbatch job-array script running the cases' shards to FILE, and prepare DIR;
-    /// runs nothing.
-    #[arg(long, value_name = "FILE")]
-    pub emit_slurm: Option<PathBuf>,
-    /// Array tasks of the emitted script, at least 1 (default: the warm-start groups, at most
-    /// 64).
-    #[arg(long, value_parser = at_least_one)]
-    pub shards: Option<usize>,
-    /// CPUs per array task of the emitted script, at least 1.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
-    pub cpus_per_task: usize,
 }
 
 fn parse_vary(s: &str) -> Result<Vary, String> {
@@ -101,11 +81,11 @@ impl SweepProgress for Lines {
 
 pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
-    let shard = match &args.shard {
+    let shard = match &args.batch.shard {
         Some(s) => Some(sweep::plan::parse_shard(s)?),
         None => env_shard()?,
     };
-    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let jobs = args.batch.jobs.unwrap_or_else(default_jobs).max(1);
     let opts = SensitivityOptions {
         rotor: args.rotor.clone(),
         flight: args.flight.clone(),
@@ -117,7 +97,7 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         sweep: SweepOptions {
             jobs,
             shard,
-            retry_failed: args.retry_failed,
+            retry_failed: args.batch.retry_failed,
         },
         warm_start: args.warm_start,
     };
@@ -157,9 +137,9 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
             s.reason
         );
     }
-    if let Some(script) = &args.emit_slurm {
+    if let Some(script) = &args.batch.emit_slurm {
         let groups = plan.groups().len();
-        let shards = args.shards.unwrap_or(groups.clamp(1, 64));
+        let shards = args.batch.shards.unwrap_or(groups.clamp(1, 64));
         let cwd = std::env::current_dir().context("current folder")?;
         let abs = |p: &std::path::Path| {
             if p.is_absolute() {
@@ -171,6 +151,7 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         let exe = std::env::current_exe().context("locating the rotorsim executable")?;
         sweep::prepare(&abs(&args.out), &plan)?;
         let extra: Vec<String> = args
+            .batch
             .retry_failed
             .then(|| "--retry-failed".to_string())
             .into_iter()
@@ -181,7 +162,7 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
             &abs(&plan_path),
             &abs(&args.out),
             shards,
-            args.cpus_per_task,
+            args.batch.cpus_per_task,
             &extra,
         );
         crate::io::write_atomic(script, text.as_bytes())

@@ -21,26 +21,35 @@ pub struct SweepArgs {
     /// DIR/sweep.html.
     #[arg(long, required = true)]
     pub out: Option<PathBuf>,
-    /// Cases run at once, at least 1 (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
-    #[arg(long, value_parser = at_least_one)]
-    pub jobs: Option<usize>,
-    /// Run only shard K of N (K from 0 to N-1); default from SLURM_ARRAY_TASK_ID and
-    /// SLURM_ARRAY_TASK_COUNT when both are set. A shard writes only its own case folders;
-    /// `rotorsim sweep merge DIR` builds sweep.csv when all have ended.
-    #[arg(long, value_name = "K/N")]
-    pub shard: Option<String>,
-    /// Run again the cases that failed in an earlier sweep into DIR (otherwise listed and kept).
-    #[arg(long)]
-    pub retry_failed: bool,
+    #[command(flatten)]
+    pub batch: BatchArgs,
     /// Start every case cold, ignoring the plan's warm starts (for comparisons).
     #[arg(long)]
     pub no_warm_start: bool,
-    /// Write an sbatch job-array script running the plan's shards to FILE, and prepare DIR;
+}
+
+/// How the cases of a batch (a sweep, a sensitivity study) run: together on this machine, as one
+/// shard of N, or as an sbatch job-array script.
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// Cases run at once, at least 1 (default: the CPUs of the machine, or SLURM_CPUS_PER_TASK).
+    #[arg(long, value_parser = at_least_one)]
+    pub jobs: Option<usize>,
+    /// Run only shard K of N of the cases (K from 0 to N-1); default from SLURM_ARRAY_TASK_ID
+    /// and SLURM_ARRAY_TASK_COUNT when both are set. A shard writes only its own case folders;
+    /// when all have ended, `rotorsim sweep merge DIR` (or the sensitivity command again,
+    /// without a shard) writes the tables.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Run again the cases that failed in an earlier run into DIR (otherwise listed and kept).
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// Write an sbatch job-array script running the cases' shards to FILE, and prepare DIR;
     /// runs nothing.
     #[arg(long, value_name = "FILE")]
     pub emit_slurm: Option<PathBuf>,
-    /// Array tasks of the emitted script, at least 1 (default: the plan's warm-start groups, at
-    /// most 64).
+    /// Array tasks of the emitted script, at least 1 (default: the warm-start groups, at most
+    /// 64).
     #[arg(long, value_parser = at_least_one)]
     pub shards: Option<usize>,
     /// CPUs per array task of the emitted script, at least 1.
@@ -143,13 +152,13 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         plan.warm_start = false;
     }
     let runner = JobRunner::default();
-    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let jobs = args.batch.jobs.unwrap_or_else(default_jobs).max(1);
     let tty = std::io::stderr().is_terminal();
     check_with_progress(&plan, &runner, jobs, tty)?;
-    if let Some(script) = &args.emit_slurm {
+    if let Some(script) = &args.batch.emit_slurm {
         return emit_slurm(&args, &plan, plan_path, out, script);
     }
-    let shard = match &args.shard {
+    let shard = match &args.batch.shard {
         Some(s) => Some(sweep::plan::parse_shard(s)?),
         None => env_shard()?,
     };
@@ -180,7 +189,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     let opts = SweepOptions {
         jobs,
         shard,
-        retry_failed: args.retry_failed,
+        retry_failed: args.batch.retry_failed,
     };
     let report = sweep::execute(&plan, out, &opts, &runner, &console)?;
     if let Some(b) = &console.bar {
@@ -305,7 +314,7 @@ fn emit_slurm(
     script: &Path,
 ) -> anyhow::Result<()> {
     let groups = plan.groups().len();
-    let shards = args.shards.unwrap_or(groups.clamp(1, 64));
+    let shards = args.batch.shards.unwrap_or(groups.clamp(1, 64));
     let cwd = std::env::current_dir().context("current folder")?;
     let abs = |p: &Path| {
         if p.is_absolute() {
@@ -320,7 +329,7 @@ fn emit_slurm(
     if args.no_warm_start {
         extra.push("--no-warm-start".to_string());
     }
-    if args.retry_failed {
+    if args.batch.retry_failed {
         extra.push("--retry-failed".to_string());
     }
     let text = sweep::slurm_script(
@@ -329,7 +338,7 @@ fn emit_slurm(
         &abs(plan_path),
         &abs(out),
         shards,
-        args.cpus_per_task,
+        args.batch.cpus_per_task,
         &extra,
     );
     crate::io::write_atomic(script, text.as_bytes())
