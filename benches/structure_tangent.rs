@@ -24,6 +24,7 @@ fn beam(c: &mut Criterion) {
         gravity: [0.5, -1.0, -9.81],
         cscale: 1.0,
         inertia: true,
+        dt: 0.0,
     };
     // the dynamic solver's seeds at h = 2 ms
     let s = fixture::seeds(&mut rng, 2e-3, 1e3, 7e5, [true; 6]);

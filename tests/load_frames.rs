@@ -212,6 +212,7 @@ fn the_unpitched_frame_is_built_from_the_section_axis_and_the_shaft() {
         gravity: m.gravity,
         cscale: 1.0,
         inertia: true,
+        dt: 0.0,
     };
     let r = &spec.retention;
     let mut worst: f64 = 0.0;
@@ -385,6 +386,7 @@ fn flap_and_pitch_bearing_moments_balance_the_section_at_the_bearing() {
             gravity: m.gravity,
             cscale: 1.0,
             inertia: true,
+            dt: 0.0,
         };
         let e = element_at(m, &m.beams["seg2"], 0.0).unwrap();
         let mo = section(m, st, &ctx, e, 0.0).unwrap().load.moment;
@@ -451,4 +453,126 @@ fn flap_and_pitch_bearing_moments_balance_the_section_at_the_bearing() {
         "{deformed_off} vs {}",
         worst[3]
     );
+}
+
+#[test]
+fn the_bearing_moments_are_the_elastomers_frequency_response() {
+    // The periodic solution of the shipped deck with each bearing axis an elastomer (loss
+    // factor 0.1, the lag axis's stiffness at its frequency; linear damper): at steady state
+    // each harmonic n of an axis's moment is the chain's complex
+    // stiffness times that harmonic of its angle, M_n = K*(n Omega) psi_n (docs/structure.md,
+    // Elastomer), with K* from the fitted chain's closed form, an independent reference for
+    // the time-domain stepping of the branches inside the rotor. The step errs at second
+    // order, (n Omega h)^2 / 12 = 5e-5 at 1/rev and 256 steps per revolution, and the
+    // revolution is periodic to 1e-5: 1e-3 of the first harmonic's size holds at n = 1 to 3.
+    use rotorsim::rotor::deck::BearingAxis;
+    use rotorsim::structure::elastomer::MaxwellChain;
+    let out = support::tmp("load_frames_elastomer");
+    let sets = [
+        "bearing.lag_loss_factor=0.1",
+        "bearing.flap_loss_factor=0.1",
+        "bearing.pitch_loss_factor=0.1",
+        "bearing.lag_damping_Nms_per_rad=0",
+        "bearing.flap_damping_Nms_per_rad=0",
+        "bearing.pitch_damping_Nms_per_rad=0",
+        "bearing.lag_reference_per_rev=0.28",
+    ];
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .current_dir(support::root())
+        .args(["run", "--damper", "linear"])
+        .args(sets.iter().flat_map(|s| ["--set", s]))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut rd = csv::Reader::from_path(out.join("linear/last_rev.csv")).unwrap();
+    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
+    let rows: Vec<Vec<f64>> = rd
+        .records()
+        .map(|r| {
+            r.unwrap()
+                .iter()
+                .map(|x| x.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = |name: &str| -> Vec<f64> {
+        let i = header.iter().position(|h| h == name).unwrap();
+        rows.iter().map(|r| r[i]).collect()
+    };
+    // complex harmonic n of a sampled revolution
+    let harmonic = |x: &[f64], n: usize| -> (f64, f64) {
+        let len = x.len() as f64;
+        x.iter().enumerate().fold((0.0, 0.0), |(re, im), (k, v)| {
+            let a = 2.0 * std::f64::consts::PI * (n * k) as f64 / len;
+            (re + 2.0 * v * a.cos() / len, im - 2.0 * v * a.sin() / len)
+        })
+    };
+    let overrides: Vec<rotorsim::overrides::Override> = sets
+        .iter()
+        .map(|s| rotorsim::overrides::Override::parse(s).unwrap())
+        .collect();
+    let d =
+        RotorDeck::from_file_with(&support::root().join("rotors/uh60a.toml"), &overrides).unwrap();
+    let om = d.spec.rotor.omega_rad_s;
+    let b = &d.spec.bearing;
+    for (axis, angle, moment, k) in [
+        (
+            BearingAxis::Lag,
+            "lag_hinge_rad",
+            "lag_hinge_moment_Nm",
+            b.lag_k,
+        ),
+        (
+            BearingAxis::Flap,
+            "flap_hinge_rad",
+            "flap_hinge_moment_Nm",
+            b.flap_k,
+        ),
+        (
+            BearingAxis::Pitch,
+            "pitch_bearing_rad",
+            "pitch_bearing_moment_Nm",
+            b.pitch_k,
+        ),
+    ] {
+        let e = b.elastomer(axis, om).expect("an elastomeric axis");
+        let c = MaxwellChain::fit(
+            k,
+            e.loss_factor,
+            e.band_rad_s[0],
+            e.band_rad_s[1],
+            e.reference_rad_s,
+        )
+        .unwrap();
+        let (psi, m) = (col(angle), col(moment));
+        let size = {
+            let (re, im) = harmonic(&m, 1);
+            re.hypot(im)
+        };
+        for n in 1..=3 {
+            let (pr, pi) = harmonic(&psi, n);
+            let (mr, mi) = harmonic(&m, n);
+            let (ks, kl) = c.complex(n as f64 * om);
+            let (wr, wi) = (ks * pr - kl * pi, ks * pi + kl * pr);
+            let err = (mr - wr).hypot(mi - wi) / size;
+            eprintln!(
+                "{angle} {n}/rev: |M_n| {:.2} N m, K* psi_n {:.2} N m, error {err:.1e} of |M_1|",
+                mr.hypot(mi),
+                wr.hypot(wi)
+            );
+            assert!(err < 1e-3, "{angle} {n}/rev: {err:.2e}");
+        }
+        // the loss part is there: the moment's 1/rev leads the angle's by atan(eta)
+        let (pr, pi) = harmonic(&psi, 1);
+        let (mr, mi) = harmonic(&m, 1);
+        let lead = (mi * pr - mr * pi).atan2(mr * pr + mi * pi);
+        let want = c.loss_factor(om).atan();
+        assert!(
+            (lead - want).abs() < 0.05 * want,
+            "{angle}: lead {lead}, atan(eta) {want}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(out);
 }

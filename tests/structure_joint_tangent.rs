@@ -8,12 +8,13 @@ use rotorsim::structure::*;
 mod joint_support;
 use joint_support::*;
 
-const EXTRAS: [Extra; 5] = [
+const EXTRAS: [Extra; 6] = [
     Extra::None,
     Extra::Angle,
     Extra::Disp,
     Extra::SpringDamper,
     Extra::DispSpring,
+    Extra::Elastomer,
 ];
 
 fn res_f64(c: &Case, a: &NodeKin<f64>, b: &NodeKin<f64>, lam: &[f64]) -> Vec<f64> {

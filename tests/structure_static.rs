@@ -159,6 +159,7 @@ fn beam_joint_and_body_tangents_match_finite_differences() {
         gravity: m.gravity,
         cscale: 7.0,
         inertia: true,
+        dt: 0.0,
     };
     let res = check_model(&m, &kin, &lam, &ctx);
     for r in &res {
@@ -249,6 +250,7 @@ fn multilane_and_single_lane_beam_tangents_agree() {
         gravity: m.gravity,
         cscale: 3.0,
         inertia: true,
+        dt: 0.0,
     };
     let lam = vec![0.5; m.n_lambda()];
     let mut a1 = Assembler::new(&m).unwrap();

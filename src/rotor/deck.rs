@@ -571,6 +571,163 @@ pub struct BearingTable {
     pub flap_c: f64,
     #[serde(rename = "pitch_damping_Nms_per_rad", default)]
     pub pitch_c: f64,
+    /// Elastomer per axis: a constant loss factor over `elastomer_band_per_rev`, the axis's
+    /// stiffness being its storage stiffness at `<axis>_reference_per_rev` (no damping key on
+    /// that axis then).
+    #[serde(default)]
+    pub lag_loss_factor: Option<f64>,
+    #[serde(default)]
+    pub flap_loss_factor: Option<f64>,
+    #[serde(default)]
+    pub pitch_loss_factor: Option<f64>,
+    #[serde(default = "one_per_rev", rename = "lag_reference_per_rev")]
+    pub lag_reference: f64,
+    #[serde(default = "one_per_rev", rename = "flap_reference_per_rev")]
+    pub flap_reference: f64,
+    #[serde(default = "one_per_rev", rename = "pitch_reference_per_rev")]
+    pub pitch_reference: f64,
+    #[serde(default = "elastomer_band", rename = "elastomer_band_per_rev")]
+    pub elastomer_band: [f64; 2],
+}
+
+fn one_per_rev() -> f64 {
+    1.0
+}
+
+/// Default band of an elastomer's constant loss factor [per rev]: from below the lag
+/// frequency (about 0.27/rev on an articulated rotor) to 4/rev.
+fn elastomer_band() -> [f64; 2] {
+    [0.25, 4.0]
+}
+
+fn kv(key: &str, msg: &str) -> (String, String) {
+    (key.to_string(), msg.to_string())
+}
+
+/// One axis of the elastomeric bearing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BearingAxis {
+    Lag,
+    Flap,
+    Pitch,
+}
+
+impl BearingAxis {
+    pub const ALL: [BearingAxis; 3] = [BearingAxis::Lag, BearingAxis::Flap, BearingAxis::Pitch];
+    pub fn name(self) -> &'static str {
+        match self {
+            BearingAxis::Lag => "lag",
+            BearingAxis::Flap => "flap",
+            BearingAxis::Pitch => "pitch",
+        }
+    }
+}
+
+/// An axis's elastomer as the deck states it, frequencies in rad/s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisElastomer {
+    pub loss_factor: f64,
+    pub band_rad_s: [f64; 2],
+    pub reference_rad_s: f64,
+}
+
+impl BearingTable {
+    /// Stiffness, damping and loss factor (if an elastomer) of an axis.
+    fn axis(&self, a: BearingAxis) -> (f64, f64, Option<f64>, f64) {
+        match a {
+            BearingAxis::Lag => (
+                self.lag_k,
+                self.lag_c,
+                self.lag_loss_factor,
+                self.lag_reference,
+            ),
+            BearingAxis::Flap => (
+                self.flap_k,
+                self.flap_c,
+                self.flap_loss_factor,
+                self.flap_reference,
+            ),
+            BearingAxis::Pitch => (
+                self.pitch_k,
+                self.pitch_c,
+                self.pitch_loss_factor,
+                self.pitch_reference,
+            ),
+        }
+    }
+
+    /// The axis's elastomer at rotor speed `omega` [rad/s] (None: a spring and a dashpot).
+    pub fn elastomer(&self, a: BearingAxis, omega: f64) -> Option<AxisElastomer> {
+        let (_, _, eta, r) = self.axis(a);
+        eta.map(|loss_factor| AxisElastomer {
+            loss_factor,
+            band_rad_s: self.elastomer_band.map(|x| x * omega),
+            reference_rad_s: r * omega,
+        })
+    }
+
+    /// Spring and dashpot of an axis [N m/rad, N m s/rad] for the linear models (fan plot,
+    /// ground and air resonance, amplitude checks): the deck's own, or an elastomer's storage
+    /// stiffness and `K''/w` at its reference frequency (exact there, and within its loss
+    /// factor's frequency dependence elsewhere).
+    pub fn equivalent(&self, a: BearingAxis, omega: f64) -> (f64, f64) {
+        let (k, c, _, _) = self.axis(a);
+        match self.elastomer(a, omega) {
+            None => (k, c),
+            Some(e) => (k, e.loss_factor * k / e.reference_rad_s),
+        }
+    }
+
+    /// Checks the elastomer keys: positive loss factors and references in the band, no
+    /// damping key beside a loss factor, and a chain that fits (passive) at `omega`.
+    fn check_elastomers(&self, omega: f64) -> Result<(), (String, String)> {
+        let [lo, hi] = self.elastomer_band;
+        if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+            return Err(kv(
+                "bearing.elastomer_band_per_rev",
+                &format!("[{lo}, {hi}]: expected 0 < low < high"),
+            ));
+        }
+        for a in BearingAxis::ALL {
+            let n = a.name();
+            let (k, c, eta, r) = self.axis(a);
+            let Some(eta) = eta else { continue };
+            if !(eta.is_finite() && eta > 0.0 && eta < 1.0) {
+                return Err(kv(
+                    &format!("bearing.{n}_loss_factor"),
+                    &format!("{eta}: expected between 0 and 1"),
+                ));
+            }
+            if c != 0.0 {
+                return Err(kv(
+                    &format!("bearing.{n}_damping_Nms_per_rad"),
+                    &format!("the {n} axis is an elastomer (bearing.{n}_loss_factor): its damping comes from the loss factor; remove one of the two"),
+                ));
+            }
+            if !(r >= lo && r <= hi) {
+                return Err(kv(
+                    &format!("bearing.{n}_reference_per_rev"),
+                    &format!("{r}: expected within bearing.elastomer_band_per_rev [{lo}, {hi}]"),
+                ));
+            }
+            if k.is_nan() || k <= 0.0 {
+                return Err(kv(
+                    &format!("bearing.{n}_stiffness_Nm_per_rad"),
+                    "an elastomer needs a positive storage stiffness",
+                ));
+            }
+            let e = self.elastomer(a, omega).expect("loss factor given");
+            crate::structure::elastomer::MaxwellChain::fit(
+                k,
+                eta,
+                e.band_rad_s[0],
+                e.band_rad_s[1],
+                e.reference_rad_s,
+            )
+            .map_err(|m| kv(&format!("bearing.{n}_loss_factor"), &m))?;
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -666,6 +823,19 @@ pub struct LagMoments {
 }
 
 impl RotorSpec {
+    /// The bearing's lag spring and dashpot for the linear models (an elastomer's equivalent
+    /// at its reference frequency, [`BearingTable::equivalent`]).
+    pub fn bearing_lag(&self) -> (f64, f64) {
+        self.bearing
+            .equivalent(BearingAxis::Lag, self.rotor.omega_rad_s)
+    }
+
+    /// The bearing's flap spring and dashpot for the linear models.
+    pub fn bearing_flap(&self) -> (f64, f64) {
+        self.bearing
+            .equivalent(BearingAxis::Flap, self.rotor.omega_rad_s)
+    }
+
     /// The blade's [`LagMoments`]: trapezoid on a fine grid of the section table (piecewise
     /// linear) from `blade.root_r_m` to the tip, plus retention segments 2 and 3 (uniform); the
     /// root hardware (horn, damper lever) is left out. `deck_path`: where the section table's
@@ -1022,6 +1192,9 @@ impl RotorSpec {
         ] {
             nonneg(k, v)?;
         }
+        self.bearing
+            .check_elastomers(self.rotor.omega_rad_s)
+            .map_err(|(k, m)| bad(&k, &m))?;
         pos(
             "pitch_control.link_length_m",
             self.pitch_control.link_length_m,

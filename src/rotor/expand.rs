@@ -12,7 +12,7 @@
 //! whose prescribed vertical motion in the hub frame gives the pitch; damper between
 //! `damper_hub_end` (rigid to the hub) and `damper_blade_end` (rigid to `bearing_lag`, so the
 //! stroke is `arm x lag angle`).
-use super::deck::{RotorSpec, Segment};
+use super::deck::{AxisElastomer, BearingAxis, RotorSpec, Segment};
 use crate::structure::section::SectionProps;
 use std::fmt::Write as _;
 
@@ -162,6 +162,10 @@ pub struct ExpandOptions {
     /// Extra lag-hinge spring and damper (linearised damper for modal analyses).
     pub lag_extra_k: f64,
     pub lag_extra_c: f64,
+    /// Bearing elastomers as their spring and dashpot equivalents
+    /// ([`crate::rotor::deck::BearingTable::equivalent`]; linear analyses of the expanded model, whose modal
+    /// analysis would otherwise see only the relaxed spring).
+    pub bearing_equivalent: bool,
     /// `[modes] speeds_rad_s`.
     pub speeds_rad_s: Vec<f64>,
     /// The damper as a `[[hydraulic]]` table (None: left out, e.g. when the caller adds the
@@ -410,10 +414,11 @@ impl BladeWriter<'_> {
                    axis: [f64; 3],
                    xd: [f64; 3],
                    k: f64,
-                   c: f64| {
+                   c: f64,
+                   el: Option<AxisElastomer>| {
             let _ = writeln!(
                 s,
-                "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_a = \"{}\"\nnode_b = \"{}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}\n",
+                "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_a = \"{}\"\nnode_b = \"{}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}",
                 pl.n(name),
                 pl.n(a),
                 pl.n(bn),
@@ -422,7 +427,38 @@ impl BladeWriter<'_> {
                 f(k),
                 f(c)
             );
+            if let Some(e) = el {
+                let _ = writeln!(
+                    s,
+                    "elastomer = {{ loss_factor = {}, band_rad_s = [{}, {}], reference_rad_s = {} }}",
+                    f(e.loss_factor),
+                    f(e.band_rad_s[0]),
+                    f(e.band_rad_s[1]),
+                    f(e.reference_rad_s)
+                );
+            }
+            s.push('\n');
         };
+        let om = spec.rotor.omega_rad_s;
+        // per axis: stiffness, damping, elastomer
+        let axis = |a: BearingAxis| {
+            if opts.bearing_equivalent {
+                let (k, c) = bg.equivalent(a, om);
+                (k, c, None)
+            } else {
+                let (k, c) = match a {
+                    BearingAxis::Lag => (bg.lag_k, bg.lag_c),
+                    BearingAxis::Flap => (bg.flap_k, bg.flap_c),
+                    BearingAxis::Pitch => (bg.pitch_k, bg.pitch_c),
+                };
+                (k, c, bg.elastomer(a, om))
+            }
+        };
+        let (lag, flap, pitch) = (
+            axis(BearingAxis::Lag),
+            axis(BearingAxis::Flap),
+            axis(BearingAxis::Pitch),
+        );
         rev(
             s,
             names::LAG,
@@ -430,8 +466,9 @@ impl BladeWriter<'_> {
             "bearing_lag",
             [0.0, 0.0, -1.0],
             [1.0, 0.0, 0.0],
-            bg.lag_k + opts.lag_extra_k,
-            bg.lag_c + opts.lag_extra_c,
+            lag.0 + opts.lag_extra_k,
+            lag.1 + opts.lag_extra_c,
+            lag.2,
         );
         rev(
             s,
@@ -440,8 +477,9 @@ impl BladeWriter<'_> {
             "bearing_flap",
             [0.0, -1.0, 0.0],
             [1.0, 0.0, 0.0],
-            bg.flap_k,
-            bg.flap_c,
+            flap.0,
+            flap.1,
+            flap.2,
         );
         rev(
             s,
@@ -450,8 +488,9 @@ impl BladeWriter<'_> {
             "seg2.n0",
             [1.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],
-            bg.pitch_k,
-            bg.pitch_c,
+            pitch.0,
+            pitch.1,
+            pitch.2,
         );
         let clamp = |s: &mut String, name: &str, a: &str, bn: &str| {
             let _ = writeln!(

@@ -9,7 +9,7 @@
 //! hydraulic stiffness `k_d = B (A0^2/V0 + A1^2/V1)` (Eq. 16) of the physical damper in series
 //! with it (a Maxwell element), at the lag frequency w:
 //! `k_eq = k_d (c w)^2 / (k_d^2 + (c w)^2)`, `c_eq = c k_d^2 / (k_d^2 + (c w)^2)`.
-use super::deck::RotorSpec;
+use super::deck::{BearingAxis, RotorSpec};
 use super::expand::ExpandOptions;
 use super::sim::expanded_model;
 use super::RotorDeck;
@@ -110,6 +110,7 @@ pub fn fan_with(
 ) -> anyhow::Result<Vec<FanPoint>> {
     let arm = spec.damper_attachment.arm_m;
     let om_n = spec.rotor.omega_rad_s;
+    let bearing_lag = spec.bearing.equivalent(BearingAxis::Lag, om_n);
     let mut out = vec![];
     // linearisation frequency: the lag frequency of the previous speed (first point: of a pass
     // with the dashpot alone)
@@ -123,6 +124,7 @@ pub fn fan_with(
             let xo = ExpandOptions {
                 lag_extra_k: arm * arm * k_eq,
                 lag_extra_c: arm * arm * c_eq,
+                bearing_equivalent: true,
                 ..Default::default()
             };
             let mut model = expanded_model(spec, &xo, file)?;
@@ -168,8 +170,8 @@ pub fn fan_with(
             omega_rad_s: om,
             modes: ms,
             tracked_hz: tracked,
-            lag_k_nm_per_rad: spec.bearing.lag_k + arm * arm * k_eq,
-            lag_c_nms_per_rad: spec.bearing.lag_c + arm * arm * c_eq,
+            lag_k_nm_per_rad: bearing_lag.0 + arm * arm * k_eq,
+            lag_c_nms_per_rad: bearing_lag.1 + arm * arm * c_eq,
         });
     }
     Ok(out)

@@ -134,6 +134,7 @@ fn eval_ctx(m: &Model, st: &State) -> EvalCtx {
         gravity: m.gravity,
         cscale: 1.0,
         inertia: true,
+        dt: 0.0,
     }
 }
 

@@ -1236,6 +1236,11 @@ impl ForcedResponse for RotorSim {
                 coords.extend(sh.inflow.state().map(|l| l * a.air.radius_m));
             }
         }
+        // the bearing elastomers' branch moments (as angles: over the chain's stiffness), so
+        // that shooting converges their history with the motion
+        for (e, scale) in elastomer_scales(&self.solver.model) {
+            coords.extend(snap.joint_elastomers_nm[e].iter().map(|m| m / scale));
+        }
         Some(super::SimState {
             t_s: snap.t_s,
             coords,
@@ -1264,13 +1269,26 @@ impl ForcedResponse for RotorSim {
         let n = crate::solver::snapshot::COORDS_PER_NODE * snap.nodes();
         let inflow = self.aero.as_ref().filter(|a| a.coupled);
         let extra = if inflow.is_some() { 3 } else { 0 };
-        if s.coords.len() != n + extra {
+        let elastomers = elastomer_scales(&self.solver.model);
+        let n_el = elastomers.len() * crate::structure::elastomer::BRANCHES;
+        if s.coords.len() != n + extra + n_el {
             anyhow::bail!(
-                "the saved state has {} coordinates, its structural state {n} and its inflow {extra}",
+                "the saved state has {} coordinates, its structural state {n}, its inflow {extra} and its bearing elastomers {n_el}",
                 s.coords.len()
             );
         }
         snap.set_coords(&self.r0, 1.0 / self.omega, &s.coords[..n]);
+        if !elastomers.is_empty() {
+            let ne = self.solver.model.elements.len();
+            snap.joint_elastomers_nm.resize(ne, vec![]);
+            let mut at = n + extra;
+            for (e, scale) in elastomers {
+                let b = crate::structure::elastomer::BRANCHES;
+                snap.joint_elastomers_nm[e] =
+                    s.coords[at..at + b].iter().map(|c| c * scale).collect();
+                at += b;
+            }
+        }
         if let Some(a) = inflow {
             if let Ok(mut sh) = a.shared.lock() {
                 let r = a.air.radius_m;
@@ -1414,6 +1432,21 @@ impl ForcedResponse for RotorSim {
             relaxed_steps: self.relaxed_steps,
         }
     }
+}
+
+/// The model's joints with an elastomer: element index and the chain's stiffness scale
+/// (`K_inf + sum k_i`, N m/rad) that turns its branch moments into angles.
+fn elastomer_scales(m: &Model) -> Vec<(usize, f64)> {
+    m.elements
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| match e {
+            Element::Joint(j) => j
+                .elastomer
+                .map(|el| (i, el.chain.k_inf + el.chain.k.iter().sum::<f64>())),
+            _ => None,
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -186,15 +186,15 @@ pub fn air_blade(
             }
         })
         .collect();
-    let b = &spec.bearing;
+    let (lag, flap) = (spec.bearing_lag(), spec.bearing_flap());
     Ok((
         AirBlade {
             hinge_offset_m: e,
             strips,
-            lag_stiffness_nm_per_rad: b.lag_k + damper_kc.0,
-            lag_damping_nms_per_rad: b.lag_c + damper_kc.1,
-            flap_stiffness_nm_per_rad: b.flap_k,
-            flap_damping_nms_per_rad: b.flap_c,
+            lag_stiffness_nm_per_rad: lag.0 + damper_kc.0,
+            lag_damping_nms_per_rad: lag.1 + damper_kc.1,
+            flap_stiffness_nm_per_rad: flap.0,
+            flap_damping_nms_per_rad: flap.1,
         },
         geo.airfoils.into_iter().map(|(_, a)| a).collect(),
     ))
@@ -273,7 +273,7 @@ pub fn air_resonance_map(
     let mut inertia = 0.0;
     for &om in speeds_rad_s {
         let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
-        let k0 = specs[0].0.spec.bearing.lag_k;
+        let k0 = specs[0].0.spec.bearing_lag().0;
         let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
             / m0.inertia_kg_m2)
             .sqrt();

@@ -258,8 +258,8 @@ impl Blades {
                 first_moment_kg_m: m.first_moment_kg_m,
                 inertia_kg_m2: m.inertia_kg_m2,
                 hinge_offset_m: b.spec.retention.hinge_r_m,
-                stiffness_nm_per_rad: b.spec.bearing.lag_k + k,
-                damping_nms_per_rad: b.spec.bearing.lag_c + c,
+                stiffness_nm_per_rad: b.spec.bearing_lag().0 + k,
+                damping_nms_per_rad: b.spec.bearing_lag().1 + c,
             });
         }
         Ok(Reduced::Lag(LagRotor {
@@ -282,7 +282,7 @@ impl Blades {
         let (b0, _) = &self.decks[0];
         let m0 = b0.spec.lag_moments(&b0.path)?;
         let mut w = ((b0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om
-            + b0.spec.bearing.lag_k)
+            + b0.spec.bearing_lag().0)
             / m0.inertia_kg_m2)
             .sqrt();
         let passes = match w_guess {

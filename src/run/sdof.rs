@@ -132,10 +132,10 @@ impl SdofParams {
             radius_m: radius,
             inertia_kg_m2: i2,
             first_moment_kg_m: s1,
-            lag_spring_n_m_per_rad: spec.bearing.lag_k,
+            lag_spring_n_m_per_rad: spec.bearing_lag().0,
             damper_arm_m: spec.damper_attachment.arm_m,
             moment: harmonics(&psi, &moment, 16)?,
-            lag_damping_n_m_s_per_rad: spec.bearing.lag_c,
+            lag_damping_n_m_s_per_rad: spec.bearing_lag().1,
         })
     }
 

@@ -228,8 +228,8 @@ fn blade(
             first_moment_kg_m: m.first_moment_kg_m,
             inertia_kg_m2: m.inertia_kg_m2,
             hinge_offset_m: spec.retention.hinge_r_m,
-            stiffness_nm_per_rad: spec.bearing.lag_k + k,
-            damping_nms_per_rad: spec.bearing.lag_c + c,
+            stiffness_nm_per_rad: spec.bearing_lag().0 + k,
+            damping_nms_per_rad: spec.bearing_lag().1 + c,
         },
         (k, c),
     ))
@@ -263,7 +263,7 @@ pub fn stability_map(
         // the damper linearised at the regressing lag's rotating-frame frequency: first the
         // blade's own lag frequency, then (once) the coupled mode's
         let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
-        let k0 = specs[0].0.spec.bearing.lag_k;
+        let k0 = specs[0].0.spec.bearing_lag().0;
         let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
             / m0.inertia_kg_m2)
             .sqrt();
@@ -289,8 +289,8 @@ pub fn stability_map(
                                 first_moment_kg_m: m.first_moment_kg_m,
                                 inertia_kg_m2: m.inertia_kg_m2,
                                 hinge_offset_m: b.spec.retention.hinge_r_m,
-                                stiffness_nm_per_rad: b.spec.bearing.lag_k + kc.0,
-                                damping_nms_per_rad: b.spec.bearing.lag_c + kc.1,
+                                stiffness_nm_per_rad: b.spec.bearing_lag().0 + kc.0,
+                                damping_nms_per_rad: b.spec.bearing_lag().1 + kc.1,
                             },
                             kc,
                         )

@@ -340,7 +340,7 @@ pub fn target_of(root: &Table, name: &str) -> Result<Target, String> {
     };
     crate::overrides::check_key(key).map_err(|e| e.to_string())?;
     let v = lookup(root, key).ok_or_else(|| {
-        format!("the deck has no value at `{key}` (a sensitivity moves a value the deck states; keys are dotted with the unit in the name, e.g. bearing.lag_damping_Nms_per_rad)")
+        format!("the deck has no value at `{key}` (a sensitivity moves a value the deck states; keys are dotted with the unit in the name, e.g. bearing.lag_stiffness_Nm_per_rad)")
     })?;
     let num = |v: &Value| match v {
         Value::Float(x) => Some(*x),

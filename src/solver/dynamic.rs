@@ -300,6 +300,7 @@ impl DynamicSolver {
             gravity: self.model.gravity,
             cscale: 1.0,
             inertia: true,
+            dt: 0.0,
         };
         self.asm
             .assemble(
@@ -517,7 +518,7 @@ impl DynamicSolver {
         let mut q_new = q_prev.clone();
         self.set_iterate(&mut x_new, &mut q_new, &q_prev, &v_new, &vd_new);
         self.model.update_distributed_loads(t, &self.kin);
-        let ctx = self.ctx(t);
+        let ctx = self.ctx(t, self.h);
         let fo = self.frame_omega;
         if !frame_terms {
             self.frame_omega = None;
@@ -530,14 +531,16 @@ impl DynamicSolver {
         Ok((self.res.clone(), self.asm.to_dense()))
     }
 
-    /// The evaluation context of a dynamic residual at time `t` (full loads and inertia).
-    fn ctx(&self, t: f64) -> EvalCtx {
+    /// The evaluation context of a dynamic residual at time `t` (full loads and inertia), at
+    /// the end of a step of `dt` (0: at a committed state).
+    fn ctx(&self, t: f64, dt: f64) -> EvalCtx {
         EvalCtx {
             t,
             load_factor: 1.0,
             gravity: self.model.gravity,
             cscale: self.cscale,
             inertia: true,
+            dt,
         }
     }
 
@@ -551,7 +554,7 @@ impl DynamicSolver {
             }
         }
         self.model.update_distributed_loads(t, &self.kin);
-        let ctx = self.ctx(t);
+        let ctx = self.ctx(t, 0.0);
         self.asm
             .force_scale(&self.model, &self.kin, &ctx, &mut self.res)
     }
@@ -587,7 +590,7 @@ impl DynamicSolver {
         q_prev.clone_from(&self.state.q);
         let mut lam_hat = std::mem::take(&mut self.ws_lam);
         lam_hat.clone_from(&self.lam_hat);
-        let ctx = self.ctx(t);
+        let ctx = self.ctx(t, h);
         let mut r0 = 0.0;
         let mut r_prev = 0.0;
         let mut it = 0;
@@ -744,7 +747,7 @@ impl DynamicSolver {
         }
         self.state.t = t;
         self.state.kin(&mut self.kin);
-        commit(&mut self.model, &self.kin);
+        commit(&mut self.model, &self.kin, h);
         self.total_iterations += it;
         self.steps += 1;
         Ok(StepInfo {
@@ -789,7 +792,7 @@ impl DynamicSolver {
                 }
             }
         };
-        let ctx = self.ctx(t);
+        let ctx = self.ctx(t, 0.0);
         self.model.update_distributed_loads(t, &self.kin);
         let xp = self.state.x.clone();
         let zero_lam = vec![0.0; self.lam_hat.len()];

@@ -90,6 +90,7 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
         gravity: model.gravity,
         cscale: 1.0,
         inertia: true,
+        dt: 0.0,
     };
     let lam = st.lambda.clone();
     let mut res = vec![0.0; ndof];

@@ -2,6 +2,7 @@
 //! model's parameters. A periodic solver restarts revolutions from them (perturbed through
 //! [`SolverSnapshot::set_coords`]) and a run writes the periodic one to disk for warm starts.
 use super::DynamicSolver;
+use crate::structure::joint::Joint;
 use crate::structure::model::Element;
 use crate::structure::rotation::*;
 use nalgebra::UnitQuaternion;
@@ -46,6 +47,10 @@ pub struct SolverSnapshot {
     pub joint_angles_rad: Vec<Option<f64>>,
     /// Committed state of every step element (e.g. a hydraulic device).
     pub step_elements: Vec<Vec<f64>>,
+    /// Committed branch moments [N m] of every joint's elastomer, empty for other elements and
+    /// joints without one (absent in older files: the elastomers keep their state).
+    #[serde(default)]
+    pub joint_elastomers_nm: Vec<Vec<f64>>,
 }
 
 impl SolverSnapshot {
@@ -148,6 +153,18 @@ impl DynamicSolver {
                 .iter()
                 .map(|s| s.state_values())
                 .collect(),
+            joint_elastomers_nm: self
+                .model
+                .elements
+                .iter()
+                .map(|e| match e {
+                    Element::Joint(Joint {
+                        elastomer: Some(el),
+                        ..
+                    }) => el.committed.branch_nm.to_vec(),
+                    _ => vec![],
+                })
+                .collect(),
         }
     }
 
@@ -210,6 +227,34 @@ impl DynamicSolver {
                 match a {
                     Some(a) if a.is_finite() => j.angle_prev = *a,
                     _ => return Err(format!("saved state has no angle for joint {}", j.name)),
+                }
+            }
+        }
+        let n_el = s.joint_elastomers_nm.len();
+        if n_el != 0 && n_el != self.model.elements.len() {
+            return Err(format!(
+                "saved state has {n_el} elastomer entries, the model {} elements (not a state of this model)",
+                self.model.elements.len()
+            ));
+        }
+        for (k, e) in self.model.elements.iter_mut().enumerate() {
+            if let Element::Joint(j) = e {
+                let angle = j.angle_prev;
+                if let Some(el) = &mut j.elastomer {
+                    el.committed.angle_rad = angle;
+                    if let Some(v) = s.joint_elastomers_nm.get(k) {
+                        if v.len() != el.committed.branch_nm.len()
+                            || v.iter().any(|x| !x.is_finite())
+                        {
+                            return Err(format!(
+                                "saved state of joint {}'s elastomer: expected {} finite branch moments, got {:?}",
+                                j.name,
+                                el.committed.branch_nm.len(),
+                                v
+                            ));
+                        }
+                        el.committed.branch_nm.copy_from_slice(v);
+                    }
                 }
             }
         }

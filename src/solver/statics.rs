@@ -85,12 +85,42 @@ pub fn diag_scale(asm: &Assembler) -> f64 {
     }
 }
 
-/// Solve the static equilibrium, updating `st` in place (load factor ramps to 1).
+/// Largest rotation increment of a Newton correction in the damped retry [rad].
+const DAMPED_MAX_ROTATION: f64 = 0.1;
+
+/// Solve the static equilibrium, updating `st` in place (load factor ramps to 1). Full Newton
+/// first; when it diverges or meets a singular matrix on the way (a large first correction can
+/// overshoot, e.g. a rotating blade whose pitch, flap and lag are all soft), once more from
+/// the same start with each correction scaled down to at most 0.1 rad of rotation (damped
+/// Newton, 8 times the iterations). If that fails too, the first error is returned.
 pub fn static_solve(
     model: &mut Model,
     st: &mut State,
     opts: &StaticOptions,
     mut progress: impl FnMut(usize, usize, usize, f64),
+) -> Result<StaticReport, NewtonError> {
+    let start = st.clone();
+    match solve(model, st, opts, None, &mut progress) {
+        Err(
+            first @ (NewtonError::StaticDiverged { .. }
+            | NewtonError::NonFinite { .. }
+            | NewtonError::Linear { .. }),
+        ) => {
+            *st = start;
+            let mut damped = opts.clone();
+            damped.newton.max_iterations *= 8;
+            solve(model, st, &damped, Some(DAMPED_MAX_ROTATION), &mut progress).map_err(|_| first)
+        }
+        r => r,
+    }
+}
+
+fn solve(
+    model: &mut Model,
+    st: &mut State,
+    opts: &StaticOptions,
+    max_rotation: Option<f64>,
+    progress: &mut impl FnMut(usize, usize, usize, f64),
 ) -> Result<StaticReport, NewtonError> {
     let t = opts.time;
     let lerr = |source, iteration| NewtonError::Linear {
@@ -112,6 +142,7 @@ pub fn static_solve(
         gravity: model.gravity,
         cscale: 1.0,
         inertia: opts.omega.is_some(),
+        dt: 0.0,
     };
     // constraint scaling from the tangent diagonal at the start
     let mut lam_hat = vec![0.0; ndof - nn];
@@ -224,6 +255,15 @@ pub fn static_solve(
                 *r = -*r;
             }
             asm.solve(&mut res);
+            if let Some(cap) = max_rotation {
+                let rot = (0..model.nodes.len())
+                    .flat_map(|i| res[6 * i + 3..6 * i + 6].iter())
+                    .fold(0.0f64, |m, v| m.max(v.abs()));
+                if rot > cap {
+                    let f = cap / rot;
+                    res.iter_mut().for_each(|r| *r *= f);
+                }
+            }
             let mut dmax: f64 = 0.0;
             for i in 0..model.nodes.len() {
                 let dx = [res[6 * i], res[6 * i + 1], res[6 * i + 2]];
@@ -262,17 +302,18 @@ pub fn static_solve(
     }
     // commit: joint angle tracking and step elements
     let kin_c: Vec<NodeKin<f64>> = (0..st.x.len()).map(|i| st.node_kin(i)).collect();
-    commit(model, &kin_c);
+    commit(model, &kin_c, 0.0);
     Ok(report)
 }
 
-/// Commit converged state: joints update their unwrapped angle, step elements `commit()`.
-pub fn commit(model: &mut Model, kin: &[NodeKin<f64>]) {
+/// Commit the converged state at the end of a step of `dt` [s] (0: statics): joints update
+/// their unwrapped angle and their elastomer's history, step elements `commit()`.
+pub fn commit(model: &mut Model, kin: &[NodeKin<f64>], dt: f64) {
     for e in model.elements.iter_mut() {
         if let crate::structure::model::Element::Joint(j) = e {
             let a = j.node_a.map(|i| kin[i]).unwrap_or_else(NodeKin::ground);
             let b = kin[j.node_b];
-            j.angle_prev = j.angle(&a, &b);
+            j.commit(&a, &b, dt);
         }
     }
     for s in model.step_elements.iter_mut() {

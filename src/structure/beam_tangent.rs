@@ -662,6 +662,7 @@ mod tests {
             gravity: [0.5, -1.0, -9.81],
             cscale: 1.0,
             inertia,
+            dt: 0.0,
         }
     }
 

@@ -1,6 +1,7 @@
 //! Model deck (TOML), documented in docs/model_deck.md. Unknown keys are rejected; every
 //! reference (node, beam, joint) is checked and reported with the deck file and the key.
 use super::beam::BeamLoad;
+use super::elastomer::{Elastomer, MaxwellChain};
 use super::hydraulic::{AppliedForce, HydraulicForceElement, HydraulicProbe};
 use super::joint::{AngleLaw, BushingCoeffs, JointKind};
 use super::kin::TimeTable;
@@ -221,6 +222,21 @@ pub struct JointDeck {
     /// Bushing axes locked by multipliers, any of `AXES` once each.
     #[serde(default)]
     pub locked: Option<Vec<String>>,
+    /// An elastomer about a revolute joint's axis; `stiffness_Nm_per_rad` is then its storage
+    /// stiffness at the reference frequency.
+    #[serde(default)]
+    pub elastomer: Option<ElastomerDeck>,
+}
+
+/// An elastomer about a joint axis: a Maxwell chain fitted to a constant loss factor over a
+/// band of frequencies (src/structure/elastomer.rs).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElastomerDeck {
+    pub loss_factor: f64,
+    pub band_rad_s: [f64; 2],
+    /// Frequency at which the storage stiffness is the joint's `stiffness_Nm_per_rad`.
+    pub reference_rad_s: f64,
 }
 
 /// A bushing's axis names in `Joint::bushing_locked` order: translations, then rotations.
@@ -1091,6 +1107,27 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
             }
             if let Some(u) = j.displacement_m {
                 jj.displacement_m = Some((u, table(&j.displacement_table)));
+            }
+            if let Some(el) = &j.elastomer {
+                let ek = format!("{key}.elastomer");
+                if kind != JointKind::Revolute || jj.prescribed_angle.is_some() {
+                    return Err(inv(
+                        ek,
+                        "an elastomer acts about a free revolute axis (type = \"revolute\" without omega_rad_s or angle_table)".into(),
+                    ));
+                }
+                if j.stiffness.is_nan() || j.stiffness <= 0.0 {
+                    return Err(inv(
+                        format!("{key}.stiffness_Nm_per_rad"),
+                        "an elastomer needs its storage stiffness here: expected > 0".into(),
+                    ));
+                }
+                let [lo, hi] = el.band_rad_s;
+                let chain =
+                    MaxwellChain::fit(j.stiffness, el.loss_factor, lo, hi, el.reference_rad_s)
+                        .map_err(|e| inv(ek, e))?;
+                jj.spring_nm_per_rad = 0.0;
+                jj.elastomer = Some(Elastomer::new(chain));
             }
         }
     }

@@ -88,8 +88,14 @@ impl MaxwellChain {
             a[(FIT_POINTS, i + 1)] = weight * unit.branch_parts(i, w_ref).0;
         }
         rhs[FIT_POINTS] = weight;
+        if a.iter().any(|v| !v.is_finite()) {
+            return Err(format!(
+                "band [{w_lo}, {w_hi}] rad/s: the fit's frequencies are out of floating-point range"
+            ));
+        }
         let x = a
-            .svd(true, true)
+            .try_svd(true, true, 1e-15, 1000)
+            .ok_or_else(|| "elastomer fit: the least-squares solve did not converge".to_string())?
             .solve(&rhs, 1e-14)
             .map_err(|e| format!("elastomer fit: {e}"))?;
         let mut c = MaxwellChain {
@@ -167,39 +173,54 @@ impl Elastomer {
         }
     }
 
-    /// Branch moments at the end of a step of `h` [s] to angle `psi_f`. `h = 0` (statics): the
-    /// fully relaxed chain (branches carry nothing), i.e. the limit of a long step.
-    fn end_branches(&self, psi_f: f64, h: f64) -> ([f64; BRANCHES], f64) {
+    /// The step's moment as an affine function of the end angle, `moment = m0 + slope psi_f`:
+    /// `(slope, m0)` for a step of `h` [s] from the committed state. `h = 0` (no time passes: a
+    /// static solve or a report at the committed state): the branches hold their committed
+    /// moments, `slope = K_inf`; on a fresh element they are zero, the relaxed spring.
+    pub fn affine(&self, h: f64) -> (f64, f64) {
         let c = &self.chain;
-        let mut m = [0.0; BRANCHES];
-        let mut slope = c.k_inf;
-        if h > 0.0 {
-            let dpsi = psi_f - self.committed.angle_rad;
-            for i in 0..BRANCHES {
-                let a = (-h / c.tau_s[i]).exp();
-                let g = c.k[i] * c.tau_s[i] * (1.0 - a) / h;
-                m[i] = a * self.committed.branch_nm[i] + g * dpsi;
-                slope += g;
-            }
+        let s = &self.committed;
+        if h <= 0.0 {
+            return (c.k_inf, s.branch_nm.iter().sum());
         }
-        (m, slope)
+        let (mut slope, mut m0) = (c.k_inf, 0.0);
+        for i in 0..BRANCHES {
+            let a = (-h / c.tau_s[i]).exp();
+            let g = c.k[i] * c.tau_s[i] * (1.0 - a) / h;
+            m0 += a * s.branch_nm[i] - g * s.angle_rad;
+            slope += g;
+        }
+        (slope, m0)
+    }
+
+    /// Branch moments at the end of a step of `h` [s] to angle `psi_f` (held when `h = 0`).
+    fn end_branches(&self, psi_f: f64, h: f64) -> [f64; BRANCHES] {
+        let c = &self.chain;
+        let s = &self.committed;
+        if h <= 0.0 {
+            return s.branch_nm;
+        }
+        let dpsi = psi_f - s.angle_rad;
+        std::array::from_fn(|i| {
+            let a = (-h / c.tau_s[i]).exp();
+            a * s.branch_nm[i] + c.k[i] * c.tau_s[i] * (1.0 - a) / h * dpsi
+        })
     }
 
     /// Moment [N m] and its tangent at the end of a step of `h` [s] to angle `psi_f` [rad].
     pub fn step(&self, psi_f: f64, h: f64) -> ElastomerStep {
-        let (m, slope) = self.end_branches(psi_f, h);
+        let (slope, m0) = self.affine(h);
         ElastomerStep {
-            moment_nm: self.chain.k_inf * psi_f + m.iter().sum::<f64>(),
+            moment_nm: m0 + slope * psi_f,
             slope_nm_per_rad: slope,
         }
     }
 
     /// Accepts the step to `psi_f` over `h` [s].
     pub fn commit(&mut self, psi_f: f64, h: f64) {
-        let (m, _) = self.end_branches(psi_f, h);
         self.committed = ElastomerState {
             angle_rad: psi_f,
-            branch_nm: m,
+            branch_nm: self.end_branches(psi_f, h),
         };
     }
 }
@@ -254,6 +275,9 @@ mod tests {
         assert!(MaxwellChain::fit(1.0, f64::NAN, 8.0, 100.0, 27.0).is_err());
         assert!(MaxwellChain::fit(1.0, 0.1, 100.0, 8.0, 27.0).is_err());
         assert!(MaxwellChain::fit(1.0, 0.1, 8.0, 100.0, 200.0).is_err());
+        // a band beyond floating-point range is refused, not looped on
+        assert!(MaxwellChain::fit(1.0, 0.1, 1e-310, 1e-309, 5e-310).is_err());
+        let _ = MaxwellChain::fit(1.0, 0.1, 1e300, 1e308, 1e301); // returns, either way
     }
 
     /// Energy per cycle of `psi = A sin(w t)` from the element's own time stepping (trapezoidal
@@ -315,7 +339,14 @@ mod tests {
             assert!((fd - an).abs() < tol, "h {h}: fd {fd}, analytic {an}");
             assert_eq!(e, before, "a trial changed the state");
         }
-        // a static step holds the relaxed stiffness only
-        assert_eq!(e.step(0.5, 0.0).moment_nm, c.k_inf * 0.5);
+        // no time passes: the branches hold, the relaxed spring adds; a fresh element is relaxed
+        let held: f64 = e.committed.branch_nm.iter().sum();
+        assert!((e.step(0.5, 0.0).moment_nm - (c.k_inf * 0.5 + held)).abs() < 1e-12 * held.abs());
+        assert_eq!(Elastomer::new(c).step(0.5, 0.0).moment_nm, c.k_inf * 0.5);
+        // the affine form is the step moment itself
+        for h in [1e-4, 1e-2] {
+            let direct = e.end_branches(0.0151, h).iter().sum::<f64>() + c.k_inf * 0.0151;
+            assert!((e.step(0.0151, h).moment_nm - direct).abs() < 1e-12 * direct.abs());
+        }
     }
 }

@@ -10,6 +10,7 @@
 //! Constraint forces `B^T lambda` with `B = dPhi/dq`: in closed form (`residual_f64`, `tangent`,
 //! used by the assembler) and, as the reference, by nested dual numbers (`residual`,
 //! `tangent_dual`).
+use super::elastomer::Elastomer;
 use super::kin::{EvalCtx, NodeKin, Seed, TimeTable};
 use super::real::{c, Dual, Real};
 use super::rotation::*;
@@ -99,6 +100,9 @@ pub struct Joint {
     pub bushing_locked: [bool; 6],
     /// Unwrapped angle at the last converged step (for the spring and sensors).
     pub angle_prev: f64,
+    /// An elastomer about the joint axis (a Maxwell chain with its history), in parallel with
+    /// the spring and damper; revolute joints only.
+    pub elastomer: Option<Elastomer>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -147,6 +151,7 @@ impl Joint {
             bushing: BushingCoeffs::default(),
             bushing_locked: [false; 6],
             angle_prev: 0.0,
+            elastomer: None,
         }
     }
 
@@ -272,13 +277,12 @@ impl Joint {
             self.bushing_residual(a, b, out);
             return;
         }
-        if (self.spring_nm_per_rad != 0.0 || self.damper_nms_per_rad != 0.0)
-            && self.prescribed_angle.is_none()
-        {
+        if self.has_spring() {
             let ang = self.angle(a, b);
             let z = mv(&mm(&a.r, &m3c(&self.qa)), [c(0.0), c(0.0), c(1.0)]);
             let rate = dot(z, sub(b.w, a.w));
-            let m = (ang.scale(self.spring_nm_per_rad)) + rate.scale(self.damper_nms_per_rad);
+            let (k, m0) = self.axis_law(ctx.dt);
+            let m = ang.scale(k) + c::<T>(m0) + rate.scale(self.damper_nms_per_rad);
             for j in 0..3 {
                 out[off_b + 3 + j] += m * z[j];
                 if self.node_a.is_some() {
@@ -399,12 +403,37 @@ impl Joint {
         s
     }
 
-    /// Whether the spring/damper about the joint axis acts (never on a bushing, whose
-    /// springs are its own).
+    /// Whether the spring/damper/elastomer about the joint axis acts (never on a bushing,
+    /// whose springs are its own).
     fn has_spring(&self) -> bool {
-        (self.spring_nm_per_rad != 0.0 || self.damper_nms_per_rad != 0.0)
+        (self.spring_nm_per_rad != 0.0
+            || self.damper_nms_per_rad != 0.0
+            || self.elastomer.is_some())
             && self.prescribed_angle.is_none()
             && self.kind != JointKind::Bushing
+    }
+
+    /// The elastic part of the axis moment as `k psi + m0` at the end of a step of `dt` [s]
+    /// (0: at the committed state): the spring plus the elastomer's step, affine in the end
+    /// angle (src/structure/elastomer.rs).
+    fn axis_law(&self, dt: f64) -> (f64, f64) {
+        match &self.elastomer {
+            None => (self.spring_nm_per_rad, 0.0),
+            Some(e) => {
+                let (slope, m0) = e.affine(dt);
+                (self.spring_nm_per_rad + slope, m0)
+            }
+        }
+    }
+
+    /// Accepts the converged configuration at the end of a step of `dt` [s] (0: statics): the
+    /// unwrapped angle and the elastomer's history.
+    pub fn commit(&mut self, a: &NodeKin<f64>, b: &NodeKin<f64>, dt: f64) {
+        let psi = self.angle(a, b);
+        self.angle_prev = psi;
+        if let Some(e) = &mut self.elastomer {
+            e.commit(psi, dt);
+        }
     }
 
     /// Constraint gradients w.r.t. the rotation of A of the rotation constraints,
@@ -485,7 +514,7 @@ impl Joint {
         add_to(off_b + 3, sub(cross(g.rho_b, fo), mo));
         if self.has_spring() {
             let z = g.f[2];
-            let mz = fmul(self.spring_moment(a, b, z), z);
+            let mz = fmul(self.spring_moment(a, b, z, ctx.dt), z);
             add_to(off_b + 3, mz);
             if has_a {
                 add_to(3, fmul(-1.0, mz));
@@ -500,22 +529,34 @@ impl Joint {
         }
     }
 
-    /// The moment the joint transmits about its free z axis: its own spring and damper,
-    /// `k psi + c psi'` (psi the unwrapped [`Joint::angle`], psi' the relative angular velocity
-    /// about the axis), what node B's side exerts on node A's side about +z (B receives
-    /// `-m z`); the constraint moments are normal to the axis. Zero for a joint without them,
-    /// with a prescribed angle, or a bushing (whose springs act on six axes).
+    /// The moment the joint transmits about its free z axis: its own spring, damper and
+    /// elastomer, `k psi + c psi' + m_e` (psi the unwrapped [`Joint::angle`], psi' the relative
+    /// angular velocity about the axis, `m_e` the elastomer's moment with its branches as
+    /// committed), what node B's side exerts on node A's side about +z (B receives `-m z`); the
+    /// constraint moments are normal to the axis. Zero for a joint without them, with a
+    /// prescribed angle, or a bushing (whose springs act on six axes).
     pub fn axis_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>) -> f64 {
         if !self.has_spring() {
             return 0.0;
         }
         let z = mv(&mm(&a.r, &self.qa), [0.0, 0.0, 1.0]);
-        self.spring_moment(a, b, z)
+        self.spring_moment(a, b, z, 0.0)
     }
 
-    /// Spring/damper moment `k psi + c z . (w_B - w_A)` about the joint axis `z`.
-    fn spring_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>, z: V3<f64>) -> f64 {
-        self.angle(a, b) * self.spring_nm_per_rad + dot(z, sub(b.w, a.w)) * self.damper_nms_per_rad
+    /// The elastomer's part of [`Joint::axis_moment`] (its branches as committed) [N m]; 0
+    /// without one.
+    pub fn elastomer_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>) -> f64 {
+        match (&self.elastomer, self.has_spring()) {
+            (Some(e), true) => e.step(self.angle(a, b), 0.0).moment_nm,
+            _ => 0.0,
+        }
+    }
+
+    /// Spring/damper/elastomer moment `k psi + m0 + c z . (w_B - w_A)` about the joint axis
+    /// `z` at the end of a step of `dt` ([`Joint::axis_law`]).
+    fn spring_moment(&self, a: &NodeKin<f64>, b: &NodeKin<f64>, z: V3<f64>, dt: f64) -> f64 {
+        let (k, m0) = self.axis_law(dt);
+        self.angle(a, b) * k + m0 + dot(z, sub(b.w, a.w)) * self.damper_nms_per_rad
     }
 
     /// Tangent in closed form, same as `tangent_dual`: the directional derivative of
@@ -579,7 +620,14 @@ impl Joint {
             let gs = sub(cross(f1, b0), cross(f0, b1));
             let gc = add(cross(f0, b0), cross(f1, b1));
             let gpsi = fmul(1.0 / (sn * sn + cs * cs), sub(fmul(cs, gs), fmul(sn, gc)));
-            (z, self.spring_moment(a, b, z), gpsi, sub(b.w, a.w))
+            let k = self.axis_law(ctx.dt).0;
+            (
+                z,
+                self.spring_moment(a, b, z, ctx.dt),
+                gpsi,
+                sub(b.w, a.w),
+                k,
+            )
         });
         let zero = [0.0; 3];
         for col in 0..nn {
@@ -617,9 +665,9 @@ impl Joint {
             let dfo = cross(ta, fo);
             let mut mom_a = add(add(cross(dfo, g.pb_xa), cross(fo, dpb_xa)), dmo);
             let mut mom_b = sub(add(cross(drho_b, fo), cross(g.rho_b, dfo)), dmo);
-            if let Some((z, mz, gpsi, wr)) = spring {
+            if let Some((z, mz, gpsi, wr, k)) = spring {
                 let dz = cross(ta, z);
-                let dm = self.spring_nm_per_rad * dot(sub(ta, tb), gpsi)
+                let dm = k * dot(sub(ta, tb), gpsi)
                     + self.damper_nms_per_rad * (dot(dz, wr) + dot(z, sub(dwb, dwa)));
                 let dmz = add(fmul(dm, z), fmul(mz, dz));
                 mom_a = sub(mom_a, dmz);

@@ -137,6 +137,10 @@ pub struct EvalCtx {
     pub cscale: f64,
     /// Whether inertial forces are included.
     pub inertia: bool,
+    /// Length of the dynamic step being solved [s] (the residual is at its end, `t`); 0
+    /// outside a step (statics, a report at a committed state), where elements with history
+    /// (elastomers) hold their committed state.
+    pub dt: f64,
 }
 
 impl Default for EvalCtx {
@@ -147,6 +151,7 @@ impl Default for EvalCtx {
             gravity: [0.0; 3],
             cscale: 1.0,
             inertia: true,
+            dt: 0.0,
         }
     }
 }

@@ -2,6 +2,7 @@
 //! point and generalized-alpha seeds) shared by the joint tangent tests and the joint cost
 //! benchmark (benches/structure_tangent.rs).
 #![allow(dead_code)]
+use rotorsim::structure::elastomer::{Elastomer, ElastomerState, MaxwellChain};
 use rotorsim::structure::rotation::*;
 use rotorsim::structure::*;
 
@@ -53,6 +54,8 @@ pub enum Extra {
     Disp,
     SpringDamper,
     DispSpring,
+    /// Spring, damper and an elastomer with history, inside a step or at a committed state.
+    Elastomer,
 }
 
 pub const KINDS: [JointKind; 4] = [
@@ -107,6 +110,20 @@ pub fn case(rng: &mut Rng, kind: JointKind, grounded: bool, extra: Extra, dyn_se
                 j.displacement_m = Some((rng.v3(0.2), table()));
             }
         }
+        Extra::Elastomer => {
+            j.spring_nm_per_rad = rng.uni(1e3, 1e5);
+            j.damper_nms_per_rad = rng.uni(10.0, 1e3);
+            let w = rng.uni(5.0, 50.0);
+            let chain =
+                MaxwellChain::fit(rng.uni(1e3, 1e5), rng.uni(0.05, 0.3), 0.3 * w, 4.0 * w, w)
+                    .expect("a passive chain");
+            let mut e = Elastomer::new(chain);
+            e.committed = ElastomerState {
+                angle_rad: rng.uni(-20.0, 20.0),
+                branch_nm: std::array::from_fn(|_| rng.uni(-1e3, 1e3)),
+            };
+            j.elastomer = Some(e);
+        }
     }
     j.angle_prev = rng.uni(-20.0, 20.0);
     let a = if grounded {
@@ -119,6 +136,12 @@ pub fn case(rng: &mut Rng, kind: JointKind, grounded: bool, extra: Extra, dyn_se
     let ctx = EvalCtx {
         t: rng.uni(0.0, 1.0),
         cscale: rng.uni(0.5, 50.0),
+        // inside a step (the elastomer's step moment) or at a committed state
+        dt: if rng.uni(0.0, 1.0) < 0.5 {
+            0.0
+        } else {
+            rng.uni(1e-4, 1e-2)
+        },
         ..Default::default()
     };
     let nnodes = 1 + !grounded as usize;
