@@ -125,3 +125,64 @@ fn no_output_csv_has_duplicate_column_names() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Reads a CSV written by rotorsim: header and rows of strings.
+fn read(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut rd = csv::Reader::from_path(path).unwrap();
+    let h = rd.headers().unwrap().iter().map(String::from).collect();
+    let rows = rd
+        .records()
+        .map(|r| r.unwrap().iter().map(String::from).collect())
+        .collect();
+    (h, rows)
+}
+
+#[test]
+fn all_revs_ends_with_last_rev_channel_for_channel() {
+    // The elastic model with its load channels (the equilibrium check's are dropped from the
+    // outputs after the run, the hub's fixed-frame loads added, the physical damper's sub-step
+    // envelopes moved last): the last revolution of all_revs.csv is last_rev.csv, every
+    // channel by its name, to the last digit written.
+    let out = tmp("all_revs_columns");
+    let o = Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .current_dir(repo(""))
+        .args([
+            "run",
+            "--damper",
+            "all",
+            "--revs",
+            "2",
+            "--periodic",
+            "march",
+            "--write-all-revs",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for model in ["linear", "nonlinear", "physical"] {
+        let (hl, last) = read(&out.join(model).join("last_rev.csv"));
+        let (ha, all) = read(&out.join(model).join("all_revs.csv"));
+        assert_eq!(all.len(), 2 * last.len());
+        let tail = &all[all.len() - last.len()..];
+        let mut compared = 0;
+        for (j, name) in hl.iter().enumerate() {
+            if name.starts_with("measured_") {
+                continue;
+            }
+            let i = ha
+                .iter()
+                .position(|c| c == name)
+                .unwrap_or_else(|| panic!("{model}: all_revs.csv has no column {name}"));
+            for (k, row) in last.iter().enumerate() {
+                assert_eq!(tail[k][i], row[j], "{model}: {name}, sample {k}");
+            }
+            compared += 1;
+        }
+        // all_revs adds the revolution and the shooting iterate
+        assert_eq!(compared + 2, ha.len(), "{model}: {ha:?}");
+        assert!(hl.iter().any(|c| c == "hub_mz_fixed_Nm"));
+    }
+    let _ = std::fs::remove_dir_all(out);
+}

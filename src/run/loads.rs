@@ -72,6 +72,10 @@ pub fn finish(run: &mut ModelRun, blades: Option<usize>) {
     run.channel_names.retain(|_| *k.next().unwrap_or(&true));
     let mut k = keep.iter();
     run.last_rev.retain(|_| *k.next().unwrap_or(&true));
+    for rev in &mut run.all_revs {
+        let mut k = keep.iter();
+        rev.samples.retain(|_| *k.next().unwrap_or(&true));
+    }
     let (Some(n), Some(_)) = (blades, root) else {
         return;
     };
@@ -79,22 +83,31 @@ pub fn finish(run: &mut ModelRun, blades: Option<usize>) {
     if root.len() != 6 || n == 0 {
         return;
     }
-    // blade 0's root loads in the non-rotating frame, then the sum over the blades
-    let m = run.azimuth_deg.len();
-    let mut fixed = vec![vec![0.0; m]; 6];
-    for (i, az) in run.azimuth_deg.iter().enumerate() {
-        let psi = az.to_radians();
-        for part in 0..2 {
-            let v = std::array::from_fn(|c| run.last_rev[root[3 * part + c]][i]);
-            let f = hub::to_fixed(psi, v);
-            for (c, fc) in f.iter().enumerate() {
-                fixed[3 * part + c][i] = *fc;
+    // blade 0's root loads in the non-rotating frame, then the sum over the blades; for every
+    // kept revolution too, so that all_revs.csv has the channels of last_rev.csv
+    let hub_loads = |samples: &[Vec<f64>]| -> Vec<Vec<f64>> {
+        let m = run.azimuth_deg.len();
+        let mut fixed = vec![vec![0.0; m]; 6];
+        for (i, az) in run.azimuth_deg.iter().enumerate() {
+            let psi = az.to_radians();
+            for part in 0..2 {
+                let v = std::array::from_fn(|c| samples[root[3 * part + c]][i]);
+                let f = hub::to_fixed(psi, v);
+                for (c, fc) in f.iter().enumerate() {
+                    fixed[3 * part + c][i] = *fc;
+                }
             }
         }
-    }
-    for (c, y) in fixed.iter().enumerate() {
+        fixed.iter().map(|y| hub::sum_of_blades(y, n)).collect()
+    };
+    let last = hub_loads(&run.last_rev);
+    let kept: Vec<Vec<Vec<f64>>> = run.all_revs.iter().map(|k| hub_loads(&k.samples)).collect();
+    for (c, y) in last.into_iter().enumerate() {
         run.channel_names.push(HUB_CHANNELS[c].to_string());
-        run.last_rev.push(hub::sum_of_blades(y, n));
+        run.last_rev.push(y);
+    }
+    for (k, y) in run.all_revs.iter_mut().zip(kept) {
+        k.samples.extend(y);
     }
 }
 
