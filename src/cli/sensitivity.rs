@@ -1,14 +1,13 @@
 //! `rotorsim sensitivity --rotor DECK --out DIR`: every value the deck labels ASSUMED (and any
 //! `--vary KEY=LOW:HIGH`) moved over its range through the sweep engine (pipeline:
 //! src/sensitivity/, docs/sensitivity.md).
-use super::sweep::{check_with_progress, default_jobs, env_shard, BatchArgs};
+use super::sweep::{check_with_progress, default_jobs, env_shard, BatchArgs, Console};
 use crate::sensitivity::{self, table::OUTPUTS, SensitivityOptions, Vary};
-use crate::sweep::{self, Case, JobRunner, SweepOptions, SweepProgress};
+use crate::sweep::{self, JobRunner, SweepOptions};
 use anyhow::{bail, Context};
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -51,32 +50,6 @@ pub struct SensitivityArgs {
 
 fn parse_vary(s: &str) -> Result<Vary, String> {
     Vary::parse(s).map_err(|e| format!("{e:#}"))
-}
-
-/// One plain line per case as it ends.
-struct Lines {
-    done: AtomicUsize,
-    total: AtomicUsize,
-}
-
-impl SweepProgress for Lines {
-    fn start(&self, to_run: usize, total: usize) {
-        self.total.store(to_run, Ordering::Relaxed);
-        self.done.store(0, Ordering::Relaxed);
-        errln!(
-            "rotorsim sensitivity: {to_run} case(s) to run of {total} ({} already done or kept)",
-            total - to_run
-        );
-    }
-    fn case_done(&self, case: &Case, result: &Result<(), String>, wall_s: f64) {
-        let n = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        let total = self.total.load(Ordering::Relaxed);
-        let what = match result {
-            Ok(()) => "done".to_string(),
-            Err(e) => format!("FAILED: {e}"),
-        };
-        errln!("[{n}/{total}] case {} {what} ({wall_s:.1} s)", case.id);
-    }
 }
 
 pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
@@ -175,10 +148,7 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let progress = Lines {
-        done: AtomicUsize::new(0),
-        total: AtomicUsize::new(0),
-    };
+    let progress = Console::lines("rotorsim sensitivity");
     let out = sensitivity::run(&opts, setup, &plan, &runner, &progress)?;
     for n in &out.notes {
         errln!("note: {n}");

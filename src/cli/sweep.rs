@@ -77,11 +77,26 @@ pub(crate) fn at_least_one(s: &str) -> Result<usize, String> {
     }
 }
 
-/// One progress bar on a terminal, plain lines otherwise.
-struct Console {
+/// One progress bar on a terminal, plain lines otherwise (also the sensitivity's, which
+/// prints lines only).
+pub(crate) struct Console {
+    /// The command the lines name (`rotorsim sweep`, `rotorsim sensitivity`).
+    command: &'static str,
     bar: Option<ProgressBar>,
     done: AtomicUsize,
     total: AtomicUsize,
+}
+
+impl Console {
+    /// Plain lines, one per case as it ends.
+    pub(crate) fn lines(command: &'static str) -> Self {
+        Console {
+            command,
+            bar: None,
+            done: AtomicUsize::new(0),
+            total: AtomicUsize::new(0),
+        }
+    }
 }
 
 impl SweepProgress for Console {
@@ -92,7 +107,8 @@ impl SweepProgress for Console {
             b.set_message(format!("{total} cases in this sweep"));
         } else {
             errln!(
-                "rotorsim sweep: {to_run} case(s) to run of {total} ({} already done or kept)",
+                "{}: {to_run} case(s) to run of {total} ({} already done or kept)",
+                self.command,
                 total - to_run
             );
         }
@@ -182,8 +198,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     });
     let console = Console {
         bar,
-        done: AtomicUsize::new(0),
-        total: AtomicUsize::new(0),
+        ..Console::lines("rotorsim sweep")
     };
     let t0 = Instant::now();
     let opts = SweepOptions {
