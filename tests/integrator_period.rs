@@ -5,11 +5,13 @@
 //! Why it matters: the lag decay's frequency differs from the linearised mode by the
 //! integrator's period error alone (docs/validation_tm4760.md, "Integrator settings and their
 //! cost"), so at equal spectral radius `rho_inf` the scheme decides which code lands nearer.
+mod support;
 use nalgebra::{Matrix3, Matrix4};
 use rotorsim::solver::{DynamicSolver, State};
 use rotorsim::structure::deck::parse_deck;
 use std::f64::consts::PI;
 use std::path::Path;
+use support::upward_crossings;
 
 /// Rigid body on a grounded bushing: x is an undamped oscillator of `omega` [rad/s].
 fn oscillator(omega: f64) -> rotorsim::structure::Model {
@@ -77,14 +79,6 @@ fn two_step_error(rho: f64, w: f64) -> f64 {
         0.0, 1.0, 0.0, 0.0,
     );
     relative_frequency_error(t.complex_eigenvalues().iter().copied(), w)
-}
-
-/// Upward zero crossings (linear interpolation) of a sampled history.
-fn upward_crossings(h: &[(f64, f64)]) -> Vec<f64> {
-    h.windows(2)
-        .filter(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
-        .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1))
-        .collect()
 }
 
 #[test]

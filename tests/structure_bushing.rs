@@ -2,6 +2,7 @@
 //! natural frequencies and free decay of a rigid body on a grounded bushing against the closed
 //! form, static deflections (small and large rotations), equal and opposite loads, and a
 //! grounded bushing next to a driven shaft under modified Newton.
+mod support;
 use rotorsim::solver::fdcheck::check_model;
 use rotorsim::solver::modal::{modes, ModalOptions};
 use rotorsim::solver::{
@@ -11,6 +12,7 @@ use rotorsim::structure::deck::parse_deck;
 use rotorsim::structure::rotation::*;
 use rotorsim::structure::*;
 use std::path::Path;
+use support::upward_crossings;
 
 mod joint_support;
 use joint_support::*;
@@ -227,12 +229,6 @@ fn rigid_body_on_grounded_bushing_has_the_closed_form_frequencies() {
 }
 
 /// Upward zero crossings of `x` (linear interpolation), from the time history `(t, x)`.
-fn upward_crossings(h: &[(f64, f64)]) -> Vec<f64> {
-    h.windows(2)
-        .filter(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
-        .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1))
-        .collect()
-}
 
 #[test]
 fn free_decay_gives_the_damped_frequency_and_logarithmic_decrement() {

@@ -88,3 +88,11 @@ pub fn hammond_rotor(inoperative: Option<usize>) -> rotorsim::stability::LagRoto
         }),
     }
 }
+
+/// Upward zero crossings (linear interpolation) of a sampled history.
+pub fn upward_crossings(h: &[(f64, f64)]) -> Vec<f64> {
+    h.windows(2)
+        .filter(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
+        .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1))
+        .collect()
+}
