@@ -303,6 +303,8 @@ const CASES: &[Case] = &[
     case("model EA NaN", cant!("EA_N = 1e6", "EA_N = nan"), STATIC_M, &["m.toml", "EA_N"]),
     case("model mass negative", cant!("m_kg_per_m = 1.0", "m_kg_per_m = -1.0"), STATIC_M, &["m.toml", "m_kg_per_m"]),
     case("model inertia negative", cant!("I2_kgm = 5e-5", "I2_kgm = -5e-5"), DYN_M, &["m.toml", "I2_kgm"]),
+    case("model elastomer on a clamp", cant!("type = \"clamp\"\nnode_b = \"beam.n0\"", "type = \"clamp\"\nnode_b = \"beam.n0\"\nelastomer = { loss_factor = 0.1, band_rad_s = [6.0, 80.0], reference_rad_s = 20.0 }"), STATIC_M, &["m.toml", "joint[0] `root`.elastomer", "free revolute axis"]),
+    case("model elastomer loss factor NaN", cant!("type = \"clamp\"\nnode_b = \"beam.n0\"", "type = \"revolute\"\nnode_b = \"beam.n0\"\nstiffness_Nm_per_rad = 100.0\nelastomer = { loss_factor = nan, band_rad_s = [6.0, 80.0], reference_rad_s = 20.0 }"), STATIC_M, &["m.toml", "joint[0] `root`.elastomer", "loss factor NaN"]),
     case("model elements zero", cant!("elements = 8", "elements = 0"), STATIC_M, &["m.toml", "elements"]),
     case("model beam of zero length", cant!("end_m = [10.0, 0.0, 0.0]", "end_m = [0.0, 0.0, 0.0]"), STATIC_M, &["m.toml", "end_m"]),
     case("model start NaN", cant!("start_m = [0.0, 0.0, 0.0]", "start_m = [nan, 0.0, 0.0]"), STATIC_M, &["m.toml", "start_m"]),
