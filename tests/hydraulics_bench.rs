@@ -310,3 +310,51 @@ fn replay_of_a_synthetic_measurement_reproduces_its_own_model() {
             > 100.0
     );
 }
+
+#[test]
+fn the_force_alone_is_the_replays_force_bit_for_bit() {
+    // A stroke that opens the relief valves, so the sub-step envelope has something to record.
+    let d = deck();
+    let time_s: Vec<f64> = (0..2000).map(|i| i as f64 / 2000.0).collect();
+    let stroke_m: Vec<f64> = time_s
+        .iter()
+        .map(|t| 6e-3 * (2.0 * std::f64::consts::PI * 4.3 * t).sin())
+        .collect();
+    let test = bench::BenchTest {
+        name: "opening".into(),
+        time_s: time_s.clone(),
+        stroke_m: stroke_m.clone(),
+        force_n: None,
+        velocity_m_s: None,
+    };
+    for model in [
+        DamperModel::Physical,
+        DamperModel::Linear,
+        DamperModel::Nonlinear,
+    ] {
+        let dev = d.build(model, IntegratorOptions::default()).unwrap();
+        let full = bench::replay(dev.as_ref(), &test).unwrap();
+        let force = bench::replay_force(dev.as_ref(), &time_s, &stroke_m).unwrap();
+        assert_eq!(force, full.force_model_n, "{model:?}");
+    }
+    // With the envelope off the steps are the same and only the envelope channels go.
+    let mut dev = d
+        .build(DamperModel::Physical, IntegratorOptions::default())
+        .unwrap();
+    let on = bench::replay(dev.as_ref(), &test).unwrap().history;
+    dev.set_substep_envelope(false);
+    let off = bench::replay(dev.as_ref(), &test).unwrap().history;
+    let opened = on
+        .channel_names
+        .iter()
+        .position(|n| *n == "x_valve0_substep_max_m")
+        .unwrap();
+    assert!(on.channels[opened].iter().any(|&x| x > 0.0));
+    for (c, name) in on.channel_names.iter().enumerate() {
+        if rotorsim::hydraulics::circuit::is_substep_envelope(name) {
+            assert!(off.channels[c].iter().all(|v| v.is_nan()), "{name}");
+        } else {
+            assert_eq!(on.channels[c], off.channels[c], "{name}");
+        }
+    }
+}

@@ -169,17 +169,21 @@ pub struct Outcome {
 /// Device of a deck for a test's sample interval (RK4, sub-steps from `max_h`).
 fn device(deck: &DamperDeck, dt: f64, max_h: f64) -> Result<Box<dyn Device>, HydraulicError> {
     let substeps = ((dt / max_h).ceil() as usize).max(1);
-    deck.build(
-        DamperModel::Physical,
-        IntegratorOptions {
-            scheme: Scheme::Rk4,
-            substeps,
-        },
-    )
-    .map_err(|e| HydraulicError::BadStep {
-        t: 0.0,
-        reason: e.to_string(),
-    })
+    let mut dev = deck
+        .build(
+            DamperModel::Physical,
+            IntegratorOptions {
+                scheme: Scheme::Rk4,
+                substeps,
+            },
+        )
+        .map_err(|e| HydraulicError::BadStep {
+            t: 0.0,
+            reason: e.to_string(),
+        })?;
+    // the fits read the force only
+    dev.set_substep_envelope(false);
+    Ok(dev)
 }
 
 /// Model force at the first `n` samples of a stroke-driven replay (force at the end of each

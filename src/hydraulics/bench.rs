@@ -428,6 +428,34 @@ pub struct Replay {
     pub history: History,
 }
 
+/// The force of [`replay`] alone, at each sample of a stroke history (`time_s` strictly
+/// increasing, equal lengths, at least one sample), without the channels: the sub-step
+/// envelope is not recorded and nothing but the force is kept.
+pub fn replay_force(
+    device: &dyn Device,
+    time_s: &[f64],
+    stroke_m: &[f64],
+) -> Result<Vec<f64>, HydraulicError> {
+    let n = time_s.len().min(stroke_m.len());
+    let mut force = Vec::with_capacity(n);
+    if n == 0 {
+        return Ok(force);
+    }
+    let mut dev = device.clone_device();
+    dev.set_substep_envelope(false);
+    dev.reset();
+    let first = dev.trial_step(time_s[0], 1e-9, stroke_m[0], stroke_m[0])?;
+    dev.reset();
+    force.push(first.force_end);
+    for k in 0..n - 1 {
+        let dt = time_s[k + 1] - time_s[k];
+        let sf = dev.trial_step(time_s[k], dt, stroke_m[k], stroke_m[k + 1])?;
+        dev.commit();
+        force.push(sf.force_end);
+    }
+    Ok(force)
+}
+
 /// Drives `device` (reset first) with the measured stroke, one step per sample interval.
 pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, HydraulicError> {
     let mut dev = device.clone_device();

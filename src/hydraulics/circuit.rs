@@ -449,6 +449,12 @@ impl SubstepEnvelope {
         max: [f64::NEG_INFINITY; 6],
     };
 
+    /// Not recorded.
+    pub const NOT_RECORDED: Self = SubstepEnvelope {
+        min: [f64::NAN; 6],
+        max: [f64::NAN; 6],
+    };
+
     /// The envelope of one state (both bounds the values at that state).
     fn at(params: &CircuitParams, t: f64, d: f64, y: &State) -> Self {
         let mut e = Self::EMPTY;
@@ -469,7 +475,7 @@ impl SubstepEnvelope {
 }
 
 impl OdeSystem<NS> for StepSystem<'_> {
-    #[inline]
+    #[inline(always)]
     fn rhs(&self, t: f64, y: &State) -> Result<State, HydraulicError> {
         let d = self.d_i + self.d_dot * (t - self.t_i);
         Ok(self
@@ -548,6 +554,8 @@ pub struct CircuitDevice {
     /// Relief-valve extremes over the sub-steps of the committed step [0] and of the trial [1]
     /// (boxed: keeps the device small where it is held by value).
     envelope: Box<[SubstepEnvelope; 2]>,
+    /// Record the envelope ([`Device::set_substep_envelope`]).
+    record_envelope: bool,
 }
 
 const DAMPER_CHANNELS: &[&str] = &[
@@ -615,6 +623,21 @@ impl CircuitDevice {
             committed_d: 0.0,
             trial: None,
             envelope: Box::new([envelope; 2]),
+            record_envelope: true,
+        }
+    }
+
+    /// The envelope of the committed state alone, when recorded.
+    fn envelope_at_commit(&self) -> SubstepEnvelope {
+        if self.record_envelope {
+            SubstepEnvelope::at(
+                &self.params,
+                self.committed_t,
+                self.committed_d,
+                &self.committed,
+            )
+        } else {
+            SubstepEnvelope::NOT_RECORDED
         }
     }
 
@@ -684,12 +707,14 @@ impl Device for CircuitDevice {
             d_dot: (d_f - d_i) / dt,
             contact: None,
             // the step's start included, so consecutive envelopes join
-            envelope: Some(SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed)),
+            envelope: self
+                .record_envelope
+                .then(|| SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed)),
         };
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
         let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
-        let envelope = sys.envelope.take().unwrap_or(SubstepEnvelope::EMPTY);
+        let envelope = sys.envelope.take().unwrap_or(SubstepEnvelope::NOT_RECORDED);
         let force_mean = y[IIMP] / dt;
         let dforce_dstroke = match self.tangent {
             Tangent::Eq16 => -0.5 * self.params.static_stiffness(&y, d_f),
@@ -787,7 +812,7 @@ impl Device for CircuitDevice {
         self.committed_t = 0.0;
         self.committed_d = 0.0;
         self.trial = None;
-        self.envelope[0] = SubstepEnvelope::at(&self.params, 0.0, 0.0, &self.committed);
+        self.envelope[0] = self.envelope_at_commit();
     }
 
     fn state_values(&self) -> Vec<f64> {
@@ -804,12 +829,12 @@ impl Device for CircuitDevice {
         self.committed_d = v[NS + 1];
         self.trial = None;
         // no sub-steps behind a restored state: its own values
-        self.envelope[0] = SubstepEnvelope::at(
-            &self.params,
-            self.committed_t,
-            self.committed_d,
-            &self.committed,
-        );
+        self.envelope[0] = self.envelope_at_commit();
         Ok(())
+    }
+
+    fn set_substep_envelope(&mut self, on: bool) {
+        self.record_envelope = on;
+        self.envelope[0] = self.envelope_at_commit();
     }
 }

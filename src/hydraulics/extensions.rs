@@ -352,6 +352,10 @@ impl Device for ExtendedDamper {
         self.inner.force_scale().max(self.committed_force().abs())
     }
 
+    fn set_substep_envelope(&mut self, on: bool) {
+        self.inner.set_substep_envelope(on);
+    }
+
     fn clone_device(&self) -> Box<dyn Device> {
         Box::new(self.clone())
     }
@@ -419,6 +423,10 @@ macro_rules! series_link_methods {
 
         fn force_scale(&self) -> f64 {
             self.inner.force_scale()
+        }
+
+        fn set_substep_envelope(&mut self, on: bool) {
+            self.inner.set_substep_envelope(on);
         }
     };
 }

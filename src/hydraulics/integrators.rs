@@ -109,7 +109,7 @@ pub const SDIRK3: SdirkTableau<3> = SdirkTableau {
 };
 
 /// One explicit RK step of size h from (t, y).
-#[inline]
+#[inline(always)]
 pub fn explicit_step<const N: usize, const S: usize>(
     tab: &ExplicitTableau<S>,
     sys: &impl OdeSystem<N>,

@@ -106,6 +106,7 @@ fn circuit_part(y: &LState) -> State {
 }
 
 impl OdeSystem<NL> for LinkSystem<'_> {
+    #[inline(always)]
     fn rhs(&self, t: f64, y: &LState) -> Result<LState, HydraulicError> {
         let d = self.d_i + self.d_dot * (t - self.t_i);
         let e = y[IE];
@@ -289,6 +290,7 @@ impl Sided<NM> for MassLinkSystem<'_> {
 }
 
 impl OdeSystem<NM> for MassLinkSystem<'_> {
+    #[inline(always)]
     fn rhs(&self, t: f64, y: &MState) -> Result<MState, HydraulicError> {
         let tau = t - self.t_i;
         let d = self.d_i + tau * (self.v_i + 0.5 * self.acc * tau);
@@ -594,6 +596,10 @@ impl Device for LinkedCircuit {
 
     fn force_scale(&self) -> f64 {
         self.inner.force_scale().max(self.committed_force().abs())
+    }
+
+    fn set_substep_envelope(&mut self, on: bool) {
+        self.inner.set_substep_envelope(on);
     }
 
     fn clone_device(&self) -> Box<dyn Device> {

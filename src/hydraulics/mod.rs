@@ -195,6 +195,11 @@ pub trait Device: Send + Sync + std::fmt::Debug {
     /// Restores a state of [`Device::state_values`] (same device kind and layout) and drops
     /// any trial state.
     fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError>;
+    /// Whether the steps record what moves within them (the relief valves' sub-step envelope
+    /// channels: one more evaluation per sub-step). On by default; a replay that reads only
+    /// the force turns it off, and the envelope channels are then NaN. Default: nothing to
+    /// record.
+    fn set_substep_envelope(&mut self, _on: bool) {}
 }
 
 /// `v` has `n` values, else a [`HydraulicError::BadState`] naming `what`.
