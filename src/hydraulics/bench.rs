@@ -417,6 +417,52 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
     })
 }
 
+impl BenchTest {
+    /// A stroke history given as arrays (time [s], stroke [m]), checked as the bench CSV reader
+    /// checks a file: equal lengths, at least two samples, finite values, increasing time.
+    /// `source` names the history in errors.
+    pub fn from_arrays(
+        source: &str,
+        time_s: Vec<f64>,
+        stroke_m: Vec<f64>,
+    ) -> Result<Self, BenchCsvError> {
+        let other = |message: String| BenchCsvError::Other {
+            file: source.into(),
+            message,
+        };
+        if time_s.len() != stroke_m.len() {
+            return Err(other(format!(
+                "time_s has {} samples and stroke_m {}: they must have the same length",
+                time_s.len(),
+                stroke_m.len()
+            )));
+        }
+        if time_s.len() < 2 {
+            return Err(other("need at least two samples".into()));
+        }
+        for (name, x) in [("time_s", &time_s), ("stroke_m", &stroke_m)] {
+            if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+                return Err(other(format!("{name}[{i}] = {} is not finite", x[i])));
+            }
+        }
+        if let Some(i) = time_s.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(other(format!(
+                "time_s[{}] = {} s does not increase (previous {} s)",
+                i + 1,
+                time_s[i + 1],
+                time_s[i]
+            )));
+        }
+        Ok(Self {
+            name: source.into(),
+            time_s,
+            stroke_m,
+            force_n: None,
+            velocity_m_s: None,
+        })
+    }
+}
+
 /// Model response to a measured stroke history.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replay {
