@@ -14,7 +14,7 @@ def _array(x, name):
     a = _np.asarray(x, dtype=_np.float64)
     if a.ndim != 1:
         raise ValueError(f"{name} must be a one-dimensional array (got shape {a.shape})")
-    return a.tolist()
+    return _np.ascontiguousarray(a)
 
 
 class Damper:
@@ -49,10 +49,7 @@ class Damper:
         --measured`` replays a bench test. The first value is the initial force. ``time_s``
         must increase; both arrays must have the same length and finite values (ValueError).
         """
-        return _np.array(
-            self._d.force(_array(time_s, "time_s"), _array(stroke_m, "stroke_m")),
-            dtype=_np.float64,
-        )
+        return self._d.force(_array(time_s, "time_s"), _array(stroke_m, "stroke_m"))
 
     def states(self, time_s, stroke_m):
         """The replay of ``force`` with the device's internal channels.
@@ -62,7 +59,7 @@ class Damper:
         A pandas DataFrame when pandas is installed, else a dict of numpy arrays.
         """
         cols = self._d.states(_array(time_s, "time_s"), _array(stroke_m, "stroke_m"))
-        data = {name: _np.array(v, dtype=_np.float64) for name, v in cols}
+        data = dict(cols)
         try:
             import pandas as pd
         except ImportError:

@@ -1,6 +1,7 @@
 //! Python bindings of rotorsim (module `rotorsim._native`, wrapped by the `rotorsim` package).
 //! Every computation is a call of the rotorsim library; this crate converts arguments and
 //! results and maps errors to Python exceptions (nothing here panics on user input).
+use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use rotorsim::hydraulics::bench::{self, BenchTest};
@@ -28,8 +29,14 @@ struct Damper {
     scheme: String,
 }
 
-/// The replay's columns: time, stroke, velocity, force and the device's channels.
-type Columns = Vec<(String, Vec<f64>)>;
+/// The replay's columns: time, stroke, velocity, force and the device's channels, as numpy
+/// arrays (no Python lists in between).
+type Columns<'py> = Vec<(String, Bound<'py, PyArray1<f64>>)>;
+
+/// A one-dimensional float64 array's values (a copy: the replay runs without the GIL).
+fn values(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    a.as_array().iter().copied().collect()
+}
 
 impl Damper {
     fn replay(
@@ -91,15 +98,26 @@ impl Damper {
     }
 
     /// Force [N] at each sample of the stroke history (the first: the device's initial force).
-    fn force(&self, py: Python<'_>, time_s: Vec<f64>, stroke_m: Vec<f64>) -> PyResult<Vec<f64>> {
-        Ok(self.replay(py, time_s, stroke_m)?.force_model_n)
+    fn force<'py>(
+        &self,
+        py: Python<'py>,
+        time_s: PyReadonlyArray1<'py, f64>,
+        stroke_m: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let r = self.replay(py, values(&time_s), values(&stroke_m))?;
+        Ok(PyArray1::from_vec(py, r.force_model_n))
     }
 
     /// The replay's columns (name, values): time_s, stroke_m, velocity_m_s, force_N and the
     /// device's internal channels, named with their units.
-    fn states(&self, py: Python<'_>, time_s: Vec<f64>, stroke_m: Vec<f64>) -> PyResult<Columns> {
-        let h = self.replay(py, time_s, stroke_m)?.history;
-        let mut cols = vec![
+    fn states<'py>(
+        &self,
+        py: Python<'py>,
+        time_s: PyReadonlyArray1<'py, f64>,
+        stroke_m: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Columns<'py>> {
+        let h = self.replay(py, values(&time_s), values(&stroke_m))?.history;
+        let mut cols: Vec<(String, Vec<f64>)> = vec![
             ("time_s".to_string(), h.time_s),
             ("stroke_m".to_string(), h.stroke_m),
             ("velocity_m_s".to_string(), h.velocity_m_s),
@@ -111,7 +129,10 @@ impl Damper {
                 .map(|n| n.to_string())
                 .zip(h.channels),
         );
-        Ok(cols)
+        Ok(cols
+            .into_iter()
+            .map(|(n, v)| (n, PyArray1::from_vec(py, v)))
+            .collect())
     }
 
     /// Names (with units) of the device's internal channels.
