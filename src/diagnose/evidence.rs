@@ -245,6 +245,23 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             p("A_orf_m2"),
             p("relief_a_m")
         ),
+        "force_lag" => format!(
+            "the data acquisition: the force channel lags the stroke channel by {:.2} ms (a filter or a sampling delay), which tilts the force-stroke loop like a compliance would; the damper is not at fault for this part",
+            1e3 * p("lag_s")
+        ),
+        "force_offset" => format!(
+            "the data acquisition: the force channel carries an offset of {:+.0} N (a zero error), which shifts both peaks alike; the damper is not at fault for this part",
+            p("offset_N")
+        ),
+        "force_gain" => format!(
+            "the data acquisition: the force channel reads {:.4} times the force (a calibration error of {:+.1}%), which scales every force alike, relief-valve plateaus included; the damper is not at fault for this part",
+            p("gain"),
+            100.0 * (p("gain") - 1.0)
+        ),
+        "force_drift" => format!(
+            "the data acquisition: the force channel drifts by {:+.1} N/s from the start of each test (a thermal or bridge drift); the damper is not at fault for this part",
+            p("drift_N_per_s")
+        ),
         _ => "no candidate beats the baseline by more than the noise-level threshold".to_string(),
     }
 }

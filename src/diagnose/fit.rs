@@ -1,6 +1,7 @@
 //! Fitting and ranking: every candidate's parameters by Levenberg-Marquardt (bounded through a
 //! logistic-log transform, multi-start), BIC on the fit data, RMS on held-out data, and the
 //! choice of the cause.
+use super::acquisition::{self, Fault, Span};
 use super::candidates::{apply_all, combined_name, combined_params, Cause, ParamSpec, Scales};
 use super::data::{check_measurements, noise_sigma, Measurement};
 use super::DiagnoseError;
@@ -28,6 +29,8 @@ pub struct DiagnoseOptions {
     pub patience: usize,
     /// Try pairs of causes when the best single one leaves a systematic residual.
     pub pairs: bool,
+    /// Acquisition faults to try (default: all).
+    pub faults: Vec<Fault>,
 }
 
 impl Default for DiagnoseOptions {
@@ -38,6 +41,7 @@ impl Default for DiagnoseOptions {
             candidates: Cause::CANDIDATES.to_vec(),
             patience: 8,
             pairs: true,
+            faults: Fault::ALL.to_vec(),
         }
     }
 }
@@ -90,6 +94,10 @@ pub struct Companion {
     /// The pair is the chosen cause.
     pub kept: bool,
     pub reason: String,
+    /// Held-out test statistic of the companion (`criterion_companions`), when the pair was
+    /// fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub held_out_z: Option<f64>,
 }
 
 /// Per-test summary (extra key `tests`).
@@ -133,6 +141,8 @@ pub struct Diagnosis {
     pub threshold_N: f64,
     pub baseline_bic: f64,
     pub criterion: String,
+    /// The companions' held-out test: statistic, correction and the z each had to exceed.
+    pub criterion_companions: String,
     pub limitations: Vec<String>,
     /// Residual signatures of the measured force, the baseline and every candidate's
     /// prediction, measured alike.
@@ -292,7 +302,7 @@ fn residuals_x(
 }
 
 /// Normal quantile of a two-sided 95% interval.
-const Z95: f64 = 1.959_963_984_540_054;
+pub(super) const Z95: f64 = 1.959_963_984_540_054;
 
 /// 95% intervals of fitted parameters: the noise's scatter plus a bound on the bias that
 /// model-form error puts on them. J is the Jacobian of the fit residuals by central differences
@@ -608,6 +618,172 @@ pub fn bic(rss: f64, n: usize, k: usize) -> f64 {
     n * (rss.max(1e-300) / n).ln() + k as f64 * n.ln()
 }
 
+/// Where a fault candidate is fitted and judged.
+struct FaultContext<'a> {
+    data: &'a [Measurement],
+    fit_w: &'a [Window],
+    held_w: &'a [Window],
+    all_w: &'a [Window],
+    sigma: f64,
+}
+
+fn spans(w: &[Window]) -> Vec<Span> {
+    w.iter()
+        .map(|w| Span {
+            test: w.test,
+            from: w.from,
+            to: w.to,
+        })
+        .collect()
+}
+
+/// An acquisition fault fitted on top of a model: the baseline (`on` None; the deck `base`)
+/// or a fitted physical cause (`on`, named `cause+fault`, its parameters kept).
+fn fault_candidate(
+    fault: Fault,
+    on: Option<&Evaluated>,
+    baseline: &[Vec<f64>],
+    base: &DamperDeck,
+    cx: &FaultContext,
+) -> Option<Evaluated> {
+    let model: &[Vec<f64>] = match on {
+        Some(e) => e.1.as_deref()?,
+        None => baseline,
+    };
+    let data = cx.data;
+    let f = acquisition::fit(fault, data, model, &spans(cx.fit_w));
+    if !f.value.is_finite() {
+        return None;
+    }
+    let sim: Vec<Vec<f64>> = data
+        .iter()
+        .zip(model)
+        .map(|(m, s)| fault.apply(f.value, &m.time_s, s))
+        .collect();
+    let n_fit: usize = cx.fit_w.iter().map(|w| w.to - w.from).sum();
+    let held = rms_over(cx.held_w, &sim, data);
+    let ms = (f.rss / n_fit.max(1) as f64).max(held * held);
+    let iv = acquisition::interval(&f, n_fit, cx.sigma, ms);
+    let (cause, mut parameters, mut intervals, k, deck, mut x, evals) = match on {
+        Some(e) => (
+            format!("{}+{}", e.0.cause, fault.name()),
+            e.0.parameters.clone(),
+            e.0.intervals.clone(),
+            e.0.k + 1,
+            e.2.clone(),
+            e.3.clone(),
+            e.0.fit_evaluations,
+        ),
+        None => (
+            fault.name().to_string(),
+            BTreeMap::new(),
+            BTreeMap::new(),
+            1,
+            base.clone(),
+            vec![],
+            0,
+        ),
+    };
+    parameters.insert(fault.param().into(), f.value);
+    intervals.insert(fault.param().into(), iv);
+    x.push(f.value);
+    let row = Candidate {
+        cause,
+        rms_N: rms_over(cx.all_w, &sim, data),
+        bic: bic(f.rss, n_fit, k),
+        parameters,
+        held_out_rms_N: held,
+        intervals,
+        k,
+        fit_evaluations: evals + f.evaluations,
+        note: on.map(|e| {
+            format!(
+                "the fault fitted on top of {} as fitted alone (not a joint fit)",
+                e.0.cause
+            )
+        }),
+        failure: None,
+    };
+    Some((row, Some(sim), deck, x))
+}
+
+/// A pair against the single it extends (`reference`: its BIC and held-out RMS): it must
+/// lower the BIC and improve the held-out RMS by more than `threshold`.
+fn judge_pair(e: &Evaluated, reference: (f64, f64), threshold: f64) -> (bool, String) {
+    let r = &e.0;
+    let d_bic = reference.0 - r.bic;
+    let d_held = reference.1 - r.held_out_rms_N;
+    let by_bic = d_bic > 0.0;
+    let by_held = d_held > threshold;
+    let reason = format!(
+        "BIC {} by {:.1} ({}); held-out RMS {} by {:.1} N against a threshold of {:.1} N ({})",
+        if by_bic { "lower" } else { "higher" },
+        d_bic.abs(),
+        if by_bic {
+            "earns its parameters"
+        } else {
+            "does not earn its parameters"
+        },
+        if d_held >= 0.0 { "lower" } else { "higher" },
+        d_held.abs(),
+        threshold,
+        if by_held {
+            "improves held-out data"
+        } else {
+            "no held-out improvement"
+        },
+    );
+    (e.1.is_some() && by_bic && by_held, reason)
+}
+
+/// Family-wise false-alarm rate of the companions' held-out test.
+const COMPANION_ALPHA: f64 = 0.05;
+
+/// Held-out test statistic of a pair against its single (module docs of the choice):
+/// `sum(e d) / (sigma ||d||)`, `e = y - mu_single`, `d = mu_pair - mu_single` over `windows`.
+fn held_out_z(
+    windows: &[Window],
+    single: &[Vec<f64>],
+    pair: &[Vec<f64>],
+    data: &[Measurement],
+    sigma: f64,
+) -> f64 {
+    let (mut ed, mut dd) = (0.0, 0.0);
+    for w in windows {
+        let (s, p, y) = (&single[w.test], &pair[w.test], &data[w.test].force_n);
+        for i in w.from..w.to {
+            let d = p[i] - s[i];
+            ed += (y[i] - s[i]) * d;
+            dd += d * d;
+        }
+    }
+    if dd > 0.0 {
+        ed / (sigma * dd.sqrt())
+    } else {
+        0.0
+    }
+}
+
+/// Standard normal quantile by bisection on `erfc` (to 1e-12).
+fn normal_quantile(p: f64) -> f64 {
+    let cdf = |z: f64| 0.5 * libm::erfc(-z / std::f64::consts::SQRT_2);
+    let (mut lo, mut hi) = (-40.0, 40.0);
+    while hi - lo > 1e-12 {
+        let m = 0.5 * (lo + hi);
+        if cdf(m) < p {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Whether a candidate's name holds an acquisition fault.
+fn has_fault(name: &str) -> bool {
+    name.split('+').any(|n| Fault::from_name(n).is_some())
+}
+
 /// Runs the diagnosis of `base` against `data`.
 pub fn diagnose(
     base: &DamperDeck,
@@ -915,6 +1091,19 @@ pub fn diagnose(
             .collect()
     };
     let mut evaluated = stage(&singles, usize::MAX);
+    // Acquisition faults on the baseline: fitted on its replays, no replay of their own.
+    let fcx = FaultContext {
+        data,
+        fit_w: &fit_w,
+        held_w: &held_w,
+        all_w: &all_w,
+        sigma,
+    };
+    evaluated.extend(
+        opts.faults
+            .iter()
+            .filter_map(|&f| fault_candidate(f, None, &baseline, base, &fcx)),
+    );
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
     // A compliant free play that is not decisively better than one of its limits gives way to
     // that limit (one parameter fewer): it moves behind the limit and may not be chosen.
@@ -931,6 +1120,7 @@ pub fn diagnose(
         .filter(|e| e.1.is_some())
         .map(|e| (e.0.clone(), e.3.clone()));
     let mut refit_single: Option<Evaluated> = None;
+    let first_cause = first.as_ref().map(|f| f.0.cause.clone());
     if let Some((row, x1)) = first {
         let first_ok = row.bic < base_bic && base_held - row.held_out_rms_N > threshold;
         let systematic = row.held_out_rms_N > 1.5 * sigma;
@@ -1056,6 +1246,7 @@ pub fn diagnose(
                             "not tried: alone its BIC ({alone:.1}) is not below the baseline's ({base_bic:.1}), and added at its starting values to {} it lowers no BIC (best {best:.1} against {:.1})",
                             row.cause, row.bic
                         ),
+                        held_out_z: None,
                     });
                 }
                 let mut ev = stage(&pairs, PAIRS_CONVERGED);
@@ -1098,24 +1289,7 @@ pub fn diagnose(
                     }
                 }
                 pair_ref = Some(reference);
-                let judge = |e: &Evaluated| -> (bool, String) {
-                    let r = &e.0;
-                    let d_bic = reference.0 - r.bic;
-                    let d_held = reference.1 - r.held_out_rms_N;
-                    let by_bic = d_bic > 0.0;
-                    let by_held = d_held > threshold;
-                    let reason = format!(
-                        "BIC {} by {:.1} ({}); held-out RMS {} by {:.1} N against a threshold of {:.1} N ({})",
-                        if by_bic { "lower" } else { "higher" },
-                        d_bic.abs(),
-                        if by_bic { "earns its parameters" } else { "does not earn its parameters" },
-                        if d_held >= 0.0 { "lower" } else { "higher" },
-                        d_held.abs(),
-                        threshold,
-                        if by_held { "improves held-out data" } else { "no held-out improvement" },
-                    );
-                    (e.1.is_some() && by_bic && by_held, reason)
-                };
+                let judge = |e: &Evaluated| judge_pair(e, reference, threshold);
                 for e in &ev {
                     let (passes, reason) = judge(e);
                     companions.push(Companion {
@@ -1124,6 +1298,7 @@ pub fn diagnose(
                         passes,
                         kept: false,
                         reason,
+                        held_out_z: None,
                     });
                 }
                 // The best single need not be one of the pair's causes (a bleed can stand in
@@ -1173,11 +1348,114 @@ pub fn diagnose(
                                 e.0.cause.split('+').next().unwrap_or_default(),
                                 row.cause
                             ),
+                            held_out_z: None,
                         });
                     }
                     ev.extend(swapped);
                 }
                 evaluated.extend(ev);
+            }
+            // Acquisition faults beside a physical cause, each fitted on top of it: beside the
+            // best single when it is physical, or, when a fault is the best single, that fault
+            // on top of every physical single that lowers the baseline's BIC.
+            let reference = pair_ref.unwrap_or((row.bic, row.held_out_rms_N));
+            let ons: Vec<(Fault, Evaluated)> = match Fault::from_name(&row.cause) {
+                Some(f) => evaluated
+                    .iter()
+                    .filter(|e| {
+                        e.1.is_some()
+                            && !e.0.cause.contains('+')
+                            && !has_fault(&e.0.cause)
+                            && e.0.bic < base_bic
+                    })
+                    .map(|e| (f, e.clone()))
+                    .collect(),
+                None => refit_single
+                    .clone()
+                    .or_else(|| evaluated.iter().find(|e| e.0.cause == row.cause).cloned())
+                    .filter(|_| !has_fault(&row.cause))
+                    .map(|on| opts.faults.iter().map(|&f| (f, on.clone())).collect())
+                    .unwrap_or_default(),
+            };
+            let fault_pairs: Vec<Evaluated> = ons
+                .iter()
+                .filter_map(|(f, on)| fault_candidate(*f, Some(on), &baseline, base, &fcx))
+                .collect();
+            if !fault_pairs.is_empty() {
+                pair_ref = Some(reference);
+                pair_stage.push_str(&format!(
+                    "; acquisition faults tried beside {}",
+                    if Fault::from_name(&row.cause).is_some() {
+                        format!("every physical single cause below the baseline's BIC ({} fitted on top of each)", row.cause)
+                    } else {
+                        row.cause.clone()
+                    }
+                ));
+            }
+            for e in &fault_pairs {
+                let (passes, reason) = judge_pair(e, reference, threshold);
+                let names: Vec<&str> = e.0.cause.split('+').collect();
+                let companion = if Fault::from_name(&row.cause).is_some() {
+                    names[0]
+                } else {
+                    names[names.len() - 1]
+                };
+                companions.push(Companion {
+                    pair: e.0.cause.clone(),
+                    companion: companion.to_string(),
+                    passes,
+                    kept: false,
+                    reason,
+                    held_out_z: None,
+                });
+            }
+            evaluated.extend(fault_pairs);
+        }
+    }
+    // Held-out test of every companion fitted, corrected for their number (Bonferroni): the
+    // pair's change to the single's prediction on the held-out data, `d = mu_pair - mu_single`,
+    // against the single's residual `e`: `z = sum(e d) / (sigma ||d||)` is standard normal if
+    // the single cause is the whole truth and the noise white, and large where the companion
+    // predicts what the single leaves. A companion passes at a family-wise false-alarm rate of
+    // `COMPANION_ALPHA` when `z > z_(1 - alpha/m)`, m the companions fitted.
+    let reference_sim: Option<Vec<Vec<f64>>> =
+        refit_single.as_ref().and_then(|b| b.1.clone()).or_else(|| {
+            let first = first_cause.as_deref()?;
+            evaluated.iter().find(|e| e.0.cause == first)?.1.clone()
+        });
+    let fitted: Vec<usize> = companions
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| {
+            evaluated
+                .iter()
+                .any(|e| e.0.cause == c.pair && e.1.is_some())
+        })
+        .map(|(i, _)| i)
+        .collect();
+    let z_required = normal_quantile(1.0 - COMPANION_ALPHA / fitted.len().max(1) as f64);
+    let mut refused: Vec<String> = Vec::new();
+    if let Some(rs) = &reference_sim {
+        for &i in &fitted {
+            let c = &mut companions[i];
+            let Some(sim) = evaluated
+                .iter()
+                .find(|e| e.0.cause == c.pair)
+                .and_then(|e| e.1.as_ref())
+            else {
+                continue;
+            };
+            let z = held_out_z(&held_w, rs, sim, data, sigma);
+            c.held_out_z = Some(z);
+            let ok = z > z_required;
+            c.reason.push_str(&format!(
+                "; held-out test z = {z:.1} {} {z_required:.2} ({} companions fitted, false-alarm rate {COMPANION_ALPHA} over all of them)",
+                if ok { "above" } else { "not above" },
+                fitted.len()
+            ));
+            if c.passes && !ok {
+                c.passes = false;
+                refused.push(c.pair.clone());
             }
         }
     }
@@ -1202,6 +1480,7 @@ pub fn diagnose(
         };
         sim.is_some()
             && Some(&row.cause) != demoted.as_ref()
+            && !refused.contains(&row.cause)
             && row.bic < ref_bic
             && ref_held - row.held_out_rms_N > threshold
     });
@@ -1398,6 +1677,10 @@ pub fn diagnose(
         threshold_N: threshold,
         baseline_bic: base_bic,
         criterion: "BIC = n ln(RSS/n) + k ln n on the fit samples (n samples, k fitted parameters); the lowest BIC is chosen if it is below the baseline's and improves the held-out RMS by more than 0.05 sigma + 3 sigma/sqrt(2 n_held) (sigma: noise from second differences); else none".into(),
+        criterion_companions: format!(
+            "a companion is kept only if its pair also passes a held-out test: z = sum(e d)/(sigma ||d||) over the held-out samples (e: the single cause's residual, d: the pair's change to its prediction; standard normal when the single cause is the whole truth and the noise white) above z_(1 - {COMPANION_ALPHA}/m) = {z_required:.2}, m = {} companions fitted (Bonferroni: a false-alarm rate of {COMPANION_ALPHA} over all of them)",
+            fitted.len()
+        ),
         limitations,
         signatures,
         identifiability,
@@ -1594,10 +1877,23 @@ fn identifiability(
                 ""
             }
         );
+        // A test stroke decides between damper models; an acquisition fault is decided by
+        // checking the acquisition itself.
+        let (why, deciding) = if has_fault(&lead.cause) || has_fault(&e.0.cause) {
+            (
+                format!("{why}; one of them is an acquisition fault: a check of the data acquisition decides (a static load against a reference load cell for gain and offset, the zero reading before and after a test for drift, the phase of the force and stroke channels on a known signal for a lag)"),
+                None,
+            )
+        } else {
+            (
+                why,
+                deciding_test(lead_deck, &e.2, &cond, cx.max_h, camp, cx.sigma),
+            )
+        };
         out.push(Identifiability {
             candidates: vec![lead.cause.clone(), e.0.cause.clone()],
             why,
-            deciding_test: deciding_test(lead_deck, &e.2, &cond, cx.max_h, camp, cx.sigma),
+            deciding_test: deciding,
         });
     }
     // Parameters the data do not bound: the cause with the parameter doubled (or halved at the
@@ -1641,4 +1937,42 @@ fn identifiability(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_quantile_matches_the_tabulated_values() {
+        assert!((normal_quantile(0.975) - Z95).abs() < 1e-9);
+        // z_(1 - 0.05/10) = 2.5758293035489 (Abramowitz and Stegun, Table 26.5)
+        assert!((normal_quantile(0.995) - 2.575_829_303_548_9).abs() < 1e-9);
+        assert!(normal_quantile(0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn held_out_z_is_the_residuals_projection_on_the_pairs_change() {
+        // e = 3 d / ||d|| sigma: z = 3 whatever the size of d
+        let w = [Window {
+            test: 0,
+            from: 0,
+            to: 4,
+        }];
+        let single = vec![vec![0.0; 4]];
+        let d = [1.0, -2.0, 0.5, 2.0];
+        let nd = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let sigma = 7.0;
+        let pair = vec![d.iter().map(|x| 10.0 * x).collect::<Vec<f64>>()];
+        let m = Measurement {
+            name: "t".into(),
+            time_s: vec![0.0, 1.0, 2.0, 3.0],
+            stroke_m: vec![0.0; 4],
+            force_n: d.iter().map(|x| 3.0 * sigma * x / nd).collect(),
+            velocity_m_s: vec![0.0; 4],
+            period_s: 1.0,
+        };
+        let z = held_out_z(&w, &single, &pair, &[m], sigma);
+        assert!((z - 3.0).abs() < 1e-12, "{z}");
+    }
 }

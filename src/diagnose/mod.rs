@@ -2,6 +2,7 @@
 //! stroke-driven data, a library of physical extensions fitted by nonlinear least squares
 //! (Levenberg-Marquardt), ranking by BIC, validation on held-out data and the choice of a cause
 //! (or `none`). See docs/diagnosis.md.
+pub mod acquisition;
 pub mod candidates;
 pub mod data;
 pub mod evidence;

@@ -571,6 +571,9 @@ fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Resu
 /// Reads the data, diagnoses it and writes every output into `args.out`.
 pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
     let mut stroke_info: Option<Value> = None;
+    // Without a measured stroke there is no stroke channel for the force to lag: a lag
+    // between the force and the simulated stroke is the rotor model's phase error.
+    let mut stroke_simulated = false;
     let mut record: Option<(FlightRecord, PathBuf)> = None;
     let mut deck_label = String::new();
     let (deck, data, source) = match (&args.flight, args.measured.is_empty()) {
@@ -609,6 +612,7 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
                 let (m, info, statement) =
                     simulated_measurement(&rec, fl, &rotor_path, &deck, &opts, say)?;
                 stroke_info = Some(info);
+                stroke_simulated = true;
                 let src = format!(
                     "Flight record {} WITHOUT damper stroke (Omega = {} rad/s), baseline deck {}. {statement}{synth}",
                     fl.display(),
@@ -658,12 +662,20 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
             "nothing to diagnose: give --damper-deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
         ),
     };
-    let opts = DiagnoseOptions {
+    let mut opts = DiagnoseOptions {
         fit_cycles: args.fit_cycles,
         max_substep_s: args.max_substep,
         ..Default::default()
     };
-    let outcome = diagnose_with_progress(&deck, &data, &opts, say)?;
+    if stroke_simulated {
+        opts.faults.retain(|f| *f != super::acquisition::Fault::Lag);
+    }
+    let mut outcome = diagnose_with_progress(&deck, &data, &opts, say)?;
+    if stroke_simulated {
+        outcome.diagnosis.limitations.push(
+            "force_lag not tried: the stroke is simulated, so a lag of the force behind it is the rotor model's phase error, not the data acquisition's".into(),
+        );
+    }
     let d = &outcome.diagnosis;
     let mut inputs: Vec<PathBuf> = args.deck.iter().cloned().collect();
     if let Some(r) = &args.rotor {
@@ -697,6 +709,15 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
             }),
             rows: vec![],
             statement: "Rotor-level check skipped: no extension was chosen (cause none), the extended deck is the baseline deck.".into(),
+            curves: vec![],
+        }),
+        Some(_) if args.rotor_check && super::acquisition::only_faults(&d.cause) => Some(RotorCheck {
+            json: json!({
+                "statement": format!("The cause is the data acquisition ({}), not the damper: the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.", d.cause),
+                "skipped": true,
+            }),
+            rows: vec![],
+            statement: format!("Rotor-level check skipped: the cause is the data acquisition ({}), the extended deck is the baseline deck.", d.cause),
             curves: vec![],
         }),
         Some((rec, fl)) if args.rotor_check => {
