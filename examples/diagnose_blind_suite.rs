@@ -2,9 +2,17 @@
 //! independent truth model, diagnosed, scored; one CSV row per campaign as it finishes, then the
 //! rates.
 //! `cargo run --release --example diagnose_blind_suite -- [OUT.csv] [CYCLES] [RATE_HZ] [ID_PREFIX...]`
-//! `cargo run --release --example diagnose_blind_suite -- --effect-size` (effect vs noise only)
+//! `cargo run --release --example diagnose_blind_suite -- --effect-size [ID_PREFIX...]` (effect
+//! vs noise only, of the campaigns whose id starts with a prefix; all without one)
 //! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns;
 //! with BLIND_JSON_DIR set, every diagnosis.json is written there as `<id>.json`).
+//! CSV columns: id, kind (bench/flight), hidden effect(s) (`+`-joined causes, acquisition faults
+//! `force_lag`, `force_offset`, `force_gain`, `force_drift` among them), magnitudes, named cause,
+//! exact, hidden among named, held-out gain, g* (best reachable gain), sub-noise, required gain,
+//! then for each true parameter the named cause fitted (a fault's `lag_s`, `offset_N`, `gain`,
+//! `drift_N_per_s` too): name, true value, fitted value, 95% interval, covered; and the wall
+//! time. Whether the faults were named follows from `hidden` and `named`; the rates printed at
+//! the end count it.
 #[path = "../tests/blind_support/mod.rs"]
 mod blind;
 use rotorsim::diagnose::rotor::flight_measurement;
@@ -19,8 +27,12 @@ fn main() -> anyhow::Result<()> {
     let a: Vec<String> = std::env::args().collect();
     if a.get(1).map(String::as_str) == Some("--effect-size") {
         // Effect size only (no diagnosis): RMS of the effect, noise sigma, best reachable gain.
+        let prefixes = &a[2..];
         println!("id,hidden,effect_rms_N,noise_sigma_N,best_gain");
         for cp in blind::suite() {
+            if !prefixes.is_empty() && !prefixes.iter().any(|p| cp.id.starts_with(p.as_str())) {
+                continue;
+            }
             let (r, s, g) = blind::effect_size(&cp, 4, 2000.0).map_err(anyhow::Error::msg)?;
             println!("{},{},{r:.1},{s:.1},{g:.3}", cp.id, cp.hidden());
         }

@@ -397,3 +397,228 @@ fn detectability_rule_scores_sub_noise_campaigns_and_the_required_gain() {
     assert!((required_gain(Some(0.272)) - 0.2176).abs() < 1e-12);
     assert!((required_gain(Some(0.131)) - 0.1048).abs() < 1e-12);
 }
+
+#[test]
+fn acquisition_faults_transform_the_recorded_force() {
+    // The recorded force of a faulted campaign, sample by sample, against the clean truth force
+    // transformed by the faults: offset, gain and drift to round-off; the lag as the truth force
+    // integrated to the shifted times (not interpolated), which at a lag of exactly two samples
+    // is the clean force two samples earlier within the integrator's tolerance.
+    let physical = Effect::SealFriction(410.0);
+    let (lag, offset, gain, drift) = (1.3e-3, -287.0, 0.962, 612.0);
+    let cp = Campaign {
+        id: "faults".into(),
+        effects: vec![
+            Effect::ForceLag(lag),
+            Effect::ForceOffset(offset),
+            Effect::ForceGain(gain),
+            Effect::ForceDrift(drift),
+            physical,
+        ],
+        seed: 7,
+        flight: false,
+    };
+    // The faults stay out of the truth physics.
+    let model = cp.truth();
+    let mut only_physical = Truth::new(Sheet::nominal());
+    physical.apply(&mut only_physical);
+    assert_eq!(model, only_physical);
+    assert_eq!(
+        cp.acquisition(),
+        Acquisition {
+            lag_s: lag,
+            offset_n: offset,
+            gain,
+            drift_n_per_s: drift
+        }
+    );
+    let rate = 2000.0;
+    let stroke = Stroke::harmonic(OMEGA, 4.0 * 0.0254 / OMEGA);
+    let n = (2.0 * stroke.period() * rate).round() as usize + 1;
+    // A test starting later than 0 (a drift counts from each test's first sample).
+    let t: Vec<f64> = (0..n).map(|k| 0.01 + k as f64 / rate).collect();
+    let tol = Tolerance::default();
+    let clean = force_at(&model, &stroke, &t, tol).unwrap();
+    let peak = clean.iter().fold(0.0f64, |a, f| a.max(f.abs()));
+    let close = |a: &[f64], b: &[f64], eps: f64, what: &str| {
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= eps, "{what}: largest difference {worst} N");
+    };
+    let fault = |e: Vec<Effect>| Acquisition::of(&e);
+    let rec = |a: Acquisition| a.record(&model, &stroke, &t, tol).unwrap();
+    let eps = 1e-12 * peak;
+    // offset, gain, drift alone: exact algebraic transforms of the clean force
+    let off: Vec<f64> = clean.iter().map(|f| f + offset).collect();
+    close(
+        &rec(fault(vec![Effect::ForceOffset(offset)])),
+        &off,
+        eps,
+        "offset",
+    );
+    let gn: Vec<f64> = clean.iter().map(|f| gain * f).collect();
+    close(&rec(fault(vec![Effect::ForceGain(gain)])), &gn, eps, "gain");
+    let dr: Vec<f64> = clean
+        .iter()
+        .zip(&t)
+        .map(|(f, tk)| f + drift * (tk - t[0]))
+        .collect();
+    close(
+        &rec(fault(vec![Effect::ForceDrift(drift)])),
+        &dr,
+        eps,
+        "drift",
+    );
+    // lag: the truth at t - lag, integrated there
+    let shifted: Vec<f64> = t.iter().map(|tk| tk - lag).collect();
+    let at_shifted = force_at(&model, &stroke, &shifted, tol).unwrap();
+    let lagged = rec(fault(vec![Effect::ForceLag(lag)]));
+    close(&lagged, &at_shifted, eps, "lag");
+    let moved = lagged
+        .iter()
+        .zip(&clean)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved > 0.02 * peak,
+        "a 1.3 ms lag moves the force: {moved} N of {peak} N"
+    );
+    // all four: gain F(t - lag) + offset + drift (t - t0)
+    let all: Vec<f64> = at_shifted
+        .iter()
+        .zip(&t)
+        .map(|(f, tk)| gain * f + offset + drift * (tk - t[0]))
+        .collect();
+    close(&rec(cp.acquisition()), &all, 1e-9 * peak, "all four faults");
+    // A lag of exactly two samples is the clean force two samples earlier (the integrator
+    // steps onto other times: within its tolerance, 0.1% of the peak), not two samples later.
+    let two = rec(fault(vec![Effect::ForceLag(2.0 / rate)]));
+    close(&two[2..], &clean[..n - 2], 1e-3 * peak, "two-sample lag");
+    // Shifted times below 0 take the force at t = 0.
+    let early: Vec<f64> = (0..n).map(|k| k as f64 / rate).collect();
+    let f_early = fault(vec![Effect::ForceLag(lag)])
+        .record(&model, &stroke, &early, tol)
+        .unwrap();
+    let f0 = force_at(&model, &stroke, &[0.0], tol).unwrap()[0];
+    assert_eq!(&f_early[..3], &[f0, f0, f0]);
+    assert!(f_early.iter().all(|f| f.is_finite()));
+}
+
+#[test]
+fn acquisition_faults_reach_the_campaign_data_and_the_effect_size() {
+    // The bench campaign carries the faulted force plus the noise (1% of the recorded peak), and
+    // the effect size of an offset alone is the offset.
+    let all = suite();
+    let find = |id: &str| all.iter().find(|c| c.id == id).expect("id").clone();
+    let cp = find("acq_offset_0");
+    let off = match cp.effects[..] {
+        [Effect::ForceOffset(o)] => o,
+        _ => panic!("acq_offset_0 is an offset alone"),
+    };
+    let (r, sigma, g) = effect_size(&cp, 4, 2000.0).unwrap();
+    assert!((r - off.abs()).abs() < 1e-9 * off.abs(), "{r} vs {off}");
+    assert!(g >= DETECTABLE_GAIN, "g* {g}");
+    let cp = find("acqpair_0");
+    let data = bench_campaign(&cp, 4, 2000.0).unwrap();
+    let (model, acq) = (cp.truth(), cp.acquisition());
+    let (mut ss, mut mean, mut count) = (0.0, 0.0, 0usize);
+    for ((_, stroke, _), m) in bench_tests(4).iter().zip(&data) {
+        let f = acq
+            .record(&model, stroke, &m.time_s, Tolerance::default())
+            .unwrap();
+        for (y, x) in m.force_n.iter().zip(&f) {
+            ss += (y - x).powi(2);
+            mean += y - x;
+            count += 1;
+        }
+    }
+    let (rms, mean) = ((ss / count as f64).sqrt(), mean / count as f64);
+    assert!(
+        (rms / sigma - 1.0).abs() < 0.05 && mean.abs() < 0.05 * sigma,
+        "residual to the faulted force: RMS {rms} N, mean {mean} N, sigma about {sigma} N"
+    );
+}
+
+#[test]
+fn acquisition_fault_campaigns_exist_and_are_scored() {
+    let all = suite();
+    let faults = |c: &Campaign| c.effects.iter().filter(|e| e.is_fault()).count();
+    let physical = |c: &Campaign| c.effects.iter().filter(|e| !e.is_fault()).count();
+    // The campaigns before them are the 67 of the suite before the faults, fault-free.
+    assert_eq!(all.len(), 83);
+    assert!(all[..67].iter().all(|c| faults(c) == 0));
+    assert_eq!(all[66].id, "flight_4");
+    let alone: Vec<&Campaign> = all.iter().filter(|c| c.id.starts_with("acq_")).collect();
+    assert_eq!(alone.len(), 8);
+    for kind in ["lag", "offset", "gain", "drift"] {
+        for i in 0..2 {
+            let c = alone
+                .iter()
+                .find(|c| c.id == format!("acq_{kind}_{i}"))
+                .expect("id");
+            assert!(!c.flight && faults(c) == 1 && physical(c) == 0, "{c:?}");
+            assert_eq!(c.effects[0].cause(), format!("force_{kind}"));
+        }
+    }
+    let beside: Vec<&Campaign> = all
+        .iter()
+        .filter(|c| c.id.starts_with("acqpair_"))
+        .collect();
+    assert!(beside.len() >= 7);
+    assert!(beside.iter().all(|c| faults(c) == 1 && physical(c) == 1));
+    let flight = all.iter().find(|c| c.id == "flight_5").expect("flight_5");
+    assert!(flight.flight && faults(flight) == 1);
+    // Magnitudes in the realistic ranges, none a round start value.
+    for e in all.iter().flat_map(|c| &c.effects) {
+        match *e {
+            Effect::ForceLag(l) => assert!((1e-3..=5e-3).contains(&l) && l != 1e-3),
+            Effect::ForceGain(g) => assert!((0.95..=1.06).contains(&g) && g != 1.0),
+            Effect::ForceOffset(o) => assert!((150.0..=1000.0).contains(&o.abs())),
+            Effect::ForceDrift(d) => assert!((300.0..=1000.0).contains(&d.abs())),
+            _ => {}
+        }
+    }
+    // The CI subset is unchanged, without faults.
+    let ids: Vec<String> = ci_subset().into_iter().map(|c| c.id).collect();
+    assert_eq!(
+        ids,
+        [
+            "flight_0", "flight_1", "flight_2", "flight_3", "flight_4", "cfp_11", "recal_1",
+            "pair_5", "pair_1"
+        ]
+    );
+    assert!(ci_subset().iter().all(|c| faults(c) == 0));
+    // Scoring: names split on '+', any order; every hidden fault by its own name.
+    let pair = all.iter().find(|c| c.id == "acqpair_0").expect("id");
+    assert_eq!(
+        name_score(pair, &["entrained_air", "force_lag"], false),
+        (true, true)
+    );
+    assert_eq!(name_score(pair, &["entrained_air"], false), (false, false));
+    assert_eq!(faults_named(pair, "entrained_air+force_lag"), Some(true));
+    assert_eq!(faults_named(pair, "force_lag"), Some(true));
+    assert_eq!(faults_named(pair, "entrained_air"), Some(false));
+    assert_eq!(faults_named(pair, "none"), Some(false));
+    assert_eq!(faults_named(&all[0], "force_lag"), None);
+    let named = |n: &str| Score {
+        named: n.into(),
+        exact: false,
+        hidden_among_named: false,
+        gain: 0.5,
+        best_gain: Some(0.9),
+        sub_noise: false,
+        gain_required: 0.3,
+        params: vec![],
+    };
+    let rows = vec![
+        (pair.clone(), named("force_lag+entrained_air")),
+        (alone[0].clone(), named("seal_friction")),
+        (all[0].clone(), named("compliant_free_play")),
+    ];
+    let r = Rates::of(&rows);
+    assert_eq!((r.faults_named, r.with_fault), (1, 2));
+    assert!(rates(&rows).contains("acquisition-fault campaigns named as acquisition faults 1/2"));
+}

@@ -78,6 +78,16 @@ pub enum Effect {
     MountCompliance(f64),
     /// Scale of C_d A_orf and of the relief valves' a.
     Recalibration(f64, f64),
+    /// Acquisition fault: the force channel lags the stroke channel by this time [s] (the force
+    /// recorded at t is the damper's at t - lag). Not in the truth physics: [`Acquisition`].
+    ForceLag(f64),
+    /// Acquisition fault: a constant [N] added to the recorded force.
+    ForceOffset(f64),
+    /// Acquisition fault: the recorded force is this factor times the true force.
+    ForceGain(f64),
+    /// Acquisition fault: a drift [N/s] added to the recorded force from each test's first
+    /// sample, `drift (t - t0)`.
+    ForceDrift(f64),
 }
 
 impl Effect {
@@ -95,7 +105,22 @@ impl Effect {
             Effect::AccumulatorBleed(_) => "accumulator_bleed",
             Effect::MountCompliance(_) => "mount_compliance",
             Effect::Recalibration(..) => "recalibration",
+            Effect::ForceLag(_) => "force_lag",
+            Effect::ForceOffset(_) => "force_offset",
+            Effect::ForceGain(_) => "force_gain",
+            Effect::ForceDrift(_) => "force_drift",
         }
+    }
+
+    /// An acquisition fault (the recorded force is wrong, not the damper).
+    pub fn is_fault(&self) -> bool {
+        matches!(
+            self,
+            Effect::ForceLag(_)
+                | Effect::ForceOffset(_)
+                | Effect::ForceGain(_)
+                | Effect::ForceDrift(_)
+        )
     }
 
     /// Names that count as naming exactly this effect. A gap behind a steel contact is the
@@ -114,6 +139,10 @@ impl Effect {
                 Effect::AccumulatorBleed(_) => &"accumulator_bleed",
                 Effect::MountCompliance(_) => &"mount_compliance",
                 Effect::Recalibration(..) => &"recalibration",
+                Effect::ForceLag(_) => &"force_lag",
+                Effect::ForceOffset(_) => &"force_offset",
+                Effect::ForceGain(_) => &"force_gain",
+                Effect::ForceDrift(_) => &"force_drift",
                 Effect::FreePlay(_) => unreachable!(),
             }),
         }
@@ -151,6 +180,10 @@ impl Effect {
             Effect::AccumulatorBleed(k) => format!("bleed {k:.2e} m^3/(s Pa)"),
             Effect::MountCompliance(k) => format!("mount {k:.2e} N/m"),
             Effect::Recalibration(o, a) => format!("Cd A_orf x{o:.2}, relief a x{a:.2}"),
+            Effect::ForceLag(l) => format!("force lag {:.2} ms", l * 1e3),
+            Effect::ForceOffset(o) => format!("force offset {o:.0} N"),
+            Effect::ForceGain(g) => format!("force gain {g:.3}"),
+            Effect::ForceDrift(d) => format!("force drift {d:.0} N/s"),
         }
     }
 
@@ -177,10 +210,15 @@ impl Effect {
                 ("A_orf_m2", Some(o * s.a_orf)),
                 ("relief_a_m", Some(a * s.relief[0].a)),
             ],
+            Effect::ForceLag(l) => vec![("lag_s", Some(l))],
+            Effect::ForceOffset(o) => vec![("offset_N", Some(o))],
+            Effect::ForceGain(g) => vec![("gain", Some(g))],
+            Effect::ForceDrift(d) => vec![("drift_N_per_s", Some(d))],
         }
     }
 
-    /// Puts the effect into the truth model.
+    /// Puts the effect into the truth model (acquisition faults: nothing, they act on the
+    /// recorded force, [`Acquisition`]).
     pub fn apply(&self, t: &mut Truth) {
         match *self {
             Effect::SealFriction(f) => t.friction = Some(Friction::seal(f)),
@@ -199,7 +237,88 @@ impl Effect {
                     r.a *= a;
                 }
             }
+            Effect::ForceLag(_)
+            | Effect::ForceOffset(_)
+            | Effect::ForceGain(_)
+            | Effect::ForceDrift(_) => {}
         }
+    }
+}
+
+/// The acquisition faults of a campaign, applied to the truth's force as it is recorded:
+/// `y(t) = gain F(t - lag) + offset + drift (t - t0)`, t0 the test's first sample time (noise is
+/// added afterwards). Without faults: lag 0, gain 1, offset and drift 0, and the recorded force
+/// is the truth's force unchanged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Acquisition {
+    pub lag_s: f64,
+    pub offset_n: f64,
+    pub gain: f64,
+    pub drift_n_per_s: f64,
+}
+
+impl Default for Acquisition {
+    fn default() -> Self {
+        Self {
+            lag_s: 0.0,
+            offset_n: 0.0,
+            gain: 1.0,
+            drift_n_per_s: 0.0,
+        }
+    }
+}
+
+impl Acquisition {
+    /// The faults among `effects` (physical effects are ignored).
+    pub fn of(effects: &[Effect]) -> Self {
+        let mut a = Self::default();
+        for e in effects {
+            match *e {
+                Effect::ForceLag(l) => a.lag_s = l,
+                Effect::ForceOffset(o) => a.offset_n = o,
+                Effect::ForceGain(g) => a.gain = g,
+                Effect::ForceDrift(d) => a.drift_n_per_s = d,
+                _ => {}
+            }
+        }
+        a
+    }
+
+    /// The times at which the truth's force is recorded at the sample times `t`: `t - lag`,
+    /// held at 0 where that is negative (the truth starts at t = 0; those samples lie in a
+    /// test's first cycle, never compared).
+    pub fn source_times(&self, t: &[f64]) -> Vec<f64> {
+        if self.lag_s == 0.0 {
+            return t.to_vec();
+        }
+        t.iter().map(|&x| (x - self.lag_s).max(0.0)).collect()
+    }
+
+    /// The algebraic part: `gain f + offset + drift (t - t[0])` of the (lagged) truth force `f`
+    /// at the sample times `t`, in place.
+    pub fn transform(&self, t: &[f64], f: &mut [f64]) {
+        if self.gain == 1.0 && self.offset_n == 0.0 && self.drift_n_per_s == 0.0 {
+            return;
+        }
+        let t0 = t.first().copied().unwrap_or(0.0);
+        for (fk, &tk) in f.iter_mut().zip(t) {
+            *fk = self.gain * *fk + self.offset_n + self.drift_n_per_s * (tk - t0);
+        }
+    }
+
+    /// The recorded force (before noise) of `model` under `stroke` at the sample times `t`: the
+    /// truth integrated to the lagged times (not an interpolation of the sampled force), then
+    /// [`Acquisition::transform`].
+    pub fn record(
+        &self,
+        model: &Truth,
+        stroke: &Stroke,
+        t: &[f64],
+        tol: Tolerance,
+    ) -> Result<Vec<f64>, String> {
+        let mut f = force_at(model, stroke, &self.source_times(t), tol)?;
+        self.transform(t, &mut f);
+        Ok(f)
     }
 }
 
@@ -220,6 +339,10 @@ impl Campaign {
             e.apply(&mut t);
         }
         t
+    }
+    /// The campaign's acquisition faults.
+    pub fn acquisition(&self) -> Acquisition {
+        Acquisition::of(&self.effects)
     }
     pub fn hidden(&self) -> String {
         if self.effects.is_empty() {
@@ -243,10 +366,11 @@ fn c(id: &str, effects: Vec<Effect>, seed: u64) -> Campaign {
     }
 }
 
-/// The full blind suite: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid of gap and
-/// contact stiffness), 7 pairs, 6 no-effect campaigns, 5 flight records. Seeds are arbitrary
-/// 64-bit numbers, magnitudes hand-picked across realistic ranges, none equal to a starting
-/// value of the diagnosis' fits.
+/// The full blind suite, 83 campaigns: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid
+/// of gap and contact stiffness), 7 pairs, 6 no-effect campaigns, 5 flight records; then the
+/// acquisition faults (force lag, offset, gain, drift): each alone at 2 magnitudes, 7 beside a
+/// physical effect, 1 flight record with a lag. Seeds are arbitrary 64-bit numbers, magnitudes
+/// hand-picked across realistic ranges, none equal to a starting value of the diagnosis' fits.
 pub fn suite() -> Vec<Campaign> {
     use Effect::*;
     let mut v = Vec::new();
@@ -390,6 +514,37 @@ pub fn suite() -> Vec<Campaign> {
         cp.flight = true;
         v.push(cp);
     }
+    // Acquisition faults, appended after every earlier seed was drawn (the campaigns above keep
+    // their ids, effects and seeds). The nominal bench campaign's peak force is 17.6 kN (noise
+    // sigma 176 N), a test lasts 0.93-1.05 s, samples every 0.5 ms: lags of 2.6-7.4 samples,
+    // offsets 1.6-3.2% of the campaign's peak, drifts of 2.1-3.6% of it over one test.
+    let faults: [(&str, [Effect; 2]); 4] = [
+        ("lag", [ForceLag(1.3e-3), ForceLag(3.7e-3)]),
+        ("offset", [ForceOffset(-287.0), ForceOffset(538.0)]),
+        ("gain", [ForceGain(0.962), ForceGain(1.047)]),
+        ("drift", [ForceDrift(-391.0), ForceDrift(612.0)]),
+    ];
+    for (name, list) in faults {
+        for (i, e) in list.into_iter().enumerate() {
+            v.push(c(&format!("acq_{name}_{i}"), vec![e], next()));
+        }
+    }
+    // A fault beside a physical effect whose g* alone is well above 0.3.
+    let fault_pairs = [
+        vec![ForceLag(2.6e-3), EntrainedAir(0.024)],
+        vec![ForceOffset(413.0), AreaAsymmetry(0.86)],
+        vec![ForceGain(1.038), SealFriction(520.0)],
+        vec![ForceDrift(471.0), PistonLeakage(6.5e-12)],
+        vec![ForceLag(1.85e-3), MountCompliance(5.7e7)],
+        vec![ForceOffset(-362.0), Recalibration(0.78, 1.0)],
+        vec![ForceGain(0.957), FreePlay(0.45e-3)],
+    ];
+    for (i, p) in fault_pairs.into_iter().enumerate() {
+        v.push(c(&format!("acqpair_{i}"), p, next()));
+    }
+    let mut cp = c("flight_5", vec![ForceLag(2.2e-3)], next());
+    cp.flight = true;
+    v.push(cp);
     v
 }
 
@@ -470,14 +625,15 @@ pub fn noise_fraction() -> f64 {
         .unwrap_or(0.01)
 }
 
-/// A bench campaign: force by the truth model, Gaussian noise of `noise_fraction()` (1%) of the
-/// campaign's peak.
+/// A bench campaign: force by the truth model as recorded (the campaign's acquisition faults,
+/// [`Acquisition`]), Gaussian noise of `noise_fraction()` (1%) of the campaign's recorded peak.
 pub fn bench_campaign(
     cp: &Campaign,
     cycles: usize,
     rate_hz: f64,
 ) -> Result<Vec<Measurement>, String> {
     let model = cp.truth();
+    let acq = cp.acquisition();
     let mut out = Vec::new();
     for (name, stroke, cyc) in bench_tests(cycles) {
         let period = stroke.period();
@@ -485,7 +641,8 @@ pub fn bench_campaign(
         let time_s: Vec<f64> = (0..n).map(|k| k as f64 / rate_hz).collect();
         let (stroke_m, velocity_m_s): (Vec<f64>, Vec<f64>) =
             time_s.iter().map(|&t| stroke.at(t)).unzip();
-        let force_n = force_at(&model, &stroke, &time_s, Tolerance::default())
+        let force_n = acq
+            .record(&model, &stroke, &time_s, Tolerance::default())
             .map_err(|e| format!("{}: {name}: {e}", cp.id))?;
         out.push(Measurement {
             name,
@@ -533,7 +690,8 @@ pub fn flight_stroke() -> Stroke {
 }
 
 /// Writes a stroke-driven flight record (CSV triple, docs/formats.md) of the campaign's truth:
-/// 2 revolutions of settling before revolution 0, then FLIGHT_REVS revolutions recorded.
+/// 2 revolutions of settling before revolution 0, then FLIGHT_REVS revolutions recorded (the
+/// force as recorded with the campaign's acquisition faults, t0 of a drift the first sample).
 pub fn write_flight_record(cp: &Campaign, stem: &Path) -> Result<(), String> {
     let model = cp.truth();
     let stroke = flight_stroke();
@@ -543,7 +701,9 @@ pub fn write_flight_record(cp: &Campaign, stem: &Path) -> Result<(), String> {
     let t: Vec<f64> = (0..n)
         .map(|i| settle + period * i as f64 / FLIGHT_AZIMUTHS as f64)
         .collect();
-    let mut f = force_at(&model, &stroke, &t, Tolerance::default())?;
+    let mut f = cp
+        .acquisition()
+        .record(&model, &stroke, &t, Tolerance::default())?;
     let mut one = vec![Measurement {
         name: String::new(),
         time_s: vec![],
@@ -790,6 +950,19 @@ pub struct Rates {
     pub sub_noise: usize,
     pub scored_params: usize,
     pub covered: usize,
+    /// Campaigns that hide at least one acquisition fault.
+    pub with_fault: usize,
+    /// Of those, the campaigns where every hidden fault is named by its own name
+    /// ([`faults_named`]).
+    pub faults_named: usize,
+}
+
+/// Whether every acquisition fault hidden in `cp` is named by its own name in the diagnosis'
+/// cause `named` (`+`-joined, any order); None on a campaign without a fault.
+pub fn faults_named(cp: &Campaign, named: &str) -> Option<bool> {
+    let names: Vec<&str> = named.split('+').collect();
+    let faults: Vec<&Effect> = cp.effects.iter().filter(|e| e.is_fault()).collect();
+    (!faults.is_empty()).then(|| faults.iter().all(|e| names.contains(&e.cause())))
 }
 
 impl Rates {
@@ -817,6 +990,10 @@ impl Rates {
                 r.scored_params += 1;
                 r.covered += c as usize;
             }
+            if let Some(ok) = faults_named(cp, &s.named) {
+                r.with_fault += 1;
+                r.faults_named += ok as usize;
+            }
         }
         r
     }
@@ -829,13 +1006,17 @@ impl Rates {
     pub fn coverage(&self) -> f64 {
         self.covered as f64 / self.scored_params.max(1) as f64
     }
+    /// Acquisition-fault campaigns whose every hidden fault is named.
+    pub fn fault_rate(&self) -> f64 {
+        self.faults_named as f64 / self.with_fault.max(1) as f64
+    }
 }
 
 impl std::fmt::Display for Rates {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "exact name {}/{} ({:.1}%), hidden among named {}/{} ({:.1}%) ({} sub-noise), none on no-effect data {}/{}, held-out gain at least min(0.3, 0.8 g*) where named {}/{} (lowest gain {:.3}), 95% intervals cover the truth {}/{} ({:.1}%)",
+            "exact name {}/{} ({:.1}%), hidden among named {}/{} ({:.1}%) ({} sub-noise), none on no-effect data {}/{}, held-out gain at least min(0.3, 0.8 g*) where named {}/{} (lowest gain {:.3}), 95% intervals cover the truth {}/{} ({:.1}%), acquisition-fault campaigns named as acquisition faults {}/{} ({:.1}%)",
             self.exact,
             self.with_effect,
             100.0 * self.exact_rate(),
@@ -850,7 +1031,10 @@ impl std::fmt::Display for Rates {
             self.min_gain_named,
             self.covered,
             self.scored_params,
-            100.0 * self.coverage()
+            100.0 * self.coverage(),
+            self.faults_named,
+            self.with_fault,
+            100.0 * self.fault_rate()
         )
     }
 }
@@ -870,12 +1054,14 @@ pub fn rates(rows: &[(Campaign, Score)]) -> String {
     )
 }
 
-/// Size of the hidden effect against the noise: the RMS difference of the noise-free truth
-/// with and without the effect over every test after its first cycle, the noise sigma
+/// Size of the hidden effect against the noise: the RMS difference of the noise-free recorded
+/// force with every effect (acquisition faults included) and the clean truth without any, over
+/// every test after its first cycle, the noise sigma
 /// (`noise_fraction()` of the peak), and the held-out gain a perfect model could reach, `1 - sigma/sqrt(sigma^2 + r^2)`
 /// (the baseline's residual is effect plus noise, a perfect model's the noise alone).
 pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f64, f64), String> {
     let with = cp.truth();
+    let acq = cp.acquisition();
     let without = Truth::new(Sheet::nominal());
     let mut tests = Vec::new();
     if cp.flight {
@@ -895,7 +1081,7 @@ pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f
     }
     let (mut ss, mut count, mut peak) = (0.0, 0usize, 0.0f64);
     for (stroke, t, per_cycle) in &tests {
-        let a = force_at(&with, stroke, t, Tolerance::default())?;
+        let a = acq.record(&with, stroke, t, Tolerance::default())?;
         let b = force_at(&without, stroke, t, Tolerance::default())?;
         peak = a.iter().fold(peak, |p, f| p.max(f.abs()));
         for (x, y) in a.iter().zip(&b).skip(*per_cycle) {
