@@ -273,10 +273,11 @@ fn blind_subset_names_the_hidden_effect_with_the_required_gain() {
     assert!(r.among_rate() >= 0.98, "{r}");
     assert_eq!(r.none_on_no_effect, r.no_effect, "{r}");
     assert_eq!(r.gain_met, r.named, "{r}");
+    assert!(r.with_fault > 0 && r.fault_rate() >= 0.9, "{r}");
 }
 
 #[test]
-#[ignore = "fails on this subset: its 95% intervals cover 11 of 14 true parameters; it holds three of the full suite's five misses (cfp_11 gap, pair_1 air and leakage, biased alike in every test), and the full suite covers 80 of 85 (docs/diagnosis.md, Blind suite); run with --ignored"]
+#[ignore = "fails on this subset: it holds four of the full suite's interval misses (cfp_11 gap, pair_1 air and leakage, flight_5 lag: biased alike in every test), and the full suite covers at least 90% (docs/diagnosis.md, Blind suite); run with --ignored"]
 fn blind_subset_intervals_cover_the_truth() {
     let r = Rates::of(subset_rows());
     assert!(r.coverage() >= 0.9, "{r}");
@@ -581,16 +582,25 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
             _ => {}
         }
     }
-    // The CI subset is unchanged, without faults.
+    // The CI subset: the earlier nine campaigns and two with a fault.
     let ids: Vec<String> = ci_subset().into_iter().map(|c| c.id).collect();
     assert_eq!(
         ids,
         [
-            "flight_0", "flight_1", "flight_2", "flight_3", "flight_4", "cfp_11", "recal_1",
-            "pair_5", "pair_1"
+            "flight_0",
+            "flight_1",
+            "flight_2",
+            "flight_3",
+            "flight_4",
+            "cfp_11",
+            "recal_1",
+            "pair_5",
+            "pair_1",
+            "flight_5",
+            "acq_gain_0"
         ]
     );
-    assert!(ci_subset().iter().all(|c| faults(c) == 0));
+    assert_eq!(ci_subset().iter().filter(|c| faults(c) > 0).count(), 2);
     // Scoring: names split on '+', any order; every hidden fault by its own name.
     let pair = all.iter().find(|c| c.id == "acqpair_0").expect("id");
     assert_eq!(

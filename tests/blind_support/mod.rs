@@ -554,10 +554,21 @@ pub fn suite() -> Vec<Campaign> {
 pub fn ci_subset() -> Vec<Campaign> {
     // Flight records, a compliant free play, and three campaigns that need the pair stage's
     // safeguards: a single cause fitted into a poor optimum (recal_1), a companion masked by
-    // the larger effect (pair_5) and a best single that is not one of the pair (pair_1).
+    // the larger effect (pair_5) and a best single that is not one of the pair (pair_1). Two
+    // acquisition faults, added after their results were seen: a lag through the flight-record
+    // path (flight_5) and a gain error, the look-alike of a re-calibration (acq_gain_0).
     let ids = [
-        "flight_0", "flight_1", "flight_2", "flight_3", "flight_4", "cfp_11", "recal_1", "pair_5",
+        "flight_0",
+        "flight_1",
+        "flight_2",
+        "flight_3",
+        "flight_4",
+        "cfp_11",
+        "recal_1",
+        "pair_5",
         "pair_1",
+        "flight_5",
+        "acq_gain_0",
     ];
     let all = suite();
     ids.iter()
