@@ -1428,9 +1428,10 @@ pub fn diagnose(
             }
         }
         if first_ok && opts.pairs {
-            // Acquisition faults beside a physical cause, each fitted on top of it: beside the
-            // best single when it is physical, or, when a fault is the best single, that fault
-            // on top of every physical single that lowers the baseline's BIC.
+            // Acquisition faults beside a physical cause (`fault_pair`): beside the best single
+            // when it is physical, or, when a fault is the best single, that fault beside the
+            // three physical singles of lowest BIC below the baseline's. They cost no replay of
+            // their own, so they are tried whether or not the residual is systematic.
             let reference = pair_ref.unwrap_or((row.bic, row.held_out_rms_N));
             let ons: Vec<(Fault, Evaluated)> = match Fault::from_name(&row.cause) {
                 Some(f) => evaluated
