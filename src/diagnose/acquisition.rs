@@ -132,6 +132,11 @@ fn rss(fault: Fault, v: f64, data: &[Measurement], model: &[Vec<f64>], spans: &[
         .sum()
 }
 
+/// Gains a calibration error can have: a channel reading half or twice the force (or with the
+/// wrong sign) has the wrong unit or wiring, not a calibration error, and a damper model that
+/// predicts almost no force must not be scaled up to the data.
+pub const GAIN_RANGE: [f64; 2] = [0.5, 2.0];
+
 /// Longest lag searched: a quarter of the shortest stroking period (a lag beyond it is a
 /// phase error no data acquisition makes).
 fn max_lag(data: &[Measurement], spans: &[Span]) -> f64 {
@@ -176,7 +181,8 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
         }
         Fault::Gain => {
             let (v, s) = linear(&|_, f| f, &|_, y| y);
-            (v, s, 1)
+            // RSS is quadratic in the gain: the bounded optimum is the clamped one.
+            (v.clamp(GAIN_RANGE[0], GAIN_RANGE[1]), s, 1)
         }
         Fault::Drift => {
             let (v, s) = linear(&|tau, _| tau, &|f, y| y - f);
@@ -309,6 +315,23 @@ mod tests {
             );
             assert!(r.rss < 1e-6 * 1e8 * 1900.0, "{}: rss {}", f.name(), r.rss);
         }
+    }
+
+    #[test]
+    fn the_gain_stays_within_a_calibration_error() {
+        // data of the opposite sign and 100 times the model: the least-squares gain is -100,
+        // the fit stops at the range's lower end
+        let (mut d, model) = test_data(&[]);
+        for y in &mut d[0].force_n {
+            *y *= -100.0;
+        }
+        let spans = [Span {
+            test: 0,
+            from: 0,
+            to: 2001,
+        }];
+        let r = fit(Fault::Gain, &d, &model, &spans);
+        assert_eq!(r.value, GAIN_RANGE[0]);
     }
 
     #[test]
