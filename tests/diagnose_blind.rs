@@ -277,7 +277,7 @@ fn blind_subset_names_the_hidden_effect_with_the_required_gain() {
 }
 
 #[test]
-#[ignore = "fails on this subset: it holds four of the full suite's interval misses (cfp_11 gap, pair_1 air and leakage, flight_5 lag: biased alike in every test), and the full suite covers at least 90% (docs/diagnosis.md, Blind suite); run with --ignored"]
+#[ignore = "fails on this subset: it holds three of the full suite's interval misses (cfp_11 gap, pair_1 air and leakage: model-form biases alike in every test); the full suite's coverage is in docs/diagnosis.md, Blind suite; run with --ignored"]
 fn blind_subset_intervals_cover_the_truth() {
     let r = Rates::of(subset_rows());
     assert!(r.coverage() >= 0.9, "{r}");
