@@ -156,3 +156,54 @@ fn bench_file_without_force_is_named() {
     );
     assert!(!dir.join("out").exists(), "no output on bad input");
 }
+
+#[test]
+fn a_calibration_gain_and_a_zero_offset_together_are_both_named() {
+    // The shipped SYNTHETIC record read 5% high and 400 N off zero: two linear acquisition
+    // faults, fitted together beside the record's own (physical) effect.
+    let dir = tmp("gain_offset");
+    std::fs::create_dir_all(&dir).unwrap();
+    for ext in ["damper.csv", "meta.json", "motion.csv", "airloads.csv"] {
+        let from = root().join(format!("flightdata/c8534like.{ext}"));
+        let text = std::fs::read_to_string(&from).unwrap();
+        let text = if ext == "damper.csv" {
+            let mut lines = text.lines();
+            let header = lines.next().unwrap();
+            let col = header
+                .split(',')
+                .position(|c| c == "damper_force_N")
+                .unwrap();
+            let mut out = vec![header.to_string()];
+            for l in lines {
+                let mut f: Vec<String> = l.split(',').map(str::to_string).collect();
+                let v: f64 = f[col].parse().unwrap();
+                f[col] = format!("{:.3}", 1.05 * v + 400.0);
+                out.push(f.join(","));
+            }
+            out.join("\n") + "\n"
+        } else {
+            text
+        };
+        std::fs::write(dir.join(format!("c8534like.{ext}")), text).unwrap();
+    }
+    diagnose(DiagnoseArgs {
+        flight: Some(dir.join("c8534like")),
+        ..args(dir.join("out"))
+    })
+    .unwrap();
+    let j = read_json(&dir.join("out/diagnosis.json"));
+    let cause = j["cause"].as_str().unwrap();
+    let names: Vec<&str> = cause.split('+').collect();
+    assert!(
+        names.contains(&"force_gain") && names.contains(&"force_offset"),
+        "{cause}"
+    );
+    for (p, truth) in [("gain", 1.05), ("offset_N", 400.0)] {
+        let iv = &j["parameter_intervals"][p];
+        let (lo, hi) = (iv[0].as_f64().unwrap(), iv[1].as_f64().unwrap());
+        assert!(
+            lo <= truth && truth <= hi,
+            "{p}: [{lo}, {hi}] against {truth}"
+        );
+    }
+}

@@ -251,6 +251,126 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
     }
 }
 
+/// The faults that are linear in the recorded force (`y = g F + o + d (t - t0)`): they are
+/// fitted together by one least-squares solve.
+pub const LINEAR: [Fault; 3] = [Fault::Offset, Fault::Gain, Fault::Drift];
+
+/// The pairs of linear faults tried together (a load cell with a wrong calibration and a zero
+/// offset, a zero that drifts beside either), in the order of [`Fault::ALL`].
+pub fn linear_pairs() -> Vec<[Fault; 2]> {
+    let mut v = Vec::new();
+    for (i, &a) in LINEAR.iter().enumerate() {
+        for &b in &LINEAR[i + 1..] {
+            let (a, b) = if ord(a) < ord(b) { (a, b) } else { (b, a) };
+            v.push([a, b]);
+        }
+    }
+    v
+}
+
+fn ord(f: Fault) -> usize {
+    Fault::ALL
+        .iter()
+        .position(|&g| g == f)
+        .unwrap_or(usize::MAX)
+}
+
+/// The recorded force of a model force `f` with every fault of `faults` at its value: the gain
+/// scales the force, then offset and drift add (`y = g F + o + d (t - t0)`); a lag first.
+pub fn apply_all(faults: &[Fault], values: &[f64], t: &[f64], f: &[f64]) -> Vec<f64> {
+    let mut y = f.to_vec();
+    for kind in [Fault::Lag, Fault::Gain, Fault::Offset, Fault::Drift] {
+        if let Some(i) = faults.iter().position(|&g| g == kind) {
+            y = kind.apply(values[i], t, &y);
+        }
+    }
+    y
+}
+
+/// Inverse of [`apply_all`] on the recorded force `y`.
+pub fn correct_all(faults: &[Fault], values: &[f64], t: &[f64], y: &[f64]) -> Vec<f64> {
+    let mut f = y.to_vec();
+    for kind in [Fault::Drift, Fault::Offset, Fault::Gain, Fault::Lag] {
+        if let Some(i) = faults.iter().position(|&g| g == kind) {
+            f = kind.correct(values[i], t, &f);
+        }
+    }
+    f
+}
+
+/// Linear faults (`LINEAR`) fitted together on top of `model` over `spans`: one least-squares
+/// solve on the columns 1 (offset), F (gain) and t - t0 (drift). Each fit's `sensitivity` is
+/// `1 / (A^T A)^-1_cc`, so [`interval`] gives the joint fit's marginal interval. None when
+/// a fault is not linear, the columns are dependent or the gain leaves [`GAIN_RANGE`].
+pub fn fit_linear(
+    faults: &[Fault],
+    data: &[Measurement],
+    model: &[Vec<f64>],
+    spans: &[Span],
+) -> Option<Vec<FaultFit>> {
+    if faults.is_empty() || !faults.iter().all(|f| LINEAR.contains(f)) {
+        return None;
+    }
+    let k = faults.len();
+    let has_gain = faults.contains(&Fault::Gain);
+    let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
+    let mut atb = nalgebra::DVector::<f64>::zeros(k);
+    let mut col = vec![0.0; k];
+    for s in spans {
+        let m = &data[s.test];
+        let t0 = m.time_s[0];
+        let r = s.from..s.to;
+        for ((&f, &t), &y) in model[s.test][r.clone()]
+            .iter()
+            .zip(&m.time_s[r.clone()])
+            .zip(&m.force_n[r])
+        {
+            for (c, fault) in col.iter_mut().zip(faults) {
+                *c = match fault {
+                    Fault::Offset => 1.0,
+                    Fault::Gain => f,
+                    _ => t - t0,
+                };
+            }
+            let b = if has_gain { y } else { y - f };
+            for r in 0..k {
+                atb[r] += col[r] * b;
+                for c in 0..k {
+                    ata[(r, c)] += col[r] * col[c];
+                }
+            }
+        }
+    }
+    let inv = ata.try_inverse()?;
+    let x = &inv * atb;
+    if let Some(g) = faults.iter().position(|&f| f == Fault::Gain) {
+        if !(GAIN_RANGE[0]..=GAIN_RANGE[1]).contains(&x[g]) {
+            return None;
+        }
+    }
+    let values: Vec<f64> = x.iter().copied().collect();
+    let rss: f64 = spans
+        .iter()
+        .map(|s| {
+            let m = &data[s.test];
+            let y = apply_all(faults, &values, &m.time_s, &model[s.test]);
+            (s.from..s.to)
+                .map(|i| (y[i] - m.force_n[i]).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    Some(
+        (0..k)
+            .map(|c| FaultFit {
+                value: values[c],
+                rss,
+                sensitivity: 1.0 / inv[(c, c)],
+                evaluations: 1,
+            })
+            .collect(),
+    )
+}
+
 /// 95% interval of a fitted fault: the noise's scatter `sigma^2 / S` (S the sensitivity) plus
 /// the model-form bound of the physical causes' intervals (`r_sys = n ms - (n - 1) sigma^2`,
 /// biasing the value by at most `sqrt(r_sys / S)`), in the parameter itself (it may be of
@@ -353,6 +473,60 @@ mod tests {
                 .fold(0.0, f64::max);
             let tol = if f == Fault::Lag { 20.0 } else { 1e-9 };
             assert!(err < tol, "{}: {err}", f.name());
+        }
+    }
+
+    #[test]
+    fn linear_faults_together_are_recovered_and_undone() {
+        let spans = [Span {
+            test: 0,
+            from: 100,
+            to: 2001,
+        }];
+        for pair in linear_pairs() {
+            let truth: Vec<f64> = pair
+                .iter()
+                .map(|f| match f {
+                    Fault::Offset => -312.5,
+                    Fault::Gain => 1.047,
+                    _ => 187.0,
+                })
+                .collect();
+            let (mut d, model) = test_data(&[]);
+            d[0].force_n = apply_all(&pair, &truth, &d[0].time_s, &model[0]);
+            let r = fit_linear(&pair, &d, &model, &spans).expect("fit");
+            for (f, v) in r.iter().zip(&truth) {
+                assert!(
+                    ((f.value - v) / v).abs() < 1e-9,
+                    "{pair:?}: {} for {v}",
+                    f.value
+                );
+                assert!(f.rss < 1e-9 * 1e8);
+            }
+            let back = correct_all(&pair, &truth, &d[0].time_s, &d[0].force_n);
+            let err = back
+                .iter()
+                .zip(&model[0])
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-9, "{pair:?}: {err}");
+        }
+        assert_eq!(linear_pairs().len(), 3);
+    }
+
+    #[test]
+    fn a_linear_fault_alone_fits_as_fit_does() {
+        let spans = [Span {
+            test: 0,
+            from: 100,
+            to: 2001,
+        }];
+        let (d, model) = test_data(&[(Fault::Offset, 40.0), (Fault::Drift, -55.0)]);
+        for f in LINEAR {
+            let a = fit(f, &d, &model, &spans);
+            let b = fit_linear(&[f], &d, &model, &spans).expect("fit")[0];
+            assert!((a.value - b.value).abs() <= 1e-9 * a.value.abs().max(1.0));
+            assert!((a.sensitivity - b.sensitivity).abs() <= 1e-9 * a.sensitivity);
         }
     }
 

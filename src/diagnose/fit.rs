@@ -720,10 +720,12 @@ fn spans(w: &[Window]) -> Vec<Span> {
         .collect()
 }
 
-/// An acquisition fault fitted on top of a model: the baseline (`on` None; the deck `base`)
-/// or a fitted physical cause (`on`, named `cause+fault`, its parameters kept).
+/// Acquisition faults fitted on top of a model: the baseline (`on` None; the deck `base`) or a
+/// fitted physical cause (`on`, named `cause+fault`, its parameters kept). One fault by
+/// [`acquisition::fit`]; several (linear ones: gain, offset, drift) together by
+/// [`acquisition::fit_linear`], named `force_gain+force_offset`.
 fn fault_candidate(
-    fault: Fault,
+    faults: &[Fault],
     on: Option<&Evaluated>,
     baseline: &[Vec<f64>],
     base: &DamperDeck,
@@ -734,61 +736,71 @@ fn fault_candidate(
         None => baseline,
     };
     let data = cx.data;
-    let f = acquisition::fit(fault, data, model, &spans(cx.fit_w));
-    if !f.value.is_finite() {
+    let sp = spans(cx.fit_w);
+    let fits = match faults {
+        [one] => vec![acquisition::fit(*one, data, model, &sp)],
+        _ => acquisition::fit_linear(faults, data, model, &sp)?,
+    };
+    if fits.iter().any(|f| !f.value.is_finite()) {
         return None;
     }
+    let values: Vec<f64> = fits.iter().map(|f| f.value).collect();
     let sim: Vec<Vec<f64>> = data
         .iter()
         .zip(model)
-        .map(|(m, s)| fault.apply(f.value, &m.time_s, s))
+        .map(|(m, s)| acquisition::apply_all(faults, &values, &m.time_s, s))
         .collect();
     let n_fit: usize = cx.fit_w.iter().map(|w| w.to - w.from).sum();
     let held = rms_over(cx.held_w, &sim, data);
-    let ms = (f.rss / n_fit.max(1) as f64).max(held * held);
-    let iv = acquisition::interval(&f, n_fit, cx.sigma, ms);
+    let rss = fits[0].rss;
+    let ms = (rss / n_fit.max(1) as f64).max(held * held);
+    let names: Vec<&str> = faults.iter().map(|f| f.name()).collect();
     let (cause, mut parameters, mut intervals, k, deck, mut x, evals) = match on {
         Some(e) => (
-            format!("{}+{}", e.0.cause, fault.name()),
+            format!("{}+{}", e.0.cause, names.join("+")),
             e.0.parameters.clone(),
             e.0.intervals.clone(),
-            e.0.k + 1,
+            e.0.k + faults.len(),
             e.2.clone(),
             e.3.clone(),
             e.0.fit_evaluations,
         ),
         None => (
-            fault.name().to_string(),
+            names.join("+"),
             BTreeMap::new(),
             BTreeMap::new(),
-            1,
+            faults.len(),
             base.clone(),
             vec![],
             0,
         ),
     };
-    // The lag against the replay, reported against the damper (`x` keeps the former: the
-    // fault's correction of the data works on the replay).
-    let shift = if fault == Fault::Lag {
-        cx.replay_delay_s
-    } else {
-        0.0
-    };
-    parameters.insert(fault.param().into(), f.value + shift);
-    intervals.insert(fault.param().into(), [iv[0] + shift, iv[1] + shift]);
-    x.push(f.value);
+    for (&fault, f) in faults.iter().zip(&fits) {
+        let iv = acquisition::interval(f, n_fit, cx.sigma, ms);
+        // The lag against the replay, reported against the damper (`x` keeps the former: the
+        // fault's correction of the data works on the replay).
+        let shift = if fault == Fault::Lag {
+            cx.replay_delay_s
+        } else {
+            0.0
+        };
+        parameters.insert(fault.param().into(), f.value + shift);
+        intervals.insert(fault.param().into(), [iv[0] + shift, iv[1] + shift]);
+        x.push(f.value);
+    }
     let row = Candidate {
         cause,
         rms_N: rms_over(cx.all_w, &sim, data),
-        bic: bic(f.rss, n_fit, k),
+        bic: bic(rss, n_fit, k),
         parameters,
         held_out_rms_N: held,
         intervals,
         k,
-        fit_evaluations: evals + f.evaluations,
+        fit_evaluations: evals + fits.iter().map(|f| f.evaluations).max().unwrap_or(0),
         note: on.map(|e| {
             format!(
-                "the fault fitted on top of {} as fitted alone (not a joint fit)",
+                "the {} fitted on top of {} as fitted alone (not a joint fit)",
+                if faults.len() == 1 { "fault" } else { "faults" },
                 e.0.cause
             )
         }),
@@ -1182,6 +1194,19 @@ pub fn diagnose(
     };
     let mut evaluated = stage(&singles, usize::MAX);
     // Acquisition faults on the baseline: fitted on its replays, no replay of their own.
+    // Each fault alone, and the linear ones two at a time (a calibration error with a zero
+    // offset, a drifting zero beside either): one least-squares solve, no replay.
+    let fault_sets: Vec<Vec<Fault>> = opts
+        .faults
+        .iter()
+        .map(|&f| vec![f])
+        .chain(
+            acquisition::linear_pairs()
+                .into_iter()
+                .filter(|p| p.iter().all(|f| opts.faults.contains(f)))
+                .map(|p| p.to_vec()),
+        )
+        .collect();
     let fcx = FaultContext {
         data,
         fit_w: &fit_w,
@@ -1195,26 +1220,26 @@ pub fn diagnose(
         },
     };
     evaluated.extend(
-        opts.faults
+        fault_sets
             .iter()
-            .filter_map(|&f| fault_candidate(f, None, &baseline, base, &fcx)),
+            .filter_map(|f| fault_candidate(f, None, &baseline, base, &fcx)),
     );
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
     // A fault beside a physical cause: the fault fitted on top of the cause's replay, then the
     // cause refitted to the data the fault corrects and the fault again on top, while the BIC
     // falls (at most twice): alternating least squares towards the joint fit.
-    let fault_pair = |f: Fault, on: &Evaluated| -> Option<Evaluated> {
+    let fault_pair = |f: &[Fault], on: &Evaluated| -> Option<Evaluated> {
         let mut cur = fault_candidate(f, Some(on), &baseline, base, &fcx)?;
         let (c, spec) = singles
             .iter()
             .find(|(c, _)| combined_name(c) == on.0.cause)?;
         let mut x = on.3.clone();
         for _ in 0..2 {
-            let v = *cur.3.last()?;
+            let v = &cur.3[cur.3.len().checked_sub(f.len())?..];
             let corrected: Vec<Measurement> = data
                 .iter()
                 .map(|m| Measurement {
-                    force_n: f.correct(v, &m.time_s, &m.force_n),
+                    force_n: acquisition::correct_all(f, v, &m.time_s, &m.force_n),
                     ..m.clone()
                 })
                 .collect();
@@ -1264,7 +1289,7 @@ pub fn diagnose(
             next.0.note = Some(format!(
                 "{} refitted to the data {} corrects, alternating with the fault's fit",
                 on.0.cause,
-                f.name()
+                f.iter().map(|f| f.name()).collect::<Vec<_>>().join("+")
             ));
             x = fit.x;
             cur = next;
@@ -1528,7 +1553,9 @@ pub fn diagnose(
             // three physical singles of lowest BIC below the baseline's. They cost no replay of
             // their own, so they are tried whether or not the residual is systematic.
             let reference = pair_ref.unwrap_or((row.bic, row.held_out_rms_N));
-            let ons: Vec<(Fault, Evaluated)> = match Fault::from_name(&row.cause) {
+            let best_faults: Option<Vec<Fault>> = acquisition::only_faults(&row.cause)
+                .then(|| row.cause.split('+').filter_map(Fault::from_name).collect());
+            let ons: Vec<(Vec<Fault>, Evaluated)> = match &best_faults {
                 Some(f) => evaluated
                     .iter()
                     .filter(|e| {
@@ -1538,25 +1565,25 @@ pub fn diagnose(
                             && e.0.bic < base_bic
                     })
                     .take(3)
-                    .map(|e| (f, e.clone()))
+                    .map(|e| (f.clone(), e.clone()))
                     .collect(),
                 None => refit_single
                     .clone()
                     .or_else(|| evaluated.iter().find(|e| e.0.cause == row.cause).cloned())
                     .filter(|_| !has_fault(&row.cause))
-                    .map(|on| opts.faults.iter().map(|&f| (f, on.clone())).collect())
+                    .map(|on| fault_sets.iter().map(|f| (f.clone(), on.clone())).collect())
                     .unwrap_or_default(),
             };
             let fault_pairs: Vec<Evaluated> = ons
                 .par_iter()
-                .filter_map(|(f, on)| fault_pair(*f, on))
+                .filter_map(|(f, on)| fault_pair(f, on))
                 .collect();
             if !fault_pairs.is_empty() {
                 pair_ref = Some(reference);
                 pair_stage.push_str(&format!(
                     "; acquisition faults (no replay of their own, so tried {}) beside {}, the physical cause refitted to the data the fault corrects",
                     if systematic { "as companions" } else { "whatever the residual" },
-                    if Fault::from_name(&row.cause).is_some() {
+                    if best_faults.is_some() {
                         format!("the three physical single causes of lowest BIC below the baseline's ({} fitted on top of each)", row.cause)
                     } else {
                         row.cause.clone()
@@ -1566,14 +1593,14 @@ pub fn diagnose(
             for e in &fault_pairs {
                 let (passes, reason) = judge_pair(e, reference, threshold);
                 let names: Vec<&str> = e.0.cause.split('+').collect();
-                let companion = if Fault::from_name(&row.cause).is_some() {
-                    names[0]
+                let companion = if best_faults.is_some() {
+                    names[0].to_string()
                 } else {
-                    names[names.len() - 1]
+                    names[1..].join("+")
                 };
                 companions.push(Companion {
                     pair: e.0.cause.clone(),
-                    companion: companion.to_string(),
+                    companion,
                     passes,
                     kept: false,
                     reason,
