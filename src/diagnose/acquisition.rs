@@ -251,28 +251,20 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
     }
 }
 
-/// The faults that are linear in the recorded force (`y = g F + o + d (t - t0)`): they are
-/// fitted together by one least-squares solve.
+/// The faults that are linear in the recorded force (`y = g F + o + d (t - t0)`), in the order
+/// of [`Fault::ALL`]: they are fitted together by one least-squares solve.
 pub const LINEAR: [Fault; 3] = [Fault::Offset, Fault::Gain, Fault::Drift];
 
 /// The pairs of linear faults tried together (a load cell with a wrong calibration and a zero
-/// offset, a zero that drifts beside either), in the order of [`Fault::ALL`].
+/// offset, a zero that drifts beside either), each in the order of [`Fault::ALL`].
 pub fn linear_pairs() -> Vec<[Fault; 2]> {
     let mut v = Vec::new();
     for (i, &a) in LINEAR.iter().enumerate() {
         for &b in &LINEAR[i + 1..] {
-            let (a, b) = if ord(a) < ord(b) { (a, b) } else { (b, a) };
             v.push([a, b]);
         }
     }
     v
-}
-
-fn ord(f: Fault) -> usize {
-    Fault::ALL
-        .iter()
-        .position(|&g| g == f)
-        .unwrap_or(usize::MAX)
 }
 
 /// The recorded force of a model force `f` with every fault of `faults` at its value: the gain

@@ -723,7 +723,7 @@ fn spans(w: &[Window]) -> Vec<Span> {
 /// Acquisition faults fitted on top of a model: the baseline (`on` None; the deck `base`) or a
 /// fitted physical cause (`on`, named `cause+fault`, its parameters kept). One fault by
 /// [`acquisition::fit`]; several (linear ones: gain, offset, drift) together by
-/// [`acquisition::fit_linear`], named `force_gain+force_offset`.
+/// [`acquisition::fit_linear`], named `force_offset+force_gain`.
 fn fault_candidate(
     faults: &[Fault],
     on: Option<&Evaluated>,
