@@ -1,7 +1,7 @@
 //! `rotorsim diagnose`: find what the damper model gets wrong in measured data, name
-//! the cause, extend the model and measure the gain on held-out data.
+//! the cause, extend the model and measure the gain on held-out data. The diagnosis is the
+//! library's [`pipeline::run`] (checks included); this file prints what it found.
 use crate::diagnose::pipeline::{self, Config};
-use anyhow::bail;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -78,28 +78,6 @@ impl DiagnoseArgs {
 }
 
 pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
-    if args.fit_cycles < 2 {
-        bail!("--fit-cycles must be >= 2 (one settles the model, the rest are compared)");
-    }
-    if !(args.max_substep > 0.0 && args.max_substep.is_finite()) {
-        bail!("--max-substep must be a positive number of seconds");
-    }
-    if !matches!(args.rotor_model.as_str(), "uh60a" | "rigid") {
-        bail!(
-            "--model: unknown rotor model '{}' (expected uh60a or rigid)",
-            args.rotor_model
-        );
-    }
-    if args.rotor_check && args.flight.is_none() {
-        bail!("--rotor-check needs a flight record (--rotor ROTOR --flight RECORD): it compares rotor runs with the record's damper force");
-    }
-    match (&args.flight, args.measured.is_empty()) {
-        (Some(_), false) => bail!("give either --flight or --measured, not both"),
-        (None, true) => bail!(
-            "nothing to diagnose: give --damper-deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
-        ),
-        _ => {}
-    }
     let cfg = Config {
         deck: args.deck.clone(),
         measured: args.measured.clone(),
@@ -114,7 +92,7 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
         substeps: args.substeps,
         rotor_check: args.rotor_check,
         check_revs: args.check_revs,
-        rigid: args.rotor_model == "rigid",
+        rotor_model: args.rotor_model.clone(),
     };
     let say = |s: &str| errln!("{s}");
     let report = pipeline::run(&cfg, &say)?;

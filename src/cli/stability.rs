@@ -1,10 +1,9 @@
 //! `rotorsim stability --rotor DECK --speeds A:B:STEP --out DIR`: ground resonance of a rotor
-//! deck on its airframe over rotor speeds (pipeline: src/run/stability.rs).
-use crate::hydraulics::DamperModel;
-use crate::io::OutDir;
+//! deck on its airframe over rotor speeds. The run is the library's [`StabilityJob`]
+//! (src/run/stability.rs); this file turns the options into one and prints.
 use crate::overrides::Override;
-use crate::rotor::RotorDeck;
-use crate::run::stability::stability_map;
+use crate::run::air_resonance::HoverOptions;
+use crate::run::stability::{StabilityJob, StabilityOutcome, TimeOptions};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -73,132 +72,43 @@ fn parse_set(s: &str) -> Result<Override, String> {
     Override::parse(s).map_err(|e| format!("{e:#}"))
 }
 
+impl StabilityArgs {
+    /// The stability run these options ask for.
+    pub fn job(&self) -> StabilityJob {
+        StabilityJob {
+            rotor: self.rotor.clone(),
+            speeds: self.speeds.clone(),
+            damper: self.damper.clone(),
+            time_speeds: self.time.clone(),
+            time: TimeOptions {
+                kick_m_s: self.kick_m_s,
+                duration_s: self.time_duration_s,
+                fit_from_s: self.time_duration_s * 7.0 / 20.0,
+                steps_per_rev: self.steps_per_rev,
+            },
+            amplitudes_m: self.amplitudes_m.clone(),
+            amplitude_at_rad_s: self.amplitude_at_rad_s,
+            hover: self.hover,
+            hover_options: HoverOptions {
+                collective_deg: self.collective_deg,
+                density_kg_m3: self.density_kg_m3,
+                speed_of_sound_m_s: self.speed_of_sound_m_s,
+                strips: self.strips,
+            },
+            set: self.set.clone(),
+            out: self.out.clone(),
+        }
+    }
+}
+
 pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
-    let speeds = crate::run::stability::parse_speeds("--speeds", &args.speeds)?;
-    let deck = RotorDeck::from_file_with(&args.rotor, &args.set)?;
-    let model = match &args.damper {
-        Some(d) => d
-            .parse::<DamperModel>()
-            .map_err(|e| anyhow::anyhow!("--damper {d}: {e}"))?,
-        None => deck.damper()?.model,
-    };
-    // --time: read and sized before the result folder exists
-    let time_opts = crate::run::stability::TimeOptions {
-        kick_m_s: args.kick_m_s,
-        duration_s: args.time_duration_s,
-        fit_from_s: args.time_duration_s * 7.0 / 20.0,
-        steps_per_rev: args.steps_per_rev,
-    };
-    let mut time_speeds: Vec<f64> = vec![];
-    if let Some(t) = &args.time {
-        time_speeds = crate::run::stability::parse_speeds("--time", t)?;
-        for &w in &time_speeds {
-            time_opts.check(w)?;
-        }
-    }
-    // --amplitudes-m: read and checked before the result folder exists
-    let amplitude = match &args.amplitudes_m {
-        None => {
-            if args.amplitude_at_rad_s.is_some() {
-                anyhow::bail!("--amplitude-at-rad-s needs --amplitudes-m (the amplitudes to start from, or `default`)");
-            }
-            None
-        }
-        Some(a) => {
-            let amplitudes_m = if a.trim() == "default" {
-                crate::run::amplitude::DEFAULT_AMPLITUDES_M.to_vec()
-            } else {
-                crate::run::ranges::parse_range(
-                    "--amplitudes-m",
-                    a,
-                    "expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`",
-                    crate::run::amplitude::MAX_AMPLITUDES,
-                    "an amplitude check may have",
-                )?
-            };
-            let w = args
-                .amplitude_at_rad_s
-                .unwrap_or(deck.spec.rotor.omega_rad_s);
-            if !(w.is_finite() && w > 0.0) {
-                anyhow::bail!("--amplitude-at-rad-s {w}: expected a positive rotor speed in rad/s");
-            }
-            crate::run::amplitude::check_amplitudes(
-                &amplitudes_m,
-                deck.spec.damper_attachment.arm_m,
-            )?;
-            Some((w, amplitudes_m))
-        }
-    };
-    let hover = crate::run::air_resonance::HoverOptions {
-        collective_deg: args.collective_deg,
-        density_kg_m3: args.density_kg_m3,
-        speed_of_sound_m_s: args.speed_of_sound_m_s,
-        strips: args.strips,
-    };
-    if args.hover {
-        hover.check()?;
-        if args.time.is_some() {
-            anyhow::bail!("--hover: the whole rotor's time domain (--time) is for ground resonance; run it without --hover (the amplitude check, --amplitudes-m, runs in hover)");
-        }
-    }
-    let out = OutDir::create(&args.out, &deck.input_files())?;
-    let result = if args.hover {
-        crate::run::air_resonance::air_resonance_map(&deck, model, &speeds, &hover)
-    } else {
-        stability_map(&deck, model, &speeds)
-    };
-    let map = match result {
-        Ok(mut m) => {
-            m.overrides = args
-                .set
-                .iter()
-                .map(|o| (o.key.clone(), o.value_text()))
-                .collect();
-            m
-        }
-        Err(e) => {
-            out.mark_incomplete(&format!("{e:#}"))?;
-            return Err(e);
-        }
-    };
-    let mut time = vec![];
-    for &w in &time_speeds {
-        outln!(
-            "time domain at {w} rad/s ({} s of motion)...",
-            args.time_duration_s
-        );
-        match crate::run::stability::time_check(&args.rotor, &args.set, model, w, &time_opts) {
-            Ok(c) => time.push(c),
-            Err(e) => {
-                out.mark_incomplete(&format!("{e:#}"))?;
-                return Err(e.context(format!("time domain at {w} rad/s")));
-            }
-        }
-    }
-    let amp = match amplitude {
-        None => None,
-        Some((w, amplitudes_m)) => {
-            outln!(
-                "amplitude check at {w} rad/s ({} starts, {} damper)...",
-                amplitudes_m.len(),
-                model.name()
-            );
-            let opts = crate::run::amplitude::AmplitudeOptions {
-                amplitudes_m,
-                hover: args.hover.then_some(hover),
-                ..Default::default()
-            };
-            match crate::run::amplitude::amplitude_check(&deck, model, w, &opts) {
-                Ok(c) => Some(c),
-                Err(e) => {
-                    out.mark_incomplete(&format!("{e:#}"))?;
-                    return Err(e.context(format!("amplitude check at {w} rad/s")));
-                }
-            }
-        }
-    };
-    crate::run::stability::write_all(&map, &time, amp.as_ref(), &deck, &out)?;
-    out.finish()?;
+    let StabilityOutcome {
+        map,
+        model,
+        speeds,
+        time,
+        amplitude: amp,
+    } = args.job().execute(&mut |line| outln!("{line}"))?;
     if let Some(c) = &amp {
         outln!("amplitude check: {}", c.statement);
     }

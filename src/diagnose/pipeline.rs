@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 /// A progress line for the user (the command prints it on stderr).
 pub type Say<'a> = &'a (dyn Fn(&str) + Sync);
 
-/// What to diagnose and how (the command's arguments, checked).
+/// What to diagnose and how: `rotorsim diagnose`'s options ([`Config::new`] gives its
+/// defaults), checked by [`run`]. The command line and the Python package both run through it.
 #[derive(Debug, Clone)]
 pub struct Config {
     /// Damper deck of the baseline model.
@@ -49,22 +50,75 @@ pub struct Config {
     /// Run the rotor-level before/after (flight records).
     pub rotor_check: bool,
     pub check_revs: usize,
-    /// The rotor runs use the rigid-blade reduction (else the multibody model).
-    pub rigid: bool,
+    /// Rotor model of the rotor runs: uh60a (the multibody model) or rigid (its rigid-blade
+    /// reduction).
+    pub rotor_model: String,
 }
 
 impl Config {
+    /// A diagnosis into `out` with the defaults of `rotorsim diagnose` (no data given).
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Config {
+            deck: None,
+            measured: vec![],
+            rotor: None,
+            flight: None,
+            out: out.into(),
+            write_deck: None,
+            fit_cycles: 3,
+            max_substep: 3.0e-5,
+            revs: 40,
+            steps_per_rev: 256,
+            substeps: 25,
+            rotor_check: false,
+            check_revs: 75,
+            rotor_model: "uh60a".into(),
+        }
+    }
+
+    /// The options' own checks, before anything is read ([`run`] starts with them).
+    pub fn check(&self) -> anyhow::Result<()> {
+        if self.fit_cycles < 2 {
+            bail!("--fit-cycles must be >= 2 (one settles the model, the rest are compared)");
+        }
+        if !(self.max_substep > 0.0 && self.max_substep.is_finite()) {
+            bail!("--max-substep must be a positive number of seconds");
+        }
+        if !matches!(self.rotor_model.as_str(), "uh60a" | "rigid") {
+            bail!(
+                "--model: unknown rotor model '{}' (expected uh60a or rigid)",
+                self.rotor_model
+            );
+        }
+        if self.rotor_check && self.flight.is_none() {
+            bail!("--rotor-check needs a flight record (--rotor ROTOR --flight RECORD): it compares rotor runs with the record's damper force");
+        }
+        match (&self.flight, self.measured.is_empty()) {
+            (Some(_), false) => bail!("give either --flight or --measured, not both"),
+            (None, true) => bail!(
+                "nothing to diagnose: give --damper-deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
+            ),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The rotor runs use the rigid-blade reduction (else the multibody model).
+    fn rigid(&self) -> bool {
+        self.rotor_model == "rigid"
+    }
+
     fn rotor_opts(&self, revs: usize) -> RotorRunOptions {
         RotorRunOptions {
             revs,
             steps_per_rev: self.steps_per_rev,
             substeps: self.substeps,
-            rigid: self.rigid,
+            rigid: self.rigid(),
         }
     }
     /// Label of the rotor model of the rotor runs (summary.json `rotor_model`).
     fn rotor_model_label(&self) -> &'static str {
-        if self.rigid {
+        if self.rigid() {
             crate::run::sdof::RIGID_LABEL
         } else {
             "UH-60A multibody rotor"
@@ -568,8 +622,9 @@ fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Resu
     Ok(())
 }
 
-/// Reads the data, diagnoses it and writes every output into `args.out`.
+/// Checks the options, reads the data, diagnoses it and writes every output into `args.out`.
 pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
+    args.check()?;
     let mut stroke_info: Option<Value> = None;
     // Without a measured stroke there is no stroke channel for the force to lag: a lag
     // between the force and the simulated stroke is the rotor model's phase error.

@@ -2,11 +2,12 @@
 //! peaks.csv, history_v<v>m_s.csv, time_history.svg, bench_summary.csv,
 //! peak_force_vs_velocity.svg, bench.html) and the replay of measured bench tests
 //! (replay_*.csv, loop_*.svg, replay_summary.csv, bench.html). The devices come built from
-//! the deck; nothing here prints (the command reports through the callbacks).
+//! the deck by [`BenchJob`], which checks the command's options; nothing here prints (the
+//! command reports through the callbacks).
 use crate::hydraulics::bench::{
     self, BenchTest, HarmonicRun, History, ReplayMetrics, SweepOptions, IN_TO_M, LB_TO_N,
 };
-use crate::hydraulics::{DamperDeck, DamperModel, Device, IntegratorOptions};
+use crate::hydraulics::{DamperDeck, DamperModel, Device, IntegratorOptions, Scheme};
 use crate::io::{csv_from_columns, OutDir};
 use crate::report::html::{Banner, HtmlReport};
 use crate::report::plot::{grid_svg, stacked_svg, Plot};
@@ -36,6 +37,210 @@ pub struct Config {
     /// Measured tests to replay, and the cycles their metrics leave out.
     pub measured: Vec<PathBuf>,
     pub skip_cycles: usize,
+}
+
+/// Peak velocities of the harmonic sweep by default, in in/s.
+pub const DEFAULT_PEAK_VELOCITIES_IN_S: [f64; 8] = [0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0];
+
+/// `rotorsim bench` as a library call: the command's options, typed ([`BenchJob::new`] gives
+/// its defaults), checked and run by [`BenchJob::execute`]. The command line and the Python
+/// package both run through it.
+#[derive(Debug, Clone)]
+pub struct BenchJob {
+    /// Damper deck (any TOML file with a `[damper]` table).
+    pub deck: PathBuf,
+    /// physical, linear, nonlinear or all (None: the deck's `model`).
+    pub damper: Option<String>,
+    /// Circular frequency of the harmonic stroking [rad/s].
+    pub omega: f64,
+    /// Peak velocities in `velocity_unit` (in/s, m/s or ft/s).
+    pub peak_velocity: Vec<f64>,
+    pub velocity_unit: String,
+    pub cycles: usize,
+    pub steps_per_cycle: usize,
+    pub substeps: usize,
+    /// Hydraulic sub-step scheme: rk4 or implicit.
+    pub scheme: String,
+    /// Output samples per second of the harmonic sweep (None: one per step).
+    pub output_rate: Option<f64>,
+    /// Measured bench tests to replay instead of the harmonic sweep.
+    pub measured: Vec<PathBuf>,
+    /// Replay only: cycles left out of the error metrics.
+    pub skip_cycles: usize,
+    pub out: PathBuf,
+}
+
+/// What a bench run did, its folder published.
+#[derive(Debug)]
+pub struct BenchOutcome {
+    /// Harmonic sweep: each model's runs (empty for a replay).
+    pub sweep: Vec<(DamperModel, Vec<HarmonicRun>)>,
+    /// Output samples per step and hydraulic sub-steps per sample of the harmonic sweep.
+    pub per_step: usize,
+    pub substeps: usize,
+    /// Output sample rate of the harmonic sweep [Hz].
+    pub output_rate_hz: f64,
+}
+
+fn velocity_factor(unit: &str) -> anyhow::Result<f64> {
+    Ok(match unit {
+        "in/s" => IN_TO_M,
+        "m/s" => 1.0,
+        "ft/s" => 0.3048,
+        _ => bail!("unknown --velocity-unit '{unit}' (expected in/s, m/s or ft/s)"),
+    })
+}
+
+impl BenchJob {
+    /// The bench of `deck` into `out` with the defaults of `rotorsim bench`.
+    pub fn new(deck: impl Into<PathBuf>, out: impl Into<PathBuf>) -> Self {
+        BenchJob {
+            deck: deck.into(),
+            damper: None,
+            omega: 27.02,
+            peak_velocity: DEFAULT_PEAK_VELOCITIES_IN_S.to_vec(),
+            velocity_unit: "in/s".into(),
+            cycles: 10,
+            steps_per_cycle: 256,
+            substeps: 25,
+            scheme: "rk4".into(),
+            output_rate: None,
+            measured: vec![],
+            skip_cycles: 0,
+            out: out.into(),
+        }
+    }
+
+    /// Checks the options and the deck, builds the devices, and runs the harmonic sweep (or
+    /// the replay of `measured`) into `out`. `on_model` gets each model's sweep (and the
+    /// hydraulic sub-stepping of its samples) once its files are written; `note` the replay's
+    /// lines (each test's error metrics).
+    pub fn execute(
+        &self,
+        on_model: &mut dyn FnMut(DamperModel, &[HarmonicRun], IntegratorOptions),
+        note: &mut dyn FnMut(&str),
+    ) -> anyhow::Result<BenchOutcome> {
+        let deck = DamperDeck::from_file(&self.deck)?;
+        let scheme: Scheme = self
+            .scheme
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--integrator {}: {e}", self.scheme))?;
+        if self.substeps == 0 || self.steps_per_cycle < 4 || self.cycles == 0 {
+            bail!("--substeps and --cycles must be >= 1 and --steps-per-cycle >= 4");
+        }
+        let replaying = !self.measured.is_empty();
+        if replaying && self.output_rate.is_some() {
+            bail!("--output-rate applies to the harmonic sweep; a replay (--measured) samples at the measurement's own instants");
+        }
+        if !replaying && self.skip_cycles > 0 {
+            bail!("--skip-cycles applies to a replay (--measured); the harmonic sweep's peaks and loops are over its last cycle (--cycles)");
+        }
+        if !(self.omega > 0.0 && self.omega.is_finite()) {
+            bail!(
+                "--omega must be a positive number of rad/s (got {})",
+                self.omega
+            );
+        }
+        // Output samples per step (the harmonic sweep only).
+        let step_rate = self.omega * self.steps_per_cycle as f64 / (2.0 * PI);
+        let per_step = match self.output_rate {
+            None => 1,
+            Some(r) if !(r > 0.0 && r.is_finite()) => bail!(
+                "--output-rate must be a positive number of samples per second (got {r})"
+            ),
+            Some(r) if r < 0.999 * step_rate => bail!(
+                "--output-rate {r} Hz is below the step rate {step_rate:.1} Hz (--omega x --steps-per-cycle / 2 pi): the bench writes a sample at every step end at least"
+            ),
+            Some(r) => ((r / step_rate).round() as usize).max(1),
+        };
+        let substeps = self.substeps.div_ceil(per_step);
+        // per amplitude and model: cycles x steps x pieces x sub-steps, every piece kept (5 columns)
+        let samples = self.cycles as f64 * self.steps_per_cycle as f64 * per_step as f64;
+        crate::solver::budget::substeps(samples * substeps as f64)
+            .plus(crate::solver::budget::samples(samples, 5.0))
+            .check(
+                &format!(
+                    "{} cycles x {} steps x {} samples per step x {} sub-steps per amplitude",
+                    self.cycles, self.steps_per_cycle, per_step, substeps
+                ),
+                "check --cycles, --steps-per-cycle, --output-rate and --substeps",
+            )?;
+        let opts = IntegratorOptions { scheme, substeps };
+        let models: Vec<DamperModel> = match self.damper.as_deref() {
+            None => vec![deck.model],
+            Some("all") => vec![
+                DamperModel::Physical,
+                DamperModel::Linear,
+                DamperModel::Nonlinear,
+            ],
+            Some(s) => vec![s
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--damper {s}: {e}"))?],
+        };
+        // Build every device first so that a deck error leaves no output at all.
+        let devices = models
+            .iter()
+            .map(|&m| Ok((m, deck.build(m, opts)?)))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        // A replay does not use the velocity unit: an unknown one is refused for the sweep only.
+        let factor = velocity_factor(&self.velocity_unit);
+        let cfg = Config {
+            deck: self.deck.clone(),
+            out: self.out.clone(),
+            omega: self.omega,
+            peak_velocity: self.peak_velocity.clone(),
+            velocity_unit: self.velocity_unit.clone(),
+            factor: factor.as_ref().map_or(1.0, |f| *f),
+            cycles: self.cycles,
+            steps_per_cycle: self.steps_per_cycle,
+            per_step,
+            opts,
+            measured: self.measured.clone(),
+            skip_cycles: self.skip_cycles,
+        };
+        let mut outcome = BenchOutcome {
+            sweep: vec![],
+            per_step,
+            substeps,
+            output_rate_hz: step_rate * per_step as f64,
+        };
+        if replaying {
+            replay(&cfg, &deck, &devices, note)?;
+            return Ok(outcome);
+        }
+        let factor = factor?;
+        if self.peak_velocity.is_empty()
+            || self
+                .peak_velocity
+                .iter()
+                .any(|v| !(*v > 0.0 && v.is_finite()))
+        {
+            bail!(
+                "--peak-velocity must be positive numbers (got {:?})",
+                self.peak_velocity
+            );
+        }
+        let names: Vec<String> = self
+            .peak_velocity
+            .iter()
+            .map(|&v| history_name(v * factor))
+            .collect();
+        for (i, a) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|b| b == a) {
+                bail!(
+                    "--peak-velocity {} and {} {} name the same history file {a} (peak velocities are told apart to 1 um/s)",
+                    self.peak_velocity[j],
+                    self.peak_velocity[i],
+                    self.velocity_unit
+                );
+            }
+        }
+        sweep(&cfg, &deck, &devices, &mut |model, runs| {
+            on_model(model, runs, opts);
+            outcome.sweep.push((model, runs.to_vec()));
+        })?;
+        Ok(outcome)
+    }
 }
 
 /// Runs the harmonic sweep of every device and writes its outputs into `cfg.out`;

@@ -9,6 +9,7 @@ use crate::overrides::Override;
 use crate::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use crate::run::outputs::{write_outputs, Written};
 use crate::run::sdof::{rigid_reduction, LagHingeSdof, SdofParams, RIGID_LABEL};
+use crate::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
 use crate::run::summary::{Measured, RunInfo};
 use crate::run::{self, fmt_measure, ModelOutcome, ModelRun, PeriodicMethod, Progress, Silent};
 use crate::solver::NewtonMethod;
@@ -593,6 +594,18 @@ impl RunJob {
     /// a model not periodic (published complete) is an error: a [`RunFailed`] carrying the
     /// outcome. Errors before the outputs are written carry none.
     pub fn execute(&self, observer: &dyn RunObserver) -> anyhow::Result<RunOutcome> {
+        self.execute_until(observer, &StopFlag::default())
+    }
+
+    /// [`RunJob::execute`] that stops when `stop` is raised: the units stop before their next
+    /// structural step and the run returns a [`RunStopped`] error, its result folder published
+    /// incomplete (nothing but the marker, which says where each unit stopped, and the
+    /// manifest).
+    pub fn execute_until(
+        &self,
+        observer: &dyn RunObserver,
+        stop: &StopFlag,
+    ) -> anyhow::Result<RunOutcome> {
         let t0 = Instant::now();
         let models = self.damper.models();
         self.check_options()?;
@@ -726,10 +739,27 @@ impl RunJob {
                 min_floquet_dirs: 0,
                 keep_all_revs: self.write_all_revs,
                 inputs_sha256: Some(inputs_sha256.clone()),
+                stop: stop.clone(),
             })
             .collect();
         let unit_models: Vec<DamperModel> = units.iter().map(|u| u.0).collect();
         let mut outcomes = run::run_units(&unit_models, &popts, &build, observer);
+        if stop.requested() {
+            // units that ended before the request keep nothing either: the run is not whole
+            let stopped: Vec<&str> = outcomes
+                .iter()
+                .filter_map(|o| o.result.as_ref().err())
+                .filter(|e| e.starts_with(STOPPED_PREFIX))
+                .map(String::as_str)
+                .collect();
+            if !stopped.is_empty() {
+                let message = stopped.join("; ");
+                out.mark_incomplete(&message)?;
+                let folder = out.path().to_path_buf();
+                drop(out); // published incomplete
+                return Err(anyhow::Error::new(RunStopped { message, folder }));
+            }
+        }
         // a failure of the physical model names the deck values behind it, where they are
         // unusual
         for (o, (_, blade)) in outcomes.iter_mut().zip(&units) {

@@ -11,7 +11,8 @@
 //!
 //! Beside it, the pipelines of the other commands that write result folders: [`bench`] (the
 //! damper bench's sweep and replay outputs), [`decay`] (a hinged blade's lag free decay) and
-//! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check).
+//! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check); [`stop`]
+//! stops runs from outside (the Python package's Ctrl-C).
 pub mod air_resonance;
 pub mod amplitude;
 pub mod bench;
@@ -26,6 +27,7 @@ pub mod report;
 pub mod rotor;
 pub mod sdof;
 pub mod stability;
+pub mod stop;
 pub mod summary;
 
 use crate::hydraulics::DamperModel;
@@ -264,6 +266,7 @@ pub fn drive_periodic(
         sim,
         &mut rev,
         &format!("{} model, hybrid reference", model.name()),
+        &o.stop,
     )?;
     sim.adopt_reference();
     sim.restore_state(start)?;
@@ -393,7 +396,7 @@ fn drive_periodic_once(
     while periods < o.max_revs {
         let periodic = sim.time_s() >= periodic_from;
         let st0 = if can_save { sim.save_state() } else { None };
-        integrate(sim, &mut rev, &march_label(periods + 1))?;
+        integrate(sim, &mut rev, &march_label(periods + 1), &o.stop)?;
         keep(&mut kept, &rev, 0);
         periods += 1;
         in_periodic += usize::from(periodic);
@@ -426,6 +429,7 @@ fn drive_periodic_once(
             .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
         let label = format!("{} model", model.name());
         let mut map = SimMap::new(sim, mon.clone(), st0, end, rev, periods, progress, label);
+        map.stop = o.stop.clone();
         if o.keep_all_revs {
             map.kept = Some(vec![]);
         }
@@ -445,6 +449,11 @@ fn drive_periodic_once(
             keep(&mut kept, r, k + 1);
         }
         drop(map);
+        // shooting reports a stopped revolution as a failed one: stop here, not march on
+        o.stop.check(
+            sim.time_s(),
+            &format!("{} model, revolution {periods} (shooting)", model.name()),
+        )?;
         start_state = Some(start);
         let mut mult: Vec<_> = out
             .ritz
@@ -491,7 +500,7 @@ fn drive_periodic_once(
             sim.restore_state(&end)?;
             while periods < o.max_revs {
                 let st0 = sim.save_state();
-                integrate(sim, &mut rev, &march_label(periods + 1))?;
+                integrate(sim, &mut rev, &march_label(periods + 1), &o.stop)?;
                 keep(&mut kept, &rev, 0);
                 periods += 1;
                 info.residual_by_channel = rev.residual(&mon);

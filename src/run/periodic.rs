@@ -49,6 +49,9 @@ pub struct PeriodicOptions {
     /// Fingerprint of this run's inputs ([`crate::io::inputs_fingerprint`]): saved with the
     /// periodic state, and compared with a saved state's when starting from one.
     pub inputs_sha256: Option<String>,
+    /// Checked before every structural step: a raised flag stops the run with
+    /// [`super::stop::Stopped`].
+    pub stop: super::stop::StopFlag,
 }
 
 impl PeriodicOptions {
@@ -63,6 +66,7 @@ impl PeriodicOptions {
             min_floquet_dirs: 0,
             keep_all_revs: false,
             inputs_sha256: None,
+            stop: Default::default(),
         }
     }
     /// Shooting to `tol`, at most `max_revs` revolutions.
@@ -76,6 +80,7 @@ impl PeriodicOptions {
             min_floquet_dirs: 0,
             keep_all_revs: false,
             inputs_sha256: None,
+            stop: Default::default(),
         }
     }
 }
@@ -162,6 +167,7 @@ pub(super) fn integrate(
     sim: &mut dyn ForcedResponse,
     rev: &mut Revolution,
     what: &str,
+    stop: &super::stop::StopFlag,
 ) -> anyhow::Result<()> {
     let n = rev.azimuth.len();
     let mut buf = vec![0.0; rev.end.len()];
@@ -185,6 +191,7 @@ pub(super) fn integrate(
         } else {
             psi
         };
+        stop.check(sim.time_s(), what)?;
         sim.step().map_err(|e| {
             e.context(format!(
                 "{what}, step {j} of {n} (t = {:.6} s)",
@@ -212,6 +219,7 @@ pub(super) struct SimMap<'a> {
     pub label: String,
     /// Accepted iterates, when the run keeps every revolution.
     pub kept: Option<Vec<Revolution>>,
+    pub stop: super::stop::StopFlag,
 }
 
 impl<'a> SimMap<'a> {
@@ -241,6 +249,7 @@ impl<'a> SimMap<'a> {
             progress,
             label,
             kept: None,
+            stop: Default::default(),
         }
     }
 
@@ -253,7 +262,7 @@ impl<'a> SimMap<'a> {
         // a perturbed revolution is never reported: no output-only channels
         let was = self.sim.output_channels();
         self.sim.set_output_channels(was && into_trial);
-        let r = integrate(self.sim, &mut rev, &what);
+        let r = integrate(self.sim, &mut rev, &what, &self.stop);
         self.sim.set_output_channels(was);
         r?;
         let end = self

@@ -1142,3 +1142,196 @@ pub fn time_check(
         fit_from_s,
     })
 }
+
+/// `rotorsim stability` as a library call: the command's options, typed ([`StabilityJob::new`]
+/// gives its defaults), checked and run by [`StabilityJob::execute`] into its result folder.
+/// The command line and the Python package both run through it.
+#[derive(Clone, Debug)]
+pub struct StabilityJob {
+    /// Rotor deck with an `[airframe]`.
+    pub rotor: std::path::PathBuf,
+    /// Rotor speeds [rad/s]: START:STOP:STEP (inclusive) or a comma-separated list.
+    pub speeds: String,
+    /// Damper model linearised at each speed (None: the deck's `damper.model`).
+    pub damper: Option<String>,
+    /// Speeds [rad/s] of the whole multibody rotor's time-domain runs (a list).
+    pub time_speeds: Option<String>,
+    /// The time-domain runs (`fit_from_s` is 7/20 of `duration_s`, set by `execute`).
+    pub time: TimeOptions,
+    /// Stroke amplitudes [m] of the nonlinear amplitude check (a list, or `default`).
+    pub amplitudes_m: Option<String>,
+    /// Rotor speed of the amplitude check [rad/s] (None: the deck's).
+    pub amplitude_at_rad_s: Option<f64>,
+    /// Air resonance in hover instead of ground resonance, and its condition.
+    pub hover: bool,
+    pub hover_options: super::air_resonance::HoverOptions,
+    /// Deck values overridden by dotted path before validation.
+    pub set: Vec<crate::overrides::Override>,
+    pub out: std::path::PathBuf,
+}
+
+/// What a stability run found, its folder published.
+#[derive(Clone, Debug)]
+pub struct StabilityOutcome {
+    pub map: StabilityMap,
+    /// The damper model linearised, and the speeds of the map [rad/s].
+    pub model: DamperModel,
+    pub speeds: Vec<f64>,
+    /// The whole rotor's time-domain runs.
+    pub time: Vec<TimeCheck>,
+    pub amplitude: Option<super::amplitude::AmplitudeCheck>,
+}
+
+impl StabilityJob {
+    /// The map of `rotor` over `speeds` into `out` with the defaults of `rotorsim stability`.
+    pub fn new(
+        rotor: impl Into<std::path::PathBuf>,
+        speeds: &str,
+        out: impl Into<std::path::PathBuf>,
+    ) -> Self {
+        StabilityJob {
+            rotor: rotor.into(),
+            speeds: speeds.to_string(),
+            damper: None,
+            time_speeds: None,
+            time: TimeOptions::default(),
+            amplitudes_m: None,
+            amplitude_at_rad_s: None,
+            hover: false,
+            hover_options: Default::default(),
+            set: vec![],
+            out: out.into(),
+        }
+    }
+
+    /// Checks the options and the deck (before the result folder exists), then computes the
+    /// map, the time-domain runs and the amplitude check and writes them. `say` gets a line as
+    /// each slow part starts. A failure after the folder exists leaves it marked incomplete.
+    pub fn execute(&self, say: &mut dyn FnMut(&str)) -> anyhow::Result<StabilityOutcome> {
+        let speeds = parse_speeds("--speeds", &self.speeds)?;
+        let deck = RotorDeck::from_file_with(&self.rotor, &self.set)?;
+        let model = match &self.damper {
+            Some(d) => d
+                .parse::<DamperModel>()
+                .map_err(|e| anyhow!("--damper {d}: {e}"))?,
+            None => deck.damper()?.model,
+        };
+        // the time-domain runs: read and sized before the result folder exists
+        let time_opts = TimeOptions {
+            fit_from_s: self.time.duration_s * 7.0 / 20.0,
+            ..self.time
+        };
+        let mut time_speeds: Vec<f64> = vec![];
+        if let Some(t) = &self.time_speeds {
+            time_speeds = parse_speeds("--time", t)?;
+            for &w in &time_speeds {
+                time_opts.check(w)?;
+            }
+        }
+        // the amplitude check: read and checked before the result folder exists
+        let amplitude = match &self.amplitudes_m {
+            None => {
+                if self.amplitude_at_rad_s.is_some() {
+                    bail!("--amplitude-at-rad-s needs --amplitudes-m (the amplitudes to start from, or `default`)");
+                }
+                None
+            }
+            Some(a) => {
+                let amplitudes_m = if a.trim() == "default" {
+                    super::amplitude::DEFAULT_AMPLITUDES_M.to_vec()
+                } else {
+                    super::ranges::parse_range(
+                        "--amplitudes-m",
+                        a,
+                        "expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`",
+                        super::amplitude::MAX_AMPLITUDES,
+                        "an amplitude check may have",
+                    )?
+                };
+                let w = self
+                    .amplitude_at_rad_s
+                    .unwrap_or(deck.spec.rotor.omega_rad_s);
+                if !(w.is_finite() && w > 0.0) {
+                    bail!("--amplitude-at-rad-s {w}: expected a positive rotor speed in rad/s");
+                }
+                super::amplitude::check_amplitudes(
+                    &amplitudes_m,
+                    deck.spec.damper_attachment.arm_m,
+                )?;
+                Some((w, amplitudes_m))
+            }
+        };
+        let hover = self.hover_options;
+        if self.hover {
+            hover.check()?;
+            if self.time_speeds.is_some() {
+                bail!("--hover: the whole rotor's time domain (--time) is for ground resonance; run it without --hover (the amplitude check, --amplitudes-m, runs in hover)");
+            }
+        }
+        let out = OutDir::create(&self.out, &deck.input_files())?;
+        let result = if self.hover {
+            super::air_resonance::air_resonance_map(&deck, model, &speeds, &hover)
+        } else {
+            stability_map(&deck, model, &speeds)
+        };
+        let map = match result {
+            Ok(mut m) => {
+                m.overrides = self
+                    .set
+                    .iter()
+                    .map(|o| (o.key.clone(), o.value_text()))
+                    .collect();
+                m
+            }
+            Err(e) => {
+                out.mark_incomplete(&format!("{e:#}"))?;
+                return Err(e);
+            }
+        };
+        let mut time = vec![];
+        for &w in &time_speeds {
+            say(&format!(
+                "time domain at {w} rad/s ({} s of motion)...",
+                self.time.duration_s
+            ));
+            match time_check(&self.rotor, &self.set, model, w, &time_opts) {
+                Ok(c) => time.push(c),
+                Err(e) => {
+                    out.mark_incomplete(&format!("{e:#}"))?;
+                    return Err(e.context(format!("time domain at {w} rad/s")));
+                }
+            }
+        }
+        let amp = match amplitude {
+            None => None,
+            Some((w, amplitudes_m)) => {
+                say(&format!(
+                    "amplitude check at {w} rad/s ({} starts, {} damper)...",
+                    amplitudes_m.len(),
+                    model.name()
+                ));
+                let opts = super::amplitude::AmplitudeOptions {
+                    amplitudes_m,
+                    hover: self.hover.then_some(hover),
+                    ..Default::default()
+                };
+                match super::amplitude::amplitude_check(&deck, model, w, &opts) {
+                    Ok(c) => Some(c),
+                    Err(e) => {
+                        out.mark_incomplete(&format!("{e:#}"))?;
+                        return Err(e.context(format!("amplitude check at {w} rad/s")));
+                    }
+                }
+            }
+        };
+        write_all(&map, &time, amp.as_ref(), &deck, &out)?;
+        out.finish()?;
+        Ok(StabilityOutcome {
+            map,
+            model,
+            speeds,
+            time,
+            amplitude: amp,
+        })
+    }
+}
