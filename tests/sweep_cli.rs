@@ -451,3 +451,41 @@ fn a_stability_sweep_tables_each_cases_least_damping() {
         "{e}"
     );
 }
+
+struct Quiet;
+impl rotorsim::sweep::SweepProgress for Quiet {
+    fn start(&self, _: usize, _: usize) {}
+    fn case_done(&self, _: &rotorsim::sweep::Case, _: &Result<(), String>, _: f64) {}
+}
+
+#[test]
+fn a_stopped_sweep_starts_no_case_and_leaves_them_to_run() {
+    use rotorsim::run::stop::STOPPED_PREFIX;
+    use rotorsim::sweep::job::SweepJob;
+    let d = tmp("sweep-stopped");
+    let job = SweepJob {
+        jobs: Some(2),
+        ..SweepJob::new(root().join(PLAN), d.join("s"))
+    };
+    // cargo runs the tests from the package root, where the plan's paths resolve
+    let plan = job.read_plan().unwrap();
+    job.stop.request();
+    let o = job.execute(&plan, &|_, _| {}, &Quiet, &mut |_| {}).unwrap();
+    assert_eq!(o.report.ran.len(), 4);
+    for (id, r) in &o.report.ran {
+        let e = r.as_ref().unwrap_err();
+        assert!(e.starts_with(STOPPED_PREFIX), "{id}: {e}");
+        assert!(e.contains(&format!("case {id} not started")), "{e}");
+        assert!(!d.join("s/cases").join(id).exists(), "{id} has a folder");
+    }
+    // run again, not stopped: every case runs (none was left failed)
+    let again = SweepJob {
+        jobs: Some(2),
+        ..SweepJob::new(root().join(PLAN), d.join("s"))
+    };
+    let o = again
+        .execute(&plan, &|_, _| {}, &Quiet, &mut |_| {})
+        .unwrap();
+    assert_eq!(o.report.ran.len(), 4);
+    assert!(o.report.failed().is_empty(), "{:?}", o.report.failed());
+}

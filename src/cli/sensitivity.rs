@@ -1,8 +1,9 @@
 //! `rotorsim sensitivity --rotor DECK --out DIR`: every value the deck labels ASSUMED (and any
 //! `--vary KEY=LOW:HIGH`) moved over its range through the sweep engine (pipeline:
 //! src/sensitivity/, docs/sensitivity.md).
-use super::sweep::{check_with_progress, default_jobs, env_shard, BatchArgs, Console};
+use super::sweep::{check_with_progress, BatchArgs, Console};
 use crate::sensitivity::{self, table::OUTPUTS, SensitivityOptions, Vary};
+use crate::sweep::job::{default_jobs, env_shard};
 use crate::sweep::{self, JobRunner, SweepOptions};
 use anyhow::{bail, Context};
 use clap::Args;

@@ -1,6 +1,7 @@
 //! `rotorsim sweep`: batch forced-response runs from a plan, on this machine or as the shards of
 //! a Slurm job array (docs/sweep.md).
-use crate::sweep::{self, Case, JobRunner, Plan, SweepOptions, SweepProgress};
+use crate::sweep::job::SweepJob;
+use crate::sweep::{self, Case, JobRunner, Plan, SweepProgress};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -132,30 +133,6 @@ impl SweepProgress for Console {
     }
 }
 
-pub(crate) fn env_shard() -> anyhow::Result<Option<(usize, usize)>> {
-    match (
-        std::env::var("SLURM_ARRAY_TASK_ID"),
-        std::env::var("SLURM_ARRAY_TASK_COUNT"),
-    ) {
-        (Ok(k), Ok(n)) => sweep::plan::parse_shard(&format!("{k}/{n}"))
-            .map(Some)
-            .context("from SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT"),
-        _ => Ok(None),
-    }
-}
-
-pub(crate) fn default_jobs() -> usize {
-    std::env::var("SLURM_CPUS_PER_TASK")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .filter(|&n| n > 0)
-        .unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        })
-}
-
 pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     if let Some(SweepCommand::Merge { dir }) = &args.command {
         return merge(dir);
@@ -163,28 +140,20 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     let (Some(plan_path), Some(out)) = (&args.plan, &args.out) else {
         bail!("expected a plan file and --out DIR (or `rotorsim sweep merge DIR`)");
     };
-    let mut plan = Plan::from_file(plan_path)?;
-    if args.no_warm_start {
-        plan.warm_start = false;
-    }
-    let runner = JobRunner::default();
-    let jobs = args.batch.jobs.unwrap_or_else(default_jobs).max(1);
+    let job = SweepJob {
+        jobs: args.batch.jobs,
+        shard: sweep::job::resolve_shard(args.batch.shard.as_deref())?,
+        retry_failed: args.batch.retry_failed,
+        warm_start: !args.no_warm_start,
+        ..SweepJob::new(plan_path, out)
+    };
+    let plan = job.read_plan()?;
+    let jobs = job.jobs();
     let tty = std::io::stderr().is_terminal();
-    check_with_progress(&plan, &runner, jobs, tty)?;
     if let Some(script) = &args.batch.emit_slurm {
+        check_with_progress(&plan, &JobRunner::default(), jobs, tty)?;
         return emit_slurm(&args, &plan, plan_path, out, script);
     }
-    let shard = match &args.batch.shard {
-        Some(s) => Some(sweep::plan::parse_shard(s)?),
-        None => env_shard()?,
-    };
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("creating sweep folder {}", out.display()))?;
-    let lock = sweep::lock(out, shard)?;
-    for n in &lock.notes {
-        errln!("note: {n}");
-    }
-    sweep::prepare(out, &plan)?;
     let bar = tty.then(|| {
         let b = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
         b.set_style(
@@ -200,17 +169,21 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         bar,
         ..Console::lines("rotorsim sweep")
     };
-    let t0 = Instant::now();
-    let opts = SweepOptions {
-        jobs,
-        shard,
-        retry_failed: args.batch.retry_failed,
-    };
-    let report = sweep::execute(&plan, out, &opts, &runner, &console)?;
+    let checking = CheckConsole::new(plan.cases.len(), tty);
+    let outcome = job.execute(
+        &plan,
+        &|n, total| checking.checked(n, total),
+        &console,
+        &mut |n| errln!("note: {n}"),
+    );
+    checking.finish();
+    let outcome = outcome?;
+    let report = &outcome.report;
+    let shard = outcome.shard;
     if let Some(b) = &console.bar {
         b.finish_and_clear();
     }
-    let wall = t0.elapsed().as_secs_f64();
+    let wall = outcome.wall_s;
     let shard_note = shard
         .map(|(k, n)| format!(" (shard {k}/{n})"))
         .unwrap_or_default();
@@ -230,8 +203,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
             outln!("failed: {id}: {e}");
         }
     }
-    if shard.is_none() {
-        let merged = sweep::table::write(&plan, out)?;
+    if let Some(merged) = &outcome.merged {
         let (ok, np, failed, not_run) = sweep::table::counts(&merged.rows);
         outln!(
             "rows: {ok} ok (periodic, or a stability map), {np} NOT periodic, {failed} failed, {not_run} not run; table: {}  plots: {}",
@@ -276,45 +248,63 @@ fn merge(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Checks every case before any runs, with a progress bar on a terminal, otherwise a line
-/// every few seconds when checking takes long (a plan of many cases).
+/// The pre-flight check's progress: a bar on a terminal, otherwise a line every few seconds
+/// when checking takes long (a plan of many cases).
+pub(crate) struct CheckConsole {
+    bar: Option<ProgressBar>,
+    t0: Instant,
+    last: std::sync::Mutex<f64>,
+}
+
+impl CheckConsole {
+    pub(crate) fn new(total: usize, tty: bool) -> Self {
+        let bar = (tty && total > 1).then(|| {
+            let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+            b.set_style(
+                ProgressStyle::with_template(
+                    "checking the plan [{bar:30}] {pos}/{len} cases ({elapsed}, ETA {eta})",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            b
+        });
+        CheckConsole {
+            bar,
+            t0: Instant::now(),
+            last: std::sync::Mutex::new(0.0),
+        }
+    }
+    pub(crate) fn checked(&self, n: usize, total: usize) {
+        if let Some(b) = &self.bar {
+            b.set_position(n as u64);
+            return;
+        }
+        let now = self.t0.elapsed().as_secs_f64();
+        if let Ok(mut l) = self.last.lock() {
+            if now - *l >= CHECK_PROGRESS_EVERY_S {
+                *l = now;
+                errln!("rotorsim sweep: checked {n} of {total} cases ({now:.0} s)");
+            }
+        }
+    }
+    pub(crate) fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// Checks every case before any runs, its progress shown.
 pub(crate) fn check_with_progress(
     plan: &Plan,
     runner: &JobRunner,
     jobs: usize,
     tty: bool,
 ) -> anyhow::Result<()> {
-    let total = plan.cases.len();
-    let t0 = Instant::now();
-    let last = std::sync::Mutex::new(0.0f64);
-    let bar = (tty && total > 1).then(|| {
-        let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template(
-                "checking the plan [{bar:30}] {pos}/{len} cases ({elapsed}, ETA {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b
-    });
-    let progress = |n: usize, total: usize| {
-        if let Some(b) = &bar {
-            b.set_position(n as u64);
-            return;
-        }
-        let now = t0.elapsed().as_secs_f64();
-        if let Ok(mut l) = last.lock() {
-            if now - *l >= CHECK_PROGRESS_EVERY_S {
-                *l = now;
-                errln!("rotorsim sweep: checked {n} of {total} cases ({now:.0} s)");
-            }
-        }
-    };
-    let r = sweep::check(plan, runner, jobs, &progress);
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    let c = CheckConsole::new(plan.cases.len(), tty);
+    let r = sweep::check(plan, runner, jobs, &|n, total| c.checked(n, total));
+    c.finish();
     r
 }
 
