@@ -184,3 +184,40 @@ fn a_bad_override_fails_with_the_cli_message() {
     assert_eq!(stderr.trim_end(), format!("error: {lib}"), "{stderr}");
     std::fs::remove_dir_all(&t).unwrap();
 }
+
+/// Raises its stop flag at the first revolution reported.
+struct StopAtFirstRevolution(rotorsim::run::stop::StopFlag);
+
+impl Progress for StopAtFirstRevolution {
+    fn revolution(&self, _i: usize, _rev: usize, _revs: usize, _m: Option<f64>) {
+        self.0.request();
+    }
+    fn finished(&self, _i: usize, _ok: bool, _message: &str) {}
+}
+
+impl RunObserver for StopAtFirstRevolution {
+    fn start(&self, _: &RunStart) {}
+}
+
+#[test]
+fn a_stopped_job_publishes_its_folder_incomplete_saying_where_it_stopped() {
+    use rotorsim::run::stop::{RunStopped, StopFlag};
+    let out = support::tmp("job-stopped").join("run");
+    let job = RunJob {
+        revs: 30,
+        ..rigid_job(&out)
+    };
+    let stop = StopFlag::new();
+    let e = job
+        .execute_until(&StopAtFirstRevolution(stop.clone()), &stop)
+        .unwrap_err();
+    let s = e.downcast_ref::<RunStopped>().expect("a RunStopped error");
+    assert!(s.message.starts_with("stopped by the user at t = "), "{s}");
+    assert!(s.message.contains("revolution 2"), "{s}");
+    assert_eq!(s.folder, out);
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["complete"], Value::Bool(false));
+    assert!(out.join("INCOMPLETE").exists());
+    assert!(!out.join("summary.json").exists());
+}
