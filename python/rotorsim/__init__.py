@@ -11,7 +11,8 @@ import numpy as _np
 from . import _native
 
 __version__ = _native.__version__
-__all__ = ["Damper", "run", "RunResult"]
+__all__ = ["Damper", "run", "RunResult", "bench", "BenchResult", "stability", "StabilityResult", "diagnose",
+           "DiagnoseResult", "sweep", "SweepResult"]
 
 
 def _array(x, name):
@@ -123,6 +124,8 @@ def run(
     revs=None,
     steps_per_rev=None,
     substeps=None,
+    periodic="shooting",
+    periodic_tol=None,
     progress=True,
 ):
     """Forced response of the rotor to a flight record, as ``rotorsim run`` does.
@@ -132,19 +135,22 @@ def run(
     rotors/uh60a.toml), ``flight`` (MCAP file or CSV stem, default flightdata/c8534like),
     ``models`` (one of linear, nonlinear, physical, or all three; default all), ``set`` (deck
     values overridden by dotted key, ``{"damper.physical.A_orf_m2": 2e-6}``), ``all_blades``,
-    ``airloads`` (measured, computed or hybrid), ``revs``, ``steps_per_rev``, ``substeps``.
+    ``airloads`` (measured, computed or hybrid), ``revs``, ``steps_per_rev``, ``substeps``,
+    ``periodic`` (shooting or march) and ``periodic_tol``.
     ``out``: the result folder to write (a temporary one, removed with the result, when not
     given). ``progress``: True for tqdm bars when tqdm is installed, False for none, or a callable
     taking one dict per event (``start``, ``revolution``, ``finished``).
 
     Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
-    line does. Returns a :class:`RunResult`.
+    line does. Ctrl-C stops the run before its next structural step and raises
+    KeyboardInterrupt saying where it stopped; the result folder is then marked incomplete.
+    Returns a :class:`RunResult`.
     """
     keep = None
     if out is None:
         keep = _tempfile.TemporaryDirectory(prefix="rotorsim-run-")
         out = _Path(keep.name) / "run"
-    sets = [] if set is None else [f"{k}={_set_value(v)}" for k, v in dict(set).items()]
+    sets = _sets(set)
     if progress is True:
         progress = _tqdm_progress()
     elif progress is False:
@@ -160,6 +166,8 @@ def run(
         revs=revs,
         steps_per_rev=steps_per_rev,
         substeps=substeps,
+        periodic=str(periodic),
+        periodic_tol=periodic_tol,
         progress=progress,
     )
     return RunResult(folder, summary, dict(last_rev), keep)
@@ -181,9 +189,18 @@ def _read_csv(path):
     try:
         import pandas as pd
     except ImportError:
-        head = _Path(path).read_text().splitlines()[0].split(",")
-        data = _np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-        return {h: data[:, i] for i, h in enumerate(head)}
+        import csv
+
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f))
+        data = {}
+        for i, h in enumerate(rows[0]):
+            vals = [r[i] for r in rows[1:]]
+            try:
+                data[h] = _np.array([float(v) for v in vals])  # exact: Python parses correctly rounded
+            except ValueError:
+                data[h] = _np.array(vals)  # a text column (a model's name, a file)
+        return data
     if int(pd.__version__.split(".")[0]) >= 3:
         return pd.read_csv(path)  # exact by default
     return pd.read_csv(path, float_precision="round_trip")
@@ -204,6 +221,16 @@ class RunResult:
         self._last_rev = {m: _Path(p) for m, p in last_rev.items()}
         with open(summary) as f:
             self.summary = _json.load(f)
+
+    @classmethod
+    def open(cls, folder):
+        """A result folder written earlier (``rotorsim run --out``, a sweep's case): its
+        summary and each model's last revolution, as :func:`run` returns them."""
+        folder = _Path(folder)
+        if not (folder / "summary.json").exists():
+            raise FileNotFoundError(f"{folder}: no summary.json (not a complete rotorsim run result folder)")
+        last = {m: folder / m / "last_rev.csv" for m in ("linear", "nonlinear", "physical")}
+        return cls(folder, folder / "summary.json", {m: p for m, p in last.items() if p.exists()})
 
     @property
     def models(self):
@@ -241,3 +268,362 @@ class RunResult:
 
     def __repr__(self):
         return f"RunResult({str(self.folder)!r}, models={self.models})"
+
+
+def _out_folder(out, prefix):
+    """The result folder to write, and the temporary folder holding it when none is given."""
+    if out is not None:
+        return _Path(out), None
+    keep = _tempfile.TemporaryDirectory(prefix=prefix)
+    return _Path(keep.name) / "out", keep
+
+
+def _paths(xs):
+    if xs is None:
+        return []
+    if isinstance(xs, (str, _Path)) or hasattr(xs, "__fspath__"):
+        xs = [xs]
+    return [str(x) for x in xs]
+
+
+def bench(
+    deck,
+    damper=None,
+    omega=None,
+    peak_velocity=None,
+    velocity_unit=None,
+    cycles=None,
+    steps_per_cycle=None,
+    substeps=None,
+    scheme=None,
+    output_rate=None,
+    measured=None,
+    skip_cycles=None,
+    out=None,
+):
+    """The damper bench of a damper deck, as ``rotorsim bench`` runs it.
+
+    ``deck``: any TOML file with a ``[damper]`` table. Every option left out takes the command
+    line's default: ``damper`` (physical, linear, nonlinear or all; default the deck's
+    ``model``), ``omega`` (27.02 rad/s), ``peak_velocity`` (0.5, 1, 2, 3, 4, 6, 8, 10),
+    ``velocity_unit`` (in/s, m/s or ft/s), ``cycles`` (10), ``steps_per_cycle`` (256),
+    ``substeps`` (25), ``scheme`` (rk4 or implicit), ``output_rate`` (samples per second of the
+    sweep; one per step by default). ``measured``: bench CSV file(s) to replay instead of the
+    harmonic sweep, ``skip_cycles`` cycles of each left out of the error metrics.
+    ``out``: the result folder to write (a temporary one, removed with the result, when not
+    given).
+
+    Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
+    line does. Returns a :class:`BenchResult`.
+    """
+    out, keep = _out_folder(out, "rotorsim-bench-")
+    folder = _native.bench(
+        str(deck),
+        str(out),
+        damper=None if damper is None else str(damper),
+        omega=None if omega is None else float(omega),
+        peak_velocity=None if peak_velocity is None else [float(v) for v in _np.atleast_1d(peak_velocity)],
+        velocity_unit=velocity_unit,
+        cycles=cycles,
+        steps_per_cycle=steps_per_cycle,
+        substeps=substeps,
+        scheme=scheme,
+        output_rate=None if output_rate is None else float(output_rate),
+        measured=_paths(measured),
+        skip_cycles=skip_cycles,
+    )
+    return BenchResult(folder, keep)
+
+
+class BenchResult:
+    """What :func:`bench` returns: its result folder and tables.
+
+    ``folder`` (a temporary folder, removed with this object, unless ``out`` was given),
+    ``replay`` (True for a replay of measured tests), ``summary`` (bench_summary.csv of the
+    harmonic sweep: peak forces, storage and loss stiffness, energy per cycle for each model and
+    peak velocity; or replay_summary.csv of a replay: each test's error metrics), and
+    ``history(peak_velocity_m_s, model=None)`` (a sweep's history file).
+    """
+
+    def __init__(self, folder, keep=None):
+        self.folder = _Path(folder)
+        self._keep = keep
+        self.replay = (self.folder / "replay_summary.csv").exists()
+        name = "replay_summary.csv" if self.replay else "bench_summary.csv"
+        self.summary = _read_csv(self.folder / name)
+
+    def history(self, peak_velocity_m_s, model=None):
+        """The sampled history of the sweep at a peak velocity (bench_summary.csv's
+        ``peak_velocity_m_s``): time, stroke, velocity, force and the device's channels."""
+        rows = self.summary
+        v = _np.asarray(rows["peak_velocity_m_s"], dtype=float)
+        models = list(rows["model"])
+        picks = [i for i in range(len(v)) if _np.isclose(v[i], peak_velocity_m_s, rtol=0, atol=1e-9)
+                 and (model is None or models[i] == model)]
+        if self.replay or not picks:
+            raise ValueError(f"no history at {peak_velocity_m_s} m/s (model {model}) in {self.folder}")
+        if model is None and len({models[i] for i in picks}) > 1:
+            raise ValueError(f"several models ran: name one ({sorted(set(models))})")
+        return _read_csv(self.folder / list(rows["history_file"])[picks[0]])
+
+    def __repr__(self):
+        return f"BenchResult({str(self.folder)!r}, replay={self.replay})"
+
+
+def _sets(set):
+    return [] if set is None else [f"{k}={_set_value(v)}" for k, v in dict(set).items()]
+
+
+def _list(x):
+    """A list option as the command line takes it: text as it is, numbers comma separated."""
+    if x is None or isinstance(x, str):
+        return x
+    return ",".join(repr(float(v)) for v in _np.atleast_1d(x))
+
+
+def stability(
+    rotor,
+    speeds,
+    damper=None,
+    time=None,
+    kick_m_s=None,
+    time_duration_s=None,
+    steps_per_rev=None,
+    amplitudes_m=None,
+    amplitude_at_rad_s=None,
+    hover=False,
+    collective_deg=None,
+    density_kg_m3=None,
+    speed_of_sound_m_s=None,
+    strips=None,
+    set=None,
+    out=None,
+):
+    """Ground (or, ``hover=True``, air) resonance of a rotor deck on its airframe over rotor
+    speeds, as ``rotorsim stability`` computes it.
+
+    ``speeds`` [rad/s]: "START:STOP:STEP" (inclusive), "a,b,c", or a list of numbers. Every
+    option left out takes the command line's default: ``damper`` (the deck's model), ``time``
+    (speeds of whole-rotor time-domain runs) with ``kick_m_s`` (1e-4), ``time_duration_s`` (20)
+    and ``steps_per_rev`` (512); ``amplitudes_m`` (stroke amplitudes of the nonlinear amplitude
+    check, a list or "default") at ``amplitude_at_rad_s`` (the deck's speed); ``hover`` with
+    ``collective_deg`` (8), ``density_kg_m3`` (1.225), ``speed_of_sound_m_s`` (340.3) and
+    ``strips``; ``set`` (deck values by dotted key). ``out``: the result folder to write (a
+    temporary one, removed with the result, when not given).
+
+    Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
+    line does. Returns a :class:`StabilityResult`.
+    """
+    out, keep = _out_folder(out, "rotorsim-stability-")
+    folder = _native.stability(
+        str(rotor),
+        _list(speeds),
+        str(out),
+        damper=None if damper is None else str(damper),
+        time=_list(time),
+        kick_m_s=kick_m_s,
+        time_duration_s=time_duration_s,
+        steps_per_rev=steps_per_rev,
+        amplitudes_m=_list(amplitudes_m),
+        amplitude_at_rad_s=amplitude_at_rad_s,
+        hover=bool(hover),
+        collective_deg=collective_deg,
+        density_kg_m3=density_kg_m3,
+        speed_of_sound_m_s=speed_of_sound_m_s,
+        strips=strips,
+        set=_sets(set),
+    )
+    return StabilityResult(folder, keep)
+
+
+class StabilityResult:
+    """What :func:`stability` returns: its result folder and tables.
+
+    ``folder`` (a temporary folder, removed with this object, unless ``out`` was given),
+    ``summary`` (summary.json as a dict: ``stable``, ``method``, the unstable ranges, the least
+    damping), ``modes`` (stability.csv: frequency, damping ratio and growth rate of each mode at
+    each speed), ``amplitude`` (amplitude.csv of the amplitude check, or None).
+    """
+
+    def __init__(self, folder, keep=None):
+        self.folder = _Path(folder)
+        self._keep = keep
+        with open(self.folder / "summary.json") as f:
+            self.summary = _json.load(f)
+        self.modes = _read_csv(self.folder / "stability.csv")
+        a = self.folder / "amplitude.csv"
+        self.amplitude = _read_csv(a) if a.exists() else None
+
+    @property
+    def stable(self):
+        """Whether every mode is damped at every speed (summary.json's ``stable``)."""
+        return self.summary["stable"]
+
+    def __repr__(self):
+        return f"StabilityResult({str(self.folder)!r}, stable={self.stable})"
+
+
+def diagnose(
+    deck=None,
+    measured=None,
+    rotor=None,
+    flight=None,
+    write_deck=None,
+    fit_cycles=None,
+    max_substep=None,
+    revs=None,
+    steps_per_rev=None,
+    substeps=None,
+    rotor_check=False,
+    check_revs=None,
+    model=None,
+    out=None,
+    progress=None,
+):
+    """What the damper model gets wrong in measured data, as ``rotorsim diagnose`` finds it:
+    the cause named, the model extended, the gain measured on held-out data.
+
+    The data: ``deck`` (the baseline damper deck) with ``measured`` bench CSV file(s), or
+    ``rotor`` (rotor deck; its ``[damper]`` is the baseline unless ``deck``) with ``flight`` (a
+    flight record). Every option left out takes the command line's default: ``fit_cycles`` (3),
+    ``max_substep`` (3e-5 s), ``revs`` (40), ``steps_per_rev`` (256), ``substeps`` (25),
+    ``rotor_check`` (False; the rotor-level before/after of a flight record) with ``check_revs``
+    (75), ``model`` (uh60a or rigid, the rotor runs' model). ``write_deck``: also write the
+    extended model as a damper deck there. ``out``: the result folder to write (a temporary one,
+    removed with the result, when not given). ``progress``: a callable given each progress line.
+
+    Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
+    line does. Returns a :class:`DiagnoseResult`.
+    """
+    out, keep = _out_folder(out, "rotorsim-diagnose-")
+    opt = lambda p: None if p is None else str(p)  # noqa: E731
+    folder = _native.diagnose(
+        str(out),
+        deck=opt(deck),
+        measured=_paths(measured),
+        rotor=opt(rotor),
+        flight=opt(flight),
+        write_deck=opt(write_deck),
+        fit_cycles=fit_cycles,
+        max_substep=None if max_substep is None else float(max_substep),
+        revs=revs,
+        steps_per_rev=steps_per_rev,
+        substeps=substeps,
+        rotor_check=bool(rotor_check),
+        check_revs=check_revs,
+        model=opt(model),
+        progress=progress,
+    )
+    return DiagnoseResult(folder, None if write_deck is None else _Path(write_deck), keep)
+
+
+class DiagnoseResult:
+    """What :func:`diagnose` returns: its result folder and diagnosis.
+
+    ``folder`` (a temporary folder, removed with this object, unless ``out`` was given),
+    ``diagnosis`` (diagnosis.json as a dict), ``cause`` (the named cause, "none" when the
+    baseline explains the data), ``parameters`` (the fitted parameters of the cause), ``gain``
+    (held-out improvement), ``candidates`` (every cause tried with its BIC and errors),
+    ``deck`` (the extended deck written, when ``write_deck`` was given).
+    """
+
+    def __init__(self, folder, deck=None, keep=None):
+        self.folder = _Path(folder)
+        self.deck = deck
+        self._keep = keep
+        with open(self.folder / "diagnosis.json") as f:
+            self.diagnosis = _json.load(f)
+
+    cause = property(lambda self: self.diagnosis["cause"], doc="The named cause.")
+    parameters = property(lambda self: self.diagnosis["parameters"], doc="The cause's fitted parameters.")
+    gain = property(lambda self: self.diagnosis["gain"], doc="Held-out improvement.")
+    candidates = property(lambda self: self.diagnosis["candidates"], doc="Every cause tried.")
+
+    def __repr__(self):
+        return f"DiagnoseResult({str(self.folder)!r}, cause={self.cause!r})"
+
+
+def _tqdm_sweep_progress():
+    """A progress callback drawing one tqdm bar over a sweep's cases, or None without tqdm."""
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return None
+    bar = []
+
+    def progress(ev):
+        if ev["event"] == "start":
+            bar.append(tqdm(total=ev["to_run"], desc="sweep", unit="case", leave=False))
+        elif ev["event"] == "case" and bar:
+            bar[0].update(1)
+            if not ev["ok"]:
+                bar[0].write(f"case {ev['case']} FAILED: {ev['message']}")
+            if bar[0].n >= bar[0].total:
+                bar.pop().close()
+
+    return progress
+
+
+def sweep(plan, out, jobs=None, shard=None, retry_failed=False, warm_start=True, progress=True):
+    """Batch forced-response runs from a sweep plan, as ``rotorsim sweep PLAN --out DIR`` runs
+    them: every case a ``rotorsim run`` into ``DIR/cases/<id>/``, ``DIR/sweep.csv`` and
+    ``DIR/sweep.html`` summarising them.
+
+    ``out`` is required (a sweep resumes: cases found complete are skipped). ``jobs``: cases run
+    at once (default SLURM_CPUS_PER_TASK or the machine's CPUs); ``shard``: "K/N" to run one
+    shard (default the Slurm array task's, when set); ``retry_failed``: run again the cases that
+    failed before; ``warm_start=False`` starts every case cold. ``progress``: a tqdm bar when
+    tqdm is installed (``True``), none (``False``), or a callable given one dict per event:
+    ``{"event": "start", "to_run", "total"}``, ``{"event": "case", "case", "ok", "message",
+    "wall_s"}``. Ctrl-C stops the sweep (KeyboardInterrupt): running cases are marked
+    incomplete, the others do not start; ``retry_failed=True`` finishes it.
+
+    A failed case does not raise: it is in ``.failed`` (and a warning names it), as the command
+    line lists it. Bad input raises FileNotFoundError or ValueError naming the plan file, the
+    case and the key. Returns a :class:`SweepResult`.
+    """
+    if progress is True:
+        progress = _tqdm_sweep_progress()
+    elif progress is False:
+        progress = None
+    folder, failed = _native.sweep(
+        str(plan),
+        str(out),
+        jobs=None if jobs is None else int(jobs),
+        shard=None if shard is None else str(shard),
+        retry_failed=bool(retry_failed),
+        warm_start=bool(warm_start),
+        progress=progress,
+    )
+    if failed:
+        import warnings
+
+        warnings.warn(
+            f"{len(failed)} sweep case(s) failed: {', '.join(i for i, _ in failed)} "
+            "(SweepResult.failed says why; retry_failed=True runs them again)",
+            stacklevel=2,
+        )
+    return SweepResult(folder, failed)
+
+
+class SweepResult:
+    """What :func:`sweep` returns: its folder and table.
+
+    ``folder``, ``failed`` (the failed cases: a list of (case id, reason)), ``table``
+    (sweep.csv: one row per case and model, its varied values and headline results; None for
+    a shard, whose table ``rotorsim sweep merge`` writes once every shard has ended), and
+    ``case(id)`` (a case's result folder read as a :class:`RunResult`).
+    """
+
+    def __init__(self, folder, failed=()):
+        self.folder = _Path(folder)
+        self.failed = list(failed)
+        t = self.folder / "sweep.csv"
+        self.table = _read_csv(t) if t.exists() else None
+
+    def case(self, case_id):
+        """The result folder of case ``case_id`` (``cases/<id>/``) as a :class:`RunResult`."""
+        return RunResult.open(self.folder / "cases" / str(case_id))
+
+    def __repr__(self):
+        return f"SweepResult({str(self.folder)!r}, failed={len(self.failed)})"

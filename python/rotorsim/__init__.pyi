@@ -1,7 +1,7 @@
 # Type stubs of the rotorsim package (docstrings in __init__.py and docs/python.md).
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -33,6 +33,8 @@ class Damper:
 class RunResult:
     folder: Path
     summary: Dict[str, Any]
+    @classmethod
+    def open(cls, folder: _Path) -> "RunResult": ...
     @property
     def models(self) -> List[str]: ...
     def last_rev(self, model: Optional[str] = ..., blade: Optional[int] = ...) -> _Frame: ...
@@ -51,5 +53,105 @@ def run(
     revs: Optional[int] = ...,
     steps_per_rev: Optional[int] = ...,
     substeps: Optional[int] = ...,
+    periodic: str = ...,
+    periodic_tol: Optional[float] = ...,
     progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
 ) -> RunResult: ...
+
+class BenchResult:
+    folder: Path
+    replay: bool
+    summary: _Frame
+    def history(self, peak_velocity_m_s: float, model: Optional[str] = ...) -> _Frame: ...
+
+def bench(
+    deck: _Path,
+    damper: Optional[str] = ...,
+    omega: Optional[float] = ...,
+    peak_velocity: Union[None, float, Iterable[float]] = ...,
+    velocity_unit: Optional[str] = ...,
+    cycles: Optional[int] = ...,
+    steps_per_cycle: Optional[int] = ...,
+    substeps: Optional[int] = ...,
+    scheme: Optional[str] = ...,
+    output_rate: Optional[float] = ...,
+    measured: Union[None, _Path, Iterable[_Path]] = ...,
+    skip_cycles: Optional[int] = ...,
+    out: Optional[_Path] = ...,
+) -> BenchResult: ...
+
+class StabilityResult:
+    folder: Path
+    summary: Dict[str, Any]
+    modes: _Frame
+    amplitude: Optional[_Frame]
+    @property
+    def stable(self) -> bool: ...
+
+_Numbers = Union[str, float, Iterable[float]]
+
+def stability(
+    rotor: _Path,
+    speeds: _Numbers,
+    damper: Optional[str] = ...,
+    time: Optional[_Numbers] = ...,
+    kick_m_s: Optional[float] = ...,
+    time_duration_s: Optional[float] = ...,
+    steps_per_rev: Optional[int] = ...,
+    amplitudes_m: Optional[_Numbers] = ...,
+    amplitude_at_rad_s: Optional[float] = ...,
+    hover: bool = ...,
+    collective_deg: Optional[float] = ...,
+    density_kg_m3: Optional[float] = ...,
+    speed_of_sound_m_s: Optional[float] = ...,
+    strips: Optional[int] = ...,
+    set: Optional[Mapping[str, Any]] = ...,
+    out: Optional[_Path] = ...,
+) -> StabilityResult: ...
+
+class DiagnoseResult:
+    folder: Path
+    deck: Optional[Path]
+    diagnosis: Dict[str, Any]
+    @property
+    def cause(self) -> str: ...
+    @property
+    def parameters(self) -> Dict[str, float]: ...
+    @property
+    def gain(self) -> float: ...
+    @property
+    def candidates(self) -> List[Dict[str, Any]]: ...
+
+def diagnose(
+    deck: Optional[_Path] = ...,
+    measured: Union[None, _Path, Iterable[_Path]] = ...,
+    rotor: Optional[_Path] = ...,
+    flight: Optional[_Path] = ...,
+    write_deck: Optional[_Path] = ...,
+    fit_cycles: Optional[int] = ...,
+    max_substep: Optional[float] = ...,
+    revs: Optional[int] = ...,
+    steps_per_rev: Optional[int] = ...,
+    substeps: Optional[int] = ...,
+    rotor_check: bool = ...,
+    check_revs: Optional[int] = ...,
+    model: Optional[str] = ...,
+    out: Optional[_Path] = ...,
+    progress: Optional[Callable[[str], None]] = ...,
+) -> DiagnoseResult: ...
+
+class SweepResult:
+    folder: Path
+    failed: List[Tuple[str, str]]
+    table: Optional[_Frame]
+    def case(self, case_id: str) -> RunResult: ...
+
+def sweep(
+    plan: _Path,
+    out: _Path,
+    jobs: Optional[int] = ...,
+    shard: Optional[str] = ...,
+    retry_failed: bool = ...,
+    warm_start: bool = ...,
+    progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
+) -> SweepResult: ...

@@ -2,16 +2,24 @@
 //! Every computation is a call of the rotorsim library; this crate converts arguments and
 //! results and maps errors to Python exceptions (nothing here panics on user input).
 use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
-use rotorsim::hydraulics::bench::{self, BenchTest};
+use rotorsim::diagnose::pipeline::Config as DiagnoseConfig;
+use rotorsim::hydraulics::bench::{self as damper_bench, BenchTest};
 use rotorsim::hydraulics::{
     DamperDeck, DamperModel, DeckError, Device, HydraulicError, IntegratorOptions, Scheme,
 };
 use rotorsim::overrides::Override;
+use rotorsim::run::bench::BenchJob;
 use rotorsim::run::job::{NamedOptions, RunJob, RunObserver, RunStart};
+use rotorsim::run::stability::StabilityJob;
+use rotorsim::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
 use rotorsim::run::Progress;
+use rotorsim::sweep::job::{resolve_shard, SweepJob};
+use rotorsim::sweep::{Case, SweepProgress};
 use std::path::PathBuf;
+use std::sync::mpsc::{channel, RecvTimeoutError};
+use std::time::Duration;
 
 fn deck_error(e: DeckError) -> PyErr {
     let msg = e.to_string();
@@ -75,9 +83,9 @@ impl Damper {
         py: Python<'_>,
         time_s: Vec<f64>,
         stroke_m: Vec<f64>,
-    ) -> PyResult<bench::Replay> {
+    ) -> PyResult<damper_bench::Replay> {
         let test = self.check(time_s, stroke_m)?;
-        py.detach(|| bench::replay(self.device.as_ref(), &test))
+        py.detach(|| damper_bench::replay(self.device.as_ref(), &test))
             .map_err(|e| self.replay_error(e))
     }
 }
@@ -121,7 +129,9 @@ impl Damper {
         let (time_s, stroke_m) = (values(&time_s), values(&stroke_m));
         let test = self.check(time_s, stroke_m)?;
         let force = py
-            .detach(|| bench::replay_force(self.device.as_ref(), &test.time_s, &test.stroke_m))
+            .detach(|| {
+                damper_bench::replay_force(self.device.as_ref(), &test.time_s, &test.stroke_m)
+            })
             .map_err(|e| self.replay_error(e))?;
         Ok(PyArray1::from_vec(py, force))
     }
@@ -184,10 +194,11 @@ impl Damper {
 /// ValueError, with the library's whole message (file, key and what was expected).
 fn run_error(e: anyhow::Error) -> PyErr {
     let msg = rotorsim::cli::error_chain(&e);
+    // some readers keep only the io error's text (ENOENT reads "... (os error 2)")
     let missing = e.chain().any(|c| {
         c.downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::NotFound)
-    });
+    }) || msg.contains("(os error 2)");
     if missing {
         PyFileNotFoundError::new_err(msg)
     } else {
@@ -247,15 +258,69 @@ impl RunObserver for PyProgress {
     }
 }
 
+/// How often a call running without the GIL looks for Ctrl-C.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Runs `work` without the GIL on a thread of its own while the calling thread (Python's main
+/// thread, where signal handlers run) looks for signals: an exception from a handler (Ctrl-C's
+/// KeyboardInterrupt) raises `stop`, which `work` checks, and is returned beside its result once
+/// it has ended.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    stop: &StopFlag,
+    work: impl FnOnce() -> T + Send,
+) -> (T, Option<PyErr>) {
+    py.detach(|| {
+        std::thread::scope(|scope| {
+            let (done, ended) = channel();
+            let worker = scope.spawn(move || {
+                let v = work();
+                let _ = done.send(());
+                v
+            });
+            let mut signal = None;
+            // a closed channel: the worker panicked (its panic is raised by the join)
+            while let Err(RecvTimeoutError::Timeout) = ended.recv_timeout(SIGNAL_POLL) {
+                if signal.is_none() {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        stop.request();
+                        signal = Some(e);
+                    }
+                }
+            }
+            match worker.join() {
+                Ok(v) => (v, signal),
+                Err(panic) => std::panic::resume_unwind(panic),
+            }
+        })
+    })
+}
+
+/// The exception of a call interrupted by `signal`: a KeyboardInterrupt says where the run
+/// stopped (when it did); any other exception from a signal handler is raised as it is.
+fn interrupted<T>(py: Python<'_>, signal: PyErr, result: &anyhow::Result<T>) -> PyErr {
+    let stopped = result
+        .as_ref()
+        .err()
+        .and_then(|e| e.downcast_ref::<RunStopped>());
+    match stopped {
+        Some(s) if signal.is_instance_of::<PyKeyboardInterrupt>(py) => {
+            PyKeyboardInterrupt::new_err(s.to_string())
+        }
+        _ => signal,
+    }
+}
+
 /// A result folder's files: the folder, summary.json and each model's last_rev.csv.
 type RunFiles = (PathBuf, PathBuf, Vec<(String, PathBuf)>);
 
 /// `rotorsim run` as a library call: the CLI's defaults for every option not given, the same
-/// checks and messages. Returns the result folder's files: (folder, summary, [(model, last_rev)]).
+/// checks and messages; Ctrl-C stops it (KeyboardInterrupt). Returns the result folder's files:
+/// (folder, summary, [(model, last_rev)]).
 #[pyfunction]
 #[pyo3(signature = (out, rotor = None, flight = None, damper = "all", set = Vec::new(),
     all_blades = false, airloads = "measured", revs = None, steps_per_rev = None,
-    substeps = None, progress = None))]
+    substeps = None, periodic = "shooting", periodic_tol = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -269,6 +334,8 @@ fn run(
     revs: Option<usize>,
     steps_per_rev: Option<usize>,
     substeps: Option<usize>,
+    periodic: &str,
+    periodic_tol: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<RunFiles> {
     let mut job = RunJob::new(out);
@@ -287,20 +354,23 @@ fn run(
     job.revs = revs.unwrap_or(job.revs);
     job.steps_per_rev = steps_per_rev.unwrap_or(job.steps_per_rev);
     job.substeps = substeps.unwrap_or(job.substeps);
+    job.periodic_tol = periodic_tol.unwrap_or(job.periodic_tol);
     job.all_blades = all_blades;
-    job.overrides = set
-        .iter()
-        .map(|s| Override::parse(s))
-        .collect::<anyhow::Result<_>>()
-        .map_err(run_error)?;
+    job.overrides = overrides(&set)?;
     job.set_named(&NamedOptions {
         damper,
         airloads,
+        periodic,
         ..NamedOptions::default()
     })
     .map_err(run_error)?;
     let observer = PyProgress(progress);
-    let outcome = py.detach(|| job.execute(&observer)).map_err(run_error)?;
+    let stop = StopFlag::new();
+    let (result, signal) = interruptible(py, &stop, || job.execute_until(&observer, &stop));
+    if let Some(signal) = signal {
+        return Err(interrupted(py, signal, &result));
+    }
+    let outcome = result.map_err(run_error)?;
     let p = outcome.published;
     Ok((
         p.folder,
@@ -312,11 +382,279 @@ fn run(
     ))
 }
 
+/// `rotorsim bench` as a library call: the command's defaults for every option not given, the
+/// same checks and messages. Returns the result folder.
+#[pyfunction]
+#[pyo3(signature = (deck, out, damper = None, omega = None, peak_velocity = None,
+    velocity_unit = None, cycles = None, steps_per_cycle = None, substeps = None, scheme = None,
+    output_rate = None, measured = Vec::new(), skip_cycles = None))]
+#[pyo3(name = "bench")]
+#[allow(clippy::too_many_arguments)]
+fn bench_job(
+    py: Python<'_>,
+    deck: PathBuf,
+    out: PathBuf,
+    damper: Option<String>,
+    omega: Option<f64>,
+    peak_velocity: Option<Vec<f64>>,
+    velocity_unit: Option<String>,
+    cycles: Option<usize>,
+    steps_per_cycle: Option<usize>,
+    substeps: Option<usize>,
+    scheme: Option<String>,
+    output_rate: Option<f64>,
+    measured: Vec<PathBuf>,
+    skip_cycles: Option<usize>,
+) -> PyResult<PathBuf> {
+    let d = BenchJob::new(deck, out);
+    let job = BenchJob {
+        damper,
+        omega: omega.unwrap_or(d.omega),
+        peak_velocity: peak_velocity.unwrap_or_else(|| d.peak_velocity.clone()),
+        velocity_unit: velocity_unit.unwrap_or_else(|| d.velocity_unit.clone()),
+        cycles: cycles.unwrap_or(d.cycles),
+        steps_per_cycle: steps_per_cycle.unwrap_or(d.steps_per_cycle),
+        substeps: substeps.unwrap_or(d.substeps),
+        scheme: scheme.unwrap_or_else(|| d.scheme.clone()),
+        output_rate,
+        measured,
+        skip_cycles: skip_cycles.unwrap_or(d.skip_cycles),
+        ..d
+    };
+    py.detach(|| job.execute(&mut |_, _, _| {}, &mut |_| {}))
+        .map_err(run_error)?;
+    Ok(job.out)
+}
+
+/// Deck overrides given as `key=value` text, parsed as `--set` is.
+fn overrides(set: &[String]) -> PyResult<Vec<Override>> {
+    set.iter()
+        .map(|s| Override::parse(s))
+        .collect::<anyhow::Result<_>>()
+        .map_err(run_error)
+}
+
+/// `rotorsim stability` as a library call: the command's defaults for every option not given,
+/// the same checks and messages. Returns the result folder.
+#[pyfunction]
+#[pyo3(signature = (rotor, speeds, out, damper = None, time = None, kick_m_s = None,
+    time_duration_s = None, steps_per_rev = None, amplitudes_m = None, amplitude_at_rad_s = None,
+    hover = false, collective_deg = None, density_kg_m3 = None, speed_of_sound_m_s = None,
+    strips = None, set = Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+fn stability(
+    py: Python<'_>,
+    rotor: PathBuf,
+    speeds: String,
+    out: PathBuf,
+    damper: Option<String>,
+    time: Option<String>,
+    kick_m_s: Option<f64>,
+    time_duration_s: Option<f64>,
+    steps_per_rev: Option<usize>,
+    amplitudes_m: Option<String>,
+    amplitude_at_rad_s: Option<f64>,
+    hover: bool,
+    collective_deg: Option<f64>,
+    density_kg_m3: Option<f64>,
+    speed_of_sound_m_s: Option<f64>,
+    strips: Option<usize>,
+    set: Vec<String>,
+) -> PyResult<PathBuf> {
+    let mut job = StabilityJob::new(rotor, &speeds, out);
+    job.damper = damper;
+    job.time_speeds = time;
+    let t = &mut job.time;
+    t.kick_m_s = kick_m_s.unwrap_or(t.kick_m_s);
+    t.duration_s = time_duration_s.unwrap_or(t.duration_s);
+    t.steps_per_rev = steps_per_rev.unwrap_or(t.steps_per_rev);
+    job.amplitudes_m = amplitudes_m;
+    job.amplitude_at_rad_s = amplitude_at_rad_s;
+    job.hover = hover;
+    let h = &mut job.hover_options;
+    h.collective_deg = collective_deg.unwrap_or(h.collective_deg);
+    h.density_kg_m3 = density_kg_m3.unwrap_or(h.density_kg_m3);
+    h.speed_of_sound_m_s = speed_of_sound_m_s.unwrap_or(h.speed_of_sound_m_s);
+    h.strips = strips.unwrap_or(h.strips);
+    job.set = overrides(&set)?;
+    py.detach(|| job.execute(&mut |_| {})).map_err(run_error)?;
+    Ok(job.out)
+}
+
+/// `rotorsim diagnose` as a library call: the command's defaults for every option not given,
+/// the same checks and messages; `progress` gets its progress lines. Returns the result folder.
+#[pyfunction]
+#[pyo3(signature = (out, deck = None, measured = Vec::new(), rotor = None, flight = None,
+    write_deck = None, fit_cycles = None, max_substep = None, revs = None, steps_per_rev = None,
+    substeps = None, rotor_check = false, check_revs = None, model = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
+fn diagnose(
+    py: Python<'_>,
+    out: PathBuf,
+    deck: Option<PathBuf>,
+    measured: Vec<PathBuf>,
+    rotor: Option<PathBuf>,
+    flight: Option<PathBuf>,
+    write_deck: Option<PathBuf>,
+    fit_cycles: Option<usize>,
+    max_substep: Option<f64>,
+    revs: Option<usize>,
+    steps_per_rev: Option<usize>,
+    substeps: Option<usize>,
+    rotor_check: bool,
+    check_revs: Option<usize>,
+    model: Option<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<PathBuf> {
+    let d = DiagnoseConfig::new(out);
+    let cfg = DiagnoseConfig {
+        deck,
+        measured,
+        rotor,
+        flight,
+        write_deck,
+        fit_cycles: fit_cycles.unwrap_or(d.fit_cycles),
+        max_substep: max_substep.unwrap_or(d.max_substep),
+        revs: revs.unwrap_or(d.revs),
+        steps_per_rev: steps_per_rev.unwrap_or(d.steps_per_rev),
+        substeps: substeps.unwrap_or(d.substeps),
+        rotor_check,
+        check_revs: check_revs.unwrap_or(d.check_revs),
+        rotor_model: model.unwrap_or_else(|| d.rotor_model.clone()),
+        ..d
+    };
+    let say = |line: &str| {
+        if let Some(cb) = &progress {
+            Python::attach(|py| {
+                if let Err(e) = cb.call1(py, (line,)) {
+                    e.print(py);
+                }
+            });
+        }
+    };
+    py.detach(|| rotorsim::diagnose::pipeline::run(&cfg, &say))
+        .map_err(run_error)?;
+    Ok(cfg.out)
+}
+
+/// Progress of a sweep handed to a Python callable `progress(event: dict)` (called with the GIL
+/// taken; an exception in it is printed and the sweep goes on).
+struct PySweepProgress(Option<Py<PyAny>>);
+
+impl SweepProgress for PySweepProgress {
+    fn start(&self, to_run: usize, total: usize) {
+        if let Some(cb) = &self.0 {
+            Python::attach(|py| {
+                let ev = pyo3::types::PyDict::new(py);
+                let r = ev
+                    .set_item("event", "start")
+                    .and_then(|_| ev.set_item("to_run", to_run))
+                    .and_then(|_| ev.set_item("total", total))
+                    .and_then(|_| cb.call1(py, (ev,)));
+                if let Err(e) = r {
+                    e.print(py);
+                }
+            });
+        }
+    }
+    fn case_done(&self, case: &Case, result: &Result<(), String>, wall_s: f64) {
+        if let Some(cb) = &self.0 {
+            Python::attach(|py| {
+                let ev = pyo3::types::PyDict::new(py);
+                let r = ev
+                    .set_item("event", "case")
+                    .and_then(|_| ev.set_item("case", &case.id))
+                    .and_then(|_| ev.set_item("ok", result.is_ok()))
+                    .and_then(|_| ev.set_item("message", result.as_ref().err()))
+                    .and_then(|_| ev.set_item("wall_s", wall_s))
+                    .and_then(|_| cb.call1(py, (ev,)));
+                if let Err(e) = r {
+                    e.print(py);
+                }
+            });
+        }
+    }
+}
+
+/// `rotorsim sweep PLAN --out DIR` as a library call: the command's defaults for every option
+/// not given, the same checks and messages; Ctrl-C stops it (KeyboardInterrupt). Returns the
+/// sweep folder and the failed cases (id, reason).
+#[pyfunction]
+#[pyo3(signature = (plan, out, jobs = None, shard = None, retry_failed = false,
+    warm_start = true, progress = None))]
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    py: Python<'_>,
+    plan: PathBuf,
+    out: PathBuf,
+    jobs: Option<usize>,
+    shard: Option<String>,
+    retry_failed: bool,
+    warm_start: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(PathBuf, Vec<(String, String)>)> {
+    if jobs == Some(0) {
+        return Err(PyValueError::new_err(
+            "jobs: expected a whole number of at least 1, found 0",
+        ));
+    }
+    let job = SweepJob {
+        jobs,
+        shard: resolve_shard(shard.as_deref()).map_err(run_error)?,
+        retry_failed,
+        warm_start,
+        ..SweepJob::new(plan, out)
+    };
+    let plan = job.read_plan().map_err(run_error)?;
+    let observer = PySweepProgress(progress);
+    let stop = job.stop.clone();
+    let (result, signal) = interruptible(py, &stop, || {
+        job.execute(&plan, &|_, _| {}, &observer, &mut |_| {})
+    });
+    if let Some(signal) = signal {
+        if !signal.is_instance_of::<PyKeyboardInterrupt>(py) {
+            return Err(signal);
+        }
+        let msg = match &result {
+            Ok(o) => {
+                let r = &o.report;
+                let stopped = r
+                    .ran
+                    .iter()
+                    .filter(|(_, r)| r.as_ref().is_err_and(|e| e.starts_with(STOPPED_PREFIX)))
+                    .count();
+                let ok = r.skipped.len() + r.ran.iter().filter(|(_, r)| r.is_ok()).count();
+                format!(
+                    "sweep stopped by the user: {ok} of {} case(s) complete, {stopped} stopped or not started (a stopped case is marked incomplete: run the sweep again with retry_failed=True to finish it)",
+                    r.total
+                )
+            }
+            Err(e) => format!(
+                "sweep stopped by the user: {}",
+                rotorsim::cli::error_chain(e)
+            ),
+        };
+        return Err(PyKeyboardInterrupt::new_err(msg));
+    }
+    let outcome = result.map_err(run_error)?;
+    let mut failed: Vec<(String, String)> = outcome.report.failed_kept.clone();
+    for (id, r) in &outcome.report.ran {
+        if let Err(e) = r {
+            failed.push((id.clone(), e.clone()));
+        }
+    }
+    Ok((job.out, failed))
+}
+
 #[pymodule]
 #[pyo3(name = "_native")]
 fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Damper>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(bench_job, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
