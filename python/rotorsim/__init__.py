@@ -126,6 +126,7 @@ def run(
     substeps=None,
     periodic="shooting",
     periodic_tol=None,
+    rotor_model="uh60a",
     progress=True,
 ):
     """Forced response of the rotor to a flight record, as ``rotorsim run`` does.
@@ -136,7 +137,8 @@ def run(
     ``models`` (one of linear, nonlinear, physical, or all three; default all), ``set`` (deck
     values overridden by dotted key, ``{"damper.physical.A_orf_m2": 2e-6}``), ``all_blades``,
     ``airloads`` (measured, computed or hybrid), ``revs``, ``steps_per_rev``, ``substeps``,
-    ``periodic`` (shooting or march) and ``periodic_tol``.
+    ``periodic`` (shooting or march), ``periodic_tol`` and ``rotor_model`` (``--model``: uh60a,
+    the multibody rotor, or rigid, its rigid-blade reduction, a run in well under a second).
     ``out``: the result folder to write (a temporary one, removed with the result, when not
     given). ``progress``: True for tqdm bars when tqdm is installed, False for none, or a callable
     taking one dict per event (``start``, ``revolution``, ``finished``).
@@ -168,6 +170,7 @@ def run(
         substeps=substeps,
         periodic=str(periodic),
         periodic_tol=periodic_tol,
+        rotor_model=str(rotor_model),
         progress=progress,
     )
     return RunResult(folder, summary, dict(last_rev), keep)

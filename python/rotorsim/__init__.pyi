@@ -55,6 +55,7 @@ def run(
     substeps: Optional[int] = ...,
     periodic: str = ...,
     periodic_tol: Optional[float] = ...,
+    rotor_model: str = ...,
     progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
 ) -> RunResult: ...
 

@@ -320,7 +320,8 @@ type RunFiles = (PathBuf, PathBuf, Vec<(String, PathBuf)>);
 #[pyfunction]
 #[pyo3(signature = (out, rotor = None, flight = None, damper = "all", set = Vec::new(),
     all_blades = false, airloads = "measured", revs = None, steps_per_rev = None,
-    substeps = None, periodic = "shooting", periodic_tol = None, progress = None))]
+    substeps = None, periodic = "shooting", periodic_tol = None, rotor_model = "uh60a",
+    progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -336,6 +337,7 @@ fn run(
     substeps: Option<usize>,
     periodic: &str,
     periodic_tol: Option<f64>,
+    rotor_model: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<RunFiles> {
     let mut job = RunJob::new(out);
@@ -361,6 +363,7 @@ fn run(
         damper,
         airloads,
         periodic,
+        model: rotor_model,
         ..NamedOptions::default()
     })
     .map_err(run_error)?;

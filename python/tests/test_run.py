@@ -76,3 +76,20 @@ def test_errors_name_the_file_and_the_key(tmp_path):
         rotorsim.run(models="linear", airloads="guessed", progress=False)
     with pytest.raises(ValueError, match="did not run"):
         rotorsim.run(models="linear", steps_per_rev=64, progress=False).last_rev("physical")
+
+
+def test_the_rigid_reduction_is_the_clis_and_reads_back(tmp_path):
+    cli = tmp_path / "cli"
+    subprocess.run([CLI, "run", "--model", "rigid", "--revs", "30", "--out", str(cli)],
+                   check=True, capture_output=True)
+    r = rotorsim.run(rotor_model="rigid", revs=30, out=tmp_path / "py", progress=False)
+    assert r.models == ["linear", "nonlinear", "physical"]
+    for m in r.models:
+        assert filecmp.cmp(cli / m / "last_rev.csv", r.folder / m / "last_rev.csv", shallow=False)
+    # a folder written earlier reads back as the call's result
+    again = rotorsim.RunResult.open(cli)
+    assert again.models == r.models and again.summary["models"].keys() == r.summary["models"].keys()
+    with pytest.raises(ValueError, match="--model"):
+        rotorsim.run(rotor_model="flexible", progress=False)
+    with pytest.raises(FileNotFoundError, match="summary.json"):
+        rotorsim.RunResult.open(tmp_path)
