@@ -10,9 +10,10 @@
 //! (result.mcap). Conventions and alignment: docs/run.md.
 //!
 //! Beside it, the pipelines of the other commands that write result folders: [`bench`] (the
-//! damper bench's sweep and replay outputs), [`decay`] (a hinged blade's lag free decay) and
-//! [`outputs`] (the run outputs' writer, shared with the diagnosis' rotor-level check); [`stop`]
-//! stops runs from outside (the Python package's Ctrl-C).
+//! damper bench's sweep and replay outputs), [`stability`] (ground and air resonance over rotor
+//! speeds), [`modes`] (a model deck's modes, a rotor deck's fan plot), [`decay`] (a hinged
+//! blade's lag free decay) and [`outputs`] (the run outputs' writer, shared with the diagnosis'
+//! rotor-level check); [`stop`] stops runs from outside (the Python package's Ctrl-C).
 pub mod air_resonance;
 pub mod amplitude;
 pub mod bench;
@@ -20,6 +21,7 @@ pub mod decay;
 pub mod job;
 pub mod loads;
 pub mod mcap_out;
+pub mod modes;
 pub mod outputs;
 pub mod periodic;
 pub mod ranges;
