@@ -11,8 +11,8 @@ import numpy as _np
 from . import _native
 
 __version__ = _native.__version__
-__all__ = ["Damper", "run", "RunResult", "bench", "BenchResult", "stability", "StabilityResult", "diagnose",
-           "DiagnoseResult", "sweep", "SweepResult"]
+__all__ = ["Damper", "run", "RunResult", "bench", "BenchResult", "stability", "StabilityResult", "modes",
+           "ModesResult", "diagnose", "DiagnoseResult", "sweep", "SweepResult"]
 
 
 def _array(x, name):
@@ -186,16 +186,16 @@ def _set_value(v):
     return str(v)
 
 
-def _read_csv(path):
+def _read_csv(path, comments=False):
     """A CSV file of the result folder: a DataFrame with pandas (values parsed exactly), else a
-    dict of numpy arrays."""
+    dict of numpy arrays. ``comments``: the file may have ``#`` lines (notes), left out."""
     try:
         import pandas as pd
     except ImportError:
         import csv
 
         with open(path, newline="") as f:
-            rows = list(csv.reader(f))
+            rows = [r for r in csv.reader(f) if not (comments and r and r[0].startswith("#"))]
         data = {}
         for i, h in enumerate(rows[0]):
             vals = [r[i] for r in rows[1:]]
@@ -204,9 +204,10 @@ def _read_csv(path):
             except ValueError:
                 data[h] = _np.array(vals)  # a text column (a model's name, a file)
         return data
+    opts = {"comment": "#"} if comments else {}
     if int(pd.__version__.split(".")[0]) >= 3:
-        return pd.read_csv(path)  # exact by default
-    return pd.read_csv(path, float_precision="round_trip")
+        return pd.read_csv(path, **opts)  # exact by default
+    return pd.read_csv(path, float_precision="round_trip", **opts)
 
 
 class RunResult:
@@ -464,6 +465,67 @@ class StabilityResult:
 
     def __repr__(self):
         return f"StabilityResult({str(self.folder)!r}, stable={self.stable})"
+
+
+def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=None):
+    """Natural frequencies and mode shapes, as ``rotorsim modes`` computes them: of a model deck
+    (``deck``) about its static equilibrium, or the fan plot of a rotor deck (``rotor``).
+
+    Give one of ``deck`` (a model deck; its ``[modes]`` table says how many modes and, with
+    ``speeds_rad_s``, at which rotor speeds: a fan) and ``rotor`` (a rotor deck or a
+    hinged-blade deck). The fan plot of a rotor deck takes, where left out, the command line's
+    defaults: ``speeds`` (fractions of the nominal speed: "START:STOP:STEP" inclusive, "a,b,c",
+    or a list of numbers; default "0:1.2:0.1"), ``reference`` (a digitized reference fan plot
+    drawn over the model's and compared with it; default the shipped UH-60A one next to the deck,
+    or a hinged-blade deck's own ``[fan_reference]``), ``count`` (modes per speed, 14). A model
+    deck does not use them. ``out``: the result folder to write (a temporary one, removed with
+    the result, when not given).
+
+    Bad input raises FileNotFoundError or ValueError naming the file and option, as the command
+    line does. Returns a :class:`ModesResult`.
+    """
+    out, keep = _out_folder(out, "rotorsim-modes-")
+    opt = lambda p: None if p is None else str(p)  # noqa: E731
+    folder = _native.modes(
+        str(out),
+        deck=opt(deck),
+        rotor=opt(rotor),
+        speeds=_list(speeds),
+        reference=opt(reference),
+        count=None if count is None else int(count),
+    )
+    return ModesResult(folder, keep)
+
+
+class ModesResult:
+    """What :func:`modes` returns: its result folder and tables.
+
+    ``folder`` (a temporary folder, removed with this object, unless ``out`` was given),
+    ``modes`` (modes.csv: each mode's frequency, damping ratio and flap, lag, torsion and axial
+    fractions; of a model deck at rest, of a rotor deck at every speed), ``shapes``
+    (mode_shapes.csv of a model deck: each node's displacements in each mode; None for a rotor
+    deck), ``fan`` (fan.csv: the frequencies over the rotor speeds; None for a model deck
+    without ``[modes] speeds_rad_s``), ``comparison`` (fan_comparison.csv: the tracked modes
+    against the reference; None without one) and ``fan_plot`` (the path of fan.svg, or None).
+    """
+
+    def __init__(self, folder, keep=None):
+        self.folder = _Path(folder)
+        self._keep = keep
+        self.modes = self._table("modes.csv")
+        self.shapes = self._table("mode_shapes.csv")
+        self.fan = self._table("fan.csv")
+        self.comparison = self._table("fan_comparison.csv")
+        plot = self.folder / "fan.svg"
+        self.fan_plot = plot if plot.exists() else None
+
+    def _table(self, name):
+        """A table of the folder (its ``#`` notes left out), or None when not written."""
+        path = self.folder / name
+        return _read_csv(path, comments=True) if path.exists() else None
+
+    def __repr__(self):
+        return f"ModesResult({str(self.folder)!r}, fan={self.fan is not None})"
 
 
 def diagnose(

@@ -110,6 +110,23 @@ def stability(
     out: Optional[_Path] = ...,
 ) -> StabilityResult: ...
 
+class ModesResult:
+    folder: Path
+    modes: _Frame
+    shapes: Optional[_Frame]
+    fan: Optional[_Frame]
+    comparison: Optional[_Frame]
+    fan_plot: Optional[Path]
+
+def modes(
+    deck: Optional[_Path] = ...,
+    rotor: Optional[_Path] = ...,
+    speeds: Optional[_Numbers] = ...,
+    reference: Optional[_Path] = ...,
+    count: Optional[int] = ...,
+    out: Optional[_Path] = ...,
+) -> ModesResult: ...
+
 class DiagnoseResult:
     folder: Path
     deck: Optional[Path]

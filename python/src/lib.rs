@@ -12,6 +12,7 @@ use rotorsim::hydraulics::{
 use rotorsim::overrides::Override;
 use rotorsim::run::bench::BenchJob;
 use rotorsim::run::job::{NamedOptions, RunJob, RunObserver, RunStart};
+use rotorsim::run::modes::ModesJob;
 use rotorsim::run::stability::StabilityJob;
 use rotorsim::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
 use rotorsim::run::Progress;
@@ -484,6 +485,34 @@ fn stability(
     Ok(job.out)
 }
 
+/// `rotorsim modes` as a library call: the command's defaults for every option not given, the
+/// same checks and messages. Give `deck` (a model deck) or `rotor` (a rotor deck's fan plot).
+/// Returns the result folder.
+#[pyfunction]
+#[pyo3(signature = (out, deck = None, rotor = None, speeds = None, reference = None,
+    count = None))]
+fn modes(
+    py: Python<'_>,
+    out: PathBuf,
+    deck: Option<PathBuf>,
+    rotor: Option<PathBuf>,
+    speeds: Option<String>,
+    reference: Option<PathBuf>,
+    count: Option<usize>,
+) -> PyResult<PathBuf> {
+    let d = ModesJob::new(out);
+    let job = ModesJob {
+        deck,
+        rotor,
+        speeds: speeds.unwrap_or_else(|| d.speeds.clone()),
+        reference,
+        count: count.unwrap_or(d.count),
+        ..d
+    };
+    py.detach(|| job.execute(&mut |_| {})).map_err(run_error)?;
+    Ok(job.out)
+}
+
 /// `rotorsim diagnose` as a library call: the command's defaults for every option not given,
 /// the same checks and messages; `progress` gets its progress lines. Returns the result folder.
 #[pyfunction]
@@ -656,6 +685,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(bench_job, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
