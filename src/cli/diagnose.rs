@@ -77,23 +77,30 @@ impl DiagnoseArgs {
     }
 }
 
+impl DiagnoseArgs {
+    /// The diagnosis these options ask for.
+    pub fn config(&self) -> Config {
+        Config {
+            deck: self.deck.clone(),
+            measured: self.measured.clone(),
+            rotor: self.rotor.clone(),
+            flight: self.flight.clone(),
+            out: self.out.clone(),
+            write_deck: self.write_deck.clone(),
+            fit_cycles: self.fit_cycles,
+            max_substep: self.max_substep,
+            revs: self.revs,
+            steps_per_rev: self.steps_per_rev,
+            substeps: self.substeps,
+            rotor_check: self.rotor_check,
+            check_revs: self.check_revs,
+            rotor_model: self.rotor_model.clone(),
+        }
+    }
+}
+
 pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
-    let cfg = Config {
-        deck: args.deck.clone(),
-        measured: args.measured.clone(),
-        rotor: args.rotor.clone(),
-        flight: args.flight.clone(),
-        out: args.out.clone(),
-        write_deck: args.write_deck.clone(),
-        fit_cycles: args.fit_cycles,
-        max_substep: args.max_substep,
-        revs: args.revs,
-        steps_per_rev: args.steps_per_rev,
-        substeps: args.substeps,
-        rotor_check: args.rotor_check,
-        check_revs: args.check_revs,
-        rotor_model: args.rotor_model.clone(),
-    };
+    let cfg = args.config();
     let say = |s: &str| errln!("{s}");
     let report = pipeline::run(&cfg, &say)?;
     let d = &report.outcome.diagnosis;
