@@ -2157,6 +2157,46 @@ mod tests {
         }
     }
 
+    /// The straight replay's delay behind the damper is second order in the sample interval:
+    /// halving the interval quarters it. The band (10%) holds the higher-order terms and the fine
+    /// replay's own delay (at most 1/64 of the 1 kHz one) and excludes first (2) and third (8)
+    /// order.
+    #[test]
+    fn the_replay_delay_is_second_order_in_the_sample_interval() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/rotors/uh60a.toml");
+        let deck = DamperDeck::from_file(std::path::Path::new(path)).unwrap();
+        let (f_hz, amp_m, periods) = (4.3, 2.0e-3, 2.0);
+        let delay = |rate_hz: f64| {
+            let n = (periods * rate_hz / f_hz).round() as usize + 1;
+            let w = 2.0 * std::f64::consts::PI * f_hz;
+            let time_s: Vec<f64> = (0..n).map(|i| i as f64 / rate_hz).collect();
+            let m = Measurement {
+                name: format!("{rate_hz} Hz"),
+                stroke_m: time_s.iter().map(|t| amp_m * (w * t).sin()).collect(),
+                velocity_m_s: time_s.iter().map(|t| amp_m * w * (w * t).cos()).collect(),
+                force_n: vec![0.0; n],
+                period_s: 1.0 / f_hz,
+                time_s,
+            };
+            let mut straight = Vec::new();
+            simulate(&deck, &m, n, 3.0e-5, &mut straight).unwrap();
+            // the second period: the start-up transient gone
+            let spans = [Span {
+                test: 0,
+                from: n / 2,
+                to: n,
+            }];
+            replay_delay(&deck, &[m], &[straight], &spans, 3.0e-5).unwrap()
+        };
+        let (d1, d2) = (delay(1000.0), delay(2000.0));
+        assert!(d1 > 0.0 && d2 > 0.0, "{d1:e} {d2:e}");
+        assert!(
+            (d1 / d2 / 4.0 - 1.0).abs() < 0.1,
+            "1 kHz {d1:e} s, 2 kHz {d2:e} s: ratio {} for 4",
+            d1 / d2
+        );
+    }
+
     #[test]
     fn normal_quantile_matches_the_tabulated_values() {
         assert!((normal_quantile(0.975) - Z95).abs() < 1e-9);
