@@ -6,7 +6,7 @@
 use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 use super::extensions::HydraulicExtensions;
 use super::fluid::Fluid;
-use super::integrators::{integrate, IntegratorOptions, OdeSystem};
+use super::integrators::{integrate, IntegratorOptions, OdeSystem, Scheme};
 use super::{check_step, Device, HydraulicError, StepForce};
 use nalgebra::{SMatrix, SVector};
 use std::sync::Arc;
@@ -430,6 +430,164 @@ pub struct StepSystem<'a> {
     pub contact: Option<[bool; 2]>,
     /// Relief-valve extremes over the sub-steps integrated (None: not recorded).
     pub envelope: Option<SubstepEnvelope>,
+    /// The damper's right-hand side with its constants computed once (None: the general one).
+    fast: Option<DamperRhs>,
+}
+
+impl<'a> StepSystem<'a> {
+    /// The circuit over the step from `(t_i, d_i)` at stroke rate `d_dot`; `fast` takes the
+    /// damper's specialised right-hand side where it applies (explicit schemes: no contact held).
+    pub fn new(params: &'a CircuitParams, t_i: f64, d_i: f64, d_dot: f64, fast: bool) -> Self {
+        Self {
+            params,
+            t_i,
+            d_i,
+            d_dot,
+            contact: None,
+            envelope: None,
+            fast: if fast { DamperRhs::new(params) } else { None },
+        }
+    }
+}
+
+/// The right-hand side of a damper circuit (no entrance orifices, leakage, bleed or entrained
+/// air) with what depends only on the parameters computed once, bit for bit
+/// [`CircuitParams::evaluate`] without the Jacobian, the flows or a held contact: the same
+/// expressions in the same order; the absent elements' flows, exact zeros, left out of the sums
+/// (a sum differing from the general one only in the sign of a zero before the check valve's
+/// flow, which is never -0, is added); one square root of `|p0 - p1|` shared by the orifice and
+/// both relief valves.
+#[derive(Debug, Clone, Copy)]
+struct DamperRhs {
+    rho: f64,
+    dp_l: f64,
+    /// `sqrt(2 dp_l / rho)`, the laminar branch's scale ([`FlowLaw::unit_flow`]).
+    u_l: f64,
+    /// `C_d A` of the orifice (0 without one) and of the check valves (0 without them).
+    cda_orifice: f64,
+    cda_check: f64,
+    /// `A lambda` of each chamber.
+    a_lambda: [f64; 2],
+}
+
+impl DamperRhs {
+    fn new(p: &CircuitParams) -> Option<Self> {
+        let e = &p.ext;
+        let cda_check = p.check.map_or(0.0, |c| c.cd * c.area);
+        // a check valve flow of -0 would keep a sum's zero sign (doc above): general path
+        let plain = p.entrance.is_none()
+            && e.leakage.is_none()
+            && e.bleed.is_none()
+            && e.air_of(0).is_none()
+            && e.air_of(1).is_none()
+            && cda_check.is_sign_positive();
+        plain.then(|| Self {
+            rho: p.fluid.rho,
+            dp_l: p.dp_laminar,
+            u_l: (2.0 * p.dp_laminar / p.fluid.rho).sqrt(),
+            cda_orifice: p.orifice.map_or(0.0, |o| o.cd * o.area),
+            cda_check,
+            a_lambda: [0, 1].map(|k| p.chambers[k].area * p.chambers[k].lambda),
+        })
+    }
+
+    /// [`FlowLaw::unit_flow`] below the laminar transition.
+    #[inline(always)]
+    fn laminar(&self, dp: f64) -> f64 {
+        let r = dp / self.dp_l;
+        self.u_l * (5.0 * r - r * r * r) * 0.25
+    }
+
+    /// [`FlowLaw::one_sided_flow`].
+    #[inline(always)]
+    fn one_sided(&self, dp: f64) -> f64 {
+        if dp <= 0.0 {
+            0.0
+        } else if dp >= self.dp_l {
+            (2.0 * dp / self.rho).sqrt()
+        } else {
+            let r = dp / self.dp_l;
+            self.u_l * (5.0 * r * r - 3.0 * r * r * r) * 0.5
+        }
+    }
+
+    /// f(t, y) at stroke `d` and stroke rate `d_dot`.
+    #[inline(always)]
+    fn rhs(
+        &self,
+        params: &CircuitParams,
+        t: f64,
+        d: f64,
+        d_dot: f64,
+        y: &State,
+    ) -> Result<State, HydraulicError> {
+        let ch = &params.chambers;
+        let vol = [0, 1].map(|k| ch[k].volume0 + self.a_lambda[k] * d);
+        if !(vol[0] > 0.0 && vol[1] > 0.0) {
+            // the general path names the chamber
+            return Ok(params.evaluate::<false>(t, d, d_dot, y, None)?.0);
+        }
+        let (p0, p1) = (y[IP0], y[IP1]);
+        let mut f = State::zeros();
+        let dp = p0 - p1;
+        let a = dp.abs();
+        let turbulent = a >= self.dp_l;
+        let s = if turbulent {
+            (2.0 * a / self.rho).sqrt()
+        } else {
+            0.0
+        };
+        // unit flow of p0 - p1 or of p1 - p0 (the same |dp|)
+        let unit = |dp: f64| {
+            if turbulent {
+                s.copysign(dp)
+            } else {
+                self.laminar(dp)
+            }
+        };
+        let o = if params.orifice.is_some() {
+            self.cda_orifice * unit(dp)
+        } else {
+            0.0
+        };
+        let mut r = [0.0; 2];
+        for (k, (ix, iv, pf, pb)) in [(IX0, IV0, p0, p1), (IX1, IV1, p1, p0)]
+            .into_iter()
+            .enumerate()
+        {
+            let Some(rv) = &params.relief[k] else {
+                continue;
+            };
+            let (x, v) = (y[ix], y[iv]);
+            let (area, _) = rv.flow_area(x);
+            if area != 0.0 {
+                r[k] = rv.cd * area * unit(pf - pb);
+            }
+            let pr = rv.poppet_rate(pf, pb, x, v);
+            f[ix] = pr.x_dot;
+            f[iv] = pr.v_dot;
+        }
+        let mut c = [0.0; 2];
+        if params.check.is_some() {
+            for (k, p) in [p0, p1].into_iter().enumerate() {
+                c[k] = self.cda_check * self.one_sided(params.p_s - p);
+            }
+        }
+        let qn = [-o - r[0] + r[1] + c[0], o + r[0] - r[1] + c[1]];
+        for (k, ip) in [(0, IP0), (1, IP1)] {
+            let p = y[ip];
+            let (b, _) = params.fluid.bulk(p);
+            let net = qn[k] - self.a_lambda[k] * d_dot;
+            f[ip] = if net < 0.0 {
+                let (sc, _) = params.fluid.cavitation_factor(p);
+                b * sc / vol[k] * net
+            } else {
+                b / vol[k] * net
+            };
+        }
+        f[IIMP] = params.force(y);
+        Ok(f)
+    }
 }
 
 /// Relief-valve poppet displacement, velocity and flow of both valves at the end of every
@@ -478,6 +636,9 @@ impl OdeSystem<NS> for StepSystem<'_> {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &State) -> Result<State, HydraulicError> {
         let d = self.d_i + self.d_dot * (t - self.t_i);
+        if let (Some(fast), None) = (&self.fast, self.contact) {
+            return fast.rhs(self.params, t, d, self.d_dot, y);
+        }
         Ok(self
             .params
             .evaluate::<false>(t, d, self.d_dot, y, self.contact)?
@@ -700,17 +861,12 @@ impl Device for CircuitDevice {
         d_f: f64,
     ) -> Result<StepForce, HydraulicError> {
         check_step(t_i, dt, d_i, d_f)?;
-        let mut sys = StepSystem {
-            params: &self.params,
-            t_i,
-            d_i,
-            d_dot: (d_f - d_i) / dt,
-            contact: None,
-            // the step's start included, so consecutive envelopes join
-            envelope: self
-                .record_envelope
-                .then(|| SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed)),
-        };
+        let explicit = self.opts.scheme == Scheme::Rk4;
+        let mut sys = StepSystem::new(&self.params, t_i, d_i, (d_f - d_i) / dt, explicit);
+        // the step's start included, so consecutive envelopes join
+        sys.envelope = self
+            .record_envelope
+            .then(|| SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed));
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
         let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;

@@ -418,45 +418,51 @@ pub fn integrate<const N: usize>(
 ) -> Result<SVector<f64, N>, HydraulicError> {
     let n = opts.substeps.max(1);
     let h = dt / n as f64;
+    let mut y = *y0;
     // One loop per scheme: the scheme is decided once, not at every sub-step.
     match opts.scheme {
-        Scheme::Rk4 => substeps(sys, t0, y0, n, h, |sys, t, y| rk4_step(sys, t, y, h)),
+        Scheme::Rk4 => {
+            for s in 0..n {
+                let t = t0 + s as f64 * h;
+                y = rk4_step(sys, t, &y, h)?;
+                end_substep(sys, t0, y0, t, h, &mut y)?;
+            }
+        }
         Scheme::Implicit => {
             let newton = NewtonOptions::default();
-            substeps(sys, t0, y0, n, h, |sys, t, y| {
-                sys.begin_implicit_substep(t, y);
-                sdirk_step(&SDIRK3, sys, t, y, h, &newton)
-            })
-        }
-    }
-}
-
-/// The sub-step loop of [`integrate`] around one step function.
-#[inline(always)]
-fn substeps<const N: usize, S: OdeSystem<N>>(
-    sys: &mut S,
-    t0: f64,
-    y0: &SVector<f64, N>,
-    n: usize,
-    h: f64,
-    mut step: impl FnMut(&mut S, f64, &SVector<f64, N>) -> Result<SVector<f64, N>, HydraulicError>,
-) -> Result<SVector<f64, N>, HydraulicError> {
-    let mut y = *y0;
-    for s in 0..n {
-        let t = t0 + s as f64 * h;
-        y = step(sys, t, &y)?;
-        sys.project(&mut y);
-        sys.end_substep(t + h, &y);
-        if let Some(c) = y.iter().position(|v| !v.is_finite()) {
-            return Err(HydraulicError::NonFinite {
-                t: t + h,
-                component: c,
-                substep_s: h,
-                rate_per_s: fastest_rate(sys, t0, y0),
-            });
+            for s in 0..n {
+                let t = t0 + s as f64 * h;
+                sys.begin_implicit_substep(t, &y);
+                y = sdirk_step(&SDIRK3, sys, t, &y, h, &newton)?;
+                end_substep(sys, t0, y0, t, h, &mut y)?;
+            }
         }
     }
     Ok(y)
+}
+
+/// The end of a sub-step of [`integrate`] from `t`: projection, the system's hook, and an error
+/// when the state is no longer finite.
+#[inline(always)]
+fn end_substep<const N: usize>(
+    sys: &mut impl OdeSystem<N>,
+    t0: f64,
+    y0: &SVector<f64, N>,
+    t: f64,
+    h: f64,
+    y: &mut SVector<f64, N>,
+) -> Result<(), HydraulicError> {
+    sys.project(y);
+    sys.end_substep(t + h, y);
+    match y.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(c) => Err(HydraulicError::NonFinite {
+            t: t + h,
+            component: c,
+            substep_s: h,
+            rate_per_s: fastest_rate(sys, t0, y0),
+        }),
+    }
 }
 
 /// The fastest rate of `sys` at (t, y), max |df_i/dy_i| [1/s] (NaN when the Jacobian cannot be
