@@ -228,6 +228,20 @@ impl CircuitParams {
         k
     }
 
+    /// The relief valves' flows of [`CircuitParams::evaluate`] alone (NaN where it errs): what
+    /// the sub-step envelope records, without the rest of the right-hand side.
+    fn relief_flows(&self, d: f64, y: &State) -> [f64; 2] {
+        if self.chambers.iter().any(|c| c.volume(d) <= 0.0) {
+            return [f64::NAN; 2];
+        }
+        let law = self.law();
+        let (p0, p1) = (y[IP0], y[IP1]);
+        let q = |k: usize, dp: f64, ix: usize| {
+            self.relief[k].map_or(0.0, |rv| rv.flow(&law, dp, y[ix]).0)
+        };
+        [q(0, p0 - p1, IX0), q(1, p1 - p0, IX1)]
+    }
+
     /// Initial state: chambers at `p_init`, poppets seated, zero impulse.
     pub fn initial_state(&self) -> State {
         let mut y = State::zeros();
@@ -614,16 +628,14 @@ impl SubstepEnvelope {
     };
 
     /// The envelope of one state (both bounds the values at that state).
-    fn at(params: &CircuitParams, t: f64, d: f64, y: &State) -> Self {
+    fn at(params: &CircuitParams, d: f64, y: &State) -> Self {
         let mut e = Self::EMPTY;
-        e.add(params, t, d, y);
+        e.add(params, d, y);
         e
     }
 
-    fn add(&mut self, params: &CircuitParams, t: f64, d: f64, y: &State) {
-        let q = params
-            .evaluate::<false>(t, d, 0.0, y, None)
-            .map_or([f64::NAN; 2], |r| r.2.relief);
+    fn add(&mut self, params: &CircuitParams, d: f64, y: &State) {
+        let q = params.relief_flows(d, y);
         let v = [y[IX0], y[IX1], y[IV0], y[IV1], q[0], q[1]];
         for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(v) {
             *lo = lo.min(x);
@@ -685,7 +697,7 @@ impl OdeSystem<NS> for StepSystem<'_> {
     fn end_substep(&mut self, t: f64, y: &State) {
         if let Some(mut e) = self.envelope {
             let d = self.d_i + self.d_dot * (t - self.t_i);
-            e.add(self.params, t, d, y);
+            e.add(self.params, d, y);
             self.envelope = Some(e);
         }
     }
@@ -774,7 +786,7 @@ const ACTUATOR_CHANNELS: &[&str] = &[
 impl CircuitDevice {
     pub fn new(params: CircuitParams, opts: IntegratorOptions) -> Self {
         let y0 = params.initial_state();
-        let envelope = SubstepEnvelope::at(&params, 0.0, 0.0, &y0);
+        let envelope = SubstepEnvelope::at(&params, 0.0, &y0);
         Self {
             params: Arc::new(params),
             opts,
@@ -791,12 +803,7 @@ impl CircuitDevice {
     /// The envelope of the committed state alone, when recorded.
     fn envelope_at_commit(&self) -> SubstepEnvelope {
         if self.record_envelope {
-            SubstepEnvelope::at(
-                &self.params,
-                self.committed_t,
-                self.committed_d,
-                &self.committed,
-            )
+            SubstepEnvelope::at(&self.params, self.committed_d, &self.committed)
         } else {
             SubstepEnvelope::NOT_RECORDED
         }
@@ -866,7 +873,7 @@ impl Device for CircuitDevice {
         // the step's start included, so consecutive envelopes join
         sys.envelope = self
             .record_envelope
-            .then(|| SubstepEnvelope::at(&self.params, t_i, d_i, &self.committed));
+            .then(|| SubstepEnvelope::at(&self.params, d_i, &self.committed));
         let mut y0 = self.committed;
         y0[IIMP] = 0.0;
         let y = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
