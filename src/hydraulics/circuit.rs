@@ -467,10 +467,10 @@ impl<'a> StepSystem<'a> {
 /// The right-hand side of a damper circuit (no entrance orifices, leakage, bleed or entrained
 /// air) with what depends only on the parameters computed once, bit for bit
 /// [`CircuitParams::evaluate`] without the Jacobian, the flows or a held contact: the same
-/// expressions in the same order; the absent elements' flows, exact zeros, left out of the sums
-/// (a sum differing from the general one only in the sign of a zero before the check valve's
-/// flow, which is never -0, is added); one square root of `|p0 - p1|` shared by the orifice and
-/// both relief valves.
+/// expressions in the same order; the absent elements' flows (+0) left out of the sums (exact:
+/// subtracting +0 is the identity; adding +0 changes at most the sign of a zero, and once the
+/// check valve's flow, never -0, is added no sum is -0); one square root of `|p0 - p1|` shared
+/// by the orifice and both relief valves.
 #[derive(Debug, Clone, Copy)]
 struct DamperRhs {
     rho: f64,
