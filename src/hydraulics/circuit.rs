@@ -1001,3 +1001,117 @@ impl Device for CircuitDevice {
         self.envelope[0] = self.envelope_at_commit();
     }
 }
+
+#[cfg(test)]
+mod damper_rhs_tests {
+    use super::*;
+    use crate::hydraulics::extensions::Leakage;
+    use crate::hydraulics::DamperDeck;
+
+    fn damper() -> CircuitParams {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/rotors/uh60a.toml");
+        DamperDeck::from_file(std::path::Path::new(path))
+            .unwrap()
+            .physical
+            .unwrap()
+    }
+
+    /// A reproducible uniform draw in [0, 1).
+    fn draws(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The specialised right-hand side equals the general one bit for bit (every component,
+    /// zero signs included) over states that visit every branch: pressure differences below,
+    /// at and above the laminar transition of both signs, pressures below the supply (check
+    /// valves open) and below zero (cavitation), seated and open poppets, both stroke rates.
+    fn assert_bitwise(p: &CircuitParams, label: &str) {
+        let fast = DamperRhs::new(p).unwrap_or_else(|| panic!("{label}: no fast path"));
+        let mut u = draws(0x5eed);
+        let dp_l = p.dp_laminar;
+        for i in 0..20_000 {
+            let mut y = State::zeros();
+            let base = match i % 4 {
+                0 => p.p_s * (2.0 * u() - 0.5),
+                1 => 1e7 * u(),
+                2 => -2e5 * u(),
+                _ => p.p_s,
+            };
+            let dp = match i % 5 {
+                0 => dp_l * (2.0 * u() - 1.0),
+                1 => [dp_l, -dp_l, 0.0][i % 3],
+                _ => 1e7 * (2.0 * u() - 1.0),
+            };
+            y[IP0] = base + dp;
+            y[IP1] = base;
+            for (ix, iv) in [(IX0, IV0), (IX1, IV1)] {
+                y[ix] = match i % 3 {
+                    0 => 0.0,
+                    1 => 2e-3 * u(),
+                    _ => 1e-3 * (2.0 * u() - 1.0),
+                };
+                y[iv] = if i % 7 == 0 { 0.0 } else { 2.0 * u() - 1.0 };
+            }
+            y[IIMP] = u();
+            let d = 0.02 * (2.0 * u() - 1.0);
+            let d_dot = if i % 11 == 0 {
+                0.0
+            } else {
+                0.5 * (2.0 * u() - 1.0)
+            };
+            let t = u();
+            let want = p.evaluate::<false>(t, d, d_dot, &y, None).unwrap().0;
+            let got = fast.rhs(p, t, d, d_dot, &y).unwrap();
+            for r in 0..NS {
+                assert_eq!(
+                    got[r].to_bits(),
+                    want[r].to_bits(),
+                    "{label}: f[{r}] {:e} vs {:e} at y = {y:?}, d = {d}, d_dot = {d_dot}",
+                    got[r],
+                    want[r]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn damper_rhs_is_the_general_rhs_bit_for_bit() {
+        let full = damper();
+        assert!(full.orifice.is_some() && full.check.is_some());
+        assert!(full.relief.iter().all(Option::is_some));
+        assert_bitwise(&full, "the example damper");
+        let mut no_check = full.clone();
+        no_check.check = None;
+        assert_bitwise(&no_check, "no check valves");
+        let mut no_orifice = full.clone();
+        no_orifice.orifice = None;
+        assert_bitwise(&no_orifice, "no orifice");
+        let mut one_relief = full.clone();
+        one_relief.relief[0] = None;
+        assert_bitwise(&one_relief, "relief valve 1 alone");
+        let mut no_relief = full.clone();
+        no_relief.relief = [None, None];
+        assert_bitwise(&no_relief, "no relief valves");
+        let mut cavitating = full.clone();
+        cavitating.fluid.p_cav = 1e5;
+        assert_bitwise(&cavitating, "cavitation on");
+    }
+
+    #[test]
+    fn extended_circuits_take_the_general_rhs() {
+        let mut leaky = damper();
+        leaky.ext.leakage = Some(Leakage { conductance: 1e-12 });
+        assert!(DamperRhs::new(&leaky).is_none());
+        let mut bleed = damper();
+        bleed.ext.bleed = Some(Leakage { conductance: 1e-12 });
+        assert!(DamperRhs::new(&bleed).is_none());
+        let actuator = ActuatorParams::paper_table1().to_circuit();
+        assert!(DamperRhs::new(&actuator).is_none());
+    }
+}
