@@ -344,38 +344,14 @@ impl ModesJob {
             .collect();
         out.write("fan.csv", csv_string(&hs, &rows).as_bytes())?;
         // modes.csv: every mode at every speed with its fractions
-        let mh = [
-            "speed_fraction",
-            "mode",
-            "freq_Hz",
-            "freq_per_rev",
-            "damping_ratio",
-            "flap_fraction",
-            "lag_fraction",
-            "torsion_fraction",
-            "axial_fraction",
-        ];
-        let mut mrows = vec![];
-        for p in &pts {
-            for (i, m) in p.modes.iter().enumerate() {
-                let per_rev = if p.omega_rad_s > 0.0 {
-                    m.omega_rad_s / p.omega_rad_s
-                } else {
-                    f64::NAN
-                };
-                mrows.push(vec![
-                    p.fraction,
-                    (i + 1) as f64,
-                    m.freq_hz,
-                    per_rev,
-                    m.damping_ratio,
-                    m.fractions[0],
-                    m.fractions[1],
-                    m.fractions[2],
-                    m.fractions[3],
-                ]);
+        let per_rev = |at: &SpeedModes, m: &Mode| {
+            if at.omega_rad_s > 0.0 {
+                m.omega_rad_s / at.omega_rad_s
+            } else {
+                f64::NAN
             }
-        }
+        };
+        let (mh, mrows) = fan_mode_rows(&found, "freq_per_rev", per_rev);
         out.write("modes.csv", csv_string(&mh, &mrows).as_bytes())?;
         // comparison with the reference at the speeds it has
         let comparison = match &reference {
@@ -514,33 +490,9 @@ impl ModesJob {
         let mut text = csv_string(&hs, &rows);
         text.push_str("# *_Hz: damped frequency Im(s)/2pi; NaN: no oscillatory mode of that kind (a free hinge at rest)\n");
         out.write("fan.csv", text.as_bytes())?;
-        let mh = [
-            "speed_fraction",
-            "mode",
-            "freq_Hz",
-            "damped_freq_Hz",
-            "damping_ratio",
-            "flap_fraction",
-            "lag_fraction",
-            "torsion_fraction",
-            "axial_fraction",
-        ];
-        let mut mrows = vec![];
-        for p in &pts {
-            for (i, m) in p.modes.iter().enumerate() {
-                mrows.push(vec![
-                    p.fraction,
-                    (i + 1) as f64,
-                    m.freq_hz,
-                    crate::rotor::hinged::damped_hz(m),
-                    m.damping_ratio,
-                    m.fractions[0],
-                    m.fractions[1],
-                    m.fractions[2],
-                    m.fractions[3],
-                ]);
-            }
-        }
+        let (mh, mrows) = fan_mode_rows(&found, "damped_freq_Hz", |_, m| {
+            crate::rotor::hinged::damped_hz(m)
+        });
         out.write("modes.csv", csv_string(&mh, &mrows).as_bytes())?;
         let comparison = match &reference {
             None => None,
@@ -626,6 +578,43 @@ fn speed_modes<'a>(pts: impl Iterator<Item = (f64, f64, &'a Vec<Mode>)>) -> Vec<
         modes: modes.clone(),
     })
     .collect()
+}
+
+/// modes.csv of a fan: every mode at every speed with its fractions; the fourth column is
+/// `col4`, given by `f4` (per-rev frequency or damped frequency).
+fn fan_mode_rows(
+    found: &[SpeedModes],
+    col4: &'static str,
+    f4: impl Fn(&SpeedModes, &Mode) -> f64,
+) -> ([&'static str; 9], Vec<Vec<f64>>) {
+    let header = [
+        "speed_fraction",
+        "mode",
+        "freq_Hz",
+        col4,
+        "damping_ratio",
+        "flap_fraction",
+        "lag_fraction",
+        "torsion_fraction",
+        "axial_fraction",
+    ];
+    let mut rows = vec![];
+    for at in found {
+        for (i, m) in at.modes.iter().enumerate() {
+            rows.push(vec![
+                at.fraction.unwrap_or(f64::NAN),
+                (i + 1) as f64,
+                m.freq_hz,
+                f4(at, m),
+                m.damping_ratio,
+                m.fractions[0],
+                m.fractions[1],
+                m.fractions[2],
+                m.fractions[3],
+            ]);
+        }
+    }
+    (header, rows)
 }
 
 fn mode_rows(ms: &[Mode]) -> Vec<Vec<f64>> {
