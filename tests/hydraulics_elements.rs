@@ -436,3 +436,34 @@ fn simple_damper_matches_the_incompressible_orifice_law_at_low_frequency() {
         );
     }
 }
+
+/// The linked circuit's force balance takes Eq. (1)'s factors once per state: the same bits as
+/// the chamber's pressure rate at every net inflow, both signs, with and without cavitation.
+#[test]
+fn chamber_rate_from_its_factors_is_the_pressure_rate_bit_for_bit() {
+    let ch = elements::Chamber {
+        area: 7.85e-5,
+        volume0: 9.42e-6,
+        lambda: -1.0,
+    };
+    for p_cav in [0.0, 2e5] {
+        let fluid = Fluid {
+            p_cav,
+            ..Fluid::constant_bulk(850.0, 1.53e9)
+        };
+        for p in [-1e4, 0.0, 3e4, 1e6, 2e7] {
+            let v = ch.volume(1.3e-3);
+            let (b, db) = fluid.bulk(p);
+            let s = fluid.cavitation_factor(p).0;
+            let f = elements::Chamber::rate_factors(b, s, v);
+            for q in [-3e-5, -1e-9, 0.0, 2e-6, 4e-5] {
+                for d_dot in [-0.3, 0.0, 0.2] {
+                    let (rate, _, g) = ch.pressure_rate_with_bulk(&fluid, (b, db), p, v, q, d_dot);
+                    let (r2, g2) = ch.rate_with(&f, q, d_dot);
+                    assert_eq!(rate.to_bits(), r2.to_bits(), "p {p} q {q} d_dot {d_dot}");
+                    assert_eq!(g.to_bits(), g2.to_bits(), "p {p} q {q} d_dot {d_dot}");
+                }
+            }
+        }
+    }
+}

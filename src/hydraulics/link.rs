@@ -25,6 +25,7 @@
 //! 1e9 N/m. The end's stroke over a step is the parabola through the last step's start and the
 //! step's ends (the chord's velocity jump at every sample would ring the mass too).
 use super::circuit::{CircuitDevice, CircuitParams, State, IIMP, IP0, IP1, IV0, IV1, IX0, IX1, NS};
+use super::elements::Chamber;
 use super::integrators::{explicit_step, OdeSystem, RK4};
 use super::{check_step, Device, HydraulicError, StepForce};
 use nalgebra::{SMatrix, SVector};
@@ -126,13 +127,15 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         // h(v) = A0 p0_dot(v) - A1 p1_dot(v) - k_c (v - d_dot) + relax, its slope and the two
         // pressure rates: Eq. (1) of each chamber, affine in v on either side of a zero net
         // inflow (its factor, B/V or B s(p)/V with the cavitation factor s, is returned with it).
+        // the pressures' factors once, not at every trial velocity (the same bits)
+        let cav = p.map(|p| self.params.fluid.cavitation_factor(p).0);
+        let fac =
+            [0, 1].map(|k| Chamber::rate_factors(self.params.bulk(k, p[k]).0, cav[k], part.vol[k]));
         let balance = |v: f64| -> (f64, f64, [f64; 2]) {
             let mut rate = [0.0; 2];
             let mut slope = [0.0; 2];
             for k in 0..2 {
-                let (r, _, g) = self
-                    .params
-                    .pressure_rate(k, p[k], part.vol[k], part.qn[k], v);
+                let (r, g) = ch[k].rate_with(&fac[k], part.qn[k], v);
                 rate[k] = r;
                 slope[k] = -g * ch[k].area * ch[k].lambda;
             }
@@ -147,7 +150,7 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         // kinks that bracket it, where one affine solve finds it.
         let mut kinks = [f64::NAN; 2];
         for (k, kink) in kinks.iter_mut().enumerate() {
-            if self.params.fluid.cavitation_factor(p[k]).0 != 1.0 {
+            if cav[k] != 1.0 {
                 *kink = part.qn[k] / (ch[k].area * ch[k].lambda);
             }
         }
