@@ -308,20 +308,13 @@ impl ModesJob {
         };
         let out = OutDir::create(&self.out, &inputs)?;
         let count = self.count.max(5);
-        let pts = match fan(&deck, &fractions, count).and_then(|p| {
-            check_finite_modes(p.iter().map(|p| (p.fraction, &p.modes[..])), path)?;
-            Ok(p)
-        }) {
-            Ok(p) => p,
-            Err(e) => {
-                out.mark_incomplete(&e.to_string())?;
-                return Err(e);
-            }
-        };
-        let found = speed_modes(pts.iter().map(|p| (p.fraction, p.omega_rad_s, &p.modes)));
-        for at in &found {
-            on_speed(at);
-        }
+        let (pts, found) = finished_fan(
+            &out,
+            path,
+            fan(&deck, &fractions, count),
+            |p| (p.fraction, p.omega_rad_s, &p.modes),
+            on_speed,
+        )?;
         let om_n = deck.spec.rotor.omega_rad_s;
         // fan.csv: tracked modes, then all modes sorted by frequency
         let mut h: Vec<String> = vec!["speed_fraction".into(), "omega_rad_s".into()];
@@ -459,20 +452,13 @@ impl ModesJob {
         fractions.sort_by(f64::total_cmp);
         fractions.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         let out = OutDir::create(&self.out, &inputs)?;
-        let pts = match fan(&spec, path, &fractions, self.count.max(TRACKED.len())).and_then(|p| {
-            check_finite_modes(p.iter().map(|p| (p.fraction, &p.modes[..])), path)?;
-            Ok(p)
-        }) {
-            Ok(p) => p,
-            Err(e) => {
-                out.mark_incomplete(&e.to_string())?;
-                return Err(e);
-            }
-        };
-        let found = speed_modes(pts.iter().map(|p| (p.fraction, p.omega_rad_s, &p.modes)));
-        for at in &found {
-            on_speed(at);
-        }
+        let (pts, found) = finished_fan(
+            &out,
+            path,
+            fan(&spec, path, &fractions, self.count.max(TRACKED.len())),
+            |p| (p.fraction, p.omega_rad_s, &p.modes),
+            on_speed,
+        )?;
         let rpm = |x: f64| x * rpm_n;
         let mut h: Vec<String> = vec!["speed_fraction".into(), "omega_rad_s".into(), "rpm".into()];
         h.extend(TRACKED.iter().map(|t| format!("{t}_Hz")));
@@ -570,14 +556,47 @@ impl ModesJob {
     }
 }
 
-/// A fan's points as [`SpeedModes`].
-fn speed_modes<'a>(pts: impl Iterator<Item = (f64, f64, &'a Vec<Mode>)>) -> Vec<SpeedModes> {
-    pts.map(|(fraction, omega_rad_s, modes)| SpeedModes {
-        fraction: Some(fraction),
-        omega_rad_s,
-        modes: modes.clone(),
-    })
-    .collect()
+/// A fan's points once every mode is finite, with each speed as [`SpeedModes`] given to
+/// `on_speed`; a fan that failed or is not finite publishes the folder incomplete with the
+/// reason. `at` gives a point's speed fraction, speed and modes.
+fn finished_fan<P>(
+    out: &OutDir,
+    path: &Path,
+    pts: anyhow::Result<Vec<P>>,
+    at: impl Fn(&P) -> (f64, f64, &Vec<Mode>),
+    on_speed: &mut dyn FnMut(&SpeedModes),
+) -> anyhow::Result<(Vec<P>, Vec<SpeedModes>)> {
+    let pts = match pts.and_then(|p| {
+        check_finite_modes(
+            p.iter().map(|p| {
+                let (fraction, _, modes) = at(p);
+                (fraction, &modes[..])
+            }),
+            path,
+        )?;
+        Ok(p)
+    }) {
+        Ok(p) => p,
+        Err(e) => {
+            out.mark_incomplete(&e.to_string())?;
+            return Err(e);
+        }
+    };
+    let found: Vec<SpeedModes> = pts
+        .iter()
+        .map(|p| {
+            let (fraction, omega_rad_s, modes) = at(p);
+            SpeedModes {
+                fraction: Some(fraction),
+                omega_rad_s,
+                modes: modes.clone(),
+            }
+        })
+        .collect();
+    for s in &found {
+        on_speed(s);
+    }
+    Ok((pts, found))
 }
 
 /// modes.csv of a fan: every mode at every speed with its fractions; the fourth column is
