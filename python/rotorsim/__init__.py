@@ -282,6 +282,11 @@ def _out_folder(out, prefix):
     return _Path(keep.name) / "out", keep
 
 
+def _opt(p):
+    """An optional path or name as text (None stays None)."""
+    return None if p is None else str(p)
+
+
 def _paths(xs):
     if xs is None:
         return []
@@ -485,13 +490,12 @@ def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=No
     line does. Returns a :class:`ModesResult`.
     """
     out, keep = _out_folder(out, "rotorsim-modes-")
-    opt = lambda p: None if p is None else str(p)  # noqa: E731
     folder = _native.modes(
         str(out),
-        deck=opt(deck),
-        rotor=opt(rotor),
+        deck=_opt(deck),
+        rotor=_opt(rotor),
         speeds=_list(speeds),
-        reference=opt(reference),
+        reference=_opt(reference),
         count=None if count is None else int(count),
     )
     return ModesResult(folder, keep)
@@ -561,14 +565,13 @@ def diagnose(
     line does. Returns a :class:`DiagnoseResult`.
     """
     out, keep = _out_folder(out, "rotorsim-diagnose-")
-    opt = lambda p: None if p is None else str(p)  # noqa: E731
     folder = _native.diagnose(
         str(out),
-        deck=opt(deck),
+        deck=_opt(deck),
         measured=_paths(measured),
-        rotor=opt(rotor),
-        flight=opt(flight),
-        write_deck=opt(write_deck),
+        rotor=_opt(rotor),
+        flight=_opt(flight),
+        write_deck=_opt(write_deck),
         fit_cycles=fit_cycles,
         max_substep=None if max_substep is None else float(max_substep),
         revs=revs,
@@ -576,7 +579,7 @@ def diagnose(
         substeps=substeps,
         rotor_check=bool(rotor_check),
         check_revs=check_revs,
-        model=opt(model),
+        model=_opt(model),
         progress=progress,
     )
     return DiagnoseResult(folder, None if write_deck is None else _Path(write_deck), keep)
