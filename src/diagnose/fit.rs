@@ -1034,13 +1034,49 @@ pub fn diagnose(
                 jobs.push((ci, z0));
             }
         }
+        let screen = keep < cands.len();
+        // Screening many candidates (the pairs): each start is first judged by its residual
+        // alone (one replay) and only the best `SCREEN_STARTS` of a candidate are scouted.
+        let mut start_evals = vec![0usize; cands.len()];
+        if screen {
+            let start_rss: Vec<f64> = jobs
+                .par_iter()
+                .map(|(ci, z0)| {
+                    let (c, spec) = &cands[*ci];
+                    residuals_x(
+                        c,
+                        scales,
+                        base,
+                        &to_x(spec, z0),
+                        data,
+                        &fit_w,
+                        opts.max_substep_s,
+                        scale,
+                    )
+                    .map_or(f64::INFINITY, |r| r.norm_squared())
+                })
+                .collect();
+            let mut order: Vec<usize> = (0..jobs.len()).collect();
+            order.sort_by(|&a, &b| start_rss[a].total_cmp(&start_rss[b]));
+            let mut taken = vec![0usize; cands.len()];
+            let mut kept = vec![false; jobs.len()];
+            for &j in &order {
+                let ci = jobs[j].0;
+                start_evals[ci] += 1;
+                if taken[ci] < SCREEN_STARTS && start_rss[j].is_finite() {
+                    taken[ci] += 1;
+                    kept[j] = true;
+                }
+            }
+            let mut k = kept.into_iter();
+            jobs.retain(|_| k.next().unwrap_or(false));
+        }
         // Several starts: each is scouted with a short run, and only the best one is run on
         // to convergence (the starts pick the basin; the descent inside it is the same).
         let mut n_starts = vec![0usize; cands.len()];
         for (ci, _) in &jobs {
             n_starts[*ci] += 1;
         }
-        let screen = keep < cands.len();
         let patience = |ci: usize| {
             if n_starts[ci] > 1 || screen {
                 SCOUT_PATIENCE.min(opts.patience)
@@ -1070,7 +1106,7 @@ pub fn diagnose(
             })
             .collect();
         let mut best: Vec<Option<Fit>> = (0..cands.len()).map(|_| None).collect();
-        let mut evals = vec![0usize; cands.len()];
+        let mut evals = start_evals;
         for (ci, f) in fits.into_iter() {
             if let Some(f) = f {
                 evals[ci] += f.evals;
@@ -1941,6 +1977,8 @@ fn demote_behind(evaluated: &mut [Evaluated], name: &str) {
 
 /// Levenberg-Marquardt patience of a scouting run from one of several starts.
 const SCOUT_PATIENCE: usize = 1;
+/// Starts of a screened candidate scouted after each start is judged by its residual alone.
+const SCREEN_STARTS: usize = 3;
 /// Pairs run to convergence after all of them are scouted.
 const PAIRS_CONVERGED: usize = 3;
 

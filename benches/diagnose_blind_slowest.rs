@@ -1,0 +1,45 @@
+//! The three slowest campaigns of the diagnosis' blind suite (SYNTHETIC, docs/diagnosis.md
+//! "Blind suite"; slowest in its timing column): two pairs of physical effects and an
+//! acquisition fault beside air. Each is diagnosed as the suite does (4 cycles per harmonic
+//! test, 2 kHz); the data are generated once, outside the timing. Target: < 30 s each on a
+//! quiet 2-core machine.
+//! `cargo bench --bench diagnose_blind_slowest`
+#[path = "../tests/blind_support/mod.rs"]
+mod blind;
+use criterion::{criterion_group, criterion_main, Criterion};
+use rotorsim::diagnose::{diagnose, DiagnoseOptions};
+use rotorsim::hydraulics::DamperDeck;
+use std::hint::black_box;
+use std::path::Path;
+
+/// The slowest three of the suite's last quiet run.
+const SLOWEST: [&str; 3] = ["pair_6", "pair_0", "acqpair_0"];
+
+fn bench(c: &mut Criterion) {
+    let base = DamperDeck::from_file(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/flightdata/damper_nominal.toml"
+    )))
+    .expect("nominal deck");
+    let opts = DiagnoseOptions::default();
+    let mut g = c.benchmark_group("diagnose_blind_slowest");
+    g.sample_size(10);
+    for id in SLOWEST {
+        let cp = blind::suite()
+            .into_iter()
+            .find(|c| c.id == id)
+            .expect("campaign");
+        let data = blind::bench_campaign(&cp, 4, 2000.0).expect("campaign data");
+        g.bench_function(id, |b| {
+            b.iter(|| {
+                let o = diagnose(black_box(&base), black_box(&data), &opts).unwrap();
+                assert!(o.diagnosis.cause.contains('+'), "{id}: a pair is named");
+                o
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
