@@ -7,7 +7,8 @@
 //! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns;
 //! with BLIND_JSON_DIR set, every diagnosis.json is written there as `<id>.json`).
 //! CSV columns: id, kind (bench/flight), hidden effect(s) (`+`-joined causes, acquisition faults
-//! `force_lag`, `force_offset`, `force_gain`, `force_drift` among them), magnitudes, named cause,
+//! `force_lag`, `force_offset`, `force_gain`, `force_drift`, `force_clipping`, `force_dropouts`
+//! among them), magnitudes, named cause,
 //! exact, hidden among named, held-out gain, g* (best reachable gain), sub-noise, required gain,
 //! then for each true parameter the named cause fitted (a fault's `lag_s`, `offset_N`, `gain`,
 //! `drift_N_per_s` too): name, true value, fitted value, 95% interval, covered; and the wall

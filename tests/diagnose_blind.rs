@@ -430,7 +430,9 @@ fn acquisition_faults_transform_the_recorded_force() {
             lag_s: lag,
             offset_n: offset,
             gain,
-            drift_n_per_s: drift
+            drift_n_per_s: drift,
+            clip_fraction: 0.0,
+            dropout_fraction: 0.0,
         }
     );
     let rate = 2000.0;
@@ -549,26 +551,35 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
     let faults = |c: &Campaign| c.effects.iter().filter(|e| e.is_fault()).count();
     let physical = |c: &Campaign| c.effects.iter().filter(|e| !e.is_fault()).count();
     // The campaigns before them are the 67 of the suite before the faults, fault-free.
-    assert_eq!(all.len(), 83);
+    assert_eq!(all.len(), 89);
     assert!(all[..67].iter().all(|c| faults(c) == 0));
     assert_eq!(all[66].id, "flight_4");
     let alone: Vec<&Campaign> = all.iter().filter(|c| c.id.starts_with("acq_")).collect();
-    assert_eq!(alone.len(), 8);
-    for kind in ["lag", "offset", "gain", "drift"] {
+    assert_eq!(alone.len(), 12);
+    for (kind, cause) in [
+        ("lag", "force_lag"),
+        ("offset", "force_offset"),
+        ("gain", "force_gain"),
+        ("drift", "force_drift"),
+        ("clip", "force_clipping"),
+        ("dropout", "force_dropouts"),
+    ] {
         for i in 0..2 {
             let c = alone
                 .iter()
                 .find(|c| c.id == format!("acq_{kind}_{i}"))
                 .expect("id");
             assert!(!c.flight && faults(c) == 1 && physical(c) == 0, "{c:?}");
-            assert_eq!(c.effects[0].cause(), format!("force_{kind}"));
+            assert_eq!(c.effects[0].cause(), cause);
         }
     }
+    // The campaigns before clipping and dropouts keep their ids, effects and seeds.
+    assert_eq!(all[82].id, "flight_5");
     let beside: Vec<&Campaign> = all
         .iter()
         .filter(|c| c.id.starts_with("acqpair_"))
         .collect();
-    assert!(beside.len() >= 7);
+    assert!(beside.len() >= 9);
     assert!(beside.iter().all(|c| faults(c) == 1 && physical(c) == 1));
     let flight = all.iter().find(|c| c.id == "flight_5").expect("flight_5");
     assert!(flight.flight && faults(flight) == 1);
@@ -579,6 +590,8 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
             Effect::ForceGain(g) => assert!((0.95..=1.06).contains(&g) && g != 1.0),
             Effect::ForceOffset(o) => assert!((150.0..=1000.0).contains(&o.abs())),
             Effect::ForceDrift(d) => assert!((300.0..=1000.0).contains(&d.abs())),
+            Effect::ForceClip(r) => assert!((0.75..0.9).contains(&r)),
+            Effect::ForceDropouts(r) => assert!((0.001..=0.02).contains(&r)),
             _ => {}
         }
     }

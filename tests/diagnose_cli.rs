@@ -158,6 +158,44 @@ fn bench_file_without_force_is_named() {
 }
 
 #[test]
+fn bench_file_dropouts_are_read_and_one_too_long_is_named() {
+    // Empty cells are dropouts to the diagnosis' reader; a stroke gap longer than a straight
+    // line bridges (1/64 of the 0.233 s period) stops it, naming the file, channel and times.
+    let dir = tmp("dropout");
+    let f = dir.join("t.csv");
+    let mut s = String::from("time_s,stroke_m,force_N\n");
+    for k in 0..2000 {
+        let t = k as f64 * 5e-4;
+        if (400..420).contains(&k) {
+            s.push_str(&format!("{t},,\n"));
+        } else {
+            s.push_str(&format!(
+                "{t},{},{}\n",
+                1e-3 * (27.0 * t).sin(),
+                1e3 * (27.0 * t).cos()
+            ));
+        }
+    }
+    std::fs::write(&f, s).unwrap();
+    let e = diagnose(DiagnoseArgs {
+        deck: Some(root().join("flightdata/damper_nominal.toml")),
+        measured: vec![f],
+        rotor: None,
+        flight: None,
+        ..args(dir.join("out"))
+    })
+    .unwrap_err();
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("t.csv")
+            && msg.contains("the stroke is missing from 0.200000 s to 0.209500 s")
+            && msg.contains("1/64 of the stroking period"),
+        "{msg}"
+    );
+    assert!(!dir.join("out").exists(), "no output on bad input");
+}
+
+#[test]
 fn a_calibration_gain_and_a_zero_offset_together_are_both_named() {
     // The shipped SYNTHETIC record read 5% high and 400 N off zero: two linear acquisition
     // faults, fitted together beside the record's own (physical) effect.

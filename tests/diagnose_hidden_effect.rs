@@ -140,17 +140,25 @@ fn bad_data_gets_a_clear_message() {
     let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
     assert!(matches!(e, DiagnoseError::SampleRate { .. }), "{e}");
     assert!(e.to_string().contains("samples per stroke cycle"), "{e}");
-    // Clipping: flat tops at the same value.
+    // Clipped beyond use: a rail so low that fewer than half the samples are measured.
     let mut data = support::campaign(&h.deck, &[2.0, 8.0], 3, 1000.0, 0.01, 2);
     for f in &mut data[1].force_n {
-        *f = f.min(9000.0);
+        *f = f.clamp(-500.0, 500.0);
     }
     let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
+    assert!(matches!(e, DiagnoseError::Unusable { .. }), "{e}");
     assert!(
-        matches!(e, DiagnoseError::Clipping { value, .. } if value == 9000.0),
+        e.to_string().contains("clipped at the load cell's range"),
         "{e}"
     );
-    assert!(e.to_string().contains("clipped"), "{e}");
+    // A stroke dropout longer than a straight line bridges (1/64 of the period).
+    let mut data = support::campaign(&h.deck, &[2.0, 8.0], 3, 1000.0, 0.01, 2);
+    for k in 100..110 {
+        data[0].stroke_m[k] = f64::NAN;
+    }
+    let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
+    assert!(matches!(e, DiagnoseError::Dropout { .. }), "{e}");
+    assert!(e.to_string().contains("1/64 of the stroking period"), "{e}");
     // Too short: one cycle.
     let data = support::campaign(&h.deck, &[2.0, 4.0], 1, 1000.0, 0.01, 2);
     let e = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap_err();
@@ -218,4 +226,83 @@ fn compliant_free_play_is_found_with_its_gap() {
             assert!(lo <= *v && *v <= hi, "{k} = {v} outside [{lo}, {hi}]");
         }
     }
+}
+
+/// Clipping and dropouts are named as acquisition faults, their samples left out of the
+/// comparison: a nominal damper's data clipped at 9 kN in one test and with rows lost in the
+/// other is `force_clipping+force_dropouts`, the rail read exactly, the damper `none`.
+#[test]
+fn clipping_and_dropouts_are_named_and_not_compared() {
+    let base = support::nominal_deck();
+    let h = support::hidden(Cause::None, 0.0);
+    let mut data = support::campaign(&h.deck, &[2.0, 8.0], 3, 1000.0, 0.01, 2);
+    for f in &mut data[1].force_n {
+        *f = f.min(9000.0);
+    }
+    let clipped = data[1].force_n.iter().filter(|&&f| f == 9000.0).count();
+    assert!(clipped > 20, "the test clips: {clipped}");
+    for k in [200, 201, 350] {
+        data[0].stroke_m[k] = f64::NAN;
+        data[0].force_n[k] = f64::NAN;
+    }
+    data[0].velocity_m_s[500] = f64::NAN;
+    let o = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap();
+    let d = &o.diagnosis;
+    assert_eq!(
+        d.cause, "force_clipping+force_dropouts",
+        "{:#?}",
+        d.candidates
+    );
+    assert_eq!(d.parameters["clip_high_N"], 9000.0);
+    assert!(!d.parameters.contains_key("clip_low_N"));
+    assert_eq!(d.parameters["dropout_rows"], 4.0);
+    let s = &d.acquisition_screen;
+    assert_eq!(
+        (s[0].dropout_rows, s[0].bridged_rows, s[0].clipped_samples),
+        (4, 4, 0)
+    );
+    assert_eq!(
+        (s[1].dropout_rows, s[1].clip_high_N, s[1].clipped_samples),
+        (0, Some(9000.0), clipped)
+    );
+    assert!(d.evidence.iter().any(|e| e.starts_with("the data acquisition: the force channel is clipped at +9000 N")), "{:#?}", d.evidence);
+    assert!(
+        d.limitations.iter().any(|l| l.starts_with("force clipped")),
+        "{:#?}",
+        d.limitations
+    );
+    // Nothing not measured reaches a figure: the noise, RMS and BIC are finite.
+    assert!(
+        d.noise_sigma_N.is_finite() && d.baseline_rms_N.is_finite() && d.baseline_bic.is_finite()
+    );
+    assert!(
+        d.candidates.iter().all(|c| !c.bic.is_nan()),
+        "{:#?}",
+        d.candidates
+    );
+    // The stroke is bridged on a straight line; the force there stays not measured.
+    let c = &o.curves[0];
+    assert!(c.stroke_m.iter().all(|x| x.is_finite()));
+    assert!(c.measured_n[200].is_nan() && c.measured_n[500].is_nan());
+    let (t, x) = (&c.time_s, &c.stroke_m);
+    let line = x[199] + (x[202] - x[199]) * (t[200] - t[199]) / (t[202] - t[199]);
+    assert!((x[200] - line).abs() < 1e-15, "{} vs {line}", x[200]);
+    // The clipped samples are not compared: the baseline's RMS over the clipped test equals its
+    // RMS over the samples below the rail.
+    let (b, m) = (&o.curves[1].baseline_n, &data[1].force_n);
+    let from = o.curves[1].from;
+    let (mut ss, mut n) = (0.0, 0);
+    for k in from..m.len() {
+        if m[k] < 9000.0 {
+            ss += (b[k] - m[k]).powi(2);
+            n += 1;
+        }
+    }
+    let rms = (ss / n as f64).sqrt();
+    let t1 = &d.tests[1];
+    assert!(
+        (t1.baseline_rms_N - rms).abs() < 1e-9 * rms,
+        "{} vs {rms}",
+        t1.baseline_rms_N
+    );
 }

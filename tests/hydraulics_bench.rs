@@ -182,6 +182,20 @@ fn bench_csv_reader_accepts_units_and_rejects_bad_files() {
     );
     let e = err("time_s,stroke_m\n0,1\n1,abc\n");
     assert!(e.contains("line 3") && e.contains("abc"), "{e}");
+    // The diagnosis' reader takes an empty or NaN cell of stroke, force or velocity as a
+    // dropout (NaN); the time, an infinity and text stay errors.
+    let d = |s: &str| bench::parse_bench_csv_with_dropouts(s, "d.csv", "d");
+    let t = d("time_s,stroke_m,force_N,velocity_m_s\n0,0,1,0\n1,,NaN,nan\n2,1,,2\n").unwrap();
+    assert!(t.stroke_m[1].is_nan() && t.stroke_m[2] == 1.0);
+    let f = t.force_n.unwrap();
+    assert!(f[1].is_nan() && f[2].is_nan() && f[0] == 1.0);
+    assert!(t.velocity_m_s.unwrap()[1].is_nan());
+    let e = d("time_s,stroke_m\n0,1\n,2\n").unwrap_err().to_string();
+    assert!(e.contains("d.csv, line 3") && e.contains("time_s"), "{e}");
+    let e = d("time_s,stroke_m\n0,1\n1,inf\n").unwrap_err().to_string();
+    assert!(e.contains("line 3") && e.contains("not finite"), "{e}");
+    let e = d("time_s,stroke_m\n0,1\n1,abc\n").unwrap_err().to_string();
+    assert!(e.contains("line 3") && e.contains("abc"), "{e}");
 }
 
 fn tmp(name: &str) -> PathBuf {

@@ -76,10 +76,34 @@ impl Fault {
     }
 }
 
+/// Clipping at the load cell's range, found by the data screen (not fitted).
+pub const CLIPPING: &str = "force_clipping";
+/// Rows missing a value, found by the data screen (not fitted).
+pub const DROPOUTS: &str = "force_dropouts";
+
+/// Whether `name` is an acquisition fault: fitted, or found by the data screen.
+pub fn is_fault(name: &str) -> bool {
+    Fault::from_name(name).is_some() || name == CLIPPING || name == DROPOUTS
+}
+
 /// Whether every part of a cause's name (`a` or `a+b`) is an acquisition fault: the damper
 /// itself is then the baseline's.
 pub fn only_faults(cause: &str) -> bool {
-    cause.split('+').all(|n| Fault::from_name(n).is_some())
+    cause.split('+').all(is_fault)
+}
+
+/// The part of a cause's name the damper model was fitted with: the name without the faults the
+/// data screen found (`none` when nothing else is left).
+pub fn fitted_cause(cause: &str) -> String {
+    let parts: Vec<&str> = cause
+        .split('+')
+        .filter(|n| *n != CLIPPING && *n != DROPOUTS)
+        .collect();
+    if parts.is_empty() {
+        "none".into()
+    } else {
+        parts.join("+")
+    }
 }
 
 /// `f` at time `s` by linear interpolation between samples (held constant outside the record).
@@ -126,6 +150,7 @@ fn rss(fault: Fault, v: f64, data: &[Measurement], model: &[Vec<f64>], spans: &[
             y[s.from..s.to]
                 .iter()
                 .zip(&m.force_n[s.from..s.to])
+                .filter(|(_, b)| !b.is_nan())
                 .map(|(a, b)| (a - b) * (a - b))
                 .sum::<f64>()
         })
@@ -160,6 +185,7 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
                 .iter()
                 .zip(&model[s.test][r.clone()])
                 .zip(&m.force_n[r])
+                .filter(|(_, y)| !y.is_nan())
             {
                 g(t - t0, *f, *y);
             }
@@ -237,6 +263,7 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
                 let p = fault.apply(v + h, &m.time_s, &model[s.test]);
                 let q = fault.apply(v - h, &m.time_s, &model[s.test]);
                 s2 += (s.from..s.to)
+                    .filter(|&i| !m.force_n[i].is_nan())
                     .map(|i| ((p[i] - q[i]) / (2.0 * h)).powi(2))
                     .sum::<f64>();
             }
@@ -316,6 +343,7 @@ pub fn fit_linear(
             .iter()
             .zip(&m.time_s[r.clone()])
             .zip(&m.force_n[r])
+            .filter(|(_, y)| !y.is_nan())
         {
             for (c, fault) in col.iter_mut().zip(faults) {
                 *c = match fault {
@@ -347,6 +375,7 @@ pub fn fit_linear(
             let m = &data[s.test];
             let y = apply_all(faults, &values, &m.time_s, &model[s.test]);
             (s.from..s.to)
+                .filter(|&i| !m.force_n[i].is_nan())
                 .map(|i| (y[i] - m.force_n[i]).powi(2))
                 .sum::<f64>()
         })

@@ -1,5 +1,5 @@
-//! Measured data for a diagnosis: checks (force present, no clipping, enough samples per cycle,
-//! enough cycles), stroking period, noise level.
+//! Measured data for a diagnosis: checks (force present, enough samples per cycle,
+//! enough cycles), the screen for dropouts and clipping, stroking period, noise level.
 use super::DiagnoseError;
 use crate::hydraulics::bench::BenchTest;
 
@@ -28,14 +28,20 @@ impl Measurement {
         let force = t.force_n.clone().ok_or_else(|| DiagnoseError::NoForce {
             test: t.name.clone(),
         })?;
-        let vel = t
-            .velocity_m_s
-            .clone()
-            .unwrap_or_else(|| crate::hydraulics::bench::differentiate(&t.time_s, &t.stroke_m));
         let period =
             estimate_period(&t.time_s, &t.stroke_m).ok_or_else(|| DiagnoseError::NoCycle {
                 test: t.name.clone(),
             })?;
+        // Differentiated across a stroke dropout from the bridged stroke (the dropout's rows
+        // stay missing in the stroke itself, for the screen); a dropout too long to bridge is
+        // the screen's error.
+        let vel = t.velocity_m_s.clone().unwrap_or_else(|| {
+            let mut x = t.stroke_m.clone();
+            if bridge(&t.name, "stroke", &t.time_s, &mut x, period).is_err() {
+                x.clone_from(&t.stroke_m);
+            }
+            crate::hydraulics::bench::differentiate(&t.time_s, &x)
+        });
         Ok(Self {
             name: t.name.clone(),
             time_s: t.time_s.clone(),
@@ -76,8 +82,21 @@ pub(crate) fn min_max(x: &[f64]) -> (f64, f64) {
         })
 }
 
-/// Period from the mean upward crossings of x (with a hysteresis of 10% of the half range).
+/// Period from the mean upward crossings of x (with a hysteresis of 10% of the half range);
+/// samples where x is missing (NaN) are skipped.
 pub fn estimate_period(t: &[f64], x: &[f64]) -> Option<f64> {
+    if x.iter().any(|v| v.is_nan()) {
+        let (t, x): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .zip(x)
+            .filter(|(_, x)| !x.is_nan())
+            .map(|(t, x)| (*t, *x))
+            .unzip();
+        return estimate_period(&t, &x);
+    }
+    if x.is_empty() {
+        return None;
+    }
     let (lo, hi) = min_max(x);
     if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return None;
@@ -110,10 +129,15 @@ pub fn noise_sigma(force: &[f64]) -> f64 {
     if force.len() < 3 {
         return 0.0;
     }
+    // Triples with a sample not measured (NaN: a dropout or clipped) are skipped.
     let mut d: Vec<f64> = force
         .windows(3)
         .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+        .filter(|v| !v.is_nan())
         .collect();
+    if d.is_empty() {
+        return 0.0;
+    }
     let mid = d.len() / 2;
     let (_, m, _) = d.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
     *m / 0.6745 / 6f64.sqrt()
@@ -126,6 +150,173 @@ pub fn periodic_derivative(x: &[f64], dt: f64) -> Vec<f64> {
     (0..n)
         .map(|i| (x[(i + 1) % n] - x[(i + n - 1) % n]) / (2.0 * dt))
         .collect()
+}
+
+/// Longest dropout of the stroke (or velocity) channel bridged, as a fraction of the stroking
+/// period: a straight line over 1/64 of a sine cycle is off by at most 0.12% of its amplitude.
+pub const MAX_BRIDGE_PERIOD_FRACTION: f64 = 1.0 / 64.0;
+
+/// What the acquisition screen found in one test and did about it (diagnosis.json
+/// `acquisition_screen`): dropouts (rows whose stroke, velocity or force is missing) and
+/// clipping (samples at the load cell's range). Neither is dropped silently: the force there
+/// is not compared, the stroke is bridged, and both are named as acquisition faults.
+#[allow(non_snake_case)]
+#[derive(Debug, Clone, serde::Serialize, PartialEq)]
+pub struct Screened {
+    pub test: String,
+    /// Rows with a missing (NaN) stroke, velocity or force; their force is not compared.
+    pub dropout_rows: usize,
+    /// Of those, rows whose stroke or velocity was missing, bridged by a straight line in time.
+    pub bridged_rows: usize,
+    /// Time of the first dropout [s].
+    pub first_dropout_s: Option<f64>,
+    /// The force channel's upper and lower rail [N] where the force sits there (clipping).
+    pub clip_high_N: Option<f64>,
+    pub clip_low_N: Option<f64>,
+    /// Samples at a rail; their force is not compared.
+    pub clipped_samples: usize,
+    /// Samples in the test.
+    pub samples: usize,
+}
+
+impl Screened {
+    /// Whether the screen found anything in this test.
+    pub fn any(&self) -> bool {
+        self.dropout_rows > 0 || self.clipped_samples > 0
+    }
+}
+
+/// Screens every measurement for dropouts and clipping: returns the measurements with the
+/// stroke and velocity bridged across dropouts and the force of dropouts and clipped samples
+/// set to NaN (not compared), and what was found in each test. A stroke dropout longer than
+/// [`MAX_BRIDGE_PERIOD_FRACTION`] of the period, at the first or last sample, or a test left
+/// with fewer than half its force samples, is an error.
+pub fn screen(ms: &[Measurement]) -> Result<(Vec<Measurement>, Vec<Screened>), DiagnoseError> {
+    let mut out = Vec::with_capacity(ms.len());
+    let mut found = Vec::with_capacity(ms.len());
+    for m in ms {
+        let n = m.time_s.len();
+        let mut m = m.clone();
+        let missing: Vec<bool> = (0..n)
+            .map(|i| {
+                !(m.stroke_m[i].is_finite()
+                    && m.velocity_m_s[i].is_finite()
+                    && m.force_n[i].is_finite())
+            })
+            .collect();
+        let dropout_rows = missing.iter().filter(|&&b| b).count();
+        let bridged_rows = (0..n)
+            .filter(|&i| !(m.stroke_m[i].is_finite() && m.velocity_m_s[i].is_finite()))
+            .count();
+        for (channel, x) in [
+            ("stroke", &mut m.stroke_m),
+            ("velocity", &mut m.velocity_m_s),
+        ] {
+            bridge(&m.name, channel, &m.time_s, x, m.period_s)?;
+        }
+        for (f, &b) in m.force_n.iter_mut().zip(&missing) {
+            if b {
+                *f = f64::NAN;
+            }
+        }
+        // Clipping: several samples exactly at the extreme value (noisy data never repeats its
+        // maximum to the last digit).
+        let (lo, hi) = min_max_finite(&m.force_n);
+        let mut clip = [None, None];
+        let mut clipped = 0;
+        for (k, v) in [hi, lo].into_iter().enumerate() {
+            if !v.is_finite() {
+                continue;
+            }
+            let count = m.force_n.iter().filter(|&&f| f == v).count();
+            if count >= 3.max(n / 500) {
+                clip[k] = Some(v);
+                clipped += count;
+                for f in m.force_n.iter_mut().filter(|f| **f == v) {
+                    *f = f64::NAN;
+                }
+            }
+        }
+        let kept = m.force_n.iter().filter(|f| f.is_finite()).count();
+        if 2 * kept < n {
+            return Err(DiagnoseError::Unusable {
+                test: m.name.clone(),
+                kept,
+                samples: n,
+                dropouts: dropout_rows,
+                clipped,
+            });
+        }
+        found.push(Screened {
+            test: m.name.clone(),
+            dropout_rows,
+            bridged_rows,
+            first_dropout_s: missing.iter().position(|&b| b).map(|i| m.time_s[i]),
+            clip_high_N: clip[0],
+            clip_low_N: clip[1],
+            clipped_samples: clipped,
+            samples: n,
+        });
+        out.push(m);
+    }
+    Ok((out, found))
+}
+
+/// Bridges runs of non-finite values of `x` by straight lines in time. Errors on a run at either end or longer than [`MAX_BRIDGE_PERIOD_FRACTION`] of
+/// `period_s`.
+fn bridge(
+    test: &str,
+    channel: &'static str,
+    t: &[f64],
+    x: &mut [f64],
+    period_s: f64,
+) -> Result<(), DiagnoseError> {
+    let n = x.len();
+    let mut i = 0;
+    while i < n {
+        if x[i].is_finite() {
+            i += 1;
+            continue;
+        }
+        let j = (i..n).find(|&k| x[k].is_finite()).unwrap_or(n);
+        let err = |reason: String| DiagnoseError::Dropout {
+            test: test.to_string(),
+            channel,
+            from_s: t[i],
+            to_s: t[j - 1],
+            reason,
+        };
+        if i == 0 || j == n {
+            return Err(err(format!(
+                "at the {} of the test, where no straight line can bridge it: trim the record",
+                if i == 0 { "start" } else { "end" }
+            )));
+        }
+        let span = t[j] - t[i - 1];
+        if span > MAX_BRIDGE_PERIOD_FRACTION * period_s {
+            return Err(err(format!(
+                "{:.2} ms between the samples around it, more than 1/64 of the stroking period ({:.2} ms) that a straight line bridges",
+                1e3 * span,
+                1e3 * MAX_BRIDGE_PERIOD_FRACTION * period_s
+            )));
+        }
+        let (x0, x1) = (x[i - 1], x[j]);
+        for k in i..j {
+            x[k] = x0 + (x1 - x0) * (t[k] - t[i - 1]) / span;
+        }
+        i = j;
+    }
+    Ok(())
+}
+
+/// Minimum and maximum of the finite values (infinities where there are none).
+pub(crate) fn min_max_finite(x: &[f64]) -> (f64, f64) {
+    min_max(
+        &x.iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect::<Vec<_>>(),
+    )
 }
 
 /// Checks every measurement; returns the limitations (what the data cannot decide) that do not
@@ -152,19 +343,6 @@ pub fn check_measurements(ms: &[Measurement]) -> Result<Vec<String>, DiagnoseErr
                 cycles: m.cycles(),
                 min: MIN_CYCLES,
             });
-        }
-        // Clipping: a flat top, several samples exactly at the extreme value (noisy data never
-        // repeats its maximum to the last digit).
-        let (lo, hi) = min_max(&m.force_n);
-        for v in [lo, hi] {
-            let count = m.force_n.iter().filter(|&&f| f == v).count();
-            if count >= 3.max(n / 500) {
-                return Err(DiagnoseError::Clipping {
-                    test: m.name.clone(),
-                    value: v,
-                    count,
-                });
-            }
         }
     }
     let amps: Vec<f64> = ms.iter().map(Measurement::amplitude_m).collect();

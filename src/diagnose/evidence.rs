@@ -13,7 +13,9 @@ fn velocity_sign_step(curves: &[Curves]) -> (f64, f64) {
         for k in c.from..c.time_s.len() {
             let r = c.measured_n[k] - c.baseline_n[k];
             let v = c.velocity_m_s[k];
-            if v > 0.2 * vmax {
+            if r.is_nan() {
+                // not measured (a dropout or clipped)
+            } else if v > 0.2 * vmax {
                 sp += r;
                 np += 1;
             } else if v < -0.2 * vmax {
@@ -28,11 +30,10 @@ fn velocity_sign_step(curves: &[Curves]) -> (f64, f64) {
 /// Time per force zero crossing spent within +-band [s] (measured, model).
 fn dwell(c: &Curves, band: f64, period: f64) -> (f64, f64) {
     let n = (c.time_s.len() - c.from).max(1) as f64;
-    let fm = c.measured_n[c.from..]
-        .iter()
-        .filter(|f| f.abs() < band)
-        .count() as f64
-        / n;
+    // Over the measured samples only (NaN: a dropout or clipped).
+    let measured = c.measured_n[c.from..].iter().filter(|f| !f.is_nan());
+    let n_measured = measured.clone().count().max(1) as f64;
+    let fm = measured.filter(|f| f.abs() < band).count() as f64 / n_measured;
     let fb = c.baseline_n[c.from..]
         .iter()
         .filter(|f| f.abs() < band)
@@ -73,10 +74,12 @@ fn best_lag(c: &Curves) -> Option<(f64, f64, f64)> {
         let (mut acc, mut cnt) = (0.0, 0usize);
         for k in c.from + max..n - max {
             let e = c.measured_n[k] - c.baseline_n[(k as isize - s) as usize];
-            acc += e * e;
-            cnt += 1;
+            if !e.is_nan() {
+                acc += e * e;
+                cnt += 1;
+            }
         }
-        (acc / cnt as f64).sqrt()
+        (acc / cnt.max(1) as f64).sqrt()
     };
     let m = max as isize;
     let vals: Vec<f64> = (-m..=m).map(rms).collect();

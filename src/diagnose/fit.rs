@@ -144,6 +144,8 @@ pub struct Diagnosis {
     /// The companions' held-out test: statistic, correction and the z each had to exceed.
     pub criterion_companions: String,
     pub limitations: Vec<String>,
+    /// Dropouts and clipping found in each test (what was not compared, what was bridged).
+    pub acquisition_screen: Vec<super::data::Screened>,
     /// Residual signatures of the measured force, the baseline and every candidate's
     /// prediction, measured alike.
     pub signatures: Vec<super::evidence::Signature>,
@@ -342,7 +344,8 @@ fn residuals_x(
         let m = &data[w.test];
         simulate(&deck, m, w.to, max_h, &mut buf).ok()?;
         for (b, f) in buf[w.from..w.to].iter().zip(&m.force_n[w.from..w.to]) {
-            r[i] = (b - f) / scale;
+            // A force not measured (a dropout or clipped: NaN) is not compared.
+            r[i] = if f.is_nan() { 0.0 } else { (b - f) / scale };
             i += 1;
         }
     }
@@ -377,7 +380,7 @@ fn intervals(
 ) -> Vec<[f64; 2]> {
     let k = x.len();
     let unbounded = vec![[0.0, f64::INFINITY]; k];
-    let n: usize = windows.iter().map(|w| w.to - w.from).sum();
+    let n = measured_samples(windows, data);
     if k == 0 || n <= k {
         return unbounded;
     }
@@ -653,11 +656,26 @@ fn rms_over(windows: &[Window], model: &[Vec<f64>], data: &[Measurement]) -> f64
     for w in windows {
         let (a, b) = (&model[w.test], &data[w.test].force_n);
         for (x, y) in a[w.from..w.to].iter().zip(&b[w.from..w.to]) {
-            s += (x - y) * (x - y);
-            n += 1;
+            if !y.is_nan() {
+                s += (x - y) * (x - y);
+                n += 1;
+            }
         }
     }
     (s / n.max(1) as f64).sqrt()
+}
+
+/// Measured force samples over `windows` (NaN, not measured, excluded).
+fn measured_samples(windows: &[Window], data: &[Measurement]) -> usize {
+    windows
+        .iter()
+        .map(|w| {
+            data[w.test].force_n[w.from..w.to]
+                .iter()
+                .filter(|f| !f.is_nan())
+                .count()
+        })
+        .sum()
 }
 
 /// BIC = n ln(RSS/n) + k ln n (Gaussian errors of unknown variance).
@@ -750,7 +768,7 @@ fn fault_candidate(
         .zip(model)
         .map(|(m, s)| acquisition::apply_all(faults, &values, &m.time_s, s))
         .collect();
-    let n_fit: usize = cx.fit_w.iter().map(|w| w.to - w.from).sum();
+    let n_fit = measured_samples(cx.fit_w, cx.data);
     let held = rms_over(cx.held_w, &sim, data);
     let rss = fits[0].rss;
     let ms = (rss / n_fit.max(1) as f64).max(held * held);
@@ -853,7 +871,7 @@ fn held_out_z(
     let (mut ed, mut dd) = (0.0, 0.0);
     for w in windows {
         let (s, p, y) = (&single[w.test], &pair[w.test], &data[w.test].force_n);
-        for i in w.from..w.to {
+        for i in (w.from..w.to).filter(|&i| !y[i].is_nan()) {
             let d = p[i] - s[i];
             ed += (y[i] - s[i]) * d;
             dd += d * d;
@@ -881,6 +899,80 @@ fn normal_quantile(p: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+type Named = (String, BTreeMap<String, f64>, BTreeMap<String, [f64; 2]>);
+
+/// Names the faults the screen found beside the fitted cause: `force_clipping` (`clip_high_N`,
+/// `clip_low_N`: the tightest rails of any test, read from the data, so their intervals are
+/// the values themselves) and `force_dropouts` (`dropout_rows`, over all tests); the cause
+/// becomes `cause+force_clipping`, or `force_clipping` alone for `none`.
+fn name_screened(
+    screened: &[super::data::Screened],
+    (cause, mut params, mut iv): Named,
+    evidence: &mut Vec<String>,
+    limitations: &mut Vec<String>,
+) -> Named {
+    let mut names: Vec<&str> = Vec::new();
+    let hi = screened
+        .iter()
+        .filter_map(|s| s.clip_high_N)
+        .min_by(f64::total_cmp);
+    let lo = screened
+        .iter()
+        .filter_map(|s| s.clip_low_N)
+        .max_by(f64::total_cmp);
+    let clipped: usize = screened.iter().map(|s| s.clipped_samples).sum();
+    if clipped > 0 {
+        names.push(acquisition::CLIPPING);
+        let mut rails = Vec::new();
+        for (key, v) in [("clip_high_N", hi), ("clip_low_N", lo)] {
+            if let Some(v) = v {
+                params.insert(key.into(), v);
+                iv.insert(key.into(), [v, v]);
+                rails.push(format!("{v:+.0} N"));
+            }
+        }
+        let tests: Vec<&str> = screened
+            .iter()
+            .filter(|s| s.clipped_samples > 0)
+            .map(|s| s.test.as_str())
+            .collect();
+        evidence.push(format!(
+            "the data acquisition: the force channel is clipped at {} (the load cell's range) in {} of {} tests ({clipped} samples): those samples are not compared; the damper is not at fault for this part",
+            rails.join(" and "),
+            tests.len(),
+            screened.len()
+        ));
+        limitations.push(format!(
+            "force clipped ({}: {}): the force beyond the range is not measured, so effects that show at the peaks (relief valves, area asymmetry) are judged on the unclipped samples only; re-record with a larger range to see them",
+            rails.join(", "),
+            tests.join(", ")
+        ));
+    }
+    let dropouts: usize = screened.iter().map(|s| s.dropout_rows).sum();
+    if dropouts > 0 {
+        names.push(acquisition::DROPOUTS);
+        params.insert("dropout_rows".into(), dropouts as f64);
+        iv.insert("dropout_rows".into(), [dropouts as f64; 2]);
+        let bridged: usize = screened.iter().map(|s| s.bridged_rows).sum();
+        let first = screened
+            .iter()
+            .find_map(|s| s.first_dropout_s.map(|t| format!("{} at {t:.4} s", s.test)));
+        evidence.push(format!(
+            "the data acquisition: {dropouts} rows miss a value (dropouts; the first in {}): their force is not compared, and the stroke of {bridged} of them is bridged by straight lines; the damper is not at fault for this part",
+            first.unwrap_or_default()
+        ));
+    }
+    if names.is_empty() {
+        return (cause, params, iv);
+    }
+    let named = if cause == "none" {
+        names.join("+")
+    } else {
+        format!("{cause}+{}", names.join("+"))
+    };
+    (named, params, iv)
+}
+
 /// Whether a candidate's name holds an acquisition fault.
 fn has_fault(name: &str) -> bool {
     name.split('+').any(|n| Fault::from_name(n).is_some())
@@ -895,6 +987,9 @@ pub fn diagnose(
     if base.physical.is_none() {
         return Err(DiagnoseError::NoPhysical);
     }
+    // Dropouts and clipping: the force there is not compared, the stroke bridged (`screen`).
+    let (screened_data, screened) = super::data::screen(data)?;
+    let data = &screened_data[..];
     let mut limitations = check_measurements(data)?;
     let one_amp = limitations
         .iter()
@@ -981,8 +1076,8 @@ pub fn diagnose(
             .fold(f64::INFINITY, f64::min),
     };
     let scale = peak.max(1.0);
-    let n_fit: usize = fit_w.iter().map(|w| w.to - w.from).sum();
-    let n_held: usize = held_w.iter().map(|w| w.to - w.from).sum();
+    let n_fit = measured_samples(&fit_w, data);
+    let n_held = measured_samples(&held_w, data);
 
     // Full replays: baseline and every fitted candidate.
     let sim_all = |deck: &DamperDeck| -> Result<Vec<Vec<f64>>, DiagnoseError> {
@@ -1889,6 +1984,13 @@ pub fn diagnose(
             signatures.push(super::evidence::signature(&curves, sim, &e.0.cause, band));
         }
     }
+    let mut evidence = evidence;
+    let (cause, params, param_iv) = name_screened(
+        &screened,
+        (cause, params, param_iv),
+        &mut evidence,
+        &mut limitations,
+    );
     let diagnosis = Diagnosis {
         gain: 1.0 - ext_held / base_held,
         cause,
@@ -1916,6 +2018,7 @@ pub fn diagnose(
             fitted.len()
         ),
         limitations,
+        acquisition_screen: screened,
         signatures,
         identifiability,
         tests,

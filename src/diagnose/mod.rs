@@ -13,7 +13,7 @@ pub mod report;
 pub mod rotor;
 
 pub use candidates::Cause;
-pub use data::{check_measurements, Measurement};
+pub use data::{check_measurements, screen, Measurement, Screened};
 pub use fit::{diagnose, Curves, DiagnoseOptions, Diagnosis, Outcome};
 
 /// Errors of the diagnosis: what cannot be decided and why.
@@ -21,11 +21,23 @@ pub use fit::{diagnose, Curves, DiagnoseOptions, Diagnosis, Outcome};
 pub enum DiagnoseError {
     #[error("{test}: no measured force: a diagnosis compares the model force with the measured one (bench CSV needs a `force_N` or `force_lb` column)")]
     NoForce { test: String },
-    #[error("{test}: force clipped: {count} samples sit exactly at {value} N (flat top); the peaks, where relief-valve and asymmetry effects show, are not measured: re-record with a larger range")]
-    Clipping {
+    #[error(
+        "{test}: the {channel} is missing from {from_s:.6} s to {to_s:.6} s (a dropout): {reason}"
+    )]
+    Dropout {
         test: String,
-        value: f64,
-        count: usize,
+        channel: &'static str,
+        from_s: f64,
+        to_s: f64,
+        reason: String,
+    },
+    #[error("{test}: only {kept} of {samples} force samples are usable ({dropouts} rows missing a value, {clipped} clipped at the load cell's range): too few to compare; re-record with a larger range")]
+    Unusable {
+        test: String,
+        kept: usize,
+        samples: usize,
+        dropouts: usize,
+        clipped: usize,
     },
     #[error("{test}: sample rate too low for the cycle: {samples_per_cycle:.1} samples per stroke cycle (period {period_s:.4} s); at least {min} are needed to resolve reversals and relief-valve opening")]
     SampleRate {

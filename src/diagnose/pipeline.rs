@@ -8,7 +8,7 @@ use super::rotor::{
 };
 use super::{DiagnoseOptions, Measurement, Outcome};
 use crate::flight::FlightRecord;
-use crate::hydraulics::bench::read_bench_csv;
+use crate::hydraulics::bench::read_bench_csv_with_dropouts;
 use crate::hydraulics::DamperDeck;
 use crate::io::{write_atomic, OutDir};
 use crate::report::html::HtmlReport;
@@ -686,11 +686,14 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
                 .measured
                 .iter()
                 .map(|p| {
-                    let t = read_bench_csv(p)?;
+                    let t = read_bench_csv_with_dropouts(p)?;
                     let m = Measurement::from_bench(&t)
                         .with_context(|| format!("bench file {}", p.display()))?;
                     // a test unfit for a diagnosis is named by its file
-                    super::check_measurements(std::slice::from_ref(&m))
+                    let one = std::slice::from_ref(&m);
+                    super::data::screen(one)
+                        .with_context(|| format!("bench file {}", p.display()))?;
+                    super::check_measurements(one)
                         .with_context(|| format!("bench file {}", p.display()))?;
                     Ok(m)
                 })

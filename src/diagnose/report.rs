@@ -66,19 +66,21 @@ pub const NOISE_BAND_SD: f64 = 2.0;
 pub fn signature_plots(d: &Diagnosis, noise: Option<&Signature>, synthetic: bool) -> Vec<Plot> {
     let mut order: Vec<&Signature> = Vec::with_capacity(d.signatures.len());
     let is = |g: &&Signature, s: &str| g.source == s;
+    // The candidate fitted (faults the data screen found are named beside it, not replayed).
+    let chosen = super::acquisition::fitted_cause(&d.cause);
     order.extend(d.signatures.iter().filter(|g| is(g, "measured")));
     order.extend(d.signatures.iter().filter(|g| is(g, "baseline")));
-    order.extend(d.signatures.iter().filter(|g| is(g, &d.cause)));
+    order.extend(d.signatures.iter().filter(|g| is(g, &chosen)));
     order.extend(
         d.signatures
             .iter()
-            .filter(|g| !is(g, "measured") && !is(g, "baseline") && !is(g, &d.cause)),
+            .filter(|g| !is(g, "measured") && !is(g, "baseline") && !is(g, &chosen)),
     );
     let rows: Vec<String> = order
         .iter()
         .map(|g| match g.source.as_str() {
             "measured" if synthetic => "measured (SYNTHETIC)".to_string(),
-            s if s == d.cause => format!("{s} (chosen)"),
+            s if s == chosen => format!("{s} (chosen)"),
             s => s.to_string(),
         })
         .collect();
@@ -115,10 +117,10 @@ pub fn signature_plots(d: &Diagnosis, noise: Option<&Signature>, synthetic: bool
                 p = match g.source.as_str() {
                     "measured" => p,
                     "baseline" => p.colour(OTHER_COLOURS[0]),
-                    s if s == d.cause => p.colour(OTHER_COLOURS[1]),
+                    s if s == chosen => p.colour(OTHER_COLOURS[1]),
                     _ => p.colour(ALSO_RAN),
                 };
-                if g.source == d.cause {
+                if g.source == chosen {
                     p = p.rings("", &[v], &[i as f64]).colour(OTHER_COLOURS[1]);
                 }
             }

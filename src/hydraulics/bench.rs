@@ -300,6 +300,17 @@ const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
 /// Reads a bench CSV file (docs/formats.md): `time_s`, `stroke_m` required, `force_N`,
 /// `velocity_m_s` optional, alternates `stroke_in`, `force_lb`, `velocity_in_s`.
 pub fn read_bench_csv(path: &Path) -> Result<BenchTest, BenchCsvError> {
+    read_with(path, false)
+}
+
+/// Reads a bench CSV file as [`read_bench_csv`] does, but an empty or `NaN` cell of the stroke,
+/// force or velocity is read as NaN (a dropout: the channel lost that sample) instead of an
+/// error; the time must still be given on every row.
+pub fn read_bench_csv_with_dropouts(path: &Path) -> Result<BenchTest, BenchCsvError> {
+    read_with(path, true)
+}
+
+fn read_with(path: &Path, dropouts: bool) -> Result<BenchTest, BenchCsvError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| BenchCsvError::Read {
         file: file.clone(),
@@ -308,11 +319,24 @@ pub fn read_bench_csv(path: &Path) -> Result<BenchTest, BenchCsvError> {
     let name = path
         .file_stem()
         .map_or_else(|| "test".to_string(), |s| s.to_string_lossy().into_owned());
-    parse_bench_csv(&text, &file, &name)
+    parse(&text, &file, &name, dropouts)
 }
 
 /// Parses bench CSV text; `file` names it in errors.
 pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, BenchCsvError> {
+    parse(text, file, name, false)
+}
+
+/// Parses bench CSV text as [`read_bench_csv_with_dropouts`] reads a file.
+pub fn parse_bench_csv_with_dropouts(
+    text: &str,
+    file: &str,
+    name: &str,
+) -> Result<BenchTest, BenchCsvError> {
+    parse(text, file, name, true)
+}
+
+fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest, BenchCsvError> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
@@ -374,6 +398,10 @@ pub fn parse_bench_csv(text: &str, file: &str, name: &str) -> Result<BenchTest, 
                 continue;
             };
             let cell = rec.get(ci).unwrap_or("");
+            if dropouts && qi != 0 && (cell.is_empty() || cell.eq_ignore_ascii_case("nan")) {
+                data[qi].push(f64::NAN);
+                continue;
+            }
             let x: f64 = cell.parse().map_err(|_| BenchCsvError::Line {
                 file: file.into(),
                 line,

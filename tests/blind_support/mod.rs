@@ -88,6 +88,12 @@ pub enum Effect {
     /// Acquisition fault: a drift [N/s] added to the recorded force from each test's first
     /// sample, `drift (t - t0)`.
     ForceDrift(f64),
+    /// Acquisition fault: the load cell's range is +-this fraction of the campaign's recorded
+    /// peak (noise included); the force beyond it reads the rail.
+    ForceClip(f64),
+    /// Acquisition fault: this fraction of the rows is lost (stroke, velocity and force NaN),
+    /// in bursts of 1-3 samples.
+    ForceDropouts(f64),
 }
 
 impl Effect {
@@ -109,6 +115,8 @@ impl Effect {
             Effect::ForceOffset(_) => "force_offset",
             Effect::ForceGain(_) => "force_gain",
             Effect::ForceDrift(_) => "force_drift",
+            Effect::ForceClip(_) => "force_clipping",
+            Effect::ForceDropouts(_) => "force_dropouts",
         }
     }
 
@@ -120,6 +128,8 @@ impl Effect {
                 | Effect::ForceOffset(_)
                 | Effect::ForceGain(_)
                 | Effect::ForceDrift(_)
+                | Effect::ForceClip(_)
+                | Effect::ForceDropouts(_)
         )
     }
 
@@ -143,6 +153,8 @@ impl Effect {
                 Effect::ForceOffset(_) => &"force_offset",
                 Effect::ForceGain(_) => &"force_gain",
                 Effect::ForceDrift(_) => &"force_drift",
+                Effect::ForceClip(_) => &"force_clipping",
+                Effect::ForceDropouts(_) => &"force_dropouts",
                 Effect::FreePlay(_) => unreachable!(),
             }),
         }
@@ -184,6 +196,8 @@ impl Effect {
             Effect::ForceOffset(o) => format!("force offset {o:.0} N"),
             Effect::ForceGain(g) => format!("force gain {g:.3}"),
             Effect::ForceDrift(d) => format!("force drift {d:.0} N/s"),
+            Effect::ForceClip(r) => format!("force clipped at {:.0}% of the peak", r * 100.0),
+            Effect::ForceDropouts(r) => format!("{:.2}% of the rows dropped", r * 100.0),
         }
     }
 
@@ -214,6 +228,8 @@ impl Effect {
             Effect::ForceOffset(o) => vec![("offset_N", Some(o))],
             Effect::ForceGain(g) => vec![("gain", Some(g))],
             Effect::ForceDrift(d) => vec![("drift_N_per_s", Some(d))],
+            // Read from the data, not fitted: not scored for interval coverage.
+            Effect::ForceClip(_) | Effect::ForceDropouts(_) => vec![],
         }
     }
 
@@ -240,7 +256,9 @@ impl Effect {
             Effect::ForceLag(_)
             | Effect::ForceOffset(_)
             | Effect::ForceGain(_)
-            | Effect::ForceDrift(_) => {}
+            | Effect::ForceDrift(_)
+            | Effect::ForceClip(_)
+            | Effect::ForceDropouts(_) => {}
         }
     }
 }
@@ -255,6 +273,10 @@ pub struct Acquisition {
     pub offset_n: f64,
     pub gain: f64,
     pub drift_n_per_s: f64,
+    /// Load cell range as a fraction of the recorded peak (0: no clipping), [`Acquisition::clip`].
+    pub clip_fraction: f64,
+    /// Fraction of rows lost (0: none), [`Acquisition::drop_rows`].
+    pub dropout_fraction: f64,
 }
 
 impl Default for Acquisition {
@@ -264,6 +286,8 @@ impl Default for Acquisition {
             offset_n: 0.0,
             gain: 1.0,
             drift_n_per_s: 0.0,
+            clip_fraction: 0.0,
+            dropout_fraction: 0.0,
         }
     }
 }
@@ -278,6 +302,8 @@ impl Acquisition {
                 Effect::ForceOffset(o) => a.offset_n = o,
                 Effect::ForceGain(g) => a.gain = g,
                 Effect::ForceDrift(d) => a.drift_n_per_s = d,
+                Effect::ForceClip(r) => a.clip_fraction = r,
+                Effect::ForceDropouts(r) => a.dropout_fraction = r,
                 _ => {}
             }
         }
@@ -319,6 +345,47 @@ impl Acquisition {
         let mut f = force_at(model, stroke, &self.source_times(t), tol)?;
         self.transform(t, &mut f);
         Ok(f)
+    }
+
+    /// The load cell's rail of a campaign whose recorded peak is `peak` (None: no clipping).
+    pub fn rail(&self, peak: f64) -> Option<f64> {
+        (self.clip_fraction > 0.0).then_some(self.clip_fraction * peak)
+    }
+
+    /// Clipping at the load cell's range, after the noise (the amplifier saturates on the
+    /// noisy signal): the force beyond +-rail reads the rail.
+    pub fn clip(&self, tests: &mut [Measurement]) {
+        let peak = tests
+            .iter()
+            .flat_map(|m| m.force_n.iter())
+            .fold(0.0f64, |a, f| a.max(f.abs()));
+        if let Some(rail) = self.rail(peak) {
+            for f in tests.iter_mut().flat_map(|m| m.force_n.iter_mut()) {
+                *f = f.clamp(-rail, rail);
+            }
+        }
+    }
+
+    /// Dropouts: about `dropout_fraction` of each test's rows lost in bursts of 1-3 samples
+    /// (stroke, velocity and force NaN), never the first or last 4 samples.
+    pub fn drop_rows(&self, tests: &mut [Measurement], seed: u64) {
+        if self.dropout_fraction <= 0.0 {
+            return;
+        }
+        let mut rng = Pcg::new(seed ^ 0xD20B_0075);
+        for m in tests {
+            let n = m.time_s.len();
+            let bursts = (self.dropout_fraction * n as f64 / 2.0).round().max(1.0) as usize;
+            for _ in 0..bursts {
+                let len = 1 + (rng.next_u32() % 3) as usize;
+                let at = 4 + (rng.uniform() * (n - 8 - len) as f64) as usize;
+                for k in at..at + len {
+                    m.stroke_m[k] = f64::NAN;
+                    m.velocity_m_s[k] = f64::NAN;
+                    m.force_n[k] = f64::NAN;
+                }
+            }
+        }
     }
 }
 
@@ -366,10 +433,11 @@ fn c(id: &str, effects: Vec<Effect>, seed: u64) -> Campaign {
     }
 }
 
-/// The full blind suite, 83 campaigns: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid
+/// The full blind suite, 89 campaigns: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid
 /// of gap and contact stiffness), 7 pairs, 6 no-effect campaigns, 5 flight records; then the
 /// acquisition faults (force lag, offset, gain, drift): each alone at 2 magnitudes, 7 beside a
-/// physical effect, 1 flight record with a lag. Seeds are arbitrary 64-bit numbers, magnitudes
+/// physical effect, 1 flight record with a lag; then clipping and dropouts, each alone at 2
+/// magnitudes and once beside a physical effect. Seeds are arbitrary 64-bit numbers, magnitudes
 /// hand-picked across realistic ranges, none equal to a starting value of the diagnosis' fits.
 pub fn suite() -> Vec<Campaign> {
     use Effect::*;
@@ -545,6 +613,26 @@ pub fn suite() -> Vec<Campaign> {
     let mut cp = c("flight_5", vec![ForceLag(2.2e-3)], next());
     cp.flight = true;
     v.push(cp);
+    // Clipping at the load cell's range and dropouts (rows lost), appended after every earlier
+    // seed was drawn: each alone at 2 magnitudes and once beside a physical effect. Rails at
+    // 81-84% of the campaign's peak cut the force peaks of the largest tests; 0.4-1.3%
+    // of the rows lost in bursts of 1-3 samples.
+    let screened: [(&str, [Effect; 2]); 2] = [
+        ("clip", [ForceClip(0.81), ForceClip(0.84)]),
+        ("dropout", [ForceDropouts(0.004), ForceDropouts(0.013)]),
+    ];
+    for (name, list) in screened {
+        for (i, e) in list.into_iter().enumerate() {
+            v.push(c(&format!("acq_{name}_{i}"), vec![e], next()));
+        }
+    }
+    let beside = [
+        vec![ForceClip(0.83), SealFriction(440.0)],
+        vec![ForceDropouts(0.008), EntrainedAir(0.017)],
+    ];
+    for (i, p) in beside.into_iter().enumerate() {
+        v.push(c(&format!("acqpair_{}", 7 + i), p, next()));
+    }
     v
 }
 
@@ -665,6 +753,8 @@ pub fn bench_campaign(
         });
     }
     add_noise(&mut out, cp.seed);
+    acq.clip(&mut out);
+    acq.drop_rows(&mut out, cp.seed);
     Ok(out)
 }
 
@@ -1069,7 +1159,9 @@ pub fn rates(rows: &[(Campaign, Score)]) -> String {
 /// force with every effect (acquisition faults included) and the clean truth without any, over
 /// every test after its first cycle, the noise sigma
 /// (`noise_fraction()` of the peak), and the held-out gain a perfect model could reach, `1 - sigma/sqrt(sigma^2 + r^2)`
-/// (the baseline's residual is effect plus noise, a perfect model's the noise alone).
+/// (the baseline's residual is effect plus noise, a perfect model's the noise alone). Samples
+/// beyond a clipping rail are left out, as the diagnosis leaves them out: a clipped force is
+/// not measured.
 pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f64, f64), String> {
     let with = cp.truth();
     let acq = cp.acquisition();
@@ -1090,14 +1182,23 @@ pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f
             tests.push((stroke, t, (period * rate_hz).round() as usize));
         }
     }
-    let (mut ss, mut count, mut peak) = (0.0, 0usize, 0.0f64);
+    let mut forces = Vec::new();
+    let mut peak = 0.0f64;
     for (stroke, t, per_cycle) in &tests {
         let a = acq.record(&with, stroke, t, Tolerance::default())?;
         let b = force_at(&without, stroke, t, Tolerance::default())?;
         peak = a.iter().fold(peak, |p, f| p.max(f.abs()));
-        for (x, y) in a.iter().zip(&b).skip(*per_cycle) {
-            ss += (x - y).powi(2);
-            count += 1;
+        forces.push((a, b, *per_cycle));
+    }
+    // Clipped samples are not measured: the effect is what the samples within range show.
+    let rail = acq.rail(peak).unwrap_or(f64::INFINITY);
+    let (mut ss, mut count) = (0.0, 0usize);
+    for (a, b, per_cycle) in &forces {
+        for (x, y) in a.iter().zip(b).skip(*per_cycle) {
+            if x.abs() < rail {
+                ss += (x - y).powi(2);
+                count += 1;
+            }
         }
     }
     let r = (ss / count.max(1) as f64).sqrt();
