@@ -179,13 +179,6 @@ pub struct Screened {
     pub samples: usize,
 }
 
-impl Screened {
-    /// Whether the screen found anything in this test.
-    pub fn any(&self) -> bool {
-        self.dropout_rows > 0 || self.clipped_samples > 0
-    }
-}
-
 /// Screens every measurement for dropouts and clipping: returns the measurements with the
 /// stroke and velocity bridged across dropouts and the force of dropouts and clipped samples
 /// set to NaN (not compared), and what was found in each test. A stroke dropout longer than
@@ -262,8 +255,8 @@ pub fn screen(ms: &[Measurement]) -> Result<(Vec<Measurement>, Vec<Screened>), D
     Ok((out, found))
 }
 
-/// Bridges runs of non-finite values of `x` by straight lines in time. Errors on a run at either end or longer than [`MAX_BRIDGE_PERIOD_FRACTION`] of
-/// `period_s`.
+/// Bridges runs of non-finite values of `x` by straight lines in time. Errors on a run at
+/// either end or longer than [`MAX_BRIDGE_PERIOD_FRACTION`] of `period_s`.
 fn bridge(
     test: &str,
     channel: &'static str,

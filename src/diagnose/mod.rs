@@ -31,7 +31,7 @@ pub enum DiagnoseError {
         to_s: f64,
         reason: String,
     },
-    #[error("{test}: only {kept} of {samples} force samples are usable ({dropouts} rows missing a value, {clipped} clipped at the load cell's range): too few to compare; re-record with a larger range")]
+    #[error("{test}: only {kept} of {samples} force samples are usable ({dropouts} rows missing a value, {clipped} clipped at the load cell's range): too few to compare; re-record the test (with a larger range where it clips)")]
     Unusable {
         test: String,
         kept: usize,
