@@ -131,6 +131,17 @@ fn flight_record_without_stroke_needs_a_rotor_deck_for_the_rotor_run() {
     );
 }
 
+/// `diagnose` of one bench file against the nominal damper deck, the result in `dir/out`.
+fn bench_args(dir: &std::path::Path, file: PathBuf) -> DiagnoseArgs {
+    DiagnoseArgs {
+        deck: Some(root().join("flightdata/damper_nominal.toml")),
+        measured: vec![file],
+        rotor: None,
+        flight: None,
+        ..args(dir.join("out"))
+    }
+}
+
 #[test]
 fn bench_file_without_force_is_named() {
     let dir = tmp("noforce");
@@ -141,14 +152,7 @@ fn bench_file_without_force_is_named() {
         s.push_str(&format!("{t},{}\n", 1e-3 * (27.0 * t).sin()));
     }
     std::fs::write(&f, s).unwrap();
-    let e = diagnose(DiagnoseArgs {
-        deck: Some(root().join("flightdata/damper_nominal.toml")),
-        measured: vec![f],
-        rotor: None,
-        flight: None,
-        ..args(dir.join("out"))
-    })
-    .unwrap_err();
+    let e = diagnose(bench_args(&dir, f)).unwrap_err();
     let msg = format!("{e:#}");
     assert!(
         msg.contains("t.csv") && msg.contains("no measured force"),
@@ -177,14 +181,7 @@ fn bench_file_dropouts_are_read_and_one_too_long_is_named() {
         }
     }
     std::fs::write(&f, s).unwrap();
-    let e = diagnose(DiagnoseArgs {
-        deck: Some(root().join("flightdata/damper_nominal.toml")),
-        measured: vec![f],
-        rotor: None,
-        flight: None,
-        ..args(dir.join("out"))
-    })
-    .unwrap_err();
+    let e = diagnose(bench_args(&dir, f)).unwrap_err();
     let msg = format!("{e:#}");
     assert!(
         msg.contains("t.csv")
