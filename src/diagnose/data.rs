@@ -214,7 +214,8 @@ pub fn screen(ms: &[Measurement]) -> Result<(Vec<Measurement>, Vec<Screened>), D
         }
         // Clipping: several samples exactly at the extreme value (noisy data never repeats its
         // maximum to the last digit).
-        let (lo, hi) = min_max_finite(&m.force_n);
+        // `min_max` passes over NaN (f64::min and max return the other operand).
+        let (lo, hi) = min_max(&m.force_n);
         let mut clip = [None, None];
         let mut clipped = 0;
         for (k, v) in [hi, lo].into_iter().enumerate() {
@@ -300,16 +301,6 @@ fn bridge(
         i = j;
     }
     Ok(())
-}
-
-/// Minimum and maximum of the finite values (infinities where there are none).
-pub(crate) fn min_max_finite(x: &[f64]) -> (f64, f64) {
-    min_max(
-        &x.iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .collect::<Vec<_>>(),
-    )
 }
 
 /// Checks every measurement; returns the limitations (what the data cannot decide) that do not

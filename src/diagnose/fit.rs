@@ -1970,7 +1970,7 @@ pub fn diagnose(
     if let Some(r) = cand_rows.iter_mut().find(|r| r.cause == cause) {
         r.intervals = param_iv.clone();
     }
-    let evidence = super::evidence::evidence(
+    let mut evidence = super::evidence::evidence(
         &curves, sigma, &cause, &params, &cand_rows, base_held, ext_held,
     );
     let band = super::evidence::dwell_band(&curves, sigma);
@@ -1984,7 +1984,6 @@ pub fn diagnose(
             signatures.push(super::evidence::signature(&curves, sim, &e.0.cause, band));
         }
     }
-    let mut evidence = evidence;
     let (cause, params, param_iv) = name_screened(
         &screened,
         (cause, params, param_iv),
