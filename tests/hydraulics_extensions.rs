@@ -78,7 +78,7 @@ fn default_extensions_are_bit_for_bit_the_paper_model() {
 #[test]
 fn written_deck_reads_back_with_every_extension() {
     let d = deck_with(
-        "seal_friction_N = 321.5\nstribeck_static_N = 400.0\nfree_play_m = 2.5e-4\nair_fraction = 0.013\nleakage_m3_per_s_Pa = 7.0e-12\nair_fraction_1 = 0.05\naccumulator_bleed_m3_per_s_Pa = 2.0e-12",
+        "seal_friction_N = 321.5\nstribeck_static_N = 400.0\nfree_play_m = 2.5e-4\nair_fraction = 0.013\nleakage_m3_per_s_Pa = 7.0e-12\nleakage_viscosity_length_Pa_s_m = 7.5e-4\nair_fraction_1 = 0.05\naccumulator_bleed_m3_per_s_Pa = 2.0e-12",
     );
     let back = DamperDeck::from_toml_str(&d.to_toml(), "back").unwrap();
     assert_eq!(back.physical, d.physical);
@@ -193,7 +193,7 @@ fn leakage_decays_exponentially_with_the_analytic_time_constant() {
     let k = 1.0e-12;
     let dp0 = 2.0e3;
     let mut p = sealed(fluid, [5.0e5 + dp0 / 2.0, 5.0e5 - dp0 / 2.0]);
-    p.ext.leakage = Some(Leakage { conductance: k });
+    p.ext.leakage = Some(AnnularLeakage::laminar(k));
     let tau = 1.0 / (k * b * (2.0 / 6.0e-5));
     let mut dev = CircuitDevice::new(p, opts());
     let dt = tau / 50.0;
@@ -210,6 +210,107 @@ fn leakage_decays_exponentially_with_the_analytic_time_constant() {
         );
         // Mass is conserved: the mean pressure stays.
         assert!(((y[IP0] + y[IP1]) / 2.0 - 5.0e5).abs() < 1e-6 * dp0);
+    }
+}
+
+/// Annular leakage of a sealed pair stroked at constant velocity w: once the transient has
+/// died (time constant 1 / (k B (1/V0 + 1/V1))) the leakage carries the swept flow,
+/// `k dp + c w = -A w`, so `dp = -(A + c) w / k` with the Couette flow per unit velocity
+/// `c = pi D h / 2` and `h = (12 mu L k / (pi D))^(1/3)` (Merritt 1967, Sec. 2.4), written out
+/// here from the geometry. Without the drag (mu L = 0) the balance is `dp = -A w / k`.
+#[test]
+fn annular_leakage_at_constant_velocity_carries_the_swept_and_the_drag_flow() {
+    let fluid = Fluid::constant_bulk(850.0, 1.5e9);
+    let (k, mu_l, w, area) = (1.0e-10, 7.5e-4, 0.01, 1.6e-3);
+    let tau = 1.0 / (k * fluid.bulk(5.0e5).0 * (2.0 / 6.0e-5));
+    let d = 2.0 * (area / std::f64::consts::PI).sqrt();
+    let h = (12.0 * mu_l * k / (std::f64::consts::PI * d)).cbrt();
+    let c = 0.5 * std::f64::consts::PI * d * h;
+    let steady = |mu_l: f64| {
+        let mut p = sealed(fluid, [5.0e5; 2]);
+        p.ext.leakage = Some(AnnularLeakage {
+            conductance: k,
+            viscosity_length: mu_l,
+        });
+        let mut dev = CircuitDevice::new(p, opts());
+        // 12 time constants: the transient is down to exp(-12) = 6e-6.
+        let n = 1200;
+        let dt = 12.0 * tau / n as f64;
+        for i in 0..n {
+            let t = i as f64 * dt;
+            dev.trial_step(t, dt, w * t, w * (t + dt)).unwrap();
+            dev.commit();
+        }
+        let y = dev.state();
+        y[IP0] - y[IP1]
+    };
+    let (with, without) = (steady(mu_l), steady(0.0));
+    let (expect, laminar) = (-(area + c) * w / k, -area * w / k);
+    assert!(
+        (with / expect - 1.0).abs() < 2e-5,
+        "dp {with} Pa, Poiseuille + Couette {expect} Pa"
+    );
+    assert!(
+        (without / laminar - 1.0).abs() < 2e-5,
+        "dp {without} Pa, Poiseuille {laminar} Pa"
+    );
+    // The drag is resolved: c / A = 0.9% here, far beyond the tolerance.
+    assert!(c / area > 100.0 * 2e-5, "c/A = {}", c / area);
+    assert_eq!(
+        AnnularLeakage {
+            conductance: k,
+            viscosity_length: mu_l
+        }
+        .clearance(area),
+        h
+    );
+}
+
+/// The drag flow moves with the piston, so a damper behind a link (a very stiff mount, with and
+/// without a moving mass) sees it as the rigid damper does.
+#[test]
+fn annular_leakage_drag_reaches_the_damper_behind_a_link() {
+    let leak = "leakage_m3_per_s_Pa = 2.0e-11\nleakage_viscosity_length_Pa_s_m = 5.0e-3";
+    let (a, w, n) = (2.0 * 0.0254 / 27.0, 27.0, 1024);
+    let run = |ext: &str| -> Vec<f64> {
+        let deck = deck_with(ext);
+        let mut dev = deck.build(DamperModel::Physical, opts()).unwrap();
+        let dt = 2.0 * std::f64::consts::PI / w / n as f64;
+        let mut out = Vec::new();
+        for i in 0..3 * n {
+            let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
+            let s = dev
+                .trial_step(t0, dt, a * (w * t0).sin(), a * (w * t1).sin())
+                .unwrap();
+            dev.commit();
+            if i >= 2 * n {
+                out.push(s.force_end);
+            }
+        }
+        out
+    };
+    let rms = |x: &[f64], y: &[f64]| {
+        (x.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / x.len() as f64).sqrt()
+    };
+    let rigid = run(leak);
+    let no_drag = run("leakage_m3_per_s_Pa = 2.0e-11");
+    let drag = rms(&rigid, &no_drag);
+    let peak = rigid.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    assert!(
+        drag > 1e-3 * peak,
+        "the drag changes the force by {drag} N RMS of a {peak} N peak"
+    );
+    for link in [
+        "mount_stiffness_N_per_m = 1.0e11",
+        "mount_stiffness_N_per_m = 1.0e11\nlink_mass_kg = 1.0e-3",
+    ] {
+        let linked = run(&format!("{leak}\n{link}"));
+        let d = rms(&linked, &rigid);
+        eprintln!("{link}: {d:.3} N RMS from the rigid damper (drag {drag:.1} N of {peak:.0} N)");
+        assert!(
+            d < 0.05 * drag,
+            "{link}: {d} N RMS from the rigid damper (drag {drag} N)"
+        );
     }
 }
 
@@ -261,7 +362,11 @@ fn extension_jacobian_matches_finite_differences() {
         .unwrap()
         .physical
         .unwrap();
-    p.ext.leakage = Some(Leakage { conductance: 5e-12 });
+    // with the drag flow, which shifts each chamber's net inflow
+    p.ext.leakage = Some(AnnularLeakage {
+        conductance: 5e-12,
+        viscosity_length: 1e-3,
+    });
     p.ext.air = Some(EntrainedAir {
         fraction: 0.03,
         p_ref: 5.0e5,

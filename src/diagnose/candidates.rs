@@ -1,6 +1,8 @@
 //! The candidate model extensions: each a physical element of the hydraulic library (or a
 //! re-calibration of uncertain nominal coefficients), with its fitted parameters and bounds.
-use crate::hydraulics::{DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction};
+use crate::hydraulics::{
+    AnnularLeakage, DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction,
+};
 use std::borrow::Cow;
 
 /// Named causes (docs/formats.md `cause`).
@@ -127,7 +129,12 @@ impl Cause {
                     p("F_p1_N", 0.2 * r1.f_p, 5.0 * r1.f_p, vec![r1.f_p]),
                 ]
             }
-            Cause::PistonLeakage => vec![p("leakage_m3_per_s_Pa", 1e-15, 1e-8, vec![1e-12, 1e-11])],
+            // Viscosity times land length, mu L: hydraulic oils 0.005-0.1 Pa s, seal lands
+            // 2-100 mm (the drag flow it gives with k is the annulus's own, not a free area).
+            Cause::PistonLeakage => vec![
+                p("leakage_m3_per_s_Pa", 1e-15, 1e-8, vec![1e-12, 1e-11]),
+                p("leakage_viscosity_length_Pa_s_m", 1e-5, 1e-2, vec![3e-4]),
+            ],
             Cause::MountCompliance => vec![p("mount_stiffness_N_per_m", 1e6, 1e10, vec![1e7, 1e8])],
             Cause::AccumulatorBleed => vec![p(
                 "accumulator_bleed_m3_per_s_Pa",
@@ -195,7 +202,12 @@ impl Cause {
                     }
                 }
             }
-            Cause::PistonLeakage => c.ext.leakage = Some(Leakage { conductance: x[0] }),
+            Cause::PistonLeakage => {
+                c.ext.leakage = Some(AnnularLeakage {
+                    conductance: x[0],
+                    viscosity_length: x.get(1).copied().unwrap_or(0.0),
+                })
+            }
             Cause::AccumulatorBleed => c.ext.bleed = Some(Leakage { conductance: x[0] }),
             Cause::MountCompliance => d.extensions.mount_stiffness_n_per_m = Some(x[0]),
             Cause::Recalibration => {

@@ -232,8 +232,9 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             p("F_p1_N")
         ),
         "piston_leakage" => format!(
-            "piston leakage {:.3e} m^3/(s Pa): a laminar bypass that lowers the force most at small amplitudes",
-            p("leakage_m3_per_s_Pa")
+            "piston leakage {:.3e} m^3/(s Pa) through the piston's clearance (viscosity times land length {:.2e} Pa s m): a laminar bypass that lowers the force most at small amplitudes, less the oil the moving piston drags along",
+            p("leakage_m3_per_s_Pa"),
+            p("leakage_viscosity_length_Pa_s_m")
         ),
         "mount_compliance" => format!(
             "elastic mounts in series, stiffness {:.3e} N/m: the link force lags the damper's own force (a Maxwell element), most visibly as a delayed build-up after each reversal",

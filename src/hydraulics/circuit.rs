@@ -228,6 +228,30 @@ impl CircuitParams {
         k
     }
 
+    /// The Couette flow of the piston leakage per unit piston velocity [m^2] (0 without it),
+    /// from the growing chamber into the shrinking one; the bore is the larger chamber area.
+    #[inline]
+    pub fn drag_area(&self) -> f64 {
+        match &self.ext.leakage {
+            Some(l) if l.viscosity_length > 0.0 => {
+                l.drag_area(self.chambers[0].area.max(self.chambers[1].area))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Net inflow into chamber k at piston velocity w: `qn` of [`FlowPart`] less the leakage's
+    /// drag flow out of it (`lambda_k c w`, c = [`CircuitParams::drag_area`]).
+    #[inline(always)]
+    pub fn net_inflow(&self, k: usize, qn: f64, w: f64) -> f64 {
+        let drag = self.drag_area();
+        if drag == 0.0 {
+            qn
+        } else {
+            qn - self.chambers[k].lambda * drag * w
+        }
+    }
+
     /// The relief valves' flows of [`CircuitParams::evaluate`] alone (NaN where it errs): what
     /// the sub-step envelope records, without the rest of the right-hand side.
     fn relief_flows(&self, d: f64, y: &State) -> [f64; 2] {
@@ -267,11 +291,18 @@ impl CircuitParams {
         let FlowPart {
             mut f,
             mut j,
-            fl,
-            qn,
+            mut fl,
+            mut qn,
             vol,
             dq,
         } = self.flow_part::<JAC>(t, d, y, contact)?;
+        let drag = self.drag_area();
+        if drag != 0.0 {
+            fl.leakage += self.chambers[0].lambda * drag * d_dot;
+            for (q, c) in qn.iter_mut().zip(&self.chambers) {
+                *q -= c.lambda * drag * d_dot;
+            }
+        }
         for (k, ip) in [(0, IP0), (1, IP1)] {
             let (rate, drate_dp, b_over_v) = self.pressure_rate(k, y[ip], vol[k], qn[k], d_dot);
             f[ip] = rate;
@@ -425,7 +456,8 @@ pub struct FlowPart {
     /// Jacobian rows of the poppets and the impulse (when asked for).
     pub j: Jacobian,
     pub fl: Flows,
-    /// Net inflow into each chamber from its flow paths [m^3/s].
+    /// Net inflow into each chamber from its flow paths [m^3/s], but the piston leakage's drag
+    /// flow, which needs the piston velocity ([`CircuitParams::net_inflow`]).
     pub qn: [f64; 2],
     /// Chamber volumes [m^3].
     pub vol: [f64; 2],
@@ -1005,7 +1037,7 @@ impl Device for CircuitDevice {
 #[cfg(test)]
 mod damper_rhs_tests {
     use super::*;
-    use crate::hydraulics::extensions::Leakage;
+    use crate::hydraulics::extensions::{AnnularLeakage, Leakage};
     use crate::hydraulics::DamperDeck;
 
     fn damper() -> CircuitParams {
@@ -1106,7 +1138,7 @@ mod damper_rhs_tests {
     #[test]
     fn extended_circuits_take_the_general_rhs() {
         let mut leaky = damper();
-        leaky.ext.leakage = Some(Leakage { conductance: 1e-12 });
+        leaky.ext.leakage = Some(AnnularLeakage::laminar(1e-12));
         assert!(DamperRhs::new(&leaky).is_none());
         let mut bleed = damper();
         bleed.ext.bleed = Some(Leakage { conductance: 1e-12 });

@@ -4,8 +4,8 @@ use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
 use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
 use super::extensions::{
-    CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage,
-    SealFriction, SeriesMount,
+    AnnularLeakage, CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions,
+    Leakage, SealFriction, SeriesMount,
 };
 use super::fluid::Fluid;
 use super::integrators::{IntegratorOptions, Scheme};
@@ -124,6 +124,7 @@ pub const EXTENSION_KEYS: &[&str] = &[
     "free_play_m",
     "air_fraction",
     "leakage_m3_per_s_Pa",
+    "leakage_viscosity_length_Pa_s_m",
     "accumulator_bleed_m3_per_s_Pa",
     "air_fraction_0",
     "air_fraction_1",
@@ -561,6 +562,11 @@ impl DamperDeck {
             "a non-negative conductance in m^3/(s Pa)",
             non_negative,
         )?;
+        let mu_l = opt(
+            "leakage_viscosity_length_Pa_s_m",
+            "a non-negative viscosity times seal land length in Pa s m",
+            non_negative,
+        )?;
         let bleed = opt(
             "accumulator_bleed_m3_per_s_Pa",
             "a non-negative conductance in m^3/(s Pa)",
@@ -640,7 +646,10 @@ impl DamperDeck {
             });
         }
         if let Some(k) = leak.filter(|k| *k > 0.0) {
-            c.ext.leakage = Some(Leakage { conductance: k });
+            c.ext.leakage = Some(AnnularLeakage {
+                conductance: k,
+                viscosity_length: mu_l.unwrap_or(0.0),
+            });
         }
         for ch in 0..2 {
             let key = format!("air_fraction_{ch}");
@@ -940,6 +949,9 @@ impl DamperDeck {
             }
             if let Some(l) = c.ext.leakage {
                 ext.push(("leakage_m3_per_s_Pa", l.conductance));
+                if l.viscosity_length > 0.0 {
+                    ext.push(("leakage_viscosity_length_Pa_s_m", l.viscosity_length));
+                }
             }
             for (ch, a) in c.ext.air_by_chamber.iter().enumerate() {
                 if let Some(a) = a {

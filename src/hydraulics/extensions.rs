@@ -6,8 +6,9 @@
 //!   force is transmitted while the gap is open);
 //! - [`EntrainedAir`]: free air in the oil, isothermal, giving a pressure-dependent effective
 //!   bulk modulus (replaces Eq. 3 in the chambers);
-//! - [`Leakage`]: laminar leakage past the piston seal, `Q = k (p0 - p1)`, in parallel with the
-//!   orifice;
+//! - [`AnnularLeakage`]: leakage through the piston's annular clearance, `Q = k (p0 - p1)` in
+//!   parallel with the orifice plus the Couette flow the moving piston drags along;
+//! - [`Leakage`]: a laminar bypass `Q = k dp` (the accumulator bleed);
 //! - [`SeriesMount`]: elastic mounts in series;
 //! - [`CompliantFreePlay`]: a gap behind a contact stiffness (free play as in hardware).
 //!
@@ -188,11 +189,49 @@ impl EntrainedAir {
     }
 }
 
-/// Laminar leakage past the piston, `Q = k (p0 - p1)` from chamber 0 to chamber 1.
+/// A laminar bypass, `Q = k dp` (the bleed of a chamber to the accumulator).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Leakage {
     /// Leakage conductance k [m^3/(s Pa)].
     pub conductance: f64,
+}
+
+/// Leakage through the annular clearance h between piston and bore, from chamber 0 to chamber 1:
+/// plane Poiseuille flow under the pressure difference plus the Couette flow of the piston
+/// wall dragging the oil toward the chamber it shrinks (Merritt, Hydraulic Control Systems,
+/// 1967, Sec. 2.4; the annulus as parallel plates of width pi D):
+/// `Q = k (p0 - p1) + (pi D h / 2) w`, `k = pi D h^3 / (12 mu L)`, w the piston velocity
+/// (positive growing chamber 0). The clearance follows from k and the product of the oil's
+/// viscosity mu and the seal land's length L, `h = (12 mu L k / (pi D))^(1/3)`; mu L = 0 is a
+/// pure Poiseuille bypass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnnularLeakage {
+    /// Poiseuille conductance k [m^3/(s Pa)].
+    pub conductance: f64,
+    /// Viscosity times seal land length, mu L [Pa s m] (0: no drag flow).
+    pub viscosity_length: f64,
+}
+
+impl AnnularLeakage {
+    /// Laminar leakage without drag (`Q = k (p0 - p1)`).
+    pub fn laminar(conductance: f64) -> Self {
+        Self {
+            conductance,
+            viscosity_length: 0.0,
+        }
+    }
+
+    /// Radial clearance h [m] of a bore of area `bore_area` (D = 2 sqrt(A / pi)).
+    pub fn clearance(&self, bore_area: f64) -> f64 {
+        let d = 2.0 * (bore_area / std::f64::consts::PI).sqrt();
+        (12.0 * self.viscosity_length * self.conductance / (std::f64::consts::PI * d)).cbrt()
+    }
+
+    /// Couette flow per unit piston velocity, `pi D h / 2` [m^2].
+    pub fn drag_area(&self, bore_area: f64) -> f64 {
+        let d = 2.0 * (bore_area / std::f64::consts::PI).sqrt();
+        0.5 * std::f64::consts::PI * d * self.clearance(bore_area)
+    }
 }
 
 /// Hydraulic extensions held in the circuit parameters (defaults: none).
@@ -202,7 +241,7 @@ pub struct HydraulicExtensions {
     /// Air in one chamber only (e.g. trapped on the rod side): chamber k uses
     /// `air_by_chamber[k]` where given, else `air`.
     pub air_by_chamber: [Option<EntrainedAir>; 2],
-    pub leakage: Option<Leakage>,
+    pub leakage: Option<AnnularLeakage>,
     /// Bleed of each chamber to the accumulator at p_s, `Q_k = k (p_k - p_s)` out of chamber k
     /// (the accumulator's link that the paper's conclusions say is not modelled).
     pub bleed: Option<Leakage>,

@@ -131,13 +131,16 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         let cav = p.map(|p| self.params.fluid.cavitation_factor(p).0);
         let fac =
             [0, 1].map(|k| Chamber::rate_factors(self.params.bulk(k, p[k]).0, cav[k], part.vol[k]));
+        // The leakage's drag flow moves with the piston: it adds to the swept area.
+        let drag = self.params.drag_area();
         let balance = |v: f64| -> (f64, f64, [f64; 2]) {
             let mut rate = [0.0; 2];
             let mut slope = [0.0; 2];
             for k in 0..2 {
-                let (r, g) = ch[k].rate_with(&fac[k], part.qn[k], v);
+                let q = self.params.net_inflow(k, part.qn[k], v);
+                let (r, g) = ch[k].rate_with(&fac[k], q, v);
                 rate[k] = r;
-                slope[k] = -g * ch[k].area * ch[k].lambda;
+                slope[k] = -g * (ch[k].area + drag) * ch[k].lambda;
             }
             (
                 ch[0].area * rate[0] - ch[1].area * rate[1] - k_c * (v - d_dot) + relax,
@@ -151,7 +154,7 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         let mut kinks = [f64::NAN; 2];
         for (k, kink) in kinks.iter_mut().enumerate() {
             if cav[k] != 1.0 {
-                *kink = part.qn[k] / (ch[k].area * ch[k].lambda);
+                *kink = part.qn[k] / ((ch[k].area + drag) * ch[k].lambda);
             }
         }
         if kinks[0] > kinks[1] || kinks[0].is_nan() {
@@ -306,7 +309,13 @@ impl OdeSystem<NM> for MassLinkSystem<'_> {
         for (k, ip) in [IP0, IP1].into_iter().enumerate() {
             f[ip] = self
                 .params
-                .pressure_rate(k, yc[ip], part.vol[k], part.qn[k], v)
+                .pressure_rate(
+                    k,
+                    yc[ip],
+                    part.vol[k],
+                    self.params.net_inflow(k, part.qn[k], v),
+                    v,
+                )
                 .0;
         }
         f[IE] = v - d_dot;

@@ -69,8 +69,8 @@ pub use dashpot::{LinearDashpot, NonlinearDashpot};
 pub use deck::{actuator_from_toml_str, DamperDeck, DamperModel, DeckError, DeviceExtensions};
 pub use elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 pub use extensions::{
-    CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions, Leakage,
-    SealFriction, SeriesMount,
+    AnnularLeakage, CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions,
+    Leakage, SealFriction, SeriesMount,
 };
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};

@@ -217,7 +217,13 @@ impl Effect {
                 ("F_p0_N", Some(s.relief[0].f_p)),
                 ("F_p1_N", Some(r * s.relief[0].f_p)),
             ],
-            Effect::PistonLeakage(k) => vec![("leakage_m3_per_s_Pa", Some(k))],
+            Effect::PistonLeakage(k) => vec![
+                ("leakage_m3_per_s_Pa", Some(k)),
+                (
+                    "leakage_viscosity_length_Pa_s_m",
+                    Some(truth::LEAK_VISCOSITY_PA_S * truth::LEAK_LAND_M),
+                ),
+            ],
             Effect::AccumulatorBleed(k) => vec![("accumulator_bleed_m3_per_s_Pa", Some(k))],
             Effect::MountCompliance(k) => vec![("mount_stiffness_N_per_m", Some(k))],
             Effect::Recalibration(o, a) => vec![

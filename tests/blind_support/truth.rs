@@ -175,9 +175,13 @@ pub struct Leak {
     pub couette: f64,
 }
 
+/// Oil viscosity [Pa s] and seal land length [m] of the annular leakage.
+pub const LEAK_VISCOSITY_PA_S: f64 = 0.03;
+pub const LEAK_LAND_M: f64 = 0.025;
+
 impl Leak {
     pub fn annular(k: f64, piston_area: f64) -> Self {
-        let (mu, len) = (0.03, 0.025);
+        let (mu, len) = (LEAK_VISCOSITY_PA_S, LEAK_LAND_M);
         let d = 2.0 * (piston_area / PI).sqrt();
         let h = (12.0 * mu * len * k / (PI * d)).cbrt();
         Self {
