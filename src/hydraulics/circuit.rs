@@ -241,10 +241,10 @@ impl CircuitParams {
     }
 
     /// Net inflow into chamber k at piston velocity w: `qn` of [`FlowPart`] less the leakage's
-    /// drag flow out of it (`lambda_k c w`, c = [`CircuitParams::drag_area`]).
+    /// drag flow out of it, `lambda_k c w` (c = [`CircuitParams::drag_area`], computed once by
+    /// the caller).
     #[inline(always)]
-    pub fn net_inflow(&self, k: usize, qn: f64, w: f64) -> f64 {
-        let drag = self.drag_area();
+    pub fn net_inflow(&self, k: usize, qn: f64, w: f64, drag: f64) -> f64 {
         if drag == 0.0 {
             qn
         } else {
@@ -299,8 +299,8 @@ impl CircuitParams {
         let drag = self.drag_area();
         if drag != 0.0 {
             fl.leakage += self.chambers[0].lambda * drag * d_dot;
-            for (q, c) in qn.iter_mut().zip(&self.chambers) {
-                *q -= c.lambda * drag * d_dot;
+            for (k, q) in qn.iter_mut().enumerate() {
+                *q = self.net_inflow(k, *q, d_dot, drag);
             }
         }
         for (k, ip) in [(0, IP0), (1, IP1)] {

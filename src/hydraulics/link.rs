@@ -137,7 +137,7 @@ impl OdeSystem<NL> for LinkSystem<'_> {
             let mut rate = [0.0; 2];
             let mut slope = [0.0; 2];
             for k in 0..2 {
-                let q = self.params.net_inflow(k, part.qn[k], v);
+                let q = self.params.net_inflow(k, part.qn[k], v, drag);
                 let (r, g) = ch[k].rate_with(&fac[k], q, v);
                 rate[k] = r;
                 slope[k] = -g * (ch[k].area + drag) * ch[k].lambda;
@@ -306,6 +306,7 @@ impl OdeSystem<NM> for MassLinkSystem<'_> {
         let part = self.params.flow_part::<false>(t, d + e, &yc, None)?;
         let mut f = MState::zeros();
         f.fixed_rows_mut::<NS>(0).copy_from(&part.f);
+        let drag = self.params.drag_area();
         for (k, ip) in [IP0, IP1].into_iter().enumerate() {
             f[ip] = self
                 .params
@@ -313,7 +314,7 @@ impl OdeSystem<NM> for MassLinkSystem<'_> {
                     k,
                     yc[ip],
                     part.vol[k],
-                    self.params.net_inflow(k, part.qn[k], v),
+                    self.params.net_inflow(k, part.qn[k], v, drag),
                     v,
                 )
                 .0;
