@@ -10,6 +10,7 @@ use super::extensions::{
 use super::fluid::Fluid;
 use super::integrators::{IntegratorOptions, Scheme};
 use super::link::{LinkMass, LinkedCircuit};
+use super::temperature::OilTemperature;
 use super::Device;
 use std::path::Path;
 use toml::{Table, Value};
@@ -97,7 +98,19 @@ pub struct DamperDeck {
     /// Device-level extensions of the physical model (`[damper.physical.extensions]`: seal
     /// friction, free play); the hydraulic ones (air, leakage) live in `physical.ext`.
     pub extensions: DeviceExtensions,
+    /// The oil's temperature law (`[damper.physical.oil]`); `physical` holds at its
+    /// `temperature_k`.
+    pub oil: Option<OilTemperature>,
 }
+
+/// Keys of `[damper.physical.oil]`.
+pub const OIL_KEYS: &[&str] = &[
+    "reference_temperature_K",
+    "temperature_K",
+    "density_thermal_coefficient_per_K",
+    "bulk_modulus_thermal_coefficient_per_K",
+    "viscosity_thermal_coefficient_per_K",
+];
 
 /// Seal friction and free play of the physical damper (default: none).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -259,6 +272,7 @@ const PHYSICAL_KEYS: &[&str] = &[
     "relief_valve_0",
     "relief_valve_1",
     "extensions",
+    "oil",
 ];
 const VALVE_KEYS: &[&str] = &[
     "m_kg",
@@ -353,15 +367,20 @@ impl DamperDeck {
             }
         };
 
-        let (physical, extensions) = match cx.table(damper, "damper", "physical")? {
-            None => (None, DeviceExtensions::default()),
+        let (physical, extensions, oil) = match cx.table(damper, "damper", "physical")? {
+            None => (None, DeviceExtensions::default(), None),
             Some(t) => {
                 let mut c = Self::parse_physical(&cx, t)?;
                 let e = match cx.table(t, "damper.physical", "extensions")? {
                     None => DeviceExtensions::default(),
                     Some(et) => Self::parse_extensions(&cx, et, &mut c)?,
                 };
-                (Some(c), e)
+                // After the extensions: the leakage and bleed move with the temperature too.
+                let oil = match cx.table(t, "damper.physical", "oil")? {
+                    None => None,
+                    Some(ot) => Some(Self::parse_oil(&cx, ot, &mut c)?),
+                };
+                (Some(c), e, oil)
             }
         };
 
@@ -372,6 +391,7 @@ impl DamperDeck {
             nonlinear,
             physical,
             extensions,
+            oil,
         };
         // The default model's table must be there.
         deck.require(model)?;
@@ -521,6 +541,49 @@ impl DamperDeck {
             p_init: [p_s; 2],
             ext: HydraulicExtensions::default(),
         })
+    }
+
+    /// `[damper.physical.oil]`: the properties above hold at `reference_temperature_K`; they are
+    /// moved to `temperature_K` (default: the reference).
+    fn parse_oil(cx: &Ctx, t: &Table, c: &mut CircuitParams) -> Result<OilTemperature, DeckError> {
+        let p = "damper.physical.oil";
+        cx.known(t, p, OIL_KEYS)?;
+        let kelvin = "a positive absolute temperature in K";
+        let t_ref = cx.num_where(t, p, "reference_temperature_K", kelvin, positive)?;
+        let t_run = if t.contains_key("temperature_K") {
+            cx.num_where(t, p, "temperature_K", kelvin, positive)?
+        } else {
+            t_ref
+        };
+        let coef = |k: &str| -> Result<f64, DeckError> {
+            if t.contains_key(k) {
+                cx.num_where(t, p, k, "a non-negative coefficient in 1/K", non_negative)
+            } else {
+                Ok(0.0)
+            }
+        };
+        let law = OilTemperature {
+            temperature_k: t_ref,
+            density_per_k: coef("density_thermal_coefficient_per_K")?,
+            bulk_modulus_per_k: coef("bulk_modulus_thermal_coefficient_per_K")?,
+            viscosity_per_k: coef("viscosity_thermal_coefficient_per_K")?,
+        };
+        Ok(law.move_to(c, t_run))
+    }
+
+    /// The deck with its oil at `t_k` [K] (the properties moved by `[damper.physical.oil]`).
+    pub fn at_oil_temperature(&self, t_k: f64) -> Result<DamperDeck, DeckError> {
+        let mut d = self.clone();
+        match (d.physical.as_mut(), self.oil) {
+            (Some(c), Some(law)) => {
+                d.oil = Some(law.move_to(c, t_k));
+                Ok(d)
+            }
+            _ => Err(DeckError::MissingTable {
+                file: self.source.clone(),
+                table: "damper.physical.oil".into(),
+            }),
+        }
     }
 
     fn parse_extensions(
@@ -964,6 +1027,21 @@ impl DamperDeck {
             if !ext.is_empty() {
                 s.push_str("\n[damper.physical.extensions]\n");
                 for (k, v) in ext {
+                    let _ = writeln!(s, "{k} = {}", num(v));
+                }
+            }
+            if let Some(o) = &self.oil {
+                // The properties above hold at the law's temperature: that is their reference.
+                s.push_str("\n[damper.physical.oil]\n");
+                for (k, v) in [
+                    ("reference_temperature_K", o.temperature_k),
+                    ("density_thermal_coefficient_per_K", o.density_per_k),
+                    (
+                        "bulk_modulus_thermal_coefficient_per_K",
+                        o.bulk_modulus_per_k,
+                    ),
+                    ("viscosity_thermal_coefficient_per_K", o.viscosity_per_k),
+                ] {
                     let _ = writeln!(s, "{k} = {}", num(v));
                 }
             }

@@ -61,6 +61,7 @@ pub mod extensions;
 pub mod fluid;
 pub mod integrators;
 pub mod link;
+pub mod temperature;
 
 pub use circuit::{
     ActuatorParams, CircuitDevice, CircuitParams, EntranceOrifices, PiecewiseLinear, Tangent,
@@ -75,6 +76,7 @@ pub use extensions::{
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
 pub use link::{LinkMass, LinkedCircuit};
+pub use temperature::OilTemperature;
 
 /// Result of one trial step of a device.
 #[derive(Debug, Clone, Copy, PartialEq)]
