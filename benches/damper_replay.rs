@@ -24,6 +24,7 @@ fn history() -> BenchTest {
         stroke_m,
         force_n: None,
         velocity_m_s: None,
+        oil_temperature_k: None,
     }
 }
 

@@ -200,6 +200,7 @@ fn truth_agrees_with_rotorsims_nominal_damper_in_physics() {
             force_n: vec![0.0; n],
             velocity_m_s: vel,
             period_s: period,
+            oil_temperature_k: None,
         };
         let mut model = Vec::new();
         simulate(&deck, &m, n, 1e-5, &mut model).unwrap();
@@ -313,6 +314,7 @@ fn truth_link_tends_to_the_librarys_quasi_static_gap_as_mass_and_damping_vanish(
         force_n: vec![0.0; n],
         velocity_m_s: vel,
         period_s: period,
+        oil_temperature_k: None,
     };
     let mut lib = Vec::new();
     simulate(&deck, &m, n, 1e-5, &mut lib).unwrap();

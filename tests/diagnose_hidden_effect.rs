@@ -6,7 +6,7 @@ use diagnose_support as support;
 use rotorsim::diagnose::fit::simulate;
 use rotorsim::diagnose::{diagnose, Cause, DiagnoseError, DiagnoseOptions};
 use rotorsim::hydraulics::bench::{parse_bench_csv, replay, BenchTest};
-use rotorsim::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, Scheme};
+use rotorsim::hydraulics::{DamperDeck, DamperModel, IntegratorOptions, OilTemperature, Scheme};
 
 /// 4 cycles at 1 kHz keep the test fast; the hit-rate example uses the full campaign.
 fn run(h: &support::Hidden, seed: u64) -> rotorsim::diagnose::Outcome {
@@ -58,6 +58,7 @@ fn check_found(h: &support::Hidden, seed: u64, o: &rotorsim::diagnose::Outcome) 
         stroke_m: m.stroke_m.clone(),
         force_n: None,
         velocity_m_s: None,
+        oil_temperature_k: None,
     };
     let dt = m.time_s[1] - m.time_s[0];
     let dev = back
@@ -305,4 +306,80 @@ fn clipping_and_dropouts_are_named_and_not_compared() {
         "{} vs {rms}",
         t1.baseline_rms_N
     );
+}
+
+/// The oil warms from test to test (20 to 80 C over a campaign of six amplitudes, hottest
+/// last) with the density and bulk-modulus laws of a mineral oil; the diagnosis, given each
+/// test's temperature and the data sheet without a temperature law, names the oil's
+/// temperature and recovers the density coefficient (SYNTHETIC: this library's damper
+/// generates the data; the blind suite's independent truth does not model temperature).
+#[test]
+fn a_warming_oil_is_named_with_its_density_coefficient() {
+    let base = support::nominal_deck();
+    let (c_rho, c_b) = (7.0e-4, 5.0e-3);
+    let law = |t_ref: f64| {
+        let mut d = base.clone();
+        d.oil = Some(OilTemperature {
+            temperature_k: t_ref,
+            density_per_k: c_rho,
+            bulk_modulus_per_k: c_b,
+            viscosity_per_k: 0.0,
+        });
+        d
+    };
+    let v = [1.0, 2.0, 3.0, 4.0, 6.0, 8.0];
+    let mut data = support::campaign(&base, &v, 4, 1000.0, 0.0, 5);
+    let temps: Vec<f64> = (0..v.len())
+        .map(|i| 293.15 + 60.0 * i as f64 / (v.len() - 1) as f64)
+        .collect();
+    // The data sheet holds at the tests' median temperature (what the diagnosis assumes).
+    let truth = law(0.5 * (temps[2] + temps[3]));
+    let mut rng = support::Rng::new(41);
+    let mut peak: f64 = 0.0;
+    for (m, &t) in data.iter_mut().zip(&temps) {
+        m.oil_temperature_k = Some(t);
+        let n = m.time_s.len();
+        let mut f = Vec::new();
+        simulate(&truth, m, n, 1.0e-5, &mut f).unwrap();
+        peak = peak.max(f.iter().fold(0.0f64, |a, x| a.max(x.abs())));
+        m.force_n = f;
+    }
+    for m in &mut data {
+        for f in &mut m.force_n {
+            *f += 0.01 * peak * rng.normal();
+        }
+    }
+    let o = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap();
+    let d = &o.diagnosis;
+    assert_eq!(d.cause, "oil_temperature", "{:#?}", d.candidates);
+    let got = d.parameters["density_thermal_coefficient_per_K"];
+    eprintln!(
+        "oil: {:?}, intervals {:?}, gain {:.3}",
+        d.parameters, d.parameter_intervals, d.gain
+    );
+    assert!((got / c_rho - 1.0).abs() < 0.25, "c_rho {got} for {c_rho}");
+    for (k, truth) in [
+        ("density_thermal_coefficient_per_K", c_rho),
+        ("bulk_modulus_thermal_coefficient_per_K", c_b),
+    ] {
+        let iv = d.parameter_intervals[k];
+        assert!(iv[0] <= truth && truth <= iv[1], "{k}: {iv:?} for {truth}");
+    }
+    assert!(
+        d.evidence
+            .iter()
+            .any(|e| e.starts_with("the oil's temperature")),
+        "{:#?}",
+        d.evidence
+    );
+    // Without temperatures the candidate is not there (nothing to fit it to).
+    for m in &mut data {
+        m.oil_temperature_k = None;
+    }
+    let o = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap();
+    assert!(o
+        .diagnosis
+        .candidates
+        .iter()
+        .all(|c| !c.cause.contains("oil_temperature")));
 }

@@ -340,6 +340,7 @@ fn the_force_alone_is_the_replays_force_bit_for_bit() {
         stroke_m: stroke_m.clone(),
         force_n: None,
         velocity_m_s: None,
+        oil_temperature_k: None,
     };
     for model in [
         DamperModel::Physical,

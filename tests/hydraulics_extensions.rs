@@ -124,6 +124,7 @@ fn coulomb_friction_adds_exactly_fc_in_steady_stroking() {
             time_s: t,
             force_n: None,
             velocity_m_s: None,
+            oil_temperature_k: None,
         };
         let a = replay(
             plain.build(DamperModel::Physical, opts()).unwrap().as_ref(),
@@ -164,6 +165,7 @@ fn free_play_transmits_no_force_inside_the_gap() {
         stroke_m: d.clone(),
         force_n: None,
         velocity_m_s: None,
+        oil_temperature_k: None,
     };
     let r = replay(dev.as_ref(), &test).unwrap();
     // After the peak (k = n/4) the stroke turns back: inside the gap until it has come back by

@@ -223,3 +223,39 @@ fn bad_oil_keys_are_named() {
         assert!(e.contains("oil.toml") && e.contains(want), "{table}: {e}");
     }
 }
+
+#[test]
+fn bench_csv_reads_the_oil_temperature_in_kelvin_or_celsius() {
+    use rotorsim::hydraulics::bench::{parse_bench_csv, parse_bench_csv_with_dropouts};
+    let c = "time_s,stroke_m,force_N,oil_temperature_C\n0.0,0.0,1.0,20.0\n0.001,0.001,2.0,21.5\n";
+    let t = parse_bench_csv(c, "c.csv", "c").unwrap();
+    assert_eq!(t.oil_temperature_k, Some(vec![293.15, 294.65]));
+    let k = "time_s,stroke_m,oil_temperature_K\n0.0,0.0,300.0\n0.001,0.001,301.0\n";
+    let t = parse_bench_csv_with_dropouts(k, "k.csv", "k").unwrap();
+    assert_eq!(t.oil_temperature_k, Some(vec![300.0, 301.0]));
+    assert_eq!(
+        parse_bench_csv("time_s,stroke_m\n0,0\n1,1\n", "n.csv", "n")
+            .unwrap()
+            .oil_temperature_k,
+        None
+    );
+    for (text, want) in [
+        (
+            "time_s,stroke_m,oil_temperature_K\n0.0,0.0,300.0\n0.001,0.001,-3.0\n",
+            "line 3",
+        ),
+        (
+            "time_s,stroke_m,oil_temperature_F\n0.0,0.0,70.0\n0.001,0.001,71.0\n",
+            "oil_temperature_C",
+        ),
+        (
+            "time_s,stroke_m,oil_temperature_K\n0.0,0.0,300.0\n0.001,0.001,\n",
+            "line 3",
+        ),
+    ] {
+        let e = parse_bench_csv_with_dropouts(text, "bad.csv", "b")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.csv") && e.contains(want), "{e}");
+    }
+}

@@ -428,6 +428,7 @@ mod tests {
             force_n: y,
             velocity_m_s: vec![0.0; n],
             period_s: 2.0 * std::f64::consts::PI / 27.0,
+            oil_temperature_k: None,
         };
         (vec![m], vec![model])
     }

@@ -25,6 +25,9 @@ pub enum Cause {
     Recalibration,
     /// Free play behind a contact stiffness (gap and stiffness fitted together).
     CompliantFreePlay,
+    /// The oil's temperature, changing from test to test: density and bulk modulus move with
+    /// it (needs each test's temperature).
+    OilTemperature,
 }
 
 /// One fitted parameter: name (with unit), bounds, starting values (multi-start).
@@ -41,10 +44,12 @@ pub struct ParamSpec {
 pub struct Scales {
     pub peak_force_n: f64,
     pub min_amplitude_m: f64,
+    /// Spread of the tests' oil temperatures [K] (0 when a test has none).
+    pub oil_span_k: f64,
 }
 
 impl Cause {
-    pub const CANDIDATES: [Cause; 11] = [
+    pub const CANDIDATES: [Cause; 12] = [
         Cause::SealFriction,
         Cause::FreePlay,
         Cause::CompliantFreePlay,
@@ -56,6 +61,7 @@ impl Cause {
         Cause::AccumulatorBleed,
         Cause::MountCompliance,
         Cause::Recalibration,
+        Cause::OilTemperature,
     ];
 
     pub fn name(self) -> &'static str {
@@ -72,6 +78,7 @@ impl Cause {
             Cause::EntrainedAirByChamber => "entrained_air_by_chamber",
             Cause::Recalibration => "recalibration",
             Cause::CompliantFreePlay => "compliant_free_play",
+            Cause::OilTemperature => "oil_temperature",
         }
     }
 
@@ -142,6 +149,23 @@ impl Cause {
                 1e-8,
                 vec![1e-12, 1e-11],
             )],
+            // With the tests at different temperatures (the base deck then has the law's
+            // reference: the data sheet's, else the tests' median). Mineral oils: c_rho ~7e-4,
+            // c_B ~5e-3 per K.
+            Cause::OilTemperature => {
+                if base.oil.is_none() || s.oil_span_k < 0.5 {
+                    return None;
+                }
+                vec![
+                    p("density_thermal_coefficient_per_K", 1e-6, 5e-3, vec![7e-4]),
+                    p(
+                        "bulk_modulus_thermal_coefficient_per_K",
+                        1e-6,
+                        3e-2,
+                        vec![5e-3],
+                    ),
+                ]
+            }
             Cause::Recalibration => {
                 let a = c.orifice?.area;
                 let mut v = vec![p("A_orf_m2", 0.2 * a, 5.0 * a, vec![a])];
@@ -210,6 +234,12 @@ impl Cause {
             }
             Cause::AccumulatorBleed => c.ext.bleed = Some(Leakage { conductance: x[0] }),
             Cause::MountCompliance => d.extensions.mount_stiffness_n_per_m = Some(x[0]),
+            Cause::OilTemperature => {
+                if let Some(o) = d.oil.as_mut() {
+                    o.density_per_k = x[0];
+                    o.bulk_modulus_per_k = x[1];
+                }
+            }
             Cause::Recalibration => {
                 if let Some(o) = c.orifice.as_mut() {
                     o.area = x[0];

@@ -19,6 +19,9 @@ pub struct Measurement {
     pub velocity_m_s: Vec<f64>,
     /// Stroking period [s] (estimated or known).
     pub period_s: f64,
+    /// The test's oil temperature [K] (the mean of its column; None without one): a test lasts
+    /// seconds, the oil warms over minutes.
+    pub oil_temperature_k: Option<f64>,
 }
 
 impl Measurement {
@@ -49,6 +52,10 @@ impl Measurement {
             force_n: force,
             velocity_m_s: vel,
             period_s: period,
+            oil_temperature_k: t
+                .oil_temperature_k
+                .as_ref()
+                .map(|v| v.iter().sum::<f64>() / v.len() as f64),
         })
     }
 

@@ -244,6 +244,11 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             "bleed of each chamber to the accumulator, {:.3e} m^3/(s Pa): the mean chamber pressure returns toward p_s instead of being pumped up by the check valves, so the oil is soft and the force dwells near zero at reversals",
             p("accumulator_bleed_m3_per_s_Pa")
         ),
+        "oil_temperature" => format!(
+            "the oil's temperature, which differs from test to test: density {:.2e} /K and bulk modulus {:.2e} /K lower per kelvin (exponential laws), so a warmer test's orifice force is lower by the density's share; the damper is not at fault for this part",
+            p("density_thermal_coefficient_per_K"),
+            p("bulk_modulus_thermal_coefficient_per_K")
+        ),
         "recalibration" => format!(
             "re-calibrated coefficients: A_orf = {:.4e} m^2, relief-valve a = {:.4e} m",
             p("A_orf_m2"),

@@ -6,7 +6,7 @@ use super::candidates::{apply_all, combined_name, combined_params, Cause, ParamS
 use super::data::{check_measurements, noise_sigma, Measurement};
 use super::DiagnoseError;
 use crate::hydraulics::{
-    DamperDeck, DamperModel, Device, HydraulicError, IntegratorOptions, Scheme,
+    DamperDeck, DamperModel, Device, HydraulicError, IntegratorOptions, OilTemperature, Scheme,
 };
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DVector, Dyn, Owned};
@@ -178,6 +178,32 @@ pub struct Outcome {
     pub curves: Vec<Curves>,
 }
 
+/// Median of the tests' oil temperatures [K] when every test has one.
+fn oil_reference_k(data: &[Measurement]) -> Option<f64> {
+    let mut t: Vec<f64> = data
+        .iter()
+        .map(|m| m.oil_temperature_k)
+        .collect::<Option<_>>()?;
+    if t.is_empty() {
+        return None;
+    }
+    t.sort_by(f64::total_cmp);
+    Some(0.5 * (t[(t.len() - 1) / 2] + t[t.len() / 2]))
+}
+
+/// Spread (max - min) of the tests' oil temperatures [K]; 0 unless every test has one.
+fn oil_span_k(data: &[Measurement]) -> f64 {
+    let t: Option<Vec<f64>> = data.iter().map(|m| m.oil_temperature_k).collect();
+    t.map_or(0.0, |t| {
+        let (lo, hi) = t
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        (hi - lo).max(0.0)
+    })
+}
+
 /// Device of a deck for a test's sample interval (RK4, sub-steps from `max_h`).
 fn device(deck: &DamperDeck, dt: f64, max_h: f64) -> Result<Box<dyn Device>, HydraulicError> {
     let substeps = ((dt / max_h).ceil() as usize).max(1);
@@ -247,6 +273,20 @@ pub fn simulate_split(
     split: usize,
     out: &mut Vec<f64>,
 ) -> Result<(), HydraulicError> {
+    // The deck at the test's oil temperature, where both are known.
+    let moved;
+    let deck = match (deck.oil, m.oil_temperature_k) {
+        (Some(_), Some(t_k)) => {
+            moved = deck
+                .at_oil_temperature(t_k)
+                .map_err(|e| HydraulicError::BadStep {
+                    t: 0.0,
+                    reason: e.to_string(),
+                })?;
+            &moved
+        }
+        _ => deck,
+    };
     let n = n.min(m.time_s.len());
     let dt = (m.time_s[n - 1] - m.time_s[0]) / (n - 1).max(1) as f64;
     let split = split.max(1);
@@ -987,6 +1027,25 @@ pub fn diagnose(
     if base.physical.is_none() {
         return Err(DiagnoseError::NoPhysical);
     }
+    // Every test with its oil temperature and a deck without the oil's law: the data sheet is
+    // taken to hold at the tests' median temperature (a law with no coefficients moves
+    // nothing, bit for bit; the `oil_temperature` candidate fits them).
+    let with_oil;
+    let base = match oil_reference_k(data) {
+        Some(t) if base.oil.is_none() => {
+            with_oil = DamperDeck {
+                oil: Some(OilTemperature {
+                    temperature_k: t,
+                    density_per_k: 0.0,
+                    bulk_modulus_per_k: 0.0,
+                    viscosity_per_k: 0.0,
+                }),
+                ..base.clone()
+            };
+            &with_oil
+        }
+        _ => base,
+    };
     // Dropouts and clipping: the force there is not compared, the stroke bridged (`screen`).
     let (screened_data, screened) = super::data::screen(data)?;
     let data = &screened_data[..];
@@ -1074,6 +1133,7 @@ pub fn diagnose(
             .iter()
             .map(Measurement::amplitude_m)
             .fold(f64::INFINITY, f64::min),
+        oil_span_k: oil_span_k(data),
     };
     let scale = peak.max(1.0);
     let n_fit = measured_samples(&fit_w, data);
@@ -2316,6 +2376,7 @@ mod tests {
                 velocity_m_s: time_s.iter().map(|t| amp_m * w * (w * t).cos()).collect(),
                 force_n: vec![0.0; n],
                 period_s: 1.0 / f_hz,
+                oil_temperature_k: None,
                 time_s,
             };
             let mut straight = Vec::new();
@@ -2365,6 +2426,7 @@ mod tests {
             force_n: d.iter().map(|x| 3.0 * sigma * x / nd).collect(),
             velocity_m_s: vec![0.0; 4],
             period_s: 1.0,
+            oil_temperature_k: None,
         };
         let z = held_out_z(&w, &single, &pair, &[m], sigma);
         assert!((z - 3.0).abs() < 1e-12, "{z}");

@@ -112,6 +112,7 @@ impl Conditions {
             stroke_m,
             velocity_m_s,
             period_s: period,
+            oil_temperature_k: None,
         }
     }
 }

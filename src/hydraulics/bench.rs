@@ -284,16 +284,32 @@ pub struct BenchTest {
     pub stroke_m: Vec<f64>,
     pub force_n: Option<Vec<f64>>,
     pub velocity_m_s: Option<Vec<f64>>,
+    /// Oil temperature [K] (optional column).
+    pub oil_temperature_k: Option<Vec<f64>>,
 }
 
-/// (quantity, accepted headers with their factor to SI)
-const QUANTITIES: &[(&str, &[(&str, f64)])] = &[
-    ("time", &[("time_s", 1.0), ("time_ms", 1e-3)]),
-    ("stroke", &[("stroke_m", 1.0), ("stroke_in", IN_TO_M)]),
-    ("force", &[("force_N", 1.0), ("force_lb", LB_TO_N)]),
+/// (quantity, accepted headers with their factor and offset to SI: `si = x factor + offset`)
+#[allow(clippy::type_complexity)]
+const QUANTITIES: &[(&str, &[(&str, f64, f64)])] = &[
+    ("time", &[("time_s", 1.0, 0.0), ("time_ms", 1e-3, 0.0)]),
+    (
+        "stroke",
+        &[("stroke_m", 1.0, 0.0), ("stroke_in", IN_TO_M, 0.0)],
+    ),
+    (
+        "force",
+        &[("force_N", 1.0, 0.0), ("force_lb", LB_TO_N, 0.0)],
+    ),
     (
         "velocity",
-        &[("velocity_m_s", 1.0), ("velocity_in_s", IN_TO_M)],
+        &[("velocity_m_s", 1.0, 0.0), ("velocity_in_s", IN_TO_M, 0.0)],
+    ),
+    (
+        "oil_temperature",
+        &[
+            ("oil_temperature_K", 1.0, 0.0),
+            ("oil_temperature_C", 1.0, 273.15),
+        ],
     ),
 ];
 
@@ -352,7 +368,7 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
         .collect();
     let joined = header.join(",");
     // Column index and SI factor per quantity.
-    let mut cols: [Option<(usize, f64)>; 4] = [None; 4];
+    let mut cols: [Option<(usize, f64, f64)>; 5] = [None; 5];
     for (ci, h) in header.iter().enumerate() {
         let Some(qi) = QUANTITIES
             .iter()
@@ -361,7 +377,7 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
             continue; // other columns are allowed and ignored
         };
         let (q, alts) = QUANTITIES[qi];
-        let Some(&(_, factor)) = alts.iter().find(|(n, _)| n == h) else {
+        let Some(&(_, factor, offset)) = alts.iter().find(|(n, _, _)| n == h) else {
             return Err(BenchCsvError::UnknownUnit {
                 file: file.into(),
                 column: h.clone(),
@@ -374,7 +390,7 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
                 message: format!("two columns give the {q} (`{h}` and another)"),
             });
         }
-        cols[qi] = Some((ci, factor));
+        cols[qi] = Some((ci, factor, offset));
     }
     for qi in 0..2 {
         if cols[qi].is_none() {
@@ -385,7 +401,7 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
             });
         }
     }
-    let mut data: [Vec<f64>; 4] = Default::default();
+    let mut data: [Vec<f64>; 5] = Default::default();
     for (ri, rec) in rdr.records().enumerate() {
         let line = ri + 2;
         let rec = rec.map_err(|e| BenchCsvError::Line {
@@ -393,12 +409,16 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
             line,
             message: e.to_string(),
         })?;
-        for qi in 0..4 {
-            let Some((ci, factor)) = cols[qi] else {
+        for qi in 0..5 {
+            let Some((ci, factor, offset)) = cols[qi] else {
                 continue;
             };
             let cell = rec.get(ci).unwrap_or("");
-            if dropouts && qi != 0 && (cell.is_empty() || cell.eq_ignore_ascii_case("nan")) {
+            // A temperature is read once per test (its mean): no dropouts of its own.
+            if dropouts
+                && (1..4).contains(&qi)
+                && (cell.is_empty() || cell.eq_ignore_ascii_case("nan"))
+            {
                 data[qi].push(f64::NAN);
                 continue;
             }
@@ -414,7 +434,7 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
                     message: format!("`{}` = {cell} is not finite", header[ci]),
                 });
             }
-            data[qi].push(x * factor);
+            data[qi].push(x * factor + offset);
         }
         let t = &data[0];
         if t.len() >= 2 && t[t.len() - 1] <= t[t.len() - 2] {
@@ -435,13 +455,21 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
             message: "need at least two samples".into(),
         });
     }
-    let [time_s, stroke_m, force, vel] = data;
+    let [time_s, stroke_m, force, vel, temp] = data;
+    if let Some(k) = temp.iter().position(|t| *t <= 0.0) {
+        return Err(BenchCsvError::Line {
+            file: file.into(),
+            line: k + 2,
+            message: format!("oil temperature {} K is not above absolute zero", temp[k]),
+        });
+    }
     Ok(BenchTest {
         name: name.into(),
         time_s,
         stroke_m,
         force_n: cols[2].map(|_| force),
         velocity_m_s: cols[3].map(|_| vel),
+        oil_temperature_k: cols[4].map(|_| temp),
     })
 }
 
@@ -487,6 +515,7 @@ impl BenchTest {
             stroke_m,
             force_n: None,
             velocity_m_s: None,
+            oil_temperature_k: None,
         })
     }
 }

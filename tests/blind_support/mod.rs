@@ -756,6 +756,7 @@ pub fn bench_campaign(
             force_n,
             velocity_m_s,
             period_s: period,
+            oil_temperature_k: None,
         });
     }
     add_noise(&mut out, cp.seed);
@@ -818,6 +819,7 @@ pub fn write_flight_record(cp: &Campaign, stem: &Path) -> Result<(), String> {
         force_n: std::mem::take(&mut f),
         velocity_m_s: vec![],
         period_s: period,
+        oil_temperature_k: None,
     }];
     add_noise(&mut one, cp.seed);
     let f = std::mem::take(&mut one[0].force_n);

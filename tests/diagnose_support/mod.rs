@@ -123,6 +123,9 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
             let a = c.orifice.unwrap().area * lerp(0.7, 1.4);
             ("A_orf_m2", a, 0.1, vec![a, c.relief[0].unwrap().a])
         }
+        // A condition of the campaign, not of the deck: tests/diagnose_hidden_effect.rs builds
+        // its campaign with temperatures.
+        Cause::OilTemperature => unreachable!("the oil's temperature is not drawn"),
     };
     let deck = cause.apply(&base, &x);
     Hidden {
@@ -185,6 +188,7 @@ pub fn campaign(
                 force_n: vec![],
                 velocity_m_s,
                 period_s: period,
+                oil_temperature_k: None,
             }
         })
         .collect();
