@@ -30,6 +30,7 @@ fn bench(c: &mut Criterion) {
             .find(|c| c.id == id)
             .expect("campaign");
         let data = blind::bench_campaign(&cp, 4, 2000.0).expect("campaign data");
+        let base = cp.base_deck(&base);
         g.bench_function(id, |b| {
             b.iter(|| {
                 let o = diagnose(black_box(&base), black_box(&data), &opts).unwrap();

@@ -84,7 +84,7 @@ fn main() -> anyhow::Result<()> {
         } else {
             blind::bench_campaign(&cp, cycles, rate).map_err(anyhow::Error::msg)?
         };
-        let o = diagnose(&base, &data, &DiagnoseOptions::default())?;
+        let o = diagnose(&cp.base_deck(&base), &data, &DiagnoseOptions::default())?;
         if let Some(dir) = std::env::var_os("BLIND_JSON_DIR") {
             // Every diagnosis in full, for study (optional).
             std::fs::create_dir_all(&dir)?;

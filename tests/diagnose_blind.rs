@@ -101,6 +101,35 @@ fn truth_orifice_gives_the_incompressible_law_at_low_frequency() {
     }
 }
 
+/// The truth's oil at 80 C: the same incompressible orifice law with the density's linear
+/// law, `rho (1 - a dT)`, and the sealed chamber's modulus `(1 - b dT)` times the sheet's.
+#[test]
+fn truth_oil_temperature_moves_density_and_bulk_modulus_linearly() {
+    use blind_support::truth::{OIL_BULK_PER_K, OIL_DENSITY_PER_K, OIL_REFERENCE_K};
+    let sheet = Sheet::nominal();
+    let hot = sheet.at_oil_temperature(OIL_REFERENCE_K + 60.0);
+    assert!((hot.rho / sheet.rho - (1.0 - 60.0 * OIL_DENSITY_PER_K)).abs() < 1e-15);
+    // Zero-pressure modulus 1/alpha.
+    let b = |s: &Sheet| 1.0 / s.alpha;
+    assert!((b(&hot) / b(&sheet) - (1.0 - 60.0 * OIL_BULK_PER_K)).abs() < 1e-15);
+    let mut s = hot.clone();
+    for r in &mut s.relief {
+        r.f_p = 1e9;
+    }
+    let t = Truth::new(s.clone());
+    let (w, amp) = (5.0, 0.01);
+    let stroke = Stroke::harmonic(w, amp);
+    let times = [1.5 * stroke.period()];
+    let f = force_at(&t, &stroke, &times, Tolerance::default()).unwrap();
+    let q = s.area[0] * w * amp;
+    let expect = s.area[0] * 0.5 * s.rho * (q / (s.cd * s.a_orf)).powi(2);
+    assert!(
+        (f[0] - expect).abs() < 5e-3 * expect,
+        "{} N vs {expect} N",
+        f[0]
+    );
+}
+
 #[test]
 fn truth_leakage_of_a_sealed_pair_decays_exponentially() {
     let s = sealed(Sheet::nominal());
@@ -246,7 +275,12 @@ fn run_campaign(cp: &Campaign, cycles: usize, rate: f64) -> Score {
     } else {
         bench_campaign(cp, cycles, rate).unwrap()
     };
-    let o = diagnose(&nominal_deck(), &data, &DiagnoseOptions::default()).unwrap();
+    let o = diagnose(
+        &cp.base_deck(&nominal_deck()),
+        &data,
+        &DiagnoseOptions::default(),
+    )
+    .unwrap();
     let best = (!cp.effects.is_empty()).then(|| effect_size(cp, cycles, rate).unwrap().2);
     score(cp, &o.diagnosis, best)
 }
@@ -554,8 +588,14 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
     let faults = |c: &Campaign| c.effects.iter().filter(|e| e.is_fault()).count();
     let physical = |c: &Campaign| c.effects.iter().filter(|e| !e.is_fault()).count();
     // The campaigns before them are the 67 of the suite before the faults, fault-free.
-    assert_eq!(all.len(), 89);
+    assert_eq!(all.len(), 91);
     assert!(all[..67].iter().all(|c| faults(c) == 0));
+    // The oil campaigns come last, fault-free, each recording its tests' temperatures.
+    for (i, c) in all[89..].iter().enumerate() {
+        assert_eq!(c.id, format!("oil_{i}"));
+        assert_eq!(faults(c), 0);
+        assert!(c.oil_temperature_k(7, 8).unwrap() > c.oil_temperature_k(0, 8).unwrap());
+    }
     assert_eq!(all[66].id, "flight_4");
     let alone: Vec<&Campaign> = all.iter().filter(|c| c.id.starts_with("acq_")).collect();
     assert_eq!(alone.len(), 12);

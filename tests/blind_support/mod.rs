@@ -6,6 +6,7 @@
 pub mod truth;
 
 use rotorsim::diagnose::{Diagnosis, Measurement};
+use rotorsim::hydraulics::{DamperDeck, OilTemperature};
 use std::f64::consts::PI;
 use std::path::Path;
 use truth::{force_at, Friction, Leak, Link, Sheet, Stroke, Tolerance, Truth};
@@ -94,6 +95,9 @@ pub enum Effect {
     /// Acquisition fault: this fraction of the rows is lost (stroke, velocity and force NaN),
     /// in bursts of 1-3 samples.
     ForceDropouts(f64),
+    /// The oil warms from 20 C by this many kelvin over the campaign, evenly from its first test
+    /// to its last, each test recording its temperature (a condition, not a fault).
+    OilWarming(f64),
 }
 
 impl Effect {
@@ -117,6 +121,7 @@ impl Effect {
             Effect::ForceDrift(_) => "force_drift",
             Effect::ForceClip(_) => "force_clipping",
             Effect::ForceDropouts(_) => "force_dropouts",
+            Effect::OilWarming(_) => "oil_temperature",
         }
     }
 
@@ -155,6 +160,7 @@ impl Effect {
                 Effect::ForceDrift(_) => &"force_drift",
                 Effect::ForceClip(_) => &"force_clipping",
                 Effect::ForceDropouts(_) => &"force_dropouts",
+                Effect::OilWarming(_) => &"oil_temperature",
                 Effect::FreePlay(_) => unreachable!(),
             }),
         }
@@ -198,6 +204,7 @@ impl Effect {
             Effect::ForceDrift(d) => format!("force drift {d:.0} N/s"),
             Effect::ForceClip(r) => format!("force clipped at {:.0}% of the peak", r * 100.0),
             Effect::ForceDropouts(r) => format!("{:.2}% of the rows dropped", r * 100.0),
+            Effect::OilWarming(dt) => format!("oil 20 to {:.0} C", 20.0 + dt),
         }
     }
 
@@ -234,6 +241,16 @@ impl Effect {
             Effect::ForceOffset(o) => vec![("offset_N", Some(o))],
             Effect::ForceGain(g) => vec![("gain", Some(g))],
             Effect::ForceDrift(d) => vec![("drift_N_per_s", Some(d))],
+            Effect::OilWarming(_) => vec![
+                (
+                    "density_thermal_coefficient_per_K",
+                    Some(truth::OIL_DENSITY_PER_K),
+                ),
+                (
+                    "bulk_modulus_thermal_coefficient_per_K",
+                    Some(truth::OIL_BULK_PER_K),
+                ),
+            ],
             // Read from the data, not fitted: not scored for interval coverage.
             Effect::ForceClip(_) | Effect::ForceDropouts(_) => vec![],
         }
@@ -265,6 +282,8 @@ impl Effect {
             | Effect::ForceDrift(_)
             | Effect::ForceClip(_)
             | Effect::ForceDropouts(_) => {}
+            // test by test: [`Campaign::truth_for_test`]
+            Effect::OilWarming(_) => {}
         }
     }
 }
@@ -413,6 +432,37 @@ impl Campaign {
         }
         t
     }
+    /// Oil temperature of test `i` of `n` [K] (None: the campaign does not record it).
+    pub fn oil_temperature_k(&self, i: usize, n: usize) -> Option<f64> {
+        self.effects.iter().find_map(|e| match *e {
+            Effect::OilWarming(dt) => {
+                Some(truth::OIL_REFERENCE_K + dt * i as f64 / (n.max(2) - 1) as f64)
+            }
+            _ => None,
+        })
+    }
+    /// The truth of test `i` of `n` (its oil at its temperature).
+    pub fn truth_for_test(&self, i: usize, n: usize) -> Truth {
+        let mut t = self.truth();
+        if let Some(k) = self.oil_temperature_k(i, n) {
+            t.sheet = t.sheet.at_oil_temperature(k);
+        }
+        t
+    }
+    /// The deck the diagnosis starts from: the nominal one, stating the temperature at which
+    /// its values hold where the campaign records temperatures.
+    pub fn base_deck(&self, nominal: &DamperDeck) -> DamperDeck {
+        let mut d = nominal.clone();
+        if self.oil_temperature_k(0, 2).is_some() {
+            d.oil = Some(OilTemperature {
+                temperature_k: truth::OIL_REFERENCE_K,
+                density_per_k: 0.0,
+                bulk_modulus_per_k: 0.0,
+                viscosity_per_k: 0.0,
+            });
+        }
+        d
+    }
     /// The campaign's acquisition faults.
     pub fn acquisition(&self) -> Acquisition {
         Acquisition::of(&self.effects)
@@ -439,11 +489,11 @@ fn c(id: &str, effects: Vec<Effect>, seed: u64) -> Campaign {
     }
 }
 
-/// The full blind suite, 89 campaigns: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid
+/// The full blind suite, 91 campaigns: 11 effects at 3-4 magnitudes (free play over a 3 x 3 grid
 /// of gap and contact stiffness), 7 pairs, 6 no-effect campaigns, 5 flight records; then the
 /// acquisition faults (force lag, offset, gain, drift): each alone at 2 magnitudes, 7 beside a
 /// physical effect, 1 flight record with a lag; then clipping and dropouts, each alone at 2
-/// magnitudes and once beside a physical effect. Seeds are arbitrary 64-bit numbers, magnitudes
+/// magnitudes and once beside a physical effect; then the oil warming at 2 magnitudes. Seeds are arbitrary 64-bit numbers, magnitudes
 /// hand-picked across realistic ranges, none equal to a starting value of the diagnosis' fits.
 pub fn suite() -> Vec<Campaign> {
     use Effect::*;
@@ -639,6 +689,12 @@ pub fn suite() -> Vec<Campaign> {
     for (i, p) in beside.into_iter().enumerate() {
         v.push(c(&format!("acqpair_{}", 7 + i), p, next()));
     }
+    // The oil warming over the campaign (each test records its temperature), appended after
+    // every earlier seed was drawn: by 60 K and by 45 K (its force +-2.2% and +-1.7% about the
+    // middle test's).
+    for (i, dt) in [60.0, 45.0].into_iter().enumerate() {
+        v.push(c(&format!("oil_{i}"), vec![OilWarming(dt)], next()));
+    }
     v
 }
 
@@ -737,10 +793,12 @@ pub fn bench_campaign(
     cycles: usize,
     rate_hz: f64,
 ) -> Result<Vec<Measurement>, String> {
-    let model = cp.truth();
     let acq = cp.acquisition();
     let mut out = Vec::new();
-    for (name, stroke, cyc) in bench_tests(cycles) {
+    let tests = bench_tests(cycles);
+    let n_tests = tests.len();
+    for (i, (name, stroke, cyc)) in tests.into_iter().enumerate() {
+        let model = cp.truth_for_test(i, n_tests);
         let period = stroke.period();
         let n = (cyc as f64 * period * rate_hz).round() as usize + 1;
         let time_s: Vec<f64> = (0..n).map(|k| k as f64 / rate_hz).collect();
@@ -756,7 +814,7 @@ pub fn bench_campaign(
             force_n,
             velocity_m_s,
             period_s: period,
-            oil_temperature_k: None,
+            oil_temperature_k: cp.oil_temperature_k(i, n_tests),
         });
     }
     add_noise(&mut out, cp.seed);
@@ -1171,7 +1229,6 @@ pub fn rates(rows: &[(Campaign, Score)]) -> String {
 /// beyond a clipping rail are left out, as the diagnosis leaves them out: a clipped force is
 /// not measured.
 pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f64, f64), String> {
-    let with = cp.truth();
     let acq = cp.acquisition();
     let without = Truth::new(Sheet::nominal());
     let mut tests = Vec::new();
@@ -1190,18 +1247,42 @@ pub fn effect_size(cp: &Campaign, cycles: usize, rate_hz: f64) -> Result<(f64, f
             tests.push((stroke, t, (period * rate_hz).round() as usize));
         }
     }
+    // The diagnosis validates on alternate tests in amplitude order (src/diagnose/fit.rs,
+    // `diagnose`): g* is measured on the same tests (a flight record: its cycles).
+    let held: Vec<bool> = if tests.len() >= 2 {
+        let amp = |(s, t, _): &(Stroke, Vec<f64>, usize)| {
+            let (lo, hi) = t
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    let d = s.at(x).0;
+                    (a.min(d), b.max(d))
+                });
+            0.5 * (hi - lo)
+        };
+        let mut order: Vec<usize> = (0..tests.len()).collect();
+        order.sort_by(|&a, &b| amp(&tests[a]).total_cmp(&amp(&tests[b])));
+        let mut h = vec![false; tests.len()];
+        for &i in order.iter().skip(1).step_by(2) {
+            h[i] = true;
+        }
+        h
+    } else {
+        vec![true; tests.len()]
+    };
     let mut forces = Vec::new();
     let mut peak = 0.0f64;
-    for (stroke, t, per_cycle) in &tests {
+    let n_tests = tests.len();
+    for (i, (stroke, t, per_cycle)) in tests.iter().enumerate() {
+        let with = cp.truth_for_test(i, n_tests);
         let a = acq.record(&with, stroke, t, Tolerance::default())?;
         let b = force_at(&without, stroke, t, Tolerance::default())?;
         peak = a.iter().fold(peak, |p, f| p.max(f.abs()));
-        forces.push((a, b, *per_cycle));
+        forces.push((a, b, *per_cycle, held[i]));
     }
     // Clipped samples are not measured: the effect is what the samples within range show.
     let rail = acq.rail(peak).unwrap_or(f64::INFINITY);
     let (mut ss, mut count) = (0.0, 0usize);
-    for (a, b, per_cycle) in &forces {
+    for (a, b, per_cycle, _) in forces.iter().filter(|f| f.3) {
         for (x, y) in a.iter().zip(b).skip(*per_cycle) {
             if x.abs() < rail {
                 ss += (x - y).powi(2);

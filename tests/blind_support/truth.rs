@@ -175,6 +175,28 @@ pub struct Leak {
     pub couette: f64,
 }
 
+/// The oil's temperature: the data sheet holds at 20 C; density and bulk modulus fall linearly
+/// with it (a mineral oil's expansion 7.5e-4/K; its modulus 0.45%/K).
+pub const OIL_REFERENCE_K: f64 = 293.15;
+pub const OIL_DENSITY_PER_K: f64 = 7.5e-4;
+pub const OIL_BULK_PER_K: f64 = 4.5e-3;
+
+impl Sheet {
+    /// The sheet with its oil at `t_k`: `rho (1 - a dT)`, and alpha, beta of Eq. (3) over
+    /// `(1 - b dT)` and its square, so the modulus is `(1 - b dT)` times the sheet's at the
+    /// correspondingly scaled pressure.
+    pub fn at_oil_temperature(&self, t_k: f64) -> Self {
+        let dt = t_k - OIL_REFERENCE_K;
+        let f = 1.0 - OIL_BULK_PER_K * dt;
+        Self {
+            rho: self.rho * (1.0 - OIL_DENSITY_PER_K * dt),
+            alpha: self.alpha / f,
+            beta: self.beta / (f * f),
+            ..self.clone()
+        }
+    }
+}
+
 /// Oil viscosity [Pa s] and seal land length [m] of the annular leakage.
 pub const LEAK_VISCOSITY_PA_S: f64 = 0.03;
 pub const LEAK_LAND_M: f64 = 0.025;
