@@ -311,7 +311,7 @@ fn clipping_and_dropouts_are_named_and_not_compared() {
 /// The oil warms from test to test (20 to 80 C over a campaign of six amplitudes, hottest
 /// last) with the density and bulk-modulus laws of a mineral oil; the diagnosis, given each
 /// test's temperature and the data sheet without a temperature law, names the oil's
-/// temperature and recovers the density coefficient (SYNTHETIC: this library's damper
+/// temperature and recovers the coefficients and the data sheet's temperature (SYNTHETIC: this library's damper
 /// generates the data; the blind suite's independent truth does not model temperature).
 #[test]
 fn a_warming_oil_is_named_with_its_density_coefficient() {
@@ -358,9 +358,11 @@ fn a_warming_oil_is_named_with_its_density_coefficient() {
         d.parameters, d.parameter_intervals, d.gain
     );
     assert!((got / c_rho - 1.0).abs() < 0.25, "c_rho {got} for {c_rho}");
+    // The deck states no temperature: the data sheet's is fitted beside the coefficients.
     for (k, truth) in [
         ("density_thermal_coefficient_per_K", c_rho),
         ("bulk_modulus_thermal_coefficient_per_K", c_b),
+        ("oil_reference_temperature_K", 0.5 * (temps[2] + temps[3])),
     ] {
         let iv = d.parameter_intervals[k];
         assert!(iv[0] <= truth && truth <= iv[1], "{k}: {iv:?} for {truth}");

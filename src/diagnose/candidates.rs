@@ -46,6 +46,8 @@ pub struct Scales {
     pub min_amplitude_m: f64,
     /// Spread of the tests' oil temperatures [K] (0 when a test has none).
     pub oil_span_k: f64,
+    /// The deck does not say at which temperature its values hold: the oil's candidate fits it.
+    pub oil_reference_unknown: bool,
 }
 
 impl Cause {
@@ -153,10 +155,11 @@ impl Cause {
             // reference: the data sheet's, else the tests' median). Mineral oils: c_rho ~7e-4,
             // c_B ~5e-3 per K.
             Cause::OilTemperature => {
-                if base.oil.is_none() || s.oil_span_k < 0.5 {
+                let law = base.oil?;
+                if s.oil_span_k < 0.5 {
                     return None;
                 }
-                vec![
+                let mut v = vec![
                     p("density_thermal_coefficient_per_K", 1e-6, 5e-3, vec![7e-4]),
                     p(
                         "bulk_modulus_thermal_coefficient_per_K",
@@ -164,7 +167,19 @@ impl Cause {
                         3e-2,
                         vec![5e-3],
                     ),
-                ]
+                ];
+                // The data sheet's temperature, unknown: within 60 K beyond the tests' range
+                // (the law's temperature is then the tests' median).
+                if s.oil_reference_unknown {
+                    let (t, w) = (law.temperature_k, 0.5 * s.oil_span_k + 60.0);
+                    v.push(p(
+                        "oil_reference_temperature_K",
+                        (t - w).max(1.0),
+                        t + w,
+                        vec![t],
+                    ));
+                }
+                v
             }
             Cause::Recalibration => {
                 let a = c.orifice?.area;
@@ -238,6 +253,10 @@ impl Cause {
                 if let Some(o) = d.oil.as_mut() {
                     o.density_per_k = x[0];
                     o.bulk_modulus_per_k = x[1];
+                    // the data sheet's values hold at the fitted temperature
+                    if let Some(&t) = x.get(2) {
+                        o.temperature_k = t;
+                    }
                 }
             }
             Cause::Recalibration => {

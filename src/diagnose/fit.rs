@@ -1031,6 +1031,7 @@ pub fn diagnose(
     // taken to hold at the tests' median temperature (a law with no coefficients moves
     // nothing, bit for bit; the `oil_temperature` candidate fits them).
     let with_oil;
+    let oil_reference_unknown = base.oil.is_none();
     let base = match oil_reference_k(data) {
         Some(t) if base.oil.is_none() => {
             with_oil = DamperDeck {
@@ -1134,6 +1135,7 @@ pub fn diagnose(
             .map(Measurement::amplitude_m)
             .fold(f64::INFINITY, f64::min),
         oil_span_k: oil_span_k(data),
+        oil_reference_unknown,
     };
     let scale = peak.max(1.0);
     let n_fit = measured_samples(&fit_w, data);
@@ -2050,6 +2052,7 @@ pub fn diagnose(
         &mut evidence,
         &mut limitations,
     );
+    let oil_is_cause = cause.contains("oil_temperature");
     let diagnosis = Diagnosis {
         gain: 1.0 - ext_held / base_held,
         cause,
@@ -2084,7 +2087,16 @@ pub fn diagnose(
     };
     Ok(Outcome {
         diagnosis,
-        extended: ext_deck,
+        // The law assumed for the oil (no coefficients, at the tests' median) is not the
+        // deck's unless the oil's temperature is the cause.
+        extended: if oil_reference_unknown && !oil_is_cause {
+            DamperDeck {
+                oil: None,
+                ..ext_deck
+            }
+        } else {
+            ext_deck
+        },
         curves,
     })
 }
