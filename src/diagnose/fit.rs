@@ -3,7 +3,7 @@
 //! choice of the cause.
 use super::acquisition::{self, Fault, Span};
 use super::candidates::{apply_all, combined_name, combined_params, Cause, ParamSpec, Scales};
-use super::data::{check_measurements, noise_sigma, Measurement};
+use super::data::{check_measurements, min_max, noise_sigma, Measurement};
 use super::DiagnoseError;
 use crate::hydraulics::{
     DamperDeck, DamperModel, Device, HydraulicError, IntegratorOptions, OilTemperature, Scheme,
@@ -195,11 +195,7 @@ fn oil_reference_k(data: &[Measurement]) -> Option<f64> {
 fn oil_span_k(data: &[Measurement]) -> f64 {
     let t: Option<Vec<f64>> = data.iter().map(|m| m.oil_temperature_k).collect();
     t.map_or(0.0, |t| {
-        let (lo, hi) = t
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            });
+        let (lo, hi) = min_max(&t);
         (hi - lo).max(0.0)
     })
 }

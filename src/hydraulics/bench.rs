@@ -456,11 +456,15 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
         });
     }
     let [time_s, stroke_m, force, vel, temp] = data;
-    if let Some(k) = temp.iter().position(|t| *t <= 0.0) {
+    let (lo, hi) = super::temperature::OIL_TEMPERATURE_RANGE_K;
+    if let Some(k) = temp.iter().position(|t| !(lo..=hi).contains(t)) {
         return Err(BenchCsvError::Line {
             file: file.into(),
             line: k + 2,
-            message: format!("oil temperature {} K is not above absolute zero", temp[k]),
+            message: format!(
+                "oil temperature {} K is outside {lo}-{hi} K (a column in C must say so: oil_temperature_C)",
+                temp[k]
+            ),
         });
     }
     Ok(BenchTest {

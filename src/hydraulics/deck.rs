@@ -10,7 +10,7 @@ use super::extensions::{
 use super::fluid::Fluid;
 use super::integrators::{IntegratorOptions, Scheme};
 use super::link::{LinkMass, LinkedCircuit};
-use super::temperature::OilTemperature;
+use super::temperature::{OilTemperature, OIL_COEFFICIENT_MAX_PER_K, OIL_TEMPERATURE_RANGE_K};
 use super::Device;
 use std::path::Path;
 use toml::{Table, Value};
@@ -548,16 +548,19 @@ impl DamperDeck {
     fn parse_oil(cx: &Ctx, t: &Table, c: &mut CircuitParams) -> Result<OilTemperature, DeckError> {
         let p = "damper.physical.oil";
         cx.known(t, p, OIL_KEYS)?;
-        let kelvin = "a positive absolute temperature in K";
-        let t_ref = cx.num_where(t, p, "reference_temperature_K", kelvin, positive)?;
+        let kelvin = "an absolute temperature in K, 150 to 600";
+        let oil_k = |x: f64| (OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&x);
+        let t_ref = cx.num_where(t, p, "reference_temperature_K", kelvin, oil_k)?;
         let t_run = if t.contains_key("temperature_K") {
-            cx.num_where(t, p, "temperature_K", kelvin, positive)?
+            cx.num_where(t, p, "temperature_K", kelvin, oil_k)?
         } else {
             t_ref
         };
         let coef = |k: &str| -> Result<f64, DeckError> {
             if t.contains_key(k) {
-                cx.num_where(t, p, k, "a non-negative coefficient in 1/K", non_negative)
+                cx.num_where(t, p, k, "a coefficient in 1/K, 0 to 0.1", |x| {
+                    (0.0..=OIL_COEFFICIENT_MAX_PER_K).contains(&x)
+                })
             } else {
                 Ok(0.0)
             }
@@ -573,6 +576,14 @@ impl DamperDeck {
 
     /// The deck with its oil at `t_k` [K] (the properties moved by `[damper.physical.oil]`).
     pub fn at_oil_temperature(&self, t_k: f64) -> Result<DamperDeck, DeckError> {
+        if !(OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&t_k) {
+            return Err(DeckError::BadValue {
+                file: self.source.clone(),
+                key: "damper.physical.oil.temperature_K".into(),
+                value: format!("{t_k}"),
+                expected: "an absolute temperature in K, 150 to 600".into(),
+            });
+        }
         let mut d = self.clone();
         match (d.physical.as_mut(), self.oil) {
             (Some(c), Some(law)) => {

@@ -223,14 +223,20 @@ impl AnnularLeakage {
 
     /// Radial clearance h [m] of a bore of area `bore_area` (D = 2 sqrt(A / pi)).
     pub fn clearance(&self, bore_area: f64) -> f64 {
-        let d = 2.0 * (bore_area / std::f64::consts::PI).sqrt();
-        (12.0 * self.viscosity_length * self.conductance / (std::f64::consts::PI * d)).cbrt()
+        self.bore_and_clearance(bore_area).1
     }
 
     /// Couette flow per unit piston velocity, `pi D h / 2` [m^2].
     pub fn drag_area(&self, bore_area: f64) -> f64 {
+        let (d, h) = self.bore_and_clearance(bore_area);
+        0.5 * std::f64::consts::PI * d * h
+    }
+
+    fn bore_and_clearance(&self, bore_area: f64) -> (f64, f64) {
         let d = 2.0 * (bore_area / std::f64::consts::PI).sqrt();
-        0.5 * std::f64::consts::PI * d * self.clearance(bore_area)
+        let h =
+            (12.0 * self.viscosity_length * self.conductance / (std::f64::consts::PI * d)).cbrt();
+        (d, h)
     }
 }
 

@@ -13,6 +13,11 @@
 //! rounding). The laminar transition of the flow laws (`dp_laminar_Pa`) is left as given.
 use super::circuit::CircuitParams;
 
+/// Oil temperatures that make sense [K]: from below any cold day to above any oil's flash point.
+pub const OIL_TEMPERATURE_RANGE_K: (f64, f64) = (150.0, 600.0);
+/// Largest temperature coefficient that makes sense [1/K] (a factor e per 10 K).
+pub const OIL_COEFFICIENT_MAX_PER_K: f64 = 0.1;
+
 /// The oil's temperature and its properties' temperature coefficients (`[damper.physical.oil]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OilTemperature {
