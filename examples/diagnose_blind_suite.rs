@@ -4,6 +4,9 @@
 //! `cargo run --release --example diagnose_blind_suite -- [OUT.csv] [CYCLES] [RATE_HZ] [ID_PREFIX...]`
 //! `cargo run --release --example diagnose_blind_suite -- --effect-size [ID_PREFIX...]` (effect
 //! vs noise only, of the campaigns whose id starts with a prefix; all without one)
+//! `cargo run --release --example diagnose_blind_suite -- --held-out ID [KEY=VALUE...]` (the
+//! held-out RMS of the nominal deck with these keys set, e.g.
+//! `damper.physical.extensions.free_play_m=8e-5`, on campaign ID's data: what a model reaches)
 //! (defaults docs/diagnosis_blind_suite.csv, 4 cycles per harmonic test, 2 kHz, all campaigns;
 //! with BLIND_JSON_DIR set, every diagnosis.json is written there as `<id>.json`).
 //! CSV columns: id, kind (bench/flight), hidden effect(s) (`+`-joined causes, acquisition faults
@@ -38,6 +41,9 @@ fn main() -> anyhow::Result<()> {
             println!("{},{},{r:.1},{s:.1},{g:.3}", cp.id, cp.hidden());
         }
         return Ok(());
+    }
+    if a.get(1).map(String::as_str) == Some("--held-out") {
+        return held_out(&a[2..]);
     }
     let out = PathBuf::from(
         a.get(1)
@@ -106,5 +112,64 @@ fn main() -> anyhow::Result<()> {
     }
     println!("{}", blind::rates(&rows));
     let _ = std::fs::remove_dir_all(&records);
+    Ok(())
+}
+
+/// Held-out RMS of the nominal deck, and of it with `KEY=VALUE` set, on a bench campaign's data
+/// (the diagnosis' own split and replay, no candidate fitted).
+fn held_out(a: &[String]) -> anyhow::Result<()> {
+    use rotorsim::diagnose::Measurement;
+    let id = a
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("--held-out ID [KEY=VALUE...]"))?;
+    let cp = blind::suite()
+        .into_iter()
+        .find(|c| &c.id == id && !c.flight)
+        .ok_or_else(|| anyhow::anyhow!("no bench campaign {id}"))?;
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/flightdata/damper_nominal.toml"
+    ));
+    let mut deck: toml::Table = std::fs::read_to_string(path)?.parse()?;
+    for kv in &a[1..] {
+        let (key, value) = kv
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("{kv}: expected KEY=VALUE"))?;
+        let value: f64 = value
+            .parse()
+            .map_err(|_| anyhow::anyhow!("{kv}: the value is not a number"))?;
+        let mut keys: Vec<&str> = key.split('.').collect();
+        let last = keys.pop().unwrap_or_default();
+        let mut t = &mut deck;
+        for k in keys {
+            t = t
+                .entry(k)
+                .or_insert_with(|| toml::Value::Table(Default::default()))
+                .as_table_mut()
+                .ok_or_else(|| anyhow::anyhow!("{key}: {k} is not a table"))?;
+        }
+        t.insert(last.into(), toml::Value::Float(value));
+    }
+    let set = DamperDeck::from_toml_str(&toml::to_string(&deck)?, "--held-out keys")?;
+    let nominal = DamperDeck::from_file(path)?;
+    let data: Vec<Measurement> =
+        blind::bench_campaign(&cp, 4, 2000.0).map_err(anyhow::Error::msg)?;
+    let opts = DiagnoseOptions {
+        candidates: vec![],
+        faults: vec![],
+        pairs: false,
+        ..Default::default()
+    };
+    let rms = |d: &DamperDeck| -> anyhow::Result<f64> {
+        Ok(diagnose(&cp.base_deck(d), &data, &opts)?
+            .diagnosis
+            .validation
+            .baseline_rms_N)
+    };
+    let (base, with) = (rms(&nominal)?, rms(&set)?);
+    println!(
+        "{id}: held-out RMS nominal {base:.2} N, with the keys {with:.2} N, gain {:.4}",
+        1.0 - with / base
+    );
     Ok(())
 }

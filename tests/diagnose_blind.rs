@@ -588,13 +588,15 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
     let faults = |c: &Campaign| c.effects.iter().filter(|e| e.is_fault()).count();
     let physical = |c: &Campaign| c.effects.iter().filter(|e| !e.is_fault()).count();
     // The campaigns before them are the 67 of the suite before the faults, fault-free.
-    assert_eq!(all.len(), 91);
+    assert_eq!(all.len(), 93);
     assert!(all[..67].iter().all(|c| faults(c) == 0));
-    // The oil campaigns come last, fault-free, each recording its tests' temperatures.
+    // The oil campaigns come last, fault-free, warming from test to test: the first two
+    // record their tests' temperatures, the last two do not.
     for (i, c) in all[89..].iter().enumerate() {
         assert_eq!(c.id, format!("oil_{i}"));
         assert_eq!(faults(c), 0);
         assert!(c.oil_temperature_k(7, 8).unwrap() > c.oil_temperature_k(0, 8).unwrap());
+        assert_eq!(c.recorded_oil_temperature_k(7, 8).is_some(), i < 2);
     }
     assert_eq!(all[66].id, "flight_4");
     let alone: Vec<&Campaign> = all.iter().filter(|c| c.id.starts_with("acq_")).collect();

@@ -385,3 +385,59 @@ fn a_warming_oil_is_named_with_its_density_coefficient() {
         .iter()
         .all(|c| !c.cause.contains("oil_temperature")));
 }
+
+/// The same warming with no temperature recorded: the tests, given in the order they were run
+/// (amplitude order here), carry the oil's drift, and the diagnosis names it with the fractions
+/// of density and bulk modulus lost from the first test to the last (SYNTHETIC: this library's
+/// damper generates the data, the data sheet holding at the first test's temperature).
+#[test]
+fn an_unrecorded_warming_is_named_as_a_drift_of_the_oil() {
+    let base = support::nominal_deck();
+    let (c_rho, c_b, warming) = (7.0e-4, 5.0e-3, 60.0);
+    let mut truth = base.clone();
+    truth.oil = Some(OilTemperature {
+        temperature_k: 293.15,
+        density_per_k: c_rho,
+        bulk_modulus_per_k: c_b,
+        viscosity_per_k: 0.0,
+    });
+    let v = [1.0, 2.0, 3.0, 4.0, 6.0, 8.0];
+    let mut data = support::campaign(&base, &v, 4, 1000.0, 0.0, 5);
+    let mut rng = support::Rng::new(43);
+    let mut peak: f64 = 0.0;
+    let n_tests = data.len();
+    for (i, m) in data.iter_mut().enumerate() {
+        m.oil_temperature_k = Some(293.15 + warming * i as f64 / (n_tests - 1) as f64);
+        let n = m.time_s.len();
+        let mut f = Vec::new();
+        simulate(&truth, m, n, 1.0e-5, &mut f).unwrap();
+        peak = peak.max(f.iter().fold(0.0f64, |a, x| a.max(x.abs())));
+        m.force_n = f;
+        m.oil_temperature_k = None;
+    }
+    for m in &mut data {
+        for f in &mut m.force_n {
+            *f += 0.01 * peak * rng.normal();
+        }
+    }
+    let o = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap();
+    let d = &o.diagnosis;
+    eprintln!(
+        "drift: {:?}, intervals {:?}, gain {:.3}",
+        d.parameters, d.parameter_intervals, d.gain
+    );
+    assert_eq!(d.cause, "oil_drift", "{:#?}", d.candidates);
+    // The library's laws are exponential: the fractions lost over the warming.
+    for (k, c) in [
+        ("oil_density_drop_fraction", c_rho),
+        ("oil_bulk_modulus_drop_fraction", c_b),
+    ] {
+        let truth = 1.0 - (-c * warming).exp();
+        let iv = d.parameter_intervals[k];
+        assert!(iv[0] <= truth && truth <= iv[1], "{k}: {iv:?} for {truth}");
+    }
+    assert!(d.evidence.iter().any(|e| e.starts_with("the oil warming")));
+    // The drift is the campaign's: the extended deck is the data sheet's, with no oil law.
+    assert_eq!(o.extended.oil, None);
+    assert_eq!(o.extended, base);
+}

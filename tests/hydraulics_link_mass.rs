@@ -341,6 +341,7 @@ fn every_candidate_builds_on_a_data_sheet_with_a_moving_mass() {
         min_amplitude_m: 2.0e-3,
         oil_span_k: 0.0,
         oil_reference_unknown: false,
+        oil_drift: true,
     };
     let opts = IntegratorOptions {
         scheme: Scheme::Rk4,

@@ -1,7 +1,7 @@
 //! The candidate model extensions: each a physical element of the hydraulic library (or a
 //! re-calibration of uncertain nominal coefficients), with its fitted parameters and bounds.
 use crate::hydraulics::{
-    AnnularLeakage, DamperDeck, EntrainedAir, FreePlay, Leakage, SealFriction,
+    AnnularLeakage, DamperDeck, EntrainedAir, FreePlay, Leakage, OilTemperature, SealFriction,
 };
 use std::borrow::Cow;
 
@@ -28,6 +28,20 @@ pub enum Cause {
     /// The oil's temperature, changing from test to test: density and bulk modulus move with
     /// it (needs each test's temperature).
     OilTemperature,
+    /// The oil warming over a campaign that records no temperature: density and bulk modulus
+    /// falling evenly (in log) with the tests' order.
+    OilDrift,
+}
+
+/// Temperature the drift's stand-in law starts from at the first test [K].
+pub const OIL_DRIFT_REFERENCE_K: f64 = 293.15;
+/// The stand-in law's temperature rise from the first test to the last [K]: the drift is
+/// fitted as a fraction over the campaign, carried by an oil law over this span.
+pub const OIL_DRIFT_SPAN_K: f64 = 100.0;
+
+/// Stand-in temperature [K] of test `i` of `n` in a campaign fitted as a drift of its oil.
+pub fn oil_drift_temperature_k(i: usize, n: usize) -> f64 {
+    OIL_DRIFT_REFERENCE_K + OIL_DRIFT_SPAN_K * i as f64 / (n.max(2) - 1) as f64
 }
 
 /// One fitted parameter: name (with unit), bounds, starting values (multi-start).
@@ -48,10 +62,13 @@ pub struct Scales {
     pub oil_span_k: f64,
     /// The deck does not say at which temperature its values hold: the oil's candidate fits it.
     pub oil_reference_unknown: bool,
+    /// No test records its oil temperature and there are at least three: the tests carry the
+    /// drift's stand-in temperatures (in the order given) and the oil may be fitted as a drift.
+    pub oil_drift: bool,
 }
 
 impl Cause {
-    pub const CANDIDATES: [Cause; 12] = [
+    pub const CANDIDATES: [Cause; 13] = [
         Cause::SealFriction,
         Cause::FreePlay,
         Cause::CompliantFreePlay,
@@ -64,6 +81,7 @@ impl Cause {
         Cause::MountCompliance,
         Cause::Recalibration,
         Cause::OilTemperature,
+        Cause::OilDrift,
     ];
 
     pub fn name(self) -> &'static str {
@@ -81,6 +99,7 @@ impl Cause {
             Cause::Recalibration => "recalibration",
             Cause::CompliantFreePlay => "compliant_free_play",
             Cause::OilTemperature => "oil_temperature",
+            Cause::OilDrift => "oil_drift",
         }
     }
 
@@ -181,6 +200,17 @@ impl Cause {
                 }
                 v
             }
+            // Fractions lost from the first test to the last (mineral oil warming by 60 K:
+            // density ~4%, bulk modulus ~25%).
+            Cause::OilDrift => {
+                if !s.oil_drift {
+                    return None;
+                }
+                vec![
+                    p("oil_density_drop_fraction", 1e-5, 0.3, vec![0.04]),
+                    p("oil_bulk_modulus_drop_fraction", 1e-5, 0.8, vec![0.25]),
+                ]
+            }
             Cause::Recalibration => {
                 let a = c.orifice?.area;
                 let mut v = vec![p("A_orf_m2", 0.2 * a, 5.0 * a, vec![a])];
@@ -258,6 +288,16 @@ impl Cause {
                         o.temperature_k = t;
                     }
                 }
+            }
+            // The law that takes the tests' stand-in temperatures to these fractions.
+            Cause::OilDrift => {
+                let per_k = |f: f64| -(1.0 - f).ln() / OIL_DRIFT_SPAN_K;
+                d.oil = Some(OilTemperature {
+                    temperature_k: OIL_DRIFT_REFERENCE_K,
+                    density_per_k: per_k(x[0]),
+                    bulk_modulus_per_k: per_k(x[1]),
+                    viscosity_per_k: 0.0,
+                });
             }
             Cause::Recalibration => {
                 if let Some(o) = c.orifice.as_mut() {

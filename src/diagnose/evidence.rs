@@ -249,6 +249,11 @@ fn cause_sentence(cause: &str, params: &BTreeMap<String, f64>) -> String {
             p("density_thermal_coefficient_per_K"),
             p("bulk_modulus_thermal_coefficient_per_K")
         ),
+        "oil_drift" => format!(
+            "the oil warming over the campaign, which records no temperature: density {:.1}% and bulk modulus {:.1}% lower at the last test than at the first (evenly with the tests' order, as given), so later tests' orifice force is lower by the density's share; the damper is not at fault for this part, and a temperature column would let the law per kelvin be fitted",
+            100.0 * p("oil_density_drop_fraction"),
+            100.0 * p("oil_bulk_modulus_drop_fraction")
+        ),
         "recalibration" => format!(
             "re-calibrated coefficients: A_orf = {:.4e} m^2, relief-valve a = {:.4e} m",
             p("A_orf_m2"),

@@ -1044,7 +1044,28 @@ pub fn diagnose(
         _ => base,
     };
     // Dropouts and clipping: the force there is not compared, the stroke bridged (`screen`).
-    let (screened_data, screened) = super::data::screen(data)?;
+    let (mut screened_data, screened) = super::data::screen(data)?;
+    let oil_span = oil_span_k(&screened_data);
+    // No test records its oil temperature: three tests or more carry stand-in temperatures
+    // rising with their order, read only by the `oil_drift` candidate's law (every other
+    // candidate's deck has none, so nothing moves).
+    let oil_drift =
+        screened_data.len() >= 3 && screened_data.iter().all(|m| m.oil_temperature_k.is_none());
+    let given_oil = base.oil;
+    let without_oil;
+    let base = if oil_drift {
+        let n = screened_data.len();
+        for (i, m) in screened_data.iter_mut().enumerate() {
+            m.oil_temperature_k = Some(super::candidates::oil_drift_temperature_k(i, n));
+        }
+        without_oil = DamperDeck {
+            oil: None,
+            ..base.clone()
+        };
+        &without_oil
+    } else {
+        base
+    };
     let data = &screened_data[..];
     let mut limitations = check_measurements(data)?;
     let one_amp = limitations
@@ -1130,8 +1151,9 @@ pub fn diagnose(
             .iter()
             .map(Measurement::amplitude_m)
             .fold(f64::INFINITY, f64::min),
-        oil_span_k: oil_span_k(data),
+        oil_span_k: oil_span,
         oil_reference_unknown,
+        oil_drift,
     };
     let scale = peak.max(1.0);
     let n_fit = measured_samples(&fit_w, data);
@@ -2085,7 +2107,13 @@ pub fn diagnose(
         diagnosis,
         // The law assumed for the oil (no coefficients, at the tests' median) is not the
         // deck's unless the oil's temperature is the cause.
-        extended: if oil_reference_unknown && !oil_is_cause {
+        // A drift is the campaign's, not the damper's: the deck keeps the oil it was given.
+        extended: if oil_drift {
+            DamperDeck {
+                oil: given_oil,
+                ..ext_deck
+            }
+        } else if oil_reference_unknown && !oil_is_cause {
             DamperDeck {
                 oil: None,
                 ..ext_deck

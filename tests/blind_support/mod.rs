@@ -98,6 +98,8 @@ pub enum Effect {
     /// The oil warms from 20 C by this many kelvin over the campaign, evenly from its first test
     /// to its last, each test recording its temperature (a condition, not a fault).
     OilWarming(f64),
+    /// The oil warms as in [`Effect::OilWarming`], but no test records its temperature.
+    OilWarmingUnrecorded(f64),
 }
 
 impl Effect {
@@ -122,6 +124,7 @@ impl Effect {
             Effect::ForceClip(_) => "force_clipping",
             Effect::ForceDropouts(_) => "force_dropouts",
             Effect::OilWarming(_) => "oil_temperature",
+            Effect::OilWarmingUnrecorded(_) => "oil_drift",
         }
     }
 
@@ -161,6 +164,7 @@ impl Effect {
                 Effect::ForceClip(_) => &"force_clipping",
                 Effect::ForceDropouts(_) => &"force_dropouts",
                 Effect::OilWarming(_) => &"oil_temperature",
+                Effect::OilWarmingUnrecorded(_) => &"oil_drift",
                 Effect::FreePlay(_) => unreachable!(),
             }),
         }
@@ -205,6 +209,9 @@ impl Effect {
             Effect::ForceClip(r) => format!("force clipped at {:.0}% of the peak", r * 100.0),
             Effect::ForceDropouts(r) => format!("{:.2}% of the rows dropped", r * 100.0),
             Effect::OilWarming(dt) => format!("oil 20 to {:.0} C", 20.0 + dt),
+            Effect::OilWarmingUnrecorded(dt) => {
+                format!("oil 20 to {:.0} C, not recorded", 20.0 + dt)
+            }
         }
     }
 
@@ -251,6 +258,17 @@ impl Effect {
                     Some(truth::OIL_BULK_PER_K),
                 ),
             ],
+            // The truth's laws are linear: the fractions lost from the first test to the last.
+            Effect::OilWarmingUnrecorded(dt) => vec![
+                (
+                    "oil_density_drop_fraction",
+                    Some(truth::OIL_DENSITY_PER_K * dt),
+                ),
+                (
+                    "oil_bulk_modulus_drop_fraction",
+                    Some(truth::OIL_BULK_PER_K * dt),
+                ),
+            ],
             // Read from the data, not fitted: not scored for interval coverage.
             Effect::ForceClip(_) | Effect::ForceDropouts(_) => vec![],
         }
@@ -283,7 +301,7 @@ impl Effect {
             | Effect::ForceClip(_)
             | Effect::ForceDropouts(_) => {}
             // test by test: [`Campaign::truth_for_test`]
-            Effect::OilWarming(_) => {}
+            Effect::OilWarming(_) | Effect::OilWarmingUnrecorded(_) => {}
         }
     }
 }
@@ -435,11 +453,19 @@ impl Campaign {
     /// Oil temperature of test `i` of `n` [K] (None: the campaign does not record it).
     pub fn oil_temperature_k(&self, i: usize, n: usize) -> Option<f64> {
         self.effects.iter().find_map(|e| match *e {
-            Effect::OilWarming(dt) => {
+            Effect::OilWarming(dt) | Effect::OilWarmingUnrecorded(dt) => {
                 Some(truth::OIL_REFERENCE_K + dt * i as f64 / (n.max(2) - 1) as f64)
             }
             _ => None,
         })
+    }
+    /// Oil temperature of test `i` of `n` as recorded with the test [K] (None: not recorded).
+    pub fn recorded_oil_temperature_k(&self, i: usize, n: usize) -> Option<f64> {
+        let recorded = self
+            .effects
+            .iter()
+            .any(|e| matches!(e, Effect::OilWarming(_)));
+        self.oil_temperature_k(i, n).filter(|_| recorded)
     }
     /// The truth of test `i` of `n` (its oil at its temperature).
     pub fn truth_for_test(&self, i: usize, n: usize) -> Truth {
@@ -453,7 +479,7 @@ impl Campaign {
     /// its values hold where the campaign records temperatures.
     pub fn base_deck(&self, nominal: &DamperDeck) -> DamperDeck {
         let mut d = nominal.clone();
-        if self.oil_temperature_k(0, 2).is_some() {
+        if self.recorded_oil_temperature_k(0, 2).is_some() {
             d.oil = Some(OilTemperature {
                 temperature_k: truth::OIL_REFERENCE_K,
                 density_per_k: 0.0,
@@ -695,6 +721,15 @@ pub fn suite() -> Vec<Campaign> {
     for (i, dt) in [60.0, 45.0].into_iter().enumerate() {
         v.push(c(&format!("oil_{i}"), vec![OilWarming(dt)], next()));
     }
+    // The same warming unrecorded (the diagnosis fits a drift with the tests' order), appended
+    // after every earlier seed was drawn: by 60 K and by 40 K.
+    for (i, dt) in [60.0, 40.0].into_iter().enumerate() {
+        v.push(c(
+            &format!("oil_{}", 2 + i),
+            vec![OilWarmingUnrecorded(dt)],
+            next(),
+        ));
+    }
     v
 }
 
@@ -814,7 +849,7 @@ pub fn bench_campaign(
             force_n,
             velocity_m_s,
             period_s: period,
-            oil_temperature_k: cp.oil_temperature_k(i, n_tests),
+            oil_temperature_k: cp.recorded_oil_temperature_k(i, n_tests),
         });
     }
     add_noise(&mut out, cp.seed);

@@ -125,7 +125,9 @@ pub fn hidden(cause: Cause, u: f64) -> Hidden {
         }
         // A condition of the campaign, not of the deck: tests/diagnose_hidden_effect.rs builds
         // its campaign with temperatures.
-        Cause::OilTemperature => unreachable!("the oil's temperature is not drawn"),
+        Cause::OilTemperature | Cause::OilDrift => {
+            unreachable!("the oil's temperature is not drawn")
+        }
     };
     let deck = cause.apply(&base, &x);
     Hidden {
