@@ -374,6 +374,7 @@ const CASES: &[Case] = &[
     case("record missing", &[], INSPECT, &["rec"]),
     case("record meta wrong type", record!("\"rotor_speed_rad_s\": 27.0", "\"rotor_speed_rad_s\": \"fast\""), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
     case("record meta negative speed", record!("\"rotor_speed_rad_s\": 27.0", "\"rotor_speed_rad_s\": -27.0"), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
+    case("record meta oil temperature in C", record!("\"rotor_speed_rad_s\": 27.0", "\"rotor_speed_rad_s\": 27.0, \"damper_oil_temperature_K\": 20.0"), INSPECT, &["rec.meta.json", "damper_oil_temperature_K", "150 to 600"]),
     case("record meta missing key", record!("\"rotor_speed_rad_s\": 27.0,", ""), INSPECT, &["rec.meta.json", "rotor_speed_rad_s"]),
     case("record meta not JSON", record!("\"counter\": \"8534-like\",", "\"counter\" \"8534-like\","), INSPECT, &["rec.meta.json", "line"]),
     case("record airloads wrong column", record!("normal_force_N_per_m", "normal_force_X"), INSPECT, &["rec.airloads.csv", "normal_force"]),

@@ -1068,6 +1068,12 @@ pub fn diagnose(
     };
     let data = &screened_data[..];
     let mut limitations = check_measurements(data)?;
+    let unused = oil_reference_unknown && !oil_drift && oil_span < 0.5;
+    if let (true, Some(t)) = (unused, oil_reference_k(data)) {
+        limitations.push(format!(
+            "the oil temperature recorded ({t:.1} K) moves nothing: the deck has no [damper.physical.oil] law, and a single temperature cannot fit one"
+        ));
+    }
     let one_amp = limitations
         .iter()
         .any(|l| l.starts_with("one stroke amplitude"));

@@ -137,7 +137,7 @@ pub fn flight_measurement(
         force_n: f,
         velocity_m_s: v,
         period_s: 360.0 / omega_deg,
-        oil_temperature_k: None,
+        oil_temperature_k: rec.meta.damper_oil_temperature_k,
     })
 }
 

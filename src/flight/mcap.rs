@@ -49,6 +49,7 @@ pub const META_SCHEMA_JSON: &str = r#"{
     "density_kg_m3": {"type": "number"},
     "speed_of_sound_m_s": {"type": "number"},
     "chord_m": {"type": "number"},
+    "damper_oil_temperature_K": {"type": "number"},
     "controls_deg": {
       "type": "object",
       "required": ["collective", "lateral_cyclic", "longitudinal_cyclic"],

@@ -31,6 +31,9 @@ pub struct FlightMeta {
     pub speed_of_sound_m_s: Option<f64>,
     /// Blade chord (extension key `chord_m`), needed to convert M^2 C airloads.
     pub chord_m: Option<f64>,
+    /// The damper's oil temperature during the record [K] (`damper_oil_temperature_K`): the
+    /// diagnosis replays the damper at it where the deck has an oil law.
+    pub damper_oil_temperature_k: Option<f64>,
     pub controls_deg: ControlsDeg,
     /// The whole metadata object as read, unknown keys included.
     pub raw: Map<String, Value>,
@@ -123,6 +126,21 @@ impl FlightMeta {
             density_kg_m3: num("density_kg_m3", false, true)?,
             speed_of_sound_m_s: num("speed_of_sound_m_s", false, true)?,
             chord_m: num("chord_m", false, true)?,
+            damper_oil_temperature_k: {
+                let key = "damper_oil_temperature_K";
+                let (lo, hi) = crate::hydraulics::temperature::OIL_TEMPERATURE_RANGE_K;
+                match num(key, false, true)? {
+                    Some(t) if !(lo..=hi).contains(&t) => {
+                        return Err(err(
+                            key,
+                            &format!(
+                                "expected an absolute temperature in K, {lo} to {hi}, found {t}"
+                            ),
+                        ))
+                    }
+                    t => t,
+                }
+            },
             controls_deg: controls,
             raw,
         })
@@ -166,6 +184,7 @@ impl FlightMeta {
         put_num("density_kg_m3", self.density_kg_m3);
         put_num("speed_of_sound_m_s", self.speed_of_sound_m_s);
         put_num("chord_m", self.chord_m);
+        put_num("damper_oil_temperature_K", self.damper_oil_temperature_k);
         m.insert("synthetic".into(), Value::Bool(self.synthetic));
         if let Some(c) = &self.counter {
             m.insert("counter".into(), Value::String(c.clone()));

@@ -1,0 +1,123 @@
+//! A flight record's damper oil temperature (meta `damper_oil_temperature_K`): read and written
+//! in both forms, refused out of sense, and the diagnosis replays the damper at it.
+use rotorsim::diagnose::fit::simulate;
+use rotorsim::diagnose::rotor::flight_measurement;
+use rotorsim::diagnose::{diagnose, DiagnoseOptions};
+use rotorsim::flight::{FlightMeta, FlightRecord};
+use rotorsim::hydraulics::{DamperDeck, OilTemperature};
+use std::path::Path;
+mod support;
+use support::{root, tmp};
+
+/// The shipped record with its meta given the oil temperature `t_k`.
+fn record_at(t_k: serde_json::Value) -> FlightRecord {
+    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    let mut raw = rec.meta.raw.clone();
+    raw.insert("damper_oil_temperature_K".into(), t_k);
+    let meta = FlightMeta::from_json(raw, Path::new("cold.meta.json")).unwrap();
+    FlightRecord::new(
+        meta,
+        rec.stations_r_over_r().to_vec(),
+        rec.revolutions().to_vec(),
+        rec.azimuths_deg().to_vec(),
+        rec.normal_n_per_m().to_vec(),
+        rec.chord_n_per_m().to_vec(),
+        rec.moment_n_m_per_m().to_vec(),
+        rec.damper().to_vec(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn the_oil_temperature_survives_csv_and_mcap() {
+    let rec = record_at(233.15.into());
+    assert_eq!(rec.meta.damper_oil_temperature_k, Some(233.15));
+    let dir = tmp("flight_oil_roundtrip");
+    rec.write_csv(&dir.join("cold")).unwrap();
+    rec.write_mcap(&dir.join("cold.mcap")).unwrap();
+    for p in [dir.join("cold"), dir.join("cold.mcap")] {
+        let back = FlightRecord::read(&p).unwrap();
+        assert_eq!(back.meta.damper_oil_temperature_k, Some(233.15), "{p:?}");
+    }
+}
+
+#[test]
+fn an_oil_temperature_out_of_sense_is_refused_by_key() {
+    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    for (v, why) in [
+        (serde_json::json!(-40.0), "positive"),
+        (serde_json::json!(40.0), "150 to 600"),
+        (serde_json::json!("cold"), "expected a number"),
+    ] {
+        let mut raw = rec.meta.raw.clone();
+        raw.insert("damper_oil_temperature_K".into(), v.clone());
+        let e = FlightMeta::from_json(raw, Path::new("x.meta.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x.meta.json") && e.contains("damper_oil_temperature_K") && e.contains(why),
+            "{v}: {e}"
+        );
+    }
+}
+
+#[test]
+fn the_diagnosis_replays_the_damper_at_the_record_s_oil_temperature() {
+    let mut deck = DamperDeck::from_file(&root().join("flightdata/damper_nominal.toml")).unwrap();
+    deck.oil = Some(OilTemperature {
+        temperature_k: 293.15,
+        density_per_k: 7.0e-4,
+        bulk_modulus_per_k: 5.0e-3,
+        viscosity_per_k: 0.0,
+    });
+    let path = Path::new("cold");
+    let m = flight_measurement(&record_at(233.15.into()), path, None).unwrap();
+    assert_eq!(m.oil_temperature_k, Some(233.15));
+    let n = m.time_s.len();
+    let mut at_record = Vec::new();
+    simulate(&deck, &m, n, 1.0e-5, &mut at_record).unwrap();
+    // The same as the deck moved to -40 C by hand, bit for bit.
+    let unmoved = rotorsim::diagnose::Measurement {
+        oil_temperature_k: None,
+        ..m.clone()
+    };
+    let mut cold = Vec::new();
+    simulate(
+        &deck.at_oil_temperature(233.15).unwrap(),
+        &unmoved,
+        n,
+        1.0e-5,
+        &mut cold,
+    )
+    .unwrap();
+    assert_eq!(at_record, cold);
+    // ...and not the deck at its reference: the cold oil is denser and stiffer.
+    let mut warm = Vec::new();
+    simulate(&deck, &unmoved, n, 1.0e-5, &mut warm).unwrap();
+    let rms = |f: &mut dyn Iterator<Item = f64>| {
+        let v: Vec<f64> = f.collect();
+        (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    let change =
+        rms(&mut cold.iter().zip(&warm).map(|(c, w)| c - w)) / rms(&mut warm.iter().copied());
+    assert!(
+        change > 0.01,
+        "the cold oil changes the force by {change} of its RMS"
+    );
+    // A deck without the law cannot use the temperature: the diagnosis says so.
+    let opts = DiagnoseOptions {
+        candidates: vec![],
+        faults: vec![],
+        pairs: false,
+        ..Default::default()
+    };
+    let bare = DamperDeck { oil: None, ..deck };
+    let d = diagnose(&bare, &[m], &opts).unwrap().diagnosis;
+    assert!(
+        d.limitations
+            .iter()
+            .any(|l| l.starts_with("the oil temperature recorded (233.2 K) moves nothing")),
+        "{:#?}",
+        d.limitations
+    );
+}
