@@ -440,4 +440,18 @@ fn an_unrecorded_warming_is_named_as_a_drift_of_the_oil() {
     // The drift is the campaign's: the extended deck is the data sheet's, with no oil law.
     assert_eq!(o.extended.oil, None);
     assert_eq!(o.extended, base);
+    // A deck with the oil's law (at the first test's temperature) reads the drift as a warming:
+    // the density's 95% interval, 3.9-4.7%, is 57-68 K by the law.
+    let o = diagnose(&truth, &data, &DiagnoseOptions::default()).unwrap();
+    assert_eq!(o.diagnosis.cause, "oil_drift");
+    let got: f64 = o
+        .diagnosis
+        .evidence
+        .iter()
+        .find_map(|e| e.split("the oil warming by ").nth(1))
+        .and_then(|t| t.split(' ').next())
+        .and_then(|k| k.parse().ok())
+        .unwrap_or_else(|| panic!("{:#?}", o.diagnosis.evidence));
+    assert!((got - warming).abs() < 8.0, "{got} K for {warming} K");
+    assert_eq!(o.extended, truth);
 }

@@ -2059,6 +2059,18 @@ pub fn diagnose(
     let mut evidence = super::evidence::evidence(
         &curves, sigma, &cause, &params, &cand_rows, base_held, ext_held,
     );
+    // A drift read by the oil law the deck gives: the warming it amounts to.
+    if let (true, Some(law), Some(&f)) = (
+        cause.split('+').any(|c| c == "oil_drift"),
+        given_oil.filter(|l| l.density_per_k > 0.0),
+        params.get("oil_density_drop_fraction"),
+    ) {
+        evidence.push(format!(
+            "by the deck's oil law (density {:.2e} /K) the density's loss is the oil warming by {:.0} K from the first test to the last",
+            law.density_per_k,
+            -(1.0 - f).ln() / law.density_per_k
+        ));
+    }
     let band = super::evidence::dwell_band(&curves, sigma);
     let measured: Vec<Vec<f64>> = data.iter().map(|m| m.force_n.clone()).collect();
     let mut signatures = vec![
