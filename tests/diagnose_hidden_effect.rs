@@ -455,3 +455,25 @@ fn an_unrecorded_warming_is_named_as_a_drift_of_the_oil() {
     assert!((got - warming).abs() < 8.0, "{got} K for {warming} K");
     assert_eq!(o.extended, truth);
 }
+
+/// Temperatures in some tests only: the oil is not fitted either way, and the diagnosis says so.
+#[test]
+fn temperatures_in_some_tests_only_are_named_as_a_limitation() {
+    let base = support::nominal_deck();
+    let mut data = support::campaign(&base, &[1.0, 3.0, 6.0], 3, 1000.0, 0.01, 7);
+    data[1].oil_temperature_k = Some(300.0);
+    let opts = DiagnoseOptions {
+        candidates: vec![],
+        faults: vec![],
+        pairs: false,
+        ..Default::default()
+    };
+    let d = diagnose(&base, &data, &opts).unwrap().diagnosis;
+    assert!(
+        d.limitations
+            .iter()
+            .any(|l| l.starts_with("1 of 3 tests record the oil temperature")),
+        "{:#?}",
+        d.limitations
+    );
+}

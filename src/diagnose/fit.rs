@@ -1068,6 +1068,16 @@ pub fn diagnose(
     };
     let data = &screened_data[..];
     let mut limitations = check_measurements(data)?;
+    let recorded = data
+        .iter()
+        .filter(|m| m.oil_temperature_k.is_some())
+        .count();
+    if !oil_drift && recorded > 0 && recorded < data.len() {
+        limitations.push(format!(
+            "{recorded} of {} tests record the oil temperature: the oil is neither fitted to the temperatures nor as a drift (record it in every test, or in none)",
+            data.len()
+        ));
+    }
     let unused = oil_reference_unknown && !oil_drift && oil_span < 0.5;
     if let (true, Some(t)) = (unused, oil_reference_k(data)) {
         limitations.push(format!(
