@@ -154,12 +154,7 @@ fn held_out(a: &[String]) -> anyhow::Result<()> {
     let nominal = DamperDeck::from_file(path)?;
     let data: Vec<Measurement> =
         blind::bench_campaign(&cp, 4, 2000.0).map_err(anyhow::Error::msg)?;
-    let opts = DiagnoseOptions {
-        candidates: vec![],
-        faults: vec![],
-        pairs: false,
-        ..Default::default()
-    };
+    let opts = DiagnoseOptions::baseline_only();
     let rms = |d: &DamperDeck| -> anyhow::Result<f64> {
         Ok(diagnose(&cp.base_deck(d), &data, &opts)?
             .diagnosis

@@ -462,12 +462,7 @@ fn temperatures_in_some_tests_only_are_named_as_a_limitation() {
     let base = support::nominal_deck();
     let mut data = support::campaign(&base, &[1.0, 3.0, 6.0], 3, 1000.0, 0.01, 7);
     data[1].oil_temperature_k = Some(300.0);
-    let opts = DiagnoseOptions {
-        candidates: vec![],
-        faults: vec![],
-        pairs: false,
-        ..Default::default()
-    };
+    let opts = DiagnoseOptions::baseline_only();
     let d = diagnose(&base, &data, &opts).unwrap().diagnosis;
     assert!(
         d.limitations

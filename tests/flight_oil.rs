@@ -11,21 +11,11 @@ use support::{root, tmp};
 
 /// The shipped record with its meta given the oil temperature `t_k`.
 fn record_at(t_k: serde_json::Value) -> FlightRecord {
-    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    let mut rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
     let mut raw = rec.meta.raw.clone();
     raw.insert("damper_oil_temperature_K".into(), t_k);
-    let meta = FlightMeta::from_json(raw, Path::new("cold.meta.json")).unwrap();
-    FlightRecord::new(
-        meta,
-        rec.stations_r_over_r().to_vec(),
-        rec.revolutions().to_vec(),
-        rec.azimuths_deg().to_vec(),
-        rec.normal_n_per_m().to_vec(),
-        rec.chord_n_per_m().to_vec(),
-        rec.moment_n_m_per_m().to_vec(),
-        rec.damper().to_vec(),
-    )
-    .unwrap()
+    rec.meta = FlightMeta::from_json(raw, Path::new("cold.meta.json")).unwrap();
+    rec
 }
 
 #[test]
@@ -105,12 +95,7 @@ fn the_diagnosis_replays_the_damper_at_the_record_s_oil_temperature() {
         "the cold oil changes the force by {change} of its RMS"
     );
     // A deck without the law cannot use the temperature: the diagnosis says so.
-    let opts = DiagnoseOptions {
-        candidates: vec![],
-        faults: vec![],
-        pairs: false,
-        ..Default::default()
-    };
+    let opts = DiagnoseOptions::baseline_only();
     let bare = DamperDeck { oil: None, ..deck };
     let d = diagnose(&bare, &[m], &opts).unwrap().diagnosis;
     assert!(

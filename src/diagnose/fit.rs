@@ -46,6 +46,20 @@ impl Default for DiagnoseOptions {
     }
 }
 
+impl DiagnoseOptions {
+    /// No candidate, fault or pair: the base deck replayed and validated on the diagnosis'
+    /// split (its held-out RMS is `validation.baseline_rms_N`), e.g. to see what a given deck
+    /// reaches.
+    pub fn baseline_only() -> Self {
+        Self {
+            candidates: vec![],
+            faults: vec![],
+            pairs: false,
+            ..Self::default()
+        }
+    }
+}
+
 /// Samples `[from, to)` of test `test` compared with the model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Window {
