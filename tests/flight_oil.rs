@@ -106,3 +106,61 @@ fn the_diagnosis_replays_the_damper_at_the_record_s_oil_temperature() {
         d.limitations
     );
 }
+
+/// `rotorsim run` on a record stating its oil temperature: the damper runs at it as when the
+/// temperature is set by hand (bit for bit), and `--set` of the temperature takes precedence.
+#[test]
+fn a_run_takes_the_damper_to_the_record_s_oil_temperature() {
+    use std::process::Command;
+    let dir = tmp("flight_oil_run");
+    let deck = dir.join("oil.toml");
+    std::fs::write(
+        &deck,
+        format!(
+            "{}\n[damper.physical.oil]\nreference_temperature_K = 293.15\ndensity_thermal_coefficient_per_K = 7.0e-4\nbulk_modulus_thermal_coefficient_per_K = 5.0e-3\n",
+            std::fs::read_to_string(root().join("flightdata/damper_nominal.toml")).unwrap()
+        ),
+    )
+    .unwrap();
+    let cold = dir.join("cold");
+    record_at(233.15.into()).write_csv(&cold).unwrap();
+    let run = |out: &str, flight: &Path, set: Option<&str>| {
+        let o = Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+            .current_dir(root())
+            .args([
+                "run", "--model", "rigid", "--revs", "20", "--damper", "physical",
+            ])
+            .arg("--damper-deck")
+            .arg(&deck)
+            .arg("--flight")
+            .arg(flight)
+            .arg("--out")
+            .arg(dir.join(out))
+            .args(set.map(|s| vec!["--set", s]).unwrap_or_default())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let s = support::read_json(&dir.join(out).join("summary.json"));
+        let rev = std::fs::read(dir.join(out).join("physical/last_rev.csv")).unwrap();
+        (s["damper_oil_temperature_K"].as_f64(), rev)
+    };
+    let shipped = root().join("flightdata/c8534like");
+    let (t_rec, by_record) = run("by_record", &cold, None);
+    let (t_set, by_hand) = run(
+        "by_hand",
+        &shipped,
+        Some("damper.physical.oil.temperature_K=233.15"),
+    );
+    assert_eq!((t_rec, t_set), (Some(233.15), Some(233.15)));
+    assert!(
+        by_record == by_hand,
+        "the record's temperature is not the one set by hand"
+    );
+    let (t_over, overridden) = run(
+        "overridden",
+        &cold,
+        Some("damper.physical.oil.temperature_K=293.15"),
+    );
+    assert_eq!(t_over, Some(293.15));
+    assert!(overridden != by_record, "--set did not take precedence");
+}

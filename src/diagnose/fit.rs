@@ -284,19 +284,13 @@ pub fn simulate_split(
     out: &mut Vec<f64>,
 ) -> Result<(), HydraulicError> {
     // The deck at the test's oil temperature, where both are known.
-    let moved;
-    let deck = match (deck.oil, m.oil_temperature_k) {
-        (Some(_), Some(t_k)) => {
-            moved = deck
-                .at_oil_temperature(t_k)
-                .map_err(|e| HydraulicError::BadStep {
-                    t: 0.0,
-                    reason: e.to_string(),
-                })?;
-            &moved
-        }
-        _ => deck,
-    };
+    let deck = deck
+        .at_known_oil_temperature(m.oil_temperature_k)
+        .map_err(|e| HydraulicError::BadStep {
+            t: 0.0,
+            reason: e.to_string(),
+        })?;
+    let deck = deck.as_ref();
     let n = n.min(m.time_s.len());
     let dt = (m.time_s[n - 1] - m.time_s[0]) / (n - 1).max(1) as f64;
     let split = split.max(1);

@@ -413,6 +413,11 @@ fn rotor_check(
             blades: None,
             blade_differences: Vec::new(),
             airframe: Vec::new(),
+            damper_oil_temperature_k: match which {
+                "baseline" => base.oil,
+                _ => extended.oil,
+            }
+            .map(|l| rec.meta.damper_oil_temperature_k.unwrap_or(l.temperature_k)),
         };
         let failed = crate::run::outputs::write_outputs(&sub, &info, &[outcome], &measured)?.failed;
         if failed.is_empty() {

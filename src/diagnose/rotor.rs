@@ -56,6 +56,8 @@ pub fn run_physical(
 ) -> anyhow::Result<ModelRun> {
     opts.check()?;
     damper.require(DamperModel::Physical)?;
+    // The damper at the record's oil temperature, as `run` takes it.
+    let damper = &*damper.at_known_oil_temperature(record.meta.damper_oil_temperature_k)?;
     let t0 = Instant::now();
     let mut sim: Box<dyn crate::rotor::ForcedResponse> = if opts.rigid {
         Box::new(crate::run::sdof::rigid_reduction(

@@ -574,6 +574,18 @@ impl DamperDeck {
         Ok(law.move_to(c, t_run))
     }
 
+    /// The deck at the oil temperature `t_k` [K] where both are known (a temperature and the
+    /// deck's oil law), else the deck as it is (e.g. a flight record's or a bench test's).
+    pub fn at_known_oil_temperature(
+        &self,
+        t_k: Option<f64>,
+    ) -> Result<std::borrow::Cow<'_, DamperDeck>, DeckError> {
+        match (t_k, self.oil) {
+            (Some(t), Some(_)) => Ok(std::borrow::Cow::Owned(self.at_oil_temperature(t)?)),
+            _ => Ok(std::borrow::Cow::Borrowed(self)),
+        }
+    }
+
     /// The deck with its oil at `t_k` [K] (the properties moved by `[damper.physical.oil]`).
     pub fn at_oil_temperature(&self, t_k: f64) -> Result<DamperDeck, DeckError> {
         if !(OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&t_k) {

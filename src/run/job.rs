@@ -617,6 +617,19 @@ impl RunJob {
         let record = FlightRecord::read(&self.flight)
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
         let (rotor, deck, blades) = self.decks_for(&models)?;
+        // The damper at the record's oil temperature where the deck has the oil's law, unless
+        // `--set` gives the temperature.
+        let record_oil = record.meta.damper_oil_temperature_k.filter(|_| {
+            !self
+                .overrides
+                .iter()
+                .any(|o| o.key.ends_with("damper.physical.oil.temperature_K"))
+        });
+        let deck = deck.at_known_oil_temperature(record_oil)?.into_owned();
+        let blades = blades
+            .into_iter()
+            .map(|(r, d)| Ok((r, d.at_known_oil_temperature(record_oil)?.into_owned())))
+            .collect::<anyhow::Result<Vec<_>>>()?;
         let nb = blades.len();
         // a rotor on an airframe is one model: its blades are coupled through the hub
         let coupled = nb > 0 && rotor.as_ref().is_some_and(|r| r.spec.airframe.is_some());
@@ -790,6 +803,7 @@ impl RunJob {
             outcomes = whole_rotor_outcomes(outcomes, &units);
         }
         let mut info = self.info(sdof, rigid, inputs_sha256, &record, t0);
+        info.damper_oil_temperature_k = deck.oil.map(|l| l.temperature_k);
         if nb > 0 {
             info.blades = Some(nb);
             info.blade_differences = rotor
@@ -916,6 +930,7 @@ impl RunJob {
             blades: None,
             blade_differences: Vec::new(),
             airframe: Vec::new(),
+            damper_oil_temperature_k: None,
         }
     }
 

@@ -531,6 +531,8 @@ pub struct RunInfo {
     pub blade_differences: Vec<String>,
     /// A rotor on an airframe: each moving direction described in words (empty without one).
     pub airframe: Vec<String>,
+    /// The oil temperature the damper ran at [K] (None: the deck has no oil law).
+    pub damper_oil_temperature_k: Option<f64>,
 }
 
 /// summary.json as a JSON value.
@@ -569,6 +571,7 @@ pub fn summary_json(
         "synthetic": info.synthetic,
         "record_counter": info.counter,
         "damper_deck": info.damper_deck,
+        "damper_oil_temperature_K": info.damper_oil_temperature_k,
         "options": {
             "revs": info.revs,
             "steps_per_rev": info.steps_per_rev,
