@@ -127,15 +127,13 @@ impl FlightMeta {
             speed_of_sound_m_s: num("speed_of_sound_m_s", false, true)?,
             chord_m: num("chord_m", false, true)?,
             damper_oil_temperature_k: {
+                use crate::hydraulics::temperature as oil;
                 let key = "damper_oil_temperature_K";
-                let (lo, hi) = crate::hydraulics::temperature::OIL_TEMPERATURE_RANGE_K;
                 match num(key, false, true)? {
-                    Some(t) if !(lo..=hi).contains(&t) => {
+                    Some(t) if !oil::is_oil_temperature_k(t) => {
                         return Err(err(
                             key,
-                            &format!(
-                                "expected an absolute temperature in K, {lo} to {hi}, found {t}"
-                            ),
+                            &format!("expected {}, found {t}", oil::oil_temperature_expected()),
                         ))
                     }
                     t => t,

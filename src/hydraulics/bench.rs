@@ -457,7 +457,10 @@ fn parse(text: &str, file: &str, name: &str, dropouts: bool) -> Result<BenchTest
     }
     let [time_s, stroke_m, force, vel, temp] = data;
     let (lo, hi) = super::temperature::OIL_TEMPERATURE_RANGE_K;
-    if let Some(k) = temp.iter().position(|t| !(lo..=hi).contains(t)) {
+    if let Some(k) = temp
+        .iter()
+        .position(|&t| !super::temperature::is_oil_temperature_k(t))
+    {
         return Err(BenchCsvError::Line {
             file: file.into(),
             line: k + 2,

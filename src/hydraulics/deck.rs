@@ -10,7 +10,9 @@ use super::extensions::{
 use super::fluid::Fluid;
 use super::integrators::{IntegratorOptions, Scheme};
 use super::link::{LinkMass, LinkedCircuit};
-use super::temperature::{OilTemperature, OIL_COEFFICIENT_MAX_PER_K, OIL_TEMPERATURE_RANGE_K};
+use super::temperature::{
+    is_oil_temperature_k, oil_temperature_expected, OilTemperature, OIL_COEFFICIENT_MAX_PER_K,
+};
 use super::Device;
 use std::path::Path;
 use toml::{Table, Value};
@@ -548,11 +550,16 @@ impl DamperDeck {
     fn parse_oil(cx: &Ctx, t: &Table, c: &mut CircuitParams) -> Result<OilTemperature, DeckError> {
         let p = "damper.physical.oil";
         cx.known(t, p, OIL_KEYS)?;
-        let kelvin = "an absolute temperature in K, 150 to 600";
-        let oil_k = |x: f64| (OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&x);
-        let t_ref = cx.num_where(t, p, "reference_temperature_K", kelvin, oil_k)?;
+        let kelvin = oil_temperature_expected();
+        let t_ref = cx.num_where(
+            t,
+            p,
+            "reference_temperature_K",
+            &kelvin,
+            is_oil_temperature_k,
+        )?;
         let t_run = if t.contains_key("temperature_K") {
-            cx.num_where(t, p, "temperature_K", kelvin, oil_k)?
+            cx.num_where(t, p, "temperature_K", &kelvin, is_oil_temperature_k)?
         } else {
             t_ref
         };
@@ -588,12 +595,12 @@ impl DamperDeck {
 
     /// The deck with its oil at `t_k` [K] (the properties moved by `[damper.physical.oil]`).
     pub fn at_oil_temperature(&self, t_k: f64) -> Result<DamperDeck, DeckError> {
-        if !(OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&t_k) {
+        if !is_oil_temperature_k(t_k) {
             return Err(DeckError::BadValue {
                 file: self.source.clone(),
                 key: "damper.physical.oil.temperature_K".into(),
                 value: format!("{t_k}"),
-                expected: "an absolute temperature in K, 150 to 600".into(),
+                expected: oil_temperature_expected(),
             });
         }
         let mut d = self.clone();

@@ -15,6 +15,17 @@ use super::circuit::CircuitParams;
 
 /// Oil temperatures that make sense [K]: from below any cold day to above any oil's flash point.
 pub const OIL_TEMPERATURE_RANGE_K: (f64, f64) = (150.0, 600.0);
+/// Whether `t_k` is an oil temperature that makes sense (within [`OIL_TEMPERATURE_RANGE_K`]).
+pub fn is_oil_temperature_k(t_k: f64) -> bool {
+    (OIL_TEMPERATURE_RANGE_K.0..=OIL_TEMPERATURE_RANGE_K.1).contains(&t_k)
+}
+
+/// What an oil temperature must be, as error messages say it.
+pub fn oil_temperature_expected() -> String {
+    let (lo, hi) = OIL_TEMPERATURE_RANGE_K;
+    format!("an absolute temperature in K, {lo} to {hi}")
+}
+
 /// Largest temperature coefficient that makes sense [1/K] (a factor e per 10 K).
 pub const OIL_COEFFICIENT_MAX_PER_K: f64 = 0.1;
 
