@@ -164,3 +164,27 @@ fn a_run_takes_the_damper_to_the_record_s_oil_temperature() {
     assert_eq!(t_over, Some(293.15));
     assert!(overridden != by_record, "--set did not take precedence");
 }
+
+/// `--set` of the temperature for every blade, or for one: that blade's damper keeps the value
+/// set, the others take the record's.
+#[test]
+fn a_set_temperature_takes_precedence_blade_by_blade() {
+    use rotorsim::overrides::Override;
+    let rec = record_at(233.15.into());
+    let mut job = rotorsim::run::job::RunJob::new(tmp("flight_oil_blades"));
+    assert_eq!(job.record_oil_temperature_k(&rec, None), Some(233.15));
+    job.overrides =
+        vec![Override::parse("blades.2.damper.physical.oil.temperature_K=300").unwrap()];
+    assert_eq!(job.record_oil_temperature_k(&rec, Some(2)), None);
+    for blade in [None, Some(1), Some(3), Some(12)] {
+        assert_eq!(
+            job.record_oil_temperature_k(&rec, blade),
+            Some(233.15),
+            "{blade:?}"
+        );
+    }
+    job.overrides = vec![Override::parse("damper.physical.oil.temperature_K=300").unwrap()];
+    for blade in [None, Some(1), Some(2)] {
+        assert_eq!(job.record_oil_temperature_k(&rec, blade), None, "{blade:?}");
+    }
+}

@@ -2141,9 +2141,9 @@ pub fn diagnose(
     };
     Ok(Outcome {
         diagnosis,
-        // The law assumed for the oil (no coefficients, at the tests' median) is not the
-        // deck's unless the oil's temperature is the cause.
-        // A drift is the campaign's, not the damper's: the deck keeps the oil it was given.
+        // A drift is the campaign's, not the damper's: the deck keeps the oil it was given. The
+        // law assumed for the oil (no coefficients, at the tests' median) is not the deck's
+        // unless the oil's temperature is the cause.
         extended: if oil_drift {
             DamperDeck {
                 oil: given_oil,

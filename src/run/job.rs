@@ -617,18 +617,16 @@ impl RunJob {
         let record = FlightRecord::read(&self.flight)
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
         let (rotor, deck, blades) = self.decks_for(&models)?;
-        // The damper at the record's oil temperature where the deck has the oil's law, unless
-        // `--set` gives the temperature.
-        let record_oil = record.meta.damper_oil_temperature_k.filter(|_| {
-            !self
-                .overrides
-                .iter()
-                .any(|o| o.key.ends_with("damper.physical.oil.temperature_K"))
-        });
-        let deck = deck.at_known_oil_temperature(record_oil)?.into_owned();
-        let blades = blades
-            .into_iter()
-            .map(|(r, d)| Ok((r, d.at_known_oil_temperature(record_oil)?.into_owned())))
+        // The dampers at the record's oil temperature where the deck has the oil's law.
+        let deck = deck
+            .at_known_oil_temperature(self.record_oil_temperature_k(&record, None))?
+            .into_owned();
+        let blades = (1..)
+            .zip(blades)
+            .map(|(k, (r, d))| {
+                let t = self.record_oil_temperature_k(&record, Some(k));
+                Ok((r, d.at_known_oil_temperature(t)?.into_owned()))
+            })
             .collect::<anyhow::Result<Vec<_>>>()?;
         let nb = blades.len();
         // a rotor on an airframe is one model: its blades are coupled through the hub
@@ -883,6 +881,23 @@ impl RunJob {
                 out.path().display()
             )
         }
+    }
+
+    /// The flight record's oil temperature [K] for the damper of blade `blade` (None: the
+    /// single blade's), unless `--set` gives the temperature for every blade or for that one.
+    pub fn record_oil_temperature_k(
+        &self,
+        record: &FlightRecord,
+        blade: Option<usize>,
+    ) -> Option<f64> {
+        const KEY: &str = "damper.physical.oil.temperature_K";
+        let own = blade.map(|k| format!("{}.{k}.{KEY}", crate::rotor::blades::KEY));
+        record.meta.damper_oil_temperature_k.filter(|_| {
+            !self
+                .overrides
+                .iter()
+                .any(|o| o.key == KEY || Some(&o.key) == own.as_ref())
+        })
     }
 
     /// The run's settings as summary.json and the report record them.
