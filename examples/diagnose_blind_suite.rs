@@ -130,27 +130,12 @@ fn held_out(a: &[String]) -> anyhow::Result<()> {
         env!("CARGO_MANIFEST_DIR"),
         "/flightdata/damper_nominal.toml"
     ));
-    let mut deck: toml::Table = std::fs::read_to_string(path)?.parse()?;
-    for kv in &a[1..] {
-        let (key, value) = kv
-            .split_once('=')
-            .ok_or_else(|| anyhow::anyhow!("{kv}: expected KEY=VALUE"))?;
-        let value: f64 = value
-            .parse()
-            .map_err(|_| anyhow::anyhow!("{kv}: the value is not a number"))?;
-        let mut keys: Vec<&str> = key.split('.').collect();
-        let last = keys.pop().unwrap_or_default();
-        let mut t = &mut deck;
-        for k in keys {
-            t = t
-                .entry(k)
-                .or_insert_with(|| toml::Value::Table(Default::default()))
-                .as_table_mut()
-                .ok_or_else(|| anyhow::anyhow!("{key}: {k} is not a table"))?;
-        }
-        t.insert(last.into(), toml::Value::Float(value));
-    }
-    let set = DamperDeck::from_toml_str(&toml::to_string(&deck)?, "--held-out keys")?;
+    // The keys as `rotorsim run --set` takes them, each validated.
+    let sets = a[1..]
+        .iter()
+        .map(|kv| rotorsim::overrides::Override::parse(kv))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let set = rotorsim::run::job::damper_deck_with(path, &sets)?;
     let nominal = DamperDeck::from_file(path)?;
     let data: Vec<Measurement> =
         blind::bench_campaign(&cp, 4, 2000.0).map_err(anyhow::Error::msg)?;
