@@ -311,8 +311,8 @@ fn clipping_and_dropouts_are_named_and_not_compared() {
 /// The oil warms from test to test (20 to 80 C over a campaign of six amplitudes, hottest
 /// last) with the density and bulk-modulus laws of a mineral oil; the diagnosis, given each
 /// test's temperature and the data sheet without a temperature law, names the oil's
-/// temperature and recovers the coefficients and the data sheet's temperature (SYNTHETIC: this library's damper
-/// generates the data; the blind suite's independent truth does not model temperature).
+/// temperature and recovers the coefficients and the data sheet's temperature (SYNTHETIC: this
+/// library's damper generates the data; the blind suite's independent truth has laws of its own).
 #[test]
 fn a_warming_oil_is_named_with_its_density_coefficient() {
     let base = support::nominal_deck();
