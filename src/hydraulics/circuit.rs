@@ -292,19 +292,36 @@ impl CircuitParams {
             mut f,
             mut j,
             mut fl,
-            mut qn,
+            qn: _,
             vol,
             dq,
         } = self.flow_part::<JAC>(t, d, y, contact)?;
         let drag = self.drag_area();
+        // The net volume rates with the orifice's and relief valves' flows added last: the
+        // turbulent flows hang on the square root, and the pressure's dependency chain is the
+        // cost of an explicit sub-step (the damper's own right-hand side sums the same way).
+        let mut rest = [
+            fl.check[0] + fl.entrance[0] - fl.bleed[0] - fl.leakage,
+            fl.check[1] + fl.entrance[1] - fl.bleed[1] + fl.leakage,
+        ];
         if drag != 0.0 {
-            fl.leakage += self.chambers[0].lambda * drag * d_dot;
-            for (k, q) in qn.iter_mut().enumerate() {
+            for (k, q) in rest.iter_mut().enumerate() {
                 *q = self.net_inflow(k, *q, d_dot, drag);
             }
+            fl.leakage += self.chambers[0].lambda * drag * d_dot;
         }
+        let ch = &self.chambers;
+        let rest = [0, 1].map(|k| rest[k] - ch[k].area * ch[k].lambda * d_dot);
+        let (o, r) = (fl.orifice, fl.relief);
+        let net = [(rest[0] - o) + (r[1] - r[0]), (rest[1] + o) + (r[0] - r[1])];
         for (k, ip) in [(0, IP0), (1, IP1)] {
-            let (rate, drate_dp, b_over_v) = self.pressure_rate(k, y[ip], vol[k], qn[k], d_dot);
+            let (rate, drate_dp, b_over_v) = Chamber::pressure_rate_of_net(
+                &self.fluid,
+                self.bulk(k, y[ip]),
+                y[ip],
+                vol[k],
+                net[k],
+            );
             f[ip] = rate;
             if JAC {
                 for (c, dqc) in dq[k].iter().enumerate() {
@@ -502,10 +519,16 @@ impl<'a> StepSystem<'a> {
 /// expressions in the same order; the absent elements' flows (+0) left out of the sums (exact:
 /// subtracting +0 is the identity; adding +0 changes at most the sign of a zero, and once the
 /// check valve's flow, never -0, is added no sum is -0); one square root of `|p0 - p1|` shared
-/// by the orifice and both relief valves.
+/// by the orifice and both relief valves. Both sum the orifice's and relief valves' flows last
+/// and multiply by reciprocals (`2/rho`, `1/V`, `1/m`, `1/alpha`): an explicit sub-step costs
+/// the latency of the pressures' dependency chain, and a division on it cost more than its
+/// square root.
 #[derive(Debug, Clone, Copy)]
 struct DamperRhs {
-    rho: f64,
+    /// `2/rho` of the turbulent law ([`FlowLaw::unit_flow`]).
+    two_over_rho: f64,
+    /// `1/m` of each relief poppet ([`ReliefValve::poppet_rate`]; 0 without one).
+    inv_m: [f64; 2],
     dp_l: f64,
     /// `sqrt(2 dp_l / rho)`, the laminar branch's scale ([`FlowLaw::unit_flow`]).
     u_l: f64,
@@ -528,7 +551,8 @@ impl DamperRhs {
             && e.air_of(1).is_none()
             && cda_check.is_sign_positive();
         plain.then(|| Self {
-            rho: p.fluid.rho,
+            two_over_rho: 2.0 / p.fluid.rho,
+            inv_m: [0, 1].map(|k| p.relief[k].map_or(0.0, |r| 1.0 / r.m)),
             dp_l: p.dp_laminar,
             u_l: (2.0 * p.dp_laminar / p.fluid.rho).sqrt(),
             cda_orifice: p.orifice.map_or(0.0, |o| o.cd * o.area),
@@ -550,7 +574,7 @@ impl DamperRhs {
         if dp <= 0.0 {
             0.0
         } else if dp >= self.dp_l {
-            (2.0 * dp / self.rho).sqrt()
+            (dp * self.two_over_rho).sqrt()
         } else {
             let r = dp / self.dp_l;
             self.u_l * (5.0 * r * r - 3.0 * r * r * r) * 0.5
@@ -579,7 +603,7 @@ impl DamperRhs {
         let a = dp.abs();
         let turbulent = a >= self.dp_l;
         let s = if turbulent {
-            (2.0 * a / self.rho).sqrt()
+            (a * self.two_over_rho).sqrt()
         } else {
             0.0
         };
@@ -609,9 +633,11 @@ impl DamperRhs {
             if area != 0.0 {
                 r[k] = rv.cd * area * unit(pf - pb);
             }
-            let pr = rv.poppet_rate(pf, pb, x, v);
-            f[ix] = pr.x_dot;
-            f[iv] = pr.v_dot;
+            let fo = rv.opening_force(pf, pb);
+            if !(x <= 0.0 && v <= 0.0 && fo <= 0.0) {
+                f[ix] = v;
+                f[iv] = (fo - rv.k * x - rv.c * v) * self.inv_m[k];
+            }
         }
         let mut c = [0.0; 2];
         if params.check.is_some() {
@@ -619,16 +645,19 @@ impl DamperRhs {
                 c[k] = self.cda_check * self.one_sided(params.p_s - p);
             }
         }
-        let qn = [-o - r[0] + r[1] + c[0], o + r[0] - r[1] + c[1]];
+        // the orifice's flow enters last: the pressure's dependency chain stays short
+        let rest = [0, 1].map(|k| c[k] - self.a_lambda[k] * d_dot);
+        let net = [(rest[0] - o) + (r[1] - r[0]), (rest[1] + o) + (r[0] - r[1])];
         for (k, ip) in [(0, IP0), (1, IP1)] {
             let p = y[ip];
             let (b, _) = params.fluid.bulk(p);
-            let net = qn[k] - self.a_lambda[k] * d_dot;
+            let net = net[k];
+            let iv = 1.0 / vol[k];
             f[ip] = if net < 0.0 {
                 let (sc, _) = params.fluid.cavitation_factor(p);
-                b * sc / vol[k] * net
+                b * sc * iv * net
             } else {
-                b / vol[k] * net
+                b * iv * net
             };
         }
         f[IIMP] = params.force(y);

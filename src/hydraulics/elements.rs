@@ -50,11 +50,26 @@ impl Chamber {
         d_dot: f64,
     ) -> (f64, f64, f64) {
         let net = q - self.area * self.lambda * d_dot;
+        Self::pressure_rate_of_net(fluid, (b, db), p, v, net)
+    }
+
+    /// Eq. (1) from the net volume rate into the chamber (inflows less `A lambda d_dot`):
+    /// `(p_dot, dp_dot/dp, dp_dot/dQ)`. `1/V` multiplies: a division on the pressure's
+    /// dependency chain would cost more than the chain's other operations together.
+    #[inline(always)]
+    pub fn pressure_rate_of_net(
+        fluid: &Fluid,
+        (b, db): (f64, f64),
+        p: f64,
+        v: f64,
+        net: f64,
+    ) -> (f64, f64, f64) {
+        let iv = 1.0 / v;
         if net < 0.0 {
             let (s, ds) = fluid.cavitation_factor(p);
-            (b * s / v * net, (db * s + b * ds) / v * net, b * s / v)
+            (b * s * iv * net, (db * s + b * ds) * iv * net, b * s * iv)
         } else {
-            (b / v * net, db / v * net, b / v)
+            (b * iv * net, db * iv * net, b * iv)
         }
     }
 }
@@ -72,9 +87,10 @@ impl Chamber {
     /// `s` (of `p`) and volume `v`.
     #[inline(always)]
     pub fn rate_factors(b: f64, s: f64, v: f64) -> RateFactors {
+        let iv = 1.0 / v;
         RateFactors {
-            outflow: b * s / v,
-            inflow: b / v,
+            outflow: b * s * iv,
+            inflow: b * iv,
         }
     }
 
@@ -126,7 +142,7 @@ impl FlowLaw {
     pub fn unit_flow(&self, dp: f64) -> (f64, f64) {
         let a = dp.abs();
         if a >= self.dp_laminar {
-            let u = (2.0 * a / self.rho).sqrt();
+            let u = (a * (2.0 / self.rho)).sqrt();
             (u.copysign(dp), u / (2.0 * a))
         } else {
             let u_l = (2.0 * self.dp_laminar / self.rho).sqrt();
@@ -209,7 +225,7 @@ impl ReliefValve {
         }
         PoppetRate {
             x_dot: v,
-            v_dot: (f - self.k * x - self.c * v) / self.m,
+            v_dot: (f - self.k * x - self.c * v) * (1.0 / self.m),
             held: false,
         }
     }
@@ -236,7 +252,7 @@ impl ReliefValve {
         let f = self.opening_force(p_front, p_back);
         PoppetRate {
             x_dot: v,
-            v_dot: (f - self.k * x - self.c * v) / self.m,
+            v_dot: (f - self.k * x - self.c * v) * (1.0 / self.m),
             held: false,
         }
     }

@@ -29,6 +29,10 @@ impl Fluid {
     /// Bulk modulus of Eq. (3), `B = (1 + alpha p + beta p^2) / (alpha + 2 beta p)`, and dB/dp.
     #[inline]
     pub fn bulk(&self, p: f64) -> (f64, f64) {
+        if self.beta == 0.0 {
+            // the constant-modulus oil: a product, no division on the pressure's chain
+            return ((1.0 + self.alpha * p) * (1.0 / self.alpha), 1.0);
+        }
         let num = 1.0 + self.alpha * p + self.beta * p * p;
         let den = self.alpha + 2.0 * self.beta * p;
         let b = num / den;
