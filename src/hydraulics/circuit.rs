@@ -521,8 +521,7 @@ impl<'a> StepSystem<'a> {
 /// check valve's flow, never -0, is added no sum is -0); one square root of `|p0 - p1|` shared
 /// by the orifice and both relief valves. Both sum the orifice's and relief valves' flows last
 /// and multiply by reciprocals (`2/rho`, `1/V`, `1/m`, `1/alpha`): an explicit sub-step costs
-/// the latency of the pressures' dependency chain, and a division on it cost more than its
-/// square root.
+/// the latency of the pressures' dependency chain, which divisions lengthen (docs/performance.md).
 #[derive(Debug, Clone, Copy)]
 struct DamperRhs {
     /// `2/rho` of the turbulent law ([`FlowLaw::unit_flow`]).

@@ -54,8 +54,8 @@ impl Chamber {
     }
 
     /// Eq. (1) from the net volume rate into the chamber (inflows less `A lambda d_dot`):
-    /// `(p_dot, dp_dot/dp, dp_dot/dQ)`. `1/V` multiplies: a division on the pressure's
-    /// dependency chain would cost more than the chain's other operations together.
+    /// `(p_dot, dp_dot/dp, dp_dot/dQ)`. `1/V` multiplies: a division would lengthen the
+    /// pressure's dependency chain, the cost of an explicit sub-step (docs/performance.md).
     #[inline(always)]
     pub fn pressure_rate_of_net(
         fluid: &Fluid,

@@ -5,7 +5,7 @@
 pub struct Fluid {
     /// Mass density rho [kg/m^3].
     pub rho: f64,
-    /// alpha of Eq. (3) [1/Pa]; with beta = 0 the bulk modulus is the constant 1/alpha.
+    /// alpha of Eq. (3) [1/Pa]; with beta = 0 the bulk modulus is 1/alpha + p.
     pub alpha: f64,
     /// beta of Eq. (3) [1/Pa^2].
     pub beta: f64,
@@ -30,7 +30,7 @@ impl Fluid {
     #[inline]
     pub fn bulk(&self, p: f64) -> (f64, f64) {
         if self.beta == 0.0 {
-            // the constant-modulus oil: a product, no division on the pressure's chain
+            // B = (1 + alpha p)/alpha as a product: no division on the pressure's chain
             return ((1.0 + self.alpha * p) * (1.0 / self.alpha), 1.0);
         }
         let num = 1.0 + self.alpha * p + self.beta * p * p;
