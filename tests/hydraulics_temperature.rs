@@ -97,6 +97,21 @@ fn moving_the_oil_follows_the_laws_and_composes() {
 /// orifice passes the swept flow, `dp = rho (A w)^2 / (2 Cd^2 A_o^2)` (Eq. 4): the force
 /// follows the density, 4.3% more at 60 K colder.
 #[test]
+fn the_loss_exponent_is_the_warming_that_loses_the_fraction() {
+    // Warmed by loss_exponent(f) / c_rho, the density has lost f of its value: 1 - exp(-x)
+    // written out (f = 0.04: x = 0.040822).
+    for f in [1e-5, 0.04, 0.3] {
+        let mut c = pair(None);
+        let rho0 = c.fluid.rho;
+        let dt = OilTemperature::loss_exponent(f) / LAW.density_per_k;
+        LAW.move_to(&mut c, LAW.temperature_k + dt);
+        let lost = 1.0 - c.fluid.rho / rho0;
+        assert!((lost - f).abs() <= 1e-12 * f.max(1e-3), "{f}: {lost}");
+    }
+    assert!((OilTemperature::loss_exponent(0.04) - 0.040_821_994_520_255).abs() < 1e-14);
+}
+
+#[test]
 fn steady_orifice_pressure_follows_the_oil_density() {
     let (w, area, cd, a_o) = (0.05, 1.6e-3, 0.7, 1.666e-5);
     let steady = |t_k: f64| {

@@ -291,7 +291,7 @@ impl Cause {
             }
             // The law that takes the tests' stand-in temperatures to these fractions.
             Cause::OilDrift => {
-                let per_k = |f: f64| -(1.0 - f).ln() / OIL_DRIFT_SPAN_K;
+                let per_k = |f: f64| OilTemperature::loss_exponent(f) / OIL_DRIFT_SPAN_K;
                 d.oil = Some(OilTemperature {
                     temperature_k: OIL_DRIFT_REFERENCE_K,
                     density_per_k: per_k(x[0]),

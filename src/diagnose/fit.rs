@@ -2086,7 +2086,7 @@ pub fn diagnose(
         evidence.push(format!(
             "by the deck's oil law (density {:.2e} /K) the density's loss is the oil warming by {:.0} K from the first test to the last",
             law.density_per_k,
-            -(1.0 - f).ln() / law.density_per_k
+            OilTemperature::loss_exponent(f) / law.density_per_k
         ));
     }
     let band = super::evidence::dwell_band(&curves, sigma);

@@ -43,6 +43,12 @@ pub struct OilTemperature {
 }
 
 impl OilTemperature {
+    /// The exponent `c (T - T_ref)` of the laws below at which a property has lost `fraction`
+    /// of its value (`1 - exp(-c dT) = fraction`): a coefficient per K times a warming.
+    pub fn loss_exponent(fraction: f64) -> f64 {
+        -(1.0 - fraction).ln()
+    }
+
     /// `c` with its oil properties moved from `self.temperature_k` to `t_k`; returns the law at
     /// its new temperature.
     pub fn move_to(&self, c: &mut CircuitParams, t_k: f64) -> OilTemperature {
