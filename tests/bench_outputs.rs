@@ -150,28 +150,33 @@ fn csv_column(text: &str, name: &str) -> Vec<String> {
 
 #[test]
 fn skip_cycles_leaves_the_settling_out_of_the_replay_error() {
-    // Steady-state "measurement" (SYNTHETIC: made by the physical model itself): cycles 8-13
-    // of a run from rest. A replay starts at rest, so its first cycles carry the settling (the
-    // check valves pump the mean pressure up) and its error; skipping them lowers it.
+    // Steady-state "measurement" (SYNTHETIC: made by the physical model itself, replayed as
+    // `bench --measured` replays, so that only the settling differs): cycles 8-13 of a replay
+    // from rest. A replay starts at rest, so its first cycles carry the settling (the check
+    // valves pump the mean pressure up) and its error; skipping them lowers it.
     let d = deck();
     let dev = d
         .build(DamperModel::Physical, IntegratorOptions::default())
         .unwrap();
     let spc = 128;
-    let r = bench::harmonic_run(dev.as_ref(), 27.02, 3.0 * IN_TO_M, 14, spc, true).unwrap();
-    let h = &r.history;
+    let omega = 27.02;
+    let amp = 3.0 * IN_TO_M / omega;
+    let dt = 2.0 * PI / omega / spc as f64;
+    let time_s: Vec<f64> = (0..=14 * spc).map(|k| k as f64 * dt).collect();
+    let stroke_m: Vec<f64> = time_s.iter().map(|&t| amp * (omega * t).sin()).collect();
+    let force_n = bench::replay_force(dev.as_ref(), &time_s, &stroke_m).unwrap();
     let first = 8 * spc;
-    let t0 = h.time_s[first];
+    let t0 = time_s[first];
     let mut text = String::from("time_s,stroke_m,force_N\n");
-    for i in first..h.time_s.len() {
+    for i in first..time_s.len() {
         text.push_str(&format!(
             "{},{},{}\n",
-            h.time_s[i] - t0,
-            h.stroke_m[i],
-            h.force_n[i]
+            time_s[i] - t0,
+            stroke_m[i],
+            force_n[i]
         ));
     }
-    let n = h.time_s.len() - first;
+    let n = time_s.len() - first;
     let dir = tmp("bench-skip");
     let csv = dir.join("steady_synthetic.csv");
     std::fs::write(&csv, text).unwrap();

@@ -339,17 +339,22 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
 struct CentralDiff(Box<dyn Device>);
 
 impl Device for CentralDiff {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &rotorsim::hydraulics::StrokePath,
     ) -> Result<rotorsim::hydraulics::StepForce, rotorsim::hydraulics::HydraulicError> {
         let h = 1e-10;
-        let p = self.0.trial_step(t_i, dt, d_i, d_f + h)?.force_mean;
-        let m = self.0.trial_step(t_i, dt, d_i, d_f - h)?.force_mean;
-        let mut s = self.0.trial_step(t_i, dt, d_i, d_f)?;
+        let (d_i, d_f) = (path.d_i, path.d_f);
+        let p = self
+            .0
+            .trial_step_path(t_i, &path.with_ends(d_i, d_f + h))?
+            .force_mean;
+        let m = self
+            .0
+            .trial_step_path(t_i, &path.with_ends(d_i, d_f - h))?
+            .force_mean;
+        let mut s = self.0.trial_step_path(t_i, path)?;
         s.dforce_dstroke = (p - m) / (2.0 * h);
         Ok(s)
     }

@@ -1,6 +1,6 @@
 //! Virtual test bench: harmonic stroking sweeps (paper Figs. 13-14) and replay of measured bench
 //! tests (bench CSV of docs/formats.md).
-use super::{Device, HydraulicError};
+use super::{sample_rates, Device, HydraulicError, StrokePath};
 use std::path::Path;
 
 /// Inches to metres.
@@ -557,16 +557,30 @@ pub fn replay_force(
     let first = dev.trial_step(time_s[0], 1e-9, stroke_m[0], stroke_m[0])?;
     dev.reset();
     force.push(first.force_end);
+    let rates = sample_rates(&time_s[..n], &stroke_m[..n]);
     for k in 0..n - 1 {
-        let dt = time_s[k + 1] - time_s[k];
-        let sf = dev.trial_step(time_s[k], dt, stroke_m[k], stroke_m[k + 1])?;
+        let sf = dev.trial_step_path(time_s[k], &sample_path(time_s, stroke_m, &rates, k))?;
         dev.commit();
         force.push(sf.force_end);
     }
     Ok(force)
 }
 
-/// Drives `device` (reset first) with the measured stroke, one step per sample interval.
+/// The stroke from sample `k` to sample `k + 1` of a replay: the cubic Hermite interpolant with
+/// the samples' rates ([`sample_rates`]), so that the force at each sample carries no lag of
+/// the replay's own (the chord's rate is the rate half a sample earlier).
+pub fn sample_path(time_s: &[f64], stroke_m: &[f64], rates: &[f64], k: usize) -> StrokePath {
+    StrokePath::hermite(
+        time_s[k + 1] - time_s[k],
+        stroke_m[k],
+        stroke_m[k + 1],
+        rates[k],
+        rates[k + 1],
+    )
+}
+
+/// Drives `device` (reset first) with the measured stroke, one step per sample interval, the
+/// stroke between samples the cubic Hermite interpolant of [`sample_path`].
 pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, HydraulicError> {
     let mut dev = device.clone_device();
     dev.reset();
@@ -592,9 +606,10 @@ pub fn replay(device: &dyn Device, test: &BenchTest) -> Result<Replay, Hydraulic
         first.force_end,
         f64::NAN,
     );
+    let rates = sample_rates(&test.time_s, &test.stroke_m);
     for k in 0..n - 1 {
-        let dt = test.time_s[k + 1] - test.time_s[k];
-        let sf = dev.trial_step(test.time_s[k], dt, test.stroke_m[k], test.stroke_m[k + 1])?;
+        let path = sample_path(&test.time_s, &test.stroke_m, &rates, k);
+        let sf = dev.trial_step_path(test.time_s[k], &path)?;
         dev.commit();
         force.push(sf.force_end);
         hist.push(

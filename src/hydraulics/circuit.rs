@@ -7,7 +7,7 @@ use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 use super::extensions::HydraulicExtensions;
 use super::fluid::Fluid;
 use super::integrators::{integrate, IntegratorOptions, OdeSystem, Scheme};
-use super::{check_step, Device, HydraulicError, StepForce};
+use super::{Device, HydraulicError, StepForce, StrokePath};
 use nalgebra::{SMatrix, SVector};
 use std::sync::Arc;
 
@@ -487,8 +487,8 @@ pub struct FlowPart {
 pub struct StepSystem<'a> {
     pub params: &'a CircuitParams,
     pub t_i: f64,
-    pub d_i: f64,
-    pub d_dot: f64,
+    /// The stroke over the step.
+    pub path: StrokePath,
     /// Seat contact frozen over the current implicit sub-step.
     pub contact: Option<[bool; 2]>,
     /// Relief-valve extremes over the sub-steps integrated (None: not recorded).
@@ -498,14 +498,13 @@ pub struct StepSystem<'a> {
 }
 
 impl<'a> StepSystem<'a> {
-    /// The circuit over the step from `(t_i, d_i)` at stroke rate `d_dot`; `fast` takes the
-    /// damper's specialised right-hand side where it applies (explicit schemes: no contact held).
-    pub fn new(params: &'a CircuitParams, t_i: f64, d_i: f64, d_dot: f64, fast: bool) -> Self {
+    /// The circuit over the step from `t_i` along `path`; `fast` takes the damper's
+    /// specialised right-hand side where it applies (explicit schemes: no contact held).
+    pub fn new(params: &'a CircuitParams, t_i: f64, path: StrokePath, fast: bool) -> Self {
         Self {
             params,
             t_i,
-            d_i,
-            d_dot,
+            path,
             contact: None,
             envelope: None,
             fast: if fast { DamperRhs::new(params) } else { None },
@@ -707,20 +706,20 @@ impl SubstepEnvelope {
 impl OdeSystem<NS> for StepSystem<'_> {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &State) -> Result<State, HydraulicError> {
-        let d = self.d_i + self.d_dot * (t - self.t_i);
+        let (d, d_dot) = self.path.at(t - self.t_i);
         if let (Some(fast), None) = (&self.fast, self.contact) {
-            return fast.rhs(self.params, t, d, self.d_dot, y);
+            return fast.rhs(self.params, t, d, d_dot, y);
         }
         Ok(self
             .params
-            .evaluate::<false>(t, d, self.d_dot, y, self.contact)?
+            .evaluate::<false>(t, d, d_dot, y, self.contact)?
             .0)
     }
     fn jacobian(&self, t: f64, y: &State) -> Result<Jacobian, HydraulicError> {
-        let d = self.d_i + self.d_dot * (t - self.t_i);
+        let (d, d_dot) = self.path.at(t - self.t_i);
         Ok(self
             .params
-            .evaluate::<true>(t, d, self.d_dot, y, self.contact)?
+            .evaluate::<true>(t, d, d_dot, y, self.contact)?
             .1)
     }
     fn weights(&self, y: &State) -> State {
@@ -756,7 +755,7 @@ impl OdeSystem<NS> for StepSystem<'_> {
 
     fn end_substep(&mut self, t: f64, y: &State) {
         if let Some(mut e) = self.envelope {
-            let d = self.d_i + self.d_dot * (t - self.t_i);
+            let (d, _) = self.path.at(t - self.t_i);
             e.add(self.params, d, y);
             self.envelope = Some(e);
         }
@@ -920,16 +919,15 @@ impl CircuitDevice {
 }
 
 impl Device for CircuitDevice {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
+        path.check(t_i)?;
+        let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         let explicit = self.opts.scheme == Scheme::Rk4;
-        let mut sys = StepSystem::new(&self.params, t_i, d_i, (d_f - d_i) / dt, explicit);
+        let mut sys = StepSystem::new(&self.params, t_i, *path, explicit);
         // the step's start included, so consecutive envelopes join
         sys.envelope = self
             .record_envelope
@@ -944,7 +942,7 @@ impl Device for CircuitDevice {
             Tangent::FiniteDifference => {
                 let c = &self.params.chambers[0];
                 let h = 1e-7 * c.volume0 / c.area;
-                sys.d_dot = (d_f + h - d_i) / dt;
+                sys.path = path.with_ends(d_i, d_f + h);
                 sys.contact = None;
                 let yh = integrate(&self.opts, &mut sys, t_i, dt, &y0)?;
                 (yh[IIMP] / dt - force_mean) / h

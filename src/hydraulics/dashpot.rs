@@ -1,7 +1,8 @@
 //! Dashpot idealizations of a damper: linear `F = -c d_dot` and nonlinear
 //! `F = -sign(v) f(|v|)` with `f` a monotone (Fritsch-Carlson) interpolation of a table.
-//! Over a step the stroke rate is constant, so `F_m` is exact.
-use super::{check_step, Device, HydraulicError, StepForce};
+//! On a straight step the stroke rate is constant, so `F_m` is exact; on a replay's Hermite
+//! path the force at the step's end is the law at the end's rate.
+use super::{Device, HydraulicError, StepForce, StrokePath};
 use std::sync::Arc;
 
 const CHANNELS: &[&str] = &["velocity_m_s"];
@@ -25,20 +26,20 @@ impl LinearDashpot {
 }
 
 impl Device for LinearDashpot {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
-        let v = (d_f - d_i) / dt;
-        self.trial_v = Some(v);
+        path.check(t_i)?;
+        // the mean rate is the chord's on any path
+        let v = path.chord_rate();
+        let v_end = path.end_rate();
+        self.trial_v = Some(v_end);
         Ok(StepForce {
             force_mean: -self.c * v,
-            dforce_dstroke: -self.c / dt,
-            force_end: -self.c * v,
+            dforce_dstroke: -self.c / path.dt,
+            force_end: -self.c * v_end,
         })
     }
     fn commit(&mut self) {
@@ -194,21 +195,24 @@ impl NonlinearDashpot {
 }
 
 impl Device for NonlinearDashpot {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
-        let v = (d_f - d_i) / dt;
-        self.trial_v = Some(v);
+        path.check(t_i)?;
+        let v = path.chord_rate();
         let (f, df) = self.force(v);
+        let v_end = path.end_rate();
+        self.trial_v = Some(v_end);
         Ok(StepForce {
-            force_mean: f,
-            dforce_dstroke: df / dt,
-            force_end: f,
+            force_mean: path.mean_of_rate(|r| self.force(r).0),
+            dforce_dstroke: df / path.dt,
+            force_end: if path.is_linear() {
+                f
+            } else {
+                self.force(v_end).0
+            },
         })
     }
     fn commit(&mut self) {

@@ -17,7 +17,7 @@
 use super::circuit::CircuitDevice;
 use super::fluid::Fluid;
 use super::link::Link;
-use super::{check_step, Device, HydraulicError, StepForce};
+use super::{Device, HydraulicError, StepForce, StrokePath};
 
 /// Seal friction: `F = -[F_c + (F_s - F_c) exp(-(v/v_s)^2)] tanh(v/v_eps)` with v the piston
 /// velocity. `tanh(v/v_eps)` regularises the Coulomb sign so that the law stays continuous;
@@ -322,14 +322,13 @@ impl ExtendedDamper {
 }
 
 impl Device for ExtendedDamper {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
+        path.check(t_i)?;
+        let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i;
         }
@@ -340,8 +339,18 @@ impl Device for ExtendedDamper {
             }
             None => (d_i, d_f, true),
         };
-        let v_h = (dh_f - dh_i) / dt;
-        let sf = self.inner.trial_step(t_i, dt, dh_i, dh_f)?;
+        // The piston moves along the end's path only while the gap stays closed on one side
+        // over the whole step (its offset from the end unchanged); else along its chord.
+        let follows = contact && ((dh_f - d_f) - (dh_i - d_i)).abs() <= 1e-12;
+        let inner_path = if follows {
+            path.with_ends(dh_i, dh_f)
+        } else {
+            StrokePath::linear(dt, dh_i, dh_f)
+        };
+        let v_h = inner_path.chord_rate();
+        // the piston's rate at the step's end (the chord's on a straight step)
+        let v_end = inner_path.end_rate();
+        let sf = self.inner.trial_step_path(t_i, &inner_path)?;
         // The sliding law's tangent is left out (its slope F_c/v_eps at reversal would swamp
         // the damper's); presliding adds its bounded one, the seal's presliding stiffness.
         let (fr_end, fr_mean, fr_slope) = match self.friction {
@@ -350,7 +359,7 @@ impl Device for ExtendedDamper {
                 let (end, mean) = f.presliding_step(self.f_fric, v_h, dd);
                 (end, mean, f.presliding_tangent(self.f_fric, dd, dt))
             }
-            Some(f) => (f.force(v_h), f.force(v_h), 0.0),
+            Some(f) => (f.force(v_end), inner_path.mean_of_rate(|v| f.force(v)), 0.0),
             None => (0.0, 0.0, 0.0),
         };
         let out = StepForce {
@@ -366,7 +375,7 @@ impl Device for ExtendedDamper {
             },
             force_end: if contact { sf.force_end + fr_end } else { 0.0 },
         };
-        self.trial = Some((dh_f, contact, v_h, fr_end));
+        self.trial = Some((dh_f, contact, v_end, fr_end));
         Ok(out)
     }
 
@@ -514,14 +523,13 @@ impl SeriesMount {
 }
 
 impl Device for SeriesMount {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
+        path.check(t_i)?;
+        let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i + self.inner.committed_force() / self.k;
         }
@@ -531,7 +539,7 @@ impl Device for SeriesMount {
         let tol = 0.1 / self.k;
         // Start: the spring keeps its deflection.
         let mut x0 = d_f + (dh_i - d_i);
-        let mut s0 = self.inner.trial_step(t_i, dt, dh_i, x0)?;
+        let mut s0 = self.inner.trial_step_path(t_i, &path.with_ends(dh_i, x0))?;
         let mut g0 = x0 - d_f - s0.force_end / self.k;
         if g0.abs() <= tol {
             self.trial = Some(x0);
@@ -553,7 +561,7 @@ impl Device for SeriesMount {
             if !x1.is_finite() {
                 break;
             }
-            let s1 = self.inner.trial_step(t_i, dt, dh_i, x1)?;
+            let s1 = self.inner.trial_step_path(t_i, &path.with_ends(dh_i, x1))?;
             let g1 = x1 - d_f - s1.force_end / self.k;
             if g1.abs() <= tol {
                 return Ok(accept(self, x1, s1));
@@ -574,7 +582,7 @@ impl Device for SeriesMount {
         // g(x) = x - d_f - F(x)/k is continuous and, for a passive device (dF/dx <= 0),
         // increasing with slope >= 1, so a bracket is found by stepping against g.
         let g = |me: &mut Self, x: f64| -> Result<(f64, StepForce), HydraulicError> {
-            let sf = me.inner.trial_step(t_i, dt, dh_i, x)?;
+            let sf = me.inner.trial_step_path(t_i, &path.with_ends(dh_i, x))?;
             Ok((x - d_f - sf.force_end / me.k, sf))
         };
         let (xb, _) = best;
@@ -632,7 +640,9 @@ impl Device for SeriesMount {
         }
         // Last resort: a stall within 1 N of force balance is accepted at its best iterate.
         if best.1 * self.k <= 1.0 {
-            let sf = self.inner.trial_step(t_i, dt, dh_i, best.0)?;
+            let sf = self
+                .inner
+                .trial_step_path(t_i, &path.with_ends(dh_i, best.0))?;
             return Ok(accept(self, best.0, sf));
         }
         Err(HydraulicError::BadStep {
@@ -700,21 +710,27 @@ impl CompliantFreePlay {
 }
 
 impl Device for CompliantFreePlay {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
+        path.check(t_i)?;
+        let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i + self.link.deflection_of(self.inner.committed_force());
         }
         let dh_i = self.d_h;
         let tol = 0.1;
+        // The piston takes the end's path (less the link's deflection, linear over the step)
+        // where the gap is closed at the step's start; inside the gap its chord.
+        let shape = if path.is_linear() || self.link.force(dh_i - d_i).1 {
+            *path
+        } else {
+            StrokePath::linear(dt, d_i, d_f)
+        };
         let eval = |me: &mut Self, x: f64| -> Result<(f64, bool, StepForce), HydraulicError> {
-            let sf = me.inner.trial_step(t_i, dt, dh_i, x)?;
+            let sf = me.inner.trial_step_path(t_i, &shape.with_ends(dh_i, x))?;
             let (fl, contact) = me.link_force(x - d_f);
             Ok((fl - sf.force_end, contact, sf))
         };

@@ -27,7 +27,7 @@
 use super::circuit::{CircuitDevice, CircuitParams, State, IIMP, IP0, IP1, IV0, IV1, IX0, IX1, NS};
 use super::elements::Chamber;
 use super::integrators::{explicit_step, OdeSystem, RK4};
-use super::{check_step, Device, HydraulicError, StepForce};
+use super::{Device, HydraulicError, StepForce, StrokePath};
 use nalgebra::{SMatrix, SVector};
 
 /// Size of the linked state: the circuit's and the link deflection.
@@ -87,14 +87,13 @@ impl Link {
     }
 }
 
-/// The circuit and link over one step, the end's stroke linear in time from `d_i` at `t_i`.
+/// The circuit and link over one step, the end's stroke along `path` from `t_i`.
 #[derive(Clone, Copy)]
 struct LinkSystem<'a> {
     params: &'a CircuitParams,
     link: Link,
     t_i: f64,
-    d_i: f64,
-    d_dot: f64,
+    path: StrokePath,
     tau: f64,
     /// The side in contact (`Link::side`) held over a sub-step, so that no Runge-Kutta stage
     /// takes the other regime's law.
@@ -109,7 +108,7 @@ fn circuit_part(y: &LState) -> State {
 impl OdeSystem<NL> for LinkSystem<'_> {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &LState) -> Result<LState, HydraulicError> {
-        let d = self.d_i + self.d_dot * (t - self.t_i);
+        let (d, d_dot) = self.path.at(t - self.t_i);
         let e = y[IE];
         let yc = circuit_part(y);
         let part = self.params.flow_part::<false>(t, d + e, &yc, None)?;
@@ -121,7 +120,6 @@ impl OdeSystem<NL> for LinkSystem<'_> {
         } else {
             self.params.force(&yc) / self.tau
         };
-        let d_dot = self.d_dot;
         let ch = &self.params.chambers;
         let p = [yc[IP0], yc[IP1]];
         // h(v) = A0 p0_dot(v) - A1 p1_dot(v) - k_c (v - d_dot) + relax, its slope and the two
@@ -264,10 +262,12 @@ struct MassLinkSystem<'a> {
     /// Contact damping `2 zeta sqrt(k m)` [N s/m].
     c: f64,
     t_i: f64,
-    /// The end's stroke over the step, `d_i + v_i tau + acc tau^2 / 2` (`tau = t - t_i`).
+    /// The end's stroke over the step, `d_i + v_i tau + acc tau^2 / 2` (`tau = t - t_i`), or
+    /// the replay's path where it is given (`path`).
     d_i: f64,
     v_i: f64,
     acc: f64,
+    path: Option<StrokePath>,
     side: i8,
 }
 
@@ -299,8 +299,13 @@ impl OdeSystem<NM> for MassLinkSystem<'_> {
     #[inline(always)]
     fn rhs(&self, t: f64, y: &MState) -> Result<MState, HydraulicError> {
         let tau = t - self.t_i;
-        let d = self.d_i + tau * (self.v_i + 0.5 * self.acc * tau);
-        let d_dot = self.v_i + self.acc * tau;
+        let (d, d_dot) = match &self.path {
+            Some(p) => p.at(tau),
+            None => (
+                self.d_i + tau * (self.v_i + 0.5 * self.acc * tau),
+                self.v_i + self.acc * tau,
+            ),
+        };
         let (e, v) = (y[IE], y[IW]);
         let yc = State::from_fn(|i, _| y[i]);
         let part = self.params.flow_part::<false>(t, d + e, &yc, None)?;
@@ -485,19 +490,18 @@ impl LinkedCircuit {
 }
 
 impl Device for LinkedCircuit {
-    fn trial_step(
+    fn trial_step_path(
         &mut self,
         t_i: f64,
-        dt: f64,
-        d_i: f64,
-        d_f: f64,
+        path: &StrokePath,
     ) -> Result<StepForce, HydraulicError> {
-        check_step(t_i, dt, d_i, d_f)?;
+        path.check(t_i)?;
+        let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         let d_dot = (d_f - d_i) / dt;
         if self.fresh {
             let f0 = self.inner.committed_force();
             self.d_h = d_i + self.link.deflection_of(f0);
-            self.v_p = d_dot;
+            self.v_p = path.start_rate();
             self.f_end = f0;
         }
         let opts = self.inner.options();
@@ -513,19 +517,19 @@ impl Device for LinkedCircuit {
                     params,
                     link: self.link,
                     t_i,
-                    d_i,
-                    d_dot,
+                    path: *path,
                     tau: RELAX_SUBSTEPS * dt / n as f64,
                     side: 0,
                 };
                 let y = integrate(self.link, &sys, n, t_i, dt, &y0)?;
                 let f = params.force(&circuit_part(&y));
-                (y, y[IIMP] / dt, f, d_dot)
+                (y, y[IIMP] / dt, f, path.end_rate())
             }
             Some(ms) => {
                 // The end's stroke: the parabola through the last step's start and this step's
                 // ends, so that the end's velocity is continuous to O(dt^2) from step to step. A
-                // chord's velocity jump at every sample would ring the mass on its contact.
+                // chord's velocity jump at every sample would ring the mass on its contact. A
+                // replay's Hermite path is continuous in velocity already and taken as it is.
                 let acc = match self.prev {
                     Some((t_p, t_e, d_p)) if (t_e - t_i).abs() <= 1e-9 * dt && t_i > t_p => {
                         let h_p = t_i - t_p;
@@ -543,15 +547,17 @@ impl Device for LinkedCircuit {
                     d_i,
                     v_i,
                     acc,
+                    path: (!path.is_linear()).then_some(*path),
                     side: 0,
                 };
                 let ym0 = MState::from_fn(|i, _| if i < NL { y0[i] } else { self.v_p });
                 let nm = self.mass_substeps(ms, dt, n);
                 let ym = integrate(self.link, &sys, nm, t_i, dt, &ym0)?;
                 let e = ym[IE];
-                let f_end = sys
-                    .with_side(self.link.side(e))
-                    .link_force(e, ym[IW] - (v_i + acc * dt));
+                let f_end = sys.with_side(self.link.side(e)).link_force(
+                    e,
+                    ym[IW] - sys.path.map_or(v_i + acc * dt, |p| p.end_rate()),
+                );
                 // The end's impulse is the oil's less the momentum the mass gained.
                 let imp = ym[IIMP] - ms.mass_kg * (ym[IW] - self.v_p);
                 let y = LState::from_fn(|i, _| ym[i]);

@@ -61,6 +61,7 @@ pub mod extensions;
 pub mod fluid;
 pub mod integrators;
 pub mod link;
+pub mod path;
 pub mod temperature;
 
 pub use circuit::{
@@ -76,6 +77,7 @@ pub use extensions::{
 pub use fluid::Fluid;
 pub use integrators::{IntegratorOptions, Scheme};
 pub use link::{LinkMass, LinkedCircuit};
+pub use path::{sample_rates, StrokePath};
 pub use temperature::OilTemperature;
 
 /// Result of one trial step of a device.
@@ -163,15 +165,21 @@ fn stability_advice(h: f64, rate: f64) -> String {
 /// state; calling it again restarts from the committed state (structural Newton iterations);
 /// `commit` accepts the last trial state.
 pub trait Device: Send + Sync + std::fmt::Debug {
+    /// Advance from the committed state at `t_i` along `path` (the stroke over the step). The
+    /// result is kept as the trial state.
+    fn trial_step_path(&mut self, t_i: f64, path: &StrokePath)
+        -> Result<StepForce, HydraulicError>;
     /// Advance from the committed state at `t_i` over `dt`, the stroke moving linearly from
-    /// `d_i` to `d_f` (constant rate). The result is kept as the trial state.
+    /// `d_i` to `d_f` (constant rate): what a structural step knows.
     fn trial_step(
         &mut self,
         t_i: f64,
         dt: f64,
         d_i: f64,
         d_f: f64,
-    ) -> Result<StepForce, HydraulicError>;
+    ) -> Result<StepForce, HydraulicError> {
+        self.trial_step_path(t_i, &StrokePath::linear(dt, d_i, d_f))
+    }
     /// Accept the last trial state (no-op when there is none).
     fn commit(&mut self);
     /// Names (with units) of the internal channels, e.g. `p0_Pa`.
