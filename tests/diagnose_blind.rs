@@ -981,12 +981,12 @@ mod second {
             worst_rms = worst_rms.max(rms);
         }
         assert!(
-            worst_peak < 0.01,
+            worst_peak < 1e-3,
             "peak forces differ by {:.2}%",
             100.0 * worst_peak
         );
         assert!(
-            worst_rms < 0.01,
+            worst_rms < 1e-3,
             "histories differ by {:.2}% RMS",
             100.0 * worst_rms
         );
