@@ -162,6 +162,7 @@ fn truth_integrator_converges_with_its_tolerance() {
         ],
         seed: 1,
         flight: false,
+        truth: TruthModel::First,
     };
     let t = cp.truth();
     let stroke = Stroke::harmonic(27.02, 8.0 * 0.0254 / 27.02);
@@ -455,6 +456,7 @@ fn acquisition_faults_transform_the_recorded_force() {
         ],
         seed: 7,
         flight: false,
+        truth: TruthModel::First,
     };
     // The faults stay out of the truth physics.
     let model = cp.truth();
@@ -689,4 +691,522 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
     let r = Rates::of(&rows);
     assert_eq!((r.faults_named, r.with_fault), (1, 2));
     assert!(rates(&rows).contains("acquisition-fault campaigns named as acquisition faults 1/2"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The second truth model (truth2.rs) and its suite (suite2.rs): the same checks against analytic
+// limits and against rotorsim's nominal damper, and its conventions.
+
+mod second {
+    use super::blind_support::suite2::{self, Programme};
+    use super::blind_support::truth2::{
+        self, force_at, record, Annulus, Bench, DataSheet, Integrator, Model, Motion, RadauTableau,
+        Sensor, Tolerance,
+    };
+    use super::blind_support::*;
+    use super::{last_cycle_peaks, nominal_deck};
+    use rotorsim::diagnose::fit::simulate;
+    use rotorsim::diagnose::Measurement;
+
+    fn sealed(mut s: DataSheet) -> DataSheet {
+        s.orifice_area = 0.0;
+        s.check_area = 0.0;
+        for p in &mut s.poppet {
+            p.a = 0.0;
+            p.b = 0.0;
+        }
+        s
+    }
+
+    #[test]
+    fn truth2_radau_tableau_satisfies_its_order_conditions() {
+        let tab = RadauTableau::new();
+        let b = tab.a[2];
+        // quadrature order 5, stage order 3
+        for k in 1..=5 {
+            let q: f64 = (0..3).map(|i| b[i] * tab.c[i].powi(k - 1)).sum();
+            assert!((q - 1.0 / k as f64).abs() < 1e-14, "b c^{} = {q}", k - 1);
+        }
+        for i in 0..3 {
+            for k in 1..=3 {
+                let q: f64 = (0..3).map(|j| tab.a[i][j] * tab.c[j].powi(k - 1)).sum();
+                assert!((q - tab.c[i].powi(k) / k as f64).abs() < 1e-14);
+            }
+        }
+        // gamma0 is an eigenvalue of A, and the error weights are Hairer & Wanner's closed form
+        let det = |g: f64| {
+            let m: Vec<Vec<f64>> = (0..3)
+                .map(|i| {
+                    (0..3)
+                        .map(|j| tab.a[i][j] - if i == j { g } else { 0.0 })
+                        .collect()
+                })
+                .collect();
+            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+        };
+        assert!(det(tab.gamma0).abs() < 1e-15);
+        let s6 = 6.0f64.sqrt();
+        let hw = [
+            -(13.0 + 7.0 * s6) / 3.0,
+            (-13.0 + 7.0 * s6) / 3.0,
+            -1.0 / 3.0,
+        ];
+        for (e, w) in tab.e.iter().zip(hw) {
+            assert!((e - tab.gamma0 * w).abs() < 1e-12, "{:?}", tab.e);
+        }
+    }
+
+    /// Pressure of a sealed chamber whose volume went from `v0` to `v`, gas fraction `x` at
+    /// `p_ref`: `(1 - x) v0 c(p_ref)/c(p) + x v0 p_ref/p = v`, by bisection.
+    fn sealed_pressure(s: &DataSheet, x: f64, p_ref: f64, v0: f64, v: f64) -> f64 {
+        let c = |p: f64| 1.0 + s.alpha * p + s.beta * p * p;
+        let vol = |p: f64| (1.0 - x) * v0 * c(p_ref) / c(p) + x * v0 * p_ref / p;
+        let (mut lo, mut hi) = (1.0e5, 1.0e9);
+        for _ in 0..200 {
+            let m = 0.5 * (lo + hi);
+            if vol(m) > v {
+                lo = m
+            } else {
+                hi = m
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    #[test]
+    fn truth2_sealed_chambers_follow_the_integral_of_eq3_with_and_without_air() {
+        for (beta, air) in [(0.0, 0.0), (2.0e-19, 0.0), (0.0, 0.02)] {
+            let mut s = sealed(DataSheet::nominal());
+            s.supply = 3.0e7; // neither chamber nears cavitation
+            s.beta = beta;
+            let mut m = Model::new(s.clone());
+            m.gas = [air, air];
+            let amp = 2.0e-4;
+            let motion = Motion::harmonic(27.02, amp);
+            let bench = Bench {
+                model: &m,
+                motion: &motion,
+                sensor: Sensor::butterworth(1e3),
+            };
+            let mut it = Integrator::new(bench, Tolerance::default());
+            it.advance(motion.period() / 4.0).unwrap(); // d = amp
+                                                        // the nuclei are free gas too
+            let x = air + m.nuclei;
+            let p0 = sealed_pressure(
+                &s,
+                x,
+                s.supply,
+                s.chamber_volume[0],
+                s.chamber_volume[0] + s.piston_area[0] * amp,
+            );
+            let p1 = sealed_pressure(
+                &s,
+                x,
+                s.supply,
+                s.chamber_volume[1],
+                s.chamber_volume[1] - s.piston_area[1] * amp,
+            );
+            let (e0, e1) = (
+                (it.y[truth2::P0] - p0).abs() / p0,
+                (it.y[truth2::P1] - p1).abs() / p1,
+            );
+            eprintln!("beta {beta} air {air}: relative errors {e0:.1e} {e1:.1e}");
+            assert!(e0 < 1e-7 && e1 < 1e-7, "beta {beta} air {air}: {e0} {e1}");
+        }
+    }
+
+    #[test]
+    fn truth2_orifice_gives_the_incompressible_law_at_low_frequency() {
+        // Relief valves shut: the force at peak velocity is A (rho/2)(A v/(Cd A_orf))^2.
+        let mut s = DataSheet::nominal();
+        for p in &mut s.poppet {
+            p.a = 0.0;
+        }
+        let m = Model::new(s.clone());
+        let (w, amp) = (5.0, 0.01);
+        let motion = Motion::harmonic(w, amp);
+        let period = motion.period();
+        let times: Vec<f64> = (0..3).map(|k| (1.0 + k as f64 * 0.5) * period).collect();
+        let f = force_at(&m, &motion, &times, Tolerance::default()).unwrap();
+        let q = s.piston_area[0] * w * amp;
+        let expect =
+            s.piston_area[0] * 0.5 * s.density * (q / (s.discharge * s.orifice_area)).powi(2);
+        for (k, fk) in f.iter().enumerate() {
+            let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+            let rel = (fk - sign * expect).abs() / expect;
+            eprintln!(
+                "sample {k}: {fk:.2} N vs {:.2} N ({rel:.1e})",
+                sign * expect
+            );
+            assert!(
+                rel < 2e-3,
+                "sample {k}: {fk} N vs {} N ({rel:.2e})",
+                sign * expect
+            );
+        }
+    }
+
+    #[test]
+    fn truth2_leakage_of_a_sealed_pair_decays_exponentially() {
+        let s = sealed(DataSheet::nominal());
+        let mut m = Model::new(s.clone());
+        let k = 1.0e-11;
+        m.annulus = Some(Annulus { k, drag: 0.0 });
+        let motion = Motion::harmonic(27.02, 0.0);
+        let bench = Bench {
+            model: &m,
+            motion: &motion,
+            sensor: Sensor::butterworth(1e3),
+        };
+        let mut it = Integrator::new(bench, Tolerance::default());
+        let dp0 = 1.0e5;
+        it.y[truth2::P0] = s.supply + dp0;
+        // both chambers' compliance at the mean pressure
+        let pm = s.supply + 0.5 * dp0;
+        let tau = 1.0
+            / (k * (1.0 / (s.chamber_volume[0] * m.compliance(0, pm))
+                + 1.0 / (s.chamber_volume[1] * m.compliance(1, pm))));
+        it.advance(tau).unwrap();
+        let dp = it.y[truth2::P0] - it.y[truth2::P1];
+        let expect = dp0 * (-1.0f64).exp();
+        eprintln!(
+            "tau {tau:.4e} s: dp {dp:.2} Pa vs {expect:.2} Pa ({:.1e})",
+            (dp - expect) / expect
+        );
+        assert!((dp - expect).abs() / expect < 1e-3, "{dp} vs {expect}");
+    }
+
+    #[test]
+    fn truth2_integrator_converges_with_its_tolerance() {
+        // 7.5 in/s at 34 rad/s with relief valves opening, a compliant gap and friction, recorded
+        // as the bench records (averaged force, sensor stroke).
+        let m = suite2::model_of(&[
+            Effect::CompliantFreePlay(0.11e-3, 3.3e8),
+            Effect::SealFriction(390.0),
+        ])
+        .unwrap();
+        let test = &Programme::A.tests()[3];
+        let rate = Programme::A.rate_hz();
+        let t = test.times(rate);
+        let run = |rtol: f64| {
+            record(
+                &m,
+                &test.motion,
+                Programme::A.sensor(),
+                &t,
+                1.0 / rate,
+                0.0,
+                Tolerance { rtol, atol: rtol },
+            )
+            .unwrap()
+        };
+        let (fr, sr) = run(1e-11);
+        let diff = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
+        };
+        let (fl, sl) = run(1e-5);
+        let (fd, sd) = run(Tolerance::default().rtol);
+        let peak = fr.iter().fold(0.0f64, |a, f| a.max(f.abs()));
+        let (loose, default) = (diff(&fl, &fr), diff(&fd, &fr));
+        eprintln!(
+            "peak {peak:.0} N; largest difference to rtol 1e-11: rtol 1e-5 {loose:.3} N, default {default:.2e} N; stroke {:.1e} m, {:.1e} m",
+            diff(&sl, &sr),
+            diff(&sd, &sr)
+        );
+        assert!(default < loose, "tighter tolerance must be closer");
+        assert!(
+            default < 1e-6 * peak,
+            "default within 1e-6 of the peak: {default} N"
+        );
+        assert!(diff(&sd, &sr) < 1e-10, "sensor stroke");
+    }
+
+    #[test]
+    fn truth2_agrees_with_rotorsims_nominal_damper_in_physics() {
+        // The two share the data sheet, not code: the instantaneous force (no averaging, no
+        // sensor, no ramp) against the library's replay of the exact stroke at 10 kHz, last of
+        // 5 cycles, on the second suite's harmonic tests.
+        let deck = nominal_deck();
+        let m = Model::new(DataSheet::nominal());
+        let rate = 10_000.0;
+        let (mut worst_peak, mut worst_rms) = (0.0f64, 0.0f64);
+        let cases: [(f64, f64, f64); 7] = [
+            (34.0, 1.5, 0.0),
+            (34.0, 3.0, 0.0),
+            (34.0, 5.0, 0.0),
+            (34.0, 7.5, 0.0),
+            (19.0, 2.0, 3e-3),
+            (19.0, 6.5, 3e-3),
+            (45.0, 4.0, 3e-3),
+        ];
+        for (w, v, mean) in cases {
+            let mut motion = Motion::harmonic(w, v * 0.0254 / w);
+            motion.mean = mean;
+            let period = motion.period();
+            let n = (5.0 * period * rate).round() as usize + 1;
+            let time_s: Vec<f64> = (0..n).map(|k| k as f64 / rate).collect();
+            let (d, vel): (Vec<f64>, Vec<f64>) = time_s.iter().map(|&t| motion.at(t)).unzip();
+            let truth = force_at(&m, &motion, &time_s, Tolerance::default()).unwrap();
+            let meas = Measurement {
+                name: "h".into(),
+                time_s: time_s.clone(),
+                stroke_m: d,
+                force_n: vec![0.0; n],
+                velocity_m_s: vel,
+                period_s: period,
+                oil_temperature_k: None,
+            };
+            let mut lib = Vec::new();
+            simulate(&deck, &meas, n, 1e-5, &mut lib).unwrap();
+            let pc = (period * rate).round() as usize;
+            let (a0, b0) = last_cycle_peaks(&truth, pc);
+            let (a1, b1) = last_cycle_peaks(&lib, pc);
+            let pk = b1.max(-a1);
+            let dpk = (a0 - a1).abs().max((b0 - b1).abs()) / pk;
+            let rms = (truth[n - pc..]
+                .iter()
+                .zip(&lib[n - pc..])
+                .map(|(x, y)| (x - y).powi(2))
+                .sum::<f64>()
+                / pc as f64)
+                .sqrt()
+                / pk;
+            eprintln!("{w} rad/s {v} in/s (mean {:.0} mm): truth2 [{a0:.0}, {b0:.0}] N, rotorsim [{a1:.0}, {b1:.0}] N; peak difference {:.3}%, RMS difference {:.3}% of peak", mean * 1e3, 100.0 * dpk, 100.0 * rms);
+            worst_peak = worst_peak.max(dpk);
+            worst_rms = worst_rms.max(rms);
+        }
+        assert!(
+            worst_peak < 1e-3,
+            "peak forces differ by {:.2}%",
+            100.0 * worst_peak
+        );
+        assert!(
+            worst_rms < 1e-3,
+            "histories differ by {:.2}% RMS",
+            100.0 * worst_rms
+        );
+    }
+
+    #[test]
+    fn truth2_records_the_force_averaged_and_the_stroke_through_its_sensor() {
+        let m = Model::new(DataSheet::nominal());
+        let prog = Programme::A;
+        let rate = prog.rate_hz();
+        let h = 1.0 / rate;
+        let test = &prog.tests()[1]; // 3 in/s at 34 rad/s, below the relief valves
+        let t = test.times(rate);
+        let (f, s) = record(
+            &m,
+            &test.motion,
+            prog.sensor(),
+            &t,
+            h,
+            0.0,
+            Tolerance::default(),
+        )
+        .unwrap();
+        // The force at t_k is the mean of the instantaneous force over [t_k - h, t_k]
+        // (composite Simpson, 32 panels, on samples 600-609).
+        let panels = 32;
+        let fine: Vec<f64> = (600 * panels - panels..=609 * panels)
+            .map(|j| j as f64 * h / panels as f64)
+            .collect();
+        let fi = force_at(&m, &test.motion, &fine, Tolerance::default()).unwrap();
+        let peak = f.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for (k, &fk) in f.iter().enumerate().skip(600).take(10) {
+            let o = (k - 600) * panels;
+            let mut sum = fi[o] + fi[o + panels];
+            for j in 1..panels {
+                sum += if j % 2 == 1 { 4.0 } else { 2.0 } * fi[o + j];
+            }
+            let mean = sum / (3.0 * panels as f64);
+            assert!(
+                (fk - mean).abs() < 1e-5 * peak,
+                "sample {k}: {fk} vs {mean}"
+            );
+        }
+        // Not the instantaneous force: half a sample's delay on a force of this rate.
+        let inst = force_at(&m, &test.motion, &t[600..610], Tolerance::default()).unwrap();
+        let moved = f[600..610]
+            .iter()
+            .zip(&inst)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(moved > 1e-3 * peak, "averaging moves the force: {moved} N");
+        // A lag of exactly three samples is the record three samples earlier.
+        let (fl, _) = record(
+            &m,
+            &test.motion,
+            prog.sensor(),
+            &t,
+            h,
+            3.0 * h,
+            Tolerance::default(),
+        )
+        .unwrap();
+        let worst = fl[3..]
+            .iter()
+            .zip(&f)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-6 * peak, "three-sample lag: {worst} N");
+        // The sensor is the true stroke delayed by its group delay 2 zeta/omega_c, to second
+        // order in omega/omega_c, after its first cycle.
+        let tau = prog.sensor().delay();
+        let amp = test.motion.terms[0].1;
+        let pc = (test.motion.period() * rate).round() as usize;
+        let worst = t[pc..]
+            .iter()
+            .zip(&s[pc..])
+            .map(|(&tk, &sk)| (sk - test.motion.at(tk - tau).0).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "sensor against the stroke {:.3} ms earlier: {:.1e} of the amplitude",
+            tau * 1e3,
+            worst / amp
+        );
+        assert!(worst < 1e-4 * amp, "{worst}");
+        // The channels' skew (force delay h/2 less the sensor's) is within half a sample.
+        for p in [Programme::A, Programme::B] {
+            let half = 0.5 / p.rate_hz();
+            eprintln!("programme {}: force delay {:.3} ms, stroke delay {:.3} ms, skew {:+.3} ms ({:+.3} samples)", p.name(), half * 1e3, p.sensor().delay() * 1e3, p.skew_s() * 1e3, p.skew_s() * p.rate_hz());
+            assert!(p.skew_s().abs() < 0.5 * half, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn suite2_campaigns_carry_the_second_truths_conventions() {
+        let all = suite2();
+        let cp = all
+            .iter()
+            .find(|c| c.id == "t2_none_1")
+            .expect("t2_none_1")
+            .clone();
+        let data = bench_campaign(&cp, 4, 2000.0).unwrap();
+        let lsb = suite2::stroke_lsb();
+        assert!((lsb - 0.05 / 65536.0).abs() < 1e-18);
+        for m in &data {
+            assert!(m
+                .stroke_m
+                .iter()
+                .all(|x| ((x / lsb) - (x / lsb).round()).abs() < 1e-6));
+            assert!(m.oil_temperature_k.is_none());
+            let dt = m.time_s[1] - m.time_s[0];
+            assert!((dt - 1e-3).abs() < 1e-12, "programme B samples at 1 kHz");
+        }
+        // the same campaign twice: bit for bit
+        assert_eq!(bench_campaign(&cp, 4, 2000.0).unwrap(), data);
+        // a fault's lag is scored with the programme's skew
+        let lag = all.iter().find(|c| c.id == "t2_acq_lag_1").unwrap();
+        let p = suite2::truth_parameters(&lag.effects[0], Programme::B);
+        assert_eq!(p[0].0, "lag_s");
+        assert!((p[0].1.unwrap() - (4.3e-3 + Programme::B.skew_s())).abs() < 1e-15);
+        let row = csv_row(&cp, &name_score_row(), 0.0);
+        assert!(row.starts_with("t2_none_1,bench,second,none,"), "{row}");
+        assert!(csv_header().starts_with("id,kind,truth,hidden,"));
+    }
+
+    fn name_score_row() -> Score {
+        Score {
+            named: "none".into(),
+            exact: true,
+            hidden_among_named: true,
+            gain: 0.0,
+            best_gain: None,
+            sub_noise: false,
+            gain_required: 0.3,
+            params: vec![],
+        }
+    }
+
+    #[test]
+    fn suite2_spans_every_effect_on_its_own_programme() {
+        let all = suite2();
+        assert!(all.len() >= 30, "{}", all.len());
+        let mut ids: Vec<&str> = all.iter().map(|c| c.id.as_str()).collect();
+        assert!(ids.iter().all(|id| id.starts_with("t2_")));
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), all.len(), "unique ids");
+        assert!(all
+            .iter()
+            .all(|c| matches!(c.truth, TruthModel::Second(_)) && !c.flight));
+        let none = all.iter().filter(|c| c.effects.is_empty()).count();
+        assert!(none >= 4);
+        let faults_alone = all
+            .iter()
+            .filter(|c| !c.effects.is_empty() && c.effects.iter().all(|e| e.is_fault()))
+            .count();
+        assert!(faults_alone >= 6);
+        let pairs = all.iter().filter(|c| c.effects.len() == 2).count();
+        assert!((1..=2).contains(&pairs));
+        for cause in [
+            "seal_friction",
+            "free_play",
+            "compliant_free_play",
+            "mount_compliance",
+            "entrained_air",
+            "entrained_air_by_chamber",
+            "area_asymmetry",
+            "relief_asymmetry",
+            "piston_leakage",
+            "accumulator_bleed",
+            "recalibration",
+            "force_lag",
+            "force_offset",
+            "force_gain",
+            "force_drift",
+            "force_clipping",
+            "force_dropouts",
+        ] {
+            assert!(
+                all.iter()
+                    .any(|c| c.effects.iter().any(|e| e.cause() == cause)),
+                "{cause}"
+            );
+        }
+        // seeds of their own, not the first suite's
+        let first: Vec<u64> = suite().iter().map(|c| c.seed).collect();
+        assert!(all.iter().all(|c| !first.contains(&c.seed)));
+        // The programmes: >= 32 samples per cycle of the highest harmonic, >= 4 cycles, >= 3
+        // amplitudes, inside the sensor's range and the chambers' travel.
+        let s = DataSheet::nominal();
+        let travel =
+            (s.chamber_volume[0] / s.piston_area[0]).min(s.chamber_volume[1] / s.piston_area[1]);
+        for p in [Programme::A, Programme::B] {
+            let mut amps: Vec<f64> = Vec::new();
+            for t in p.tests() {
+                let top = t.motion.terms.iter().fold(0.0f64, |a, x| a.max(x.0)) * t.motion.omega;
+                assert!(
+                    p.rate_hz() * 2.0 * std::f64::consts::PI / top >= 32.0,
+                    "{}",
+                    t.name
+                );
+                assert!(t.cycles >= 4);
+                let reach = t.motion.mean.abs() + t.motion.terms.iter().map(|x| x.1).sum::<f64>();
+                assert!(
+                    reach < 0.5 * suite2::STROKE_RANGE_M && reach < 0.5 * travel,
+                    "{}",
+                    t.name
+                );
+                amps.push(t.motion.terms.iter().map(|x| x.1).sum::<f64>());
+            }
+            amps.sort_by(f64::total_cmp);
+            amps.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+            assert!(amps.len() >= 3);
+        }
+        // magnitudes none of the first suite's
+        let first_effects: Vec<Effect> = suite().iter().flat_map(|c| c.effects.clone()).collect();
+        for e in all.iter().flat_map(|c| &c.effects) {
+            assert!(
+                !first_effects.contains(e),
+                "{e:?} is a first-suite magnitude"
+            );
+        }
+    }
 }
