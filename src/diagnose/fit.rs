@@ -4,6 +4,7 @@
 use super::acquisition::{self, Fault, Span};
 use super::candidates::{apply_all, combined_name, combined_params, Cause, ParamSpec, Scales};
 use super::data::{check_measurements, min_max, noise_sigma, Measurement};
+use super::support::{self, NoEffect, NoEffectContext, NotSupported, PartSupport};
 use super::DiagnoseError;
 use crate::hydraulics::{
     bench::sample_path, sample_rates, DamperDeck, DamperModel, Device, HydraulicError,
@@ -167,6 +168,33 @@ pub struct Diagnosis {
     /// Candidates the data cannot tell apart, why, and the test that would decide.
     pub identifiability: Vec<super::identify::Identifiability>,
     pub tests: Vec<TestSummary>,
+    /// The no-effect value (or band) of every parameter of the cause that has one
+    /// ([`super::support::no_effect`]).
+    pub parameter_no_effect: BTreeMap<String, NoEffect>,
+    /// Candidates that passed the tests of their role (first cause or companion) but are not
+    /// named: the data do not distinguish one of their causes from no effect.
+    pub considered_not_supported: Vec<NotSupported>,
+    /// The naming rule, as text, with the lag's timing uncertainty of these data.
+    pub criterion_naming: String,
+}
+
+impl Diagnosis {
+    /// The naming rule checked on the named cause: one entry per cause of the name (`a`,
+    /// `a+b`, `a+force_lag`, screened faults too; none for `none`), `supported` when the 95%
+    /// interval of at least one of its parameters (`parameter_intervals`) excludes that
+    /// parameter's no-effect value (`parameter_no_effect`; the lag: lies wholly outside its
+    /// timing uncertainty), with the reason (which interval, which value). A diagnosis names
+    /// only supported causes, so every entry of a diagnosis made by [`diagnose`] is supported;
+    /// a test can assert it on any diagnosis, e.g.
+    /// `assert!(d.named_parameters_supported().iter().all(|p| p.supported))`.
+    pub fn named_parameters_supported(&self) -> Vec<PartSupport> {
+        super::support::support(
+            &self.cause,
+            &self.parameters,
+            &self.parameter_intervals,
+            &self.parameter_no_effect,
+        )
+    }
 }
 
 /// Measured, baseline and extended force of one test (for the report).
@@ -1010,6 +1038,21 @@ fn name_screened(
     (named, params, iv)
 }
 
+/// The tests' sample interval [s]: each test's median step, the largest of them (the lag's
+/// timing uncertainty is half of it).
+fn sample_interval_s(data: &[Measurement]) -> f64 {
+    data.iter()
+        .map(|m| {
+            let mut d: Vec<f64> = m.time_s.windows(2).map(|w| w[1] - w[0]).collect();
+            if d.is_empty() {
+                return 0.0;
+            }
+            let mid = d.len() / 2;
+            *d.select_nth_unstable_by(mid, f64::total_cmp).1
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Whether a candidate's name holds an acquisition fault.
 fn has_fault(name: &str) -> bool {
     name.split('+').any(|n| Fault::from_name(n).is_some())
@@ -1453,6 +1496,23 @@ pub fn diagnose(
             .filter_map(|f| fault_candidate(f, None, &baseline, base, &fcx)),
     );
     evaluated.sort_by(|a, b| a.0.bic.total_cmp(&b.0.bic));
+    // The naming rule (src/diagnose/support.rs): a cause is named only where the 95% interval
+    // of one of its parameters excludes its no-effect value; the lag's is a band, the timing
+    // uncertainty (half the sample interval plus the replay's own delay).
+    let sample_h = sample_interval_s(data);
+    let ne_cx = NoEffectContext::new(base, sample_h, fcx.replay_delay_s);
+    let no_effect_of = |r: &Candidate, iv: &BTreeMap<String, [f64; 2]>| {
+        support::no_effects(&r.cause, &r.parameters, iv, &ne_cx)
+    };
+    let parts_of = |r: &Candidate| -> Vec<PartSupport> {
+        support::support(
+            &r.cause,
+            &r.parameters,
+            &r.intervals,
+            &no_effect_of(r, &r.intervals),
+        )
+    };
+    let supported = |r: &Candidate| support::all_supported(&parts_of(r));
     // A fault beside a physical cause: the fault fitted on top of the cause's replay, then the
     // cause refitted to the data the fault corrects and the fault again on top, while the BIC
     // falls (at most twice): alternating least squares towards the joint fit.
@@ -1534,10 +1594,19 @@ pub fn diagnose(
     let mut pair_ref: Option<(f64, f64)> = None;
     let mut companions: Vec<Companion> = Vec::new();
     let mut pair_stage = String::from("no single cause passes: no companion is tried");
+    // The first cause: the lowest-BIC candidate the data support (those ahead of it that the
+    // data do not support are passed over and, where they pass the tests, recorded).
     let first = evaluated
-        .first()
-        .filter(|e| e.1.is_some())
+        .iter()
+        .filter(|e| e.1.is_some() && Some(&e.0.cause) != demoted.as_ref())
+        .find(|e| supported(&e.0))
         .map(|e| (e.0.clone(), e.3.clone()));
+    let passed_over: Vec<String> = evaluated
+        .iter()
+        .filter(|e| e.1.is_some() && Some(&e.0.cause) != demoted.as_ref())
+        .take_while(|e| first.as_ref().is_none_or(|f| f.0.cause != e.0.cause))
+        .map(|e| e.0.cause.clone())
+        .collect();
     let mut refit_single: Option<Evaluated> = None;
     let first_cause = first.as_ref().map(|f| f.0.cause.clone());
     if let Some((row, x1)) = first {
@@ -1838,6 +1907,12 @@ pub fn diagnose(
             evaluated.extend(fault_pairs);
         }
     }
+    if !passed_over.is_empty() {
+        pair_stage.push_str(&format!(
+            "; passed over as the first cause (lower BIC, but an interval that includes no effect): {}",
+            passed_over.join(", ")
+        ));
+    }
     // Held-out test of every companion fitted, corrected for their number (Bonferroni): the
     // pair's change to the single's prediction on the held-out data, `d = mu_pair - mu_single`,
     // against the single's residual `e`: `z = sum(e d) / (sigma ||d||)` is standard normal if
@@ -1885,6 +1960,37 @@ pub fn diagnose(
             }
         }
     }
+    // The naming rule on every companion that passes its tests: each cause of the pair with its
+    // own interval (the first cause's too, refitted beside the companion).
+    let mut not_supported: Vec<NotSupported> = Vec::new();
+    for c in companions.iter_mut().filter(|c| c.passes) {
+        let Some(e) = evaluated
+            .iter()
+            .find(|e| e.0.cause == c.pair && e.1.is_some())
+        else {
+            continue;
+        };
+        let parts = parts_of(&e.0);
+        if support::all_supported(&parts) {
+            continue;
+        }
+        let ns = NotSupported::new(
+            &e.0.cause,
+            "companion",
+            &e.0.parameters,
+            &e.0.intervals,
+            no_effect_of(&e.0, &e.0.intervals),
+            &parts,
+            "passes the companions' tests (BIC, held-out RMS, held-out z)",
+        );
+        c.passes = false;
+        c.reason.push_str(&format!(
+            "; not named: the data do not support {} (considered_not_supported)",
+            ns.parts_not_supported.join(" and ")
+        ));
+        refused.push(c.pair.clone());
+        not_supported.push(ns);
+    }
     if let Some(b) = refit_single {
         if let Some(slot) = evaluated.iter_mut().find(|e| e.0.cause == b.0.cause) {
             *slot = b;
@@ -1895,54 +2001,8 @@ pub fn diagnose(
         demote_behind(&mut evaluated, d);
     }
 
-    // Choice: the lowest BIC, if it beats the baseline's BIC and improves the held-out RMS by
-    // more than the noise-level threshold.
-    // A pair must beat the single it extends as the single beat the baseline.
-    let chosen = evaluated.iter().find(|(row, sim, _, _)| {
-        let (ref_bic, ref_held) = if row.cause.contains('+') {
-            pair_ref.unwrap_or((f64::NEG_INFINITY, f64::NEG_INFINITY))
-        } else {
-            (base_bic, base_held)
-        };
-        sim.is_some()
-            && Some(&row.cause) != demoted.as_ref()
-            && !refused.contains(&row.cause)
-            && row.bic < ref_bic
-            && ref_held - row.held_out_rms_N > threshold
-    });
-    // Only the lowest-BIC candidate may be chosen, unless it is a pair that fails its own test
-    // (then the best single is next in line) or a demoted compliant free play.
-    let chosen = chosen.filter(|c| {
-        evaluated
-            .iter()
-            .take_while(|e| !std::ptr::eq(*e, *c))
-            .all(|e| e.0.cause.contains('+') || Some(&e.0.cause) == demoted.as_ref())
-    });
-    let (cause, params, ext_sim, ext_deck, ext_rms, ext_held, param_iv) = match chosen {
-        Some((row, Some(sim), deck, _)) => (
-            row.cause.clone(),
-            row.parameters.clone(),
-            sim.clone(),
-            deck.clone(),
-            row.rms_N,
-            row.held_out_rms_N,
-            row.intervals.clone(),
-        ),
-        _ => (
-            "none".to_string(),
-            BTreeMap::new(),
-            baseline.clone(),
-            base.clone(),
-            base_rms,
-            base_held,
-            BTreeMap::new(),
-        ),
-    };
-    // The cause's parameters test by test: their spread beyond the noise widens the intervals
-    // (in ln x, in quadrature with the noise and model-form half-width).
-    let mut param_iv = param_iv;
-    let mut spreads = BTreeMap::new();
-    // Three tests or more: test by test; fewer (a flight record): cycle by cycle from the second.
+    // Three tests or more: the spread test by test; fewer (a flight record): cycle by cycle
+    // from the second.
     let (spread_w, labels): (Vec<Window>, Vec<String>) = if data.len() >= 3 {
         let labels = data.iter().map(|m| m.name.clone()).collect();
         (all_w.clone(), labels)
@@ -1964,25 +2024,133 @@ pub fn diagnose(
             })
             .unzip()
     };
-    if let (Some((row, Some(_), _, x)), true) = (chosen, spread_w.len() >= 3) {
-        if let Some(causes) = causes_of(&row.cause) {
-            if let Some(spec) = combined_params(&causes, base, scales) {
-                let spread = parameter_spread(
-                    &causes, scales, base, &spec, x, data, &spread_w, &labels, opts, sigma, scale,
-                );
-                for ((p, xc), sp) in spec.iter().zip(x).zip(spread) {
-                    if let Some(iv) = param_iv.get_mut(p.name) {
-                        if iv[1].is_finite() && iv[0] > 0.0 && sp.spread_ln > 0.0 {
-                            let half = (iv[1] / xc).ln().max((xc / iv[0]).ln());
-                            let half = half.hypot(Z95 * sp.spread_ln);
-                            *iv = [xc * (-half).exp(), xc * half.exp()];
+    // Choice: the lowest BIC among the candidates the data support, if it beats the baseline's
+    // BIC and improves the held-out RMS by more than the noise-level threshold. A pair must
+    // beat the single it extends as the single beat the baseline. The cause's intervals then
+    // take its spread across tests: a cause the data no longer support with them is passed over
+    // too, and the choice made again.
+    let mut spread_refused: Vec<String> = Vec::new();
+    let (chosen, param_iv, spreads) = loop {
+        let chosen = evaluated.iter().find(|(row, sim, _, _)| {
+            let (ref_bic, ref_held) = if row.cause.contains('+') {
+                pair_ref.unwrap_or((f64::NEG_INFINITY, f64::NEG_INFINITY))
+            } else {
+                (base_bic, base_held)
+            };
+            sim.is_some()
+                && Some(&row.cause) != demoted.as_ref()
+                && !refused.contains(&row.cause)
+                && !spread_refused.contains(&row.cause)
+                && row.bic < ref_bic
+                && ref_held - row.held_out_rms_N > threshold
+                && supported(row)
+        });
+        // Only the lowest-BIC candidate the data support may be chosen, unless it is a pair
+        // that fails its own test (then the best single is next in line) or a demoted
+        // compliant free play.
+        let chosen = chosen.filter(|c| {
+            evaluated
+                .iter()
+                .take_while(|e| !std::ptr::eq(*e, *c))
+                .all(|e| {
+                    e.0.cause.contains('+')
+                        || Some(&e.0.cause) == demoted.as_ref()
+                        || spread_refused.contains(&e.0.cause)
+                        || !supported(&e.0)
+                })
+        });
+        let Some(row) = chosen.map(|c| &c.0) else {
+            break (None, BTreeMap::new(), BTreeMap::new());
+        };
+        // The cause's parameters test by test: their spread beyond the noise widens the
+        // intervals (in ln x, in quadrature with the noise and model-form half-width).
+        let mut param_iv = row.intervals.clone();
+        let mut spreads = BTreeMap::new();
+        if let (Some((_, Some(_), _, x)), true) = (chosen, spread_w.len() >= 3) {
+            if let Some(causes) = causes_of(&row.cause) {
+                if let Some(spec) = combined_params(&causes, base, scales) {
+                    let spread = parameter_spread(
+                        &causes, scales, base, &spec, x, data, &spread_w, &labels, opts, sigma,
+                        scale,
+                    );
+                    for ((p, xc), sp) in spec.iter().zip(x).zip(spread) {
+                        if let Some(iv) = param_iv.get_mut(p.name) {
+                            if iv[1].is_finite() && iv[0] > 0.0 && sp.spread_ln > 0.0 {
+                                let half = (iv[1] / xc).ln().max((xc / iv[0]).ln());
+                                let half = half.hypot(Z95 * sp.spread_ln);
+                                *iv = [xc * (-half).exp(), xc * half.exp()];
+                            }
                         }
+                        spreads.insert(p.name.to_string(), sp);
                     }
-                    spreads.insert(p.name.to_string(), sp);
                 }
             }
         }
+        let ne = no_effect_of(row, &param_iv);
+        let parts = support::support(&row.cause, &row.parameters, &param_iv, &ne);
+        if support::all_supported(&parts) {
+            break (chosen, param_iv, spreads);
+        }
+        not_supported.push(NotSupported::new(
+            &row.cause,
+            if companions.iter().any(|c| c.pair == row.cause) {
+                "companion"
+            } else {
+                "cause"
+            },
+            &row.parameters,
+            &param_iv,
+            ne,
+            &parts,
+            "passes the tests of the choice, but with its parameters' spread across the tests",
+        ));
+        spread_refused.push(row.cause.clone());
+    };
+    // Candidates passed over as the first cause: every one ahead of the first supported
+    // candidate that passes the choice's tests against the baseline.
+    for e in evaluated
+        .iter()
+        .filter(|e| e.1.is_some() && Some(&e.0.cause) != demoted.as_ref())
+        .filter(|e| !companions.iter().any(|c| c.pair == e.0.cause))
+        .take_while(|e| !supported(&e.0) || spread_refused.contains(&e.0.cause))
+    {
+        let r = &e.0;
+        if spread_refused.contains(&r.cause)
+            || !(r.bic < base_bic && base_held - r.held_out_rms_N > threshold)
+        {
+            continue;
+        }
+        not_supported.push(NotSupported::new(
+            &r.cause,
+            "cause",
+            &r.parameters,
+            &r.intervals,
+            no_effect_of(r, &r.intervals),
+            &parts_of(r),
+            &format!(
+                "BIC {:.1} below the baseline's {base_bic:.1} and held-out RMS {:.1} N below the baseline's {base_held:.1} N by more than the threshold {threshold:.1} N",
+                r.bic, r.held_out_rms_N
+            ),
+        ));
     }
+    let (cause, params, ext_sim, ext_deck, ext_rms, ext_held) = match chosen {
+        Some((row, Some(sim), deck, _)) => (
+            row.cause.clone(),
+            row.parameters.clone(),
+            sim.clone(),
+            deck.clone(),
+            row.rms_N,
+            row.held_out_rms_N,
+        ),
+        _ => (
+            "none".to_string(),
+            BTreeMap::new(),
+            baseline.clone(),
+            base.clone(),
+            base_rms,
+            base_held,
+        ),
+    };
     let free_play_limit = free_play_limit(&cause, &evaluated, &param_iv);
     for c in &mut companions {
         c.kept = c.pair == cause;
@@ -2093,6 +2261,7 @@ pub fn diagnose(
             signatures.push(super::evidence::signature(&curves, sim, &e.0.cause, band));
         }
     }
+    let parameter_no_effect = support::no_effects(&cause, &params, &param_iv, &ne_cx);
     let (cause, params, param_iv) = name_screened(
         &screened,
         (cause, params, param_iv),
@@ -2131,6 +2300,14 @@ pub fn diagnose(
         signatures,
         identifiability,
         tests,
+        parameter_no_effect,
+        considered_not_supported: not_supported,
+        criterion_naming: format!(
+            "a cause (each cause of a pair, a physical cause and an acquisition fault beside it alike) is named only if the 95% interval of at least one of its parameters excludes that parameter's no-effect value (an end unbounded toward it does not); the lag's no-effect value is its timing uncertainty, +-{:.4} ms here (half the sample interval h = {:.4} ms, plus the replay's own delay {:.4} ms): its interval must lie wholly outside it; candidates that pass the tests but not this are listed in considered_not_supported",
+            1e3 * ne_cx.lag_timing_s,
+            1e3 * sample_h,
+            1e3 * fcx.replay_delay_s.abs()
+        ),
     };
     Ok(Outcome {
         diagnosis,

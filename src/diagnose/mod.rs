@@ -11,10 +11,12 @@ pub mod identify;
 pub mod pipeline;
 pub mod report;
 pub mod rotor;
+pub mod support;
 
 pub use candidates::Cause;
 pub use data::{check_measurements, screen, Measurement, Screened};
 pub use fit::{diagnose, Curves, DiagnoseOptions, Diagnosis, Outcome};
+pub use support::{NoEffect, NotSupported, PartSupport};
 
 /// Errors of the diagnosis: what cannot be decided and why.
 #[derive(Debug, thiserror::Error)]

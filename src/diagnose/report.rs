@@ -252,6 +252,46 @@ pub fn html_with(
             .collect();
         r.table(&["not separable", "why", "test that would decide"], &rows);
     }
+    if !d.considered_not_supported.is_empty() {
+        r.heading(2, "Considered, not supported");
+        r.paragraph("Candidates that pass the tests of their role (first cause or companion) but are not named: the 95% interval of each parameter of at least one of their causes includes its no-effect value (a lag: lies within the timing uncertainty), so the data do not tell that cause from no effect.");
+        let rows: Vec<Vec<String>> = d
+            .considered_not_supported
+            .iter()
+            .map(|n| {
+                let params = n
+                    .parameters
+                    .iter()
+                    .map(|(k, v)| {
+                        let iv = n.intervals.get(k).map_or(String::new(), |[lo, hi]| {
+                            format!(" (95% {lo:.3e} - {hi:.3e})")
+                        });
+                        let ne = n
+                            .no_effect
+                            .get(k)
+                            .map_or("none of its own".into(), |e| e.describe());
+                        format!("{k} = {v:.4e}{iv}, no effect at {ne}")
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; ");
+                vec![
+                    n.name.clone(),
+                    n.role.clone(),
+                    params,
+                    n.parts_not_supported.join(", "),
+                ]
+            })
+            .collect();
+        r.table(
+            &[
+                "candidate",
+                "role",
+                "parameters (95% interval), no-effect value",
+                "not supported",
+            ],
+            &rows,
+        );
+    }
     if !d.parameter_spread.is_empty() {
         r.heading(2, "The cause's parameters test by test");
         r.paragraph("Each parameter of the cause fitted to each test alone. A model of the right form gives every test the same value up to noise; a value that moves with amplitude or frequency stands in for something the model does not have. The spread is the standard deviation of ln x across tests beyond the noise (DerSimonian-Laird); the 95% interval above includes it.");
