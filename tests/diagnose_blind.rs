@@ -310,6 +310,44 @@ fn blind_subset_names_the_hidden_effect_with_the_required_gain() {
     assert_eq!(r.none_on_no_effect, r.no_effect, "{r}");
     assert_eq!(r.gain_met, r.named, "{r}");
     assert!(r.with_fault > 0 && r.fault_rate() >= 0.9, "{r}");
+    // the naming rule, on every diagnosis of the subset (both truths)
+    for (cp, s) in subset_rows() {
+        assert!(
+            s.named_supported,
+            "{}: {} named without support",
+            cp.id, s.named
+        );
+    }
+}
+
+/// The naming rule over every row of both committed suites (docs/diagnosis_blind_suite.csv and
+/// docs/diagnosis_blind_suite_truth2.csv, each the run its section of docs/diagnosis.md
+/// reports): no named cause has an interval that contains its no-effect value.
+#[test]
+fn every_row_of_both_suites_names_only_supported_causes() {
+    for (file, rows_expected) in [
+        ("docs/diagnosis_blind_suite.csv", suite().len()),
+        ("docs/diagnosis_blind_suite_truth2.csv", suite2().len()),
+    ] {
+        let text = std::fs::read_to_string(file).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = header
+            .iter()
+            .position(|h| *h == "named_supported")
+            .unwrap_or_else(|| panic!("{file}: no named_supported column"));
+        let ids = header.iter().position(|h| *h == "id").unwrap();
+        let mut n = 0;
+        for line in lines {
+            // the magnitudes column is quoted and may hold commas: count from the row's end
+            let cells: Vec<&str> = line.split(',').collect();
+            let back = header.len() - col;
+            let cell = cells[cells.len() - back];
+            assert_eq!(cell, "true", "{file}: {}", cells[ids]);
+            n += 1;
+        }
+        assert_eq!(n, rows_expected, "{file}: every campaign of the suite");
+    }
 }
 
 /// The subset's campaigns run once for both tests (`subset_rows`). It holds one of the full
@@ -642,7 +680,7 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
             _ => {}
         }
     }
-    // The CI subset: the earlier nine campaigns and two with a fault.
+    // The CI subset: the earlier nine campaigns, two with a fault and two of the second truth.
     let ids: Vec<String> = ci_subset().into_iter().map(|c| c.id).collect();
     assert_eq!(
         ids,
@@ -657,7 +695,9 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
             "pair_5",
             "pair_1",
             "flight_5",
-            "acq_gain_0"
+            "acq_gain_0",
+            "t2_none_0",
+            "t2_pair_0"
         ]
     );
     assert_eq!(ci_subset().iter().filter(|c| faults(c) > 0).count(), 2);
@@ -682,6 +722,7 @@ fn acquisition_fault_campaigns_exist_and_are_scored() {
         sub_noise: false,
         gain_required: 0.3,
         params: vec![],
+        named_supported: true,
     };
     let rows = vec![
         (pair.clone(), named("force_lag+entrained_air")),
@@ -1121,6 +1162,7 @@ mod second {
             sub_noise: false,
             gain_required: 0.3,
             params: vec![],
+            named_supported: true,
         }
     }
 

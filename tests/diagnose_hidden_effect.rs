@@ -351,6 +351,7 @@ fn a_warming_oil_is_named_with_its_density_coefficient() {
     }
     let o = diagnose(&base, &data, &DiagnoseOptions::default()).unwrap();
     let d = &o.diagnosis;
+    eprintln!("{}: {}; {}", d.cause, d.criterion, d.pair_stage);
     assert_eq!(d.cause, "oil_temperature", "{:#?}", d.candidates);
     let got = d.parameters["density_thermal_coefficient_per_K"];
     eprintln!(

@@ -157,6 +157,46 @@ fn rss(fault: Fault, v: f64, data: &[Measurement], model: &[Vec<f64>], spans: &[
         .sum()
 }
 
+/// The lag within `[-band, band]` that best aligns `model` with the recorded force over
+/// `spans` (golden-section search; RSS is smooth in the lag at this scale), and the model so
+/// shifted, one full series per test. What a sampling convention alone can do to a model: the
+/// no-effect reference a cause must beat ([`super::support::timing_uncertainty_s`]).
+pub fn aligned_within(
+    data: &[Measurement],
+    model: &[Vec<f64>],
+    spans: &[Span],
+    band: f64,
+) -> (f64, Vec<Vec<f64>>) {
+    let e = |v: f64| rss(Fault::Lag, v, data, model, spans);
+    let (mut a, mut b) = (-band.abs(), band.abs());
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (e(c), e(d));
+    while b - a > 1e-3 * band.abs().max(1e-9) {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - g * (b - a);
+            fc = e(c);
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + g * (b - a);
+            fd = e(d);
+        }
+    }
+    let mid = 0.5 * (a + b);
+    // the ends of the band and no lag too: the optimum may sit on one
+    let lag = [0.0, -band.abs(), mid, band.abs()]
+        .into_iter()
+        .min_by(|x, y| e(*x).total_cmp(&e(*y)))
+        .unwrap_or(0.0);
+    let shifted = data
+        .iter()
+        .zip(model)
+        .map(|(m, f)| Fault::Lag.apply(lag, &m.time_s, f))
+        .collect();
+    (lag, shifted)
+}
+
 /// Gains a calibration error can have: a channel reading half or twice the force (or with the
 /// wrong sign) has the wrong unit or wiring, not a calibration error, and a damper model that
 /// predicts almost no force must not be scaled up to the data.
@@ -222,24 +262,23 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
                     (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64
                 })
                 .fold(f64::INFINITY, f64::min);
-            let kmax = (max_lag(data, spans) / dt).floor().max(1.0) as usize;
+            let kmax = (max_lag(data, spans) / dt).floor().max(1.0) as i64;
             let mut evals = 0;
             let mut e = |v: f64| {
                 evals += 1;
                 rss(fault, v, data, model, spans)
             };
+            // Either sign: the force channel may lag the stroke channel or lead it (a stroke
+            // sensor's filter delays the stroke).
             let (mut kbest, mut best) = (0, f64::INFINITY);
-            for k in 0..=kmax {
+            for k in -kmax..=kmax {
                 let r = e(k as f64 * dt);
                 if r < best {
                     (kbest, best) = (k, r);
                 }
             }
             // Golden section on [k-1, k+1] samples (RSS is smooth between samples).
-            let (mut a, mut b) = (
-                (kbest as f64 - 1.0).max(0.0) * dt,
-                (kbest as f64 + 1.0) * dt,
-            );
+            let (mut a, mut b) = ((kbest as f64 - 1.0) * dt, (kbest as f64 + 1.0) * dt);
             let g = 0.5 * (5f64.sqrt() - 1.0);
             let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
             let (mut fc, mut fd) = (e(c), e(d));
