@@ -157,6 +157,26 @@ fn rss(fault: Fault, v: f64, data: &[Measurement], model: &[Vec<f64>], spans: &[
         .sum()
 }
 
+/// The minimiser of `e` on `[a, b]` by golden-section search, to a bracket of width `tol`
+/// (the bracket's middle).
+fn golden_section(e: &mut impl FnMut(f64) -> f64, mut a: f64, mut b: f64, tol: f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (e(c), e(d));
+    while b - a > tol {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - g * (b - a);
+            fc = e(c);
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + g * (b - a);
+            fd = e(d);
+        }
+    }
+    0.5 * (a + b)
+}
+
 /// The lag within `[-band, band]` that best aligns `model` with the recorded force over
 /// `spans` (golden-section search; RSS is smooth in the lag at this scale), and the model so
 /// shifted, one full series per test. What a sampling convention alone can do to a model: the
@@ -168,22 +188,12 @@ pub fn aligned_within(
     band: f64,
 ) -> (f64, Vec<Vec<f64>>) {
     let e = |v: f64| rss(Fault::Lag, v, data, model, spans);
-    let (mut a, mut b) = (-band.abs(), band.abs());
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (e(c), e(d));
-    while b - a > 1e-3 * band.abs().max(1e-9) {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = e(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = e(d);
-        }
-    }
-    let mid = 0.5 * (a + b);
+    let mid = golden_section(
+        &mut |v| e(v),
+        -band.abs(),
+        band.abs(),
+        1e-3 * band.abs().max(1e-9),
+    );
     // the ends of the band and no lag too: the optimum may sit on one
     let lag = [0.0, -band.abs(), mid, band.abs()]
         .into_iter()
@@ -278,22 +288,12 @@ pub fn fit(fault: Fault, data: &[Measurement], model: &[Vec<f64>], spans: &[Span
                 }
             }
             // Golden section on [k-1, k+1] samples (RSS is smooth between samples).
-            let (mut a, mut b) = ((kbest as f64 - 1.0) * dt, (kbest as f64 + 1.0) * dt);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-            let (mut fc, mut fd) = (e(c), e(d));
-            while b - a > 1e-4 * dt {
-                if fc < fd {
-                    (b, d, fd) = (d, c, fc);
-                    c = b - g * (b - a);
-                    fc = e(c);
-                } else {
-                    (a, c, fc) = (c, d, fd);
-                    d = a + g * (b - a);
-                    fd = e(d);
-                }
-            }
-            let v = 0.5 * (a + b);
+            let v = golden_section(
+                &mut e,
+                (kbest as f64 - 1.0) * dt,
+                (kbest as f64 + 1.0) * dt,
+                1e-4 * dt,
+            );
             // Sensitivity: sum of (dF/dt)^2 at the lagged times (central differences).
             let h = 0.5 * dt;
             let mut s2 = 0.0;

@@ -207,18 +207,6 @@ pub fn magnitude(e: &Effect) -> String {
     }
 }
 
-/// Central differences (one-sided at the ends), as rotorsim differentiates a bench CSV's stroke
-/// when it has no velocity column.
-fn central_difference(t: &[f64], x: &[f64]) -> Vec<f64> {
-    let n = t.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
-            (x[b] - x[a]) / (t[b] - t[a])
-        })
-        .collect()
-}
-
 /// Sample times, recorded force, sensor stroke.
 pub type Recorded = (Vec<f64>, Vec<f64>, Vec<f64>);
 
@@ -268,7 +256,7 @@ pub fn bench_campaign(cp: &Campaign, programme: Programme) -> Result<Vec<Measure
                 q.clamp(-top, top - 1.0) * lsb
             })
             .collect();
-        let velocity = central_difference(&t, &stroke);
+        let velocity = rotorsim::hydraulics::bench::differentiate(&t, &stroke);
         out.push(Measurement {
             name: test.name.clone(),
             time_s: t,
