@@ -14,10 +14,10 @@
 //! - the case folders of a sweep or study (`cases/`): one weighted group a file, since the
 //!   study's own tables summarise them.
 //!
-//! Normalised: the result folder's, the work folder's and the repository's paths become
-//! `<OUT>`, `<WORK>`, `<REPO>`; what differs from run to run is left out (wall and CPU times,
-//! run ids, start and end times, the version, and the sha256 and size of outputs in
-//! manifest.json).
+//! Normalised: the binary's, the result folder's, the work folder's and the repository's paths
+//! become `<BIN>`, `<OUT>`, `<WORK>`, `<REPO>`; what differs from run to run or build to build
+//! is left out (wall times, run ids, start and end times, the version and git commit, and the
+//! sha256 and size of outputs in manifest.json).
 //!
 //! A file whose hash differs passes only if its fingerprint agrees within 1e-9 relative (each
 //! line against its own largest magnitude) and the case is listed, with the reason, in
@@ -35,7 +35,8 @@ const SAMPLES: usize = 5;
 const MAX_GROUPS: usize = 64;
 
 /// Keys whose values differ from run to run (and any key ending in `_wall_time_s`).
-const VOLATILE_KEYS: [&str; 7] = [
+const VOLATILE_KEYS: [&str; 8] = [
+    "git_commit",
     "wall_time_s",
     "cost_per_step_s",
     "start_time",
@@ -74,6 +75,7 @@ pub struct Paths {
 impl Paths {
     pub fn new(out: &Path, work: &Path) -> Self {
         let mut subs = vec![
+            (env!("CARGO_BIN_EXE_rotorsim").to_string(), "<BIN>"),
             (out.display().to_string(), "<OUT>"),
             (work.display().to_string(), "<WORK>"),
             (repo().display().to_string(), "<REPO>"),
