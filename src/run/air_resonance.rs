@@ -272,11 +272,8 @@ pub fn air_resonance_map(
     let mut nominal = vec![];
     let mut inertia = 0.0;
     for &om in speeds_rad_s {
-        let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
-        let k0 = specs[0].0.spec.bearing_lag().0;
-        let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
-            / m0.inertia_kg_m2)
-            .sqrt();
+        let mut w = super::rigid_blade::RigidLagBlade::of(&specs[0].0.spec, &specs[0].0.path)?
+            .lag_frequency_rad_s(om);
         let mut result = None;
         for _ in 0..2 {
             let w_lin = w.max(0.05 * om).max(0.1);

@@ -7,12 +7,13 @@
 //! and the linearised map's at 0.1 mm. Where the time-domain growth rate changes sign between
 //! two amplitudes there is a limit cycle.
 use super::air_resonance::HoverOptions;
+use super::rigid_blade::RigidLagBlade;
 use super::stability::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::rotor::RotorDeck;
 use crate::stability::{
     cyclic_amplitude, free_response_with_dampers, AirRotor, AirframeAxis, BladeDamper, BodyDof,
-    Hover, LagBlade, LagRotor, Mode, ModeLabel,
+    Hover, LagRotor, Mode, ModeLabel,
 };
 use anyhow::{anyhow, bail};
 use rayon::prelude::*;
@@ -251,16 +252,8 @@ impl Blades {
             return Ok(Reduced::Air(Box::new(r), Box::new(h)));
         }
         let mut blades = Vec::with_capacity(self.decks.len());
-        for ((b, _), &(k, c)) in self.decks.iter().zip(kc) {
-            let m = b.spec.lag_moments(&b.path)?;
-            blades.push(LagBlade {
-                mass_kg: m.mass_kg,
-                first_moment_kg_m: m.first_moment_kg_m,
-                inertia_kg_m2: m.inertia_kg_m2,
-                hinge_offset_m: b.spec.retention.hinge_r_m,
-                stiffness_nm_per_rad: b.spec.bearing_lag().0 + k,
-                damping_nms_per_rad: b.spec.bearing_lag().1 + c,
-            });
+        for ((b, _), &kc) in self.decks.iter().zip(kc) {
+            blades.push(RigidLagBlade::of(&b.spec, &b.path)?.lag_blade(kc));
         }
         Ok(Reduced::Lag(LagRotor {
             blades,
@@ -280,11 +273,7 @@ impl Blades {
         w_guess: Option<f64>,
     ) -> anyhow::Result<Equivalent> {
         let (b0, _) = &self.decks[0];
-        let m0 = b0.spec.lag_moments(&b0.path)?;
-        let mut w = ((b0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om
-            + b0.spec.bearing_lag().0)
-            / m0.inertia_kg_m2)
-            .sqrt();
+        let mut w = RigidLagBlade::of(&b0.spec, &b0.path)?.lag_frequency_rad_s(om);
         let passes = match w_guess {
             Some(g) => {
                 w = g;
