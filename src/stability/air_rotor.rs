@@ -38,8 +38,8 @@
 //! eigenvalues by the continuation of [`super::lag_rotor`].
 use super::dampers::{coupled_step, BladeDamper, DeviceResponse, StepForces};
 use super::lag_rotor::{
-    continued_modes, eigen_pairs, floquet_multipliers, upper_modes, Mode, ModeLabel, Result,
-    StabilityError,
+    continued_modes, eigen_pairs, floquet_multipliers, nearest, need_blades, out_of_range,
+    unit_cyclic, upper_modes, Mode, ModeLabel, Result, StabilityError,
 };
 use crate::aero::airfoil::{Airfoil, ClampCounts};
 use crate::aero::section::{blade_element, Air};
@@ -307,20 +307,10 @@ impl AirRotor {
             if ok && value.is_finite() {
                 Ok(())
             } else {
-                Err(StabilityError::OutOfRange {
-                    field,
-                    value,
-                    expected,
-                })
+                Err(out_of_range(field, value, expected))
             }
         };
-        if self.blades.is_empty() {
-            return Err(StabilityError::TooFewBlades {
-                what: "the air-resonance rotor",
-                count: 0,
-                min: 1,
-            });
-        }
+        need_blades("the air-resonance rotor", self.blades.len(), 1)?;
         for (k, b) in self.blades.iter().enumerate() {
             let f = |n: &str| format!("blades[{k}].{n}");
             bad(
@@ -896,13 +886,7 @@ impl AirRotor {
     /// All Coleman eigenvalues (conjugates included) with their labels, about the hover `h`.
     fn coleman_all(&self, h: &Hover) -> Result<Vec<(c64, ModeLabel)>> {
         let nb = self.blades.len();
-        if nb < 3 {
-            return Err(StabilityError::TooFewBlades {
-                what: "the Coleman transformation",
-                count: nb,
-                min: 3,
-            });
-        }
+        need_blades("the Coleman transformation", nb, 3)?;
         if !self.is_isotropic() {
             return Err(StabilityError::Numerical(
                 "the Coleman transformation needs identical blades (use Floquet)".into(),
@@ -974,12 +958,7 @@ impl AirRotor {
             .0;
         let [mm, cm, km] = self.coleman_matrices(h, 0.0)?;
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
-        let j = (0..lams.len())
-            .min_by(|&a, &b| {
-                (lams[a] - target)
-                    .norm()
-                    .total_cmp(&(lams[b] - target).norm())
-            })
+        let j = nearest(&lams, target)
             .ok_or_else(|| StabilityError::Numerical("no Coleman eigenvalue".into()))?;
         let lam = lams[j];
         let n = self.coordinate_count();
@@ -993,14 +972,7 @@ impl AirRotor {
                 z[n + i] += td[(i, c)] * m[c] + tt[(i, c)] * md[c];
             }
         }
-        let a = super::cyclic_amplitude(&z, self.blades.len(), h.omega_rad_s, 0.0, lam.im.abs());
-        if !(a > 0.0 && a.is_finite()) {
-            return Err(StabilityError::Numerical(format!(
-                "the {label} mode has no cyclic lag motion"
-            )));
-        }
-        z.iter_mut().for_each(|v| *v /= a);
-        Ok(z)
+        unit_cyclic(z, self.blades.len(), h.omega_rad_s, lam.im.abs(), label)
     }
 
     /// Free response of the linearised equations about the hover `h` with `dampers[k]` on
@@ -1264,6 +1236,7 @@ impl OdeRhs for Tabulated<'_> {
         Ok(())
     }
 
+    #[inline]
     fn rhs(&mut self, y: &[f64], out: &mut [f64]) {
         let (n, o) = (self.n, &self.table[self.at]);
         for i in 0..n {

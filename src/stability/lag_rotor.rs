@@ -268,11 +268,15 @@ pub(super) fn range(
     if ok {
         Ok(())
     } else {
-        Err(StabilityError::OutOfRange {
-            field,
-            value,
-            expected,
-        })
+        Err(out_of_range(field, value, expected))
+    }
+}
+
+pub(super) fn out_of_range(field: String, value: f64, expected: &'static str) -> StabilityError {
+    StabilityError::OutOfRange {
+        field,
+        value,
+        expected,
     }
 }
 
@@ -355,13 +359,7 @@ struct Hub {
 
 impl LagRotor {
     pub fn validate(&self) -> Result<()> {
-        if self.blades.is_empty() {
-            return Err(StabilityError::TooFewBlades {
-                what: "the lag rotor",
-                count: 0,
-                min: 1,
-            });
-        }
+        need_blades("the lag rotor", self.blades.len(), 1)?;
         for (k, b) in self.blades.iter().enumerate() {
             b.validate(k)?;
         }
@@ -516,13 +514,7 @@ impl LagRotor {
         self.validate()?;
         check_omega(omega)?;
         let nb = self.blades.len();
-        if nb < 3 {
-            return Err(StabilityError::TooFewBlades {
-                what: "the Coleman transformation",
-                count: nb,
-                min: 3,
-            });
-        }
+        need_blades("the Coleman transformation", nb, 3)?;
         if let Some((blade, field)) = self.first_dissimilar() {
             return Err(StabilityError::NotIsotropic { blade, field });
         }
@@ -654,12 +646,7 @@ impl LagRotor {
             .ok_or_else(|| StabilityError::Numerical(format!("no {label} mode")))?;
         let (mm, cm, km, _) = self.cyclic_block(omega_rad_s);
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
-        let j = (0..lams.len())
-            .min_by(|&a, &b| {
-                (lams[a] - target.eigenvalue)
-                    .norm()
-                    .total_cmp(&(lams[b] - target.eigenvalue).norm())
-            })
+        let j = nearest(&lams, target.eigenvalue)
             .ok_or_else(|| StabilityError::Numerical("empty Coleman block".into()))?;
         let (lam, nh) = (lams[j], self.hubs().len());
         let q = |i: usize| u[(i, j)].re;
@@ -676,16 +663,7 @@ impl LagRotor {
             z[nb + h] = q(2 + h);
             z[n + nb + h] = v(2 + h);
         }
-        let a = cyclic_amplitude(&z, nb, omega_rad_s, 0.0, lam.im.abs());
-        if !(a > 0.0 && a.is_finite()) {
-            return Err(StabilityError::Numerical(format!(
-                "the {label} mode has no cyclic lag motion"
-            )));
-        }
-        for x in &mut z {
-            *x /= a;
-        }
-        Ok(z)
+        unit_cyclic(z, nb, omega_rad_s, lam.im.abs(), label)
     }
 
     /// Floquet characteristic exponents of the periodic equations in individual blade
@@ -853,6 +831,42 @@ pub(super) fn eigen_pairs(
     Ok((lams, eig.U().to_owned()))
 }
 
+/// At least `min` blades for `what`.
+pub(super) fn need_blades(what: &'static str, count: usize, min: usize) -> Result<()> {
+    if count < min {
+        return Err(StabilityError::TooFewBlades { what, count, min });
+    }
+    Ok(())
+}
+
+/// The index of the eigenvalue in `lams` nearest `target`.
+pub(super) fn nearest(lams: &[c64], target: c64) -> Option<usize> {
+    (0..lams.len()).min_by(|&a, &b| {
+        (lams[a] - target)
+            .norm()
+            .total_cmp(&(lams[b] - target).norm())
+    })
+}
+
+/// The mode state `z` (blade 1 at zero azimuth, whirl frequency `w`) scaled to a cyclic lag
+/// amplitude of 1 rad ([`cyclic_amplitude`]).
+pub(super) fn unit_cyclic(
+    mut z: Vec<f64>,
+    blades: usize,
+    omega: f64,
+    w: f64,
+    label: ModeLabel,
+) -> Result<Vec<f64>> {
+    let a = cyclic_amplitude(&z, blades, omega, 0.0, w);
+    if !(a > 0.0 && a.is_finite()) {
+        return Err(StabilityError::Numerical(format!(
+            "the {label} mode has no cyclic lag motion"
+        )));
+    }
+    z.iter_mut().for_each(|x| *x /= a);
+    Ok(z)
+}
+
 /// One mode per conjugate pair (`Im >= 0`) of `all`, sorted by frequency.
 pub(super) fn upper_modes(all: Vec<(c64, ModeLabel)>) -> Vec<Mode> {
     modes_by_frequency(all.into_iter().filter(|(l, _)| l.im >= 0.0))
@@ -967,23 +981,11 @@ impl PeriodicSystem {
             (-s * sn, -2.0 * w * s * cs, w * w * s * sn)
         }
     }
-}
 
-impl OdeRhs for PeriodicSystem {
-    type Error = StabilityError;
-
-    fn set_time(&mut self, t: f64) -> Result<()> {
-        for k in 0..self.phase.len() {
-            let (s, c) = (self.omega * t + self.phase[k]).sin_cos();
-            self.sin[k] = s;
-            self.cos[k] = c;
-            self.moment[k] = self.moment_start[k] + (t - self.moment_t0) * self.moment_slope[k];
-        }
-        Ok(())
-    }
-
-    /// `dz = f(t, z)` at the time of the last `set_time`; `z = [q, q']`.
-    fn rhs(&mut self, z: &[f64], dz: &mut [f64]) {
+    /// `dz = f(t, z)` at the time of the last `set_time`; `z = [q, q']`. Inlined into the
+    /// loop over the monodromy's columns.
+    #[inline(always)]
+    fn eval(&mut self, z: &[f64], dz: &mut [f64]) {
         let nb = self.inertia.len();
         let n = nb + self.hubs.len();
         let (q, v) = z.split_at(n);
@@ -1029,6 +1031,32 @@ impl OdeRhs for PeriodicSystem {
         }
         for j in 0..self.hubs.len() {
             dz[n + nb + j] = a[j];
+        }
+    }
+}
+
+impl OdeRhs for PeriodicSystem {
+    type Error = StabilityError;
+
+    #[inline]
+    fn set_time(&mut self, t: f64) -> Result<()> {
+        for k in 0..self.phase.len() {
+            let (s, c) = (self.omega * t + self.phase[k]).sin_cos();
+            self.sin[k] = s;
+            self.cos[k] = c;
+            self.moment[k] = self.moment_start[k] + (t - self.moment_t0) * self.moment_slope[k];
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn rhs(&mut self, z: &[f64], dz: &mut [f64]) {
+        self.eval(z, dz);
+    }
+
+    fn rhs_columns(&mut self, z: &[f64], dz: &mut [f64], m: usize) {
+        for (zc, dc) in z.chunks_exact(m).zip(dz.chunks_exact_mut(m)) {
+            self.eval(zc, dc);
         }
     }
 }
