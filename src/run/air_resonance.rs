@@ -255,13 +255,7 @@ pub fn air_resonance_map(
     opts.check()?;
     let (body, mut notes) = body(deck)?;
     let n = deck.spec.rotor.blades;
-    let mut specs = Vec::with_capacity(n);
-    for k in 1..=n {
-        let b = deck.blade(k)?;
-        let damper = b.damper()?;
-        damper.require(model)?;
-        specs.push((b, damper));
-    }
+    let specs = super::rigid_blade::blade_decks(deck, model)?;
     notes.push("blades rigid on coincident lag and flap hinges (lag inboard), no elastic bending or torsion, no pitch-flap coupling; quasi-steady strip aerodynamics with the uniform induced velocity of momentum theory frozen at the hover equilibrium (no dynamic inflow); no gravity".into());
     let air = Air {
         density_kg_m3: opts.density_kg_m3,
@@ -282,11 +276,9 @@ pub fn air_resonance_map(
             let mut airfoils = vec![];
             let mut done: Vec<(usize, (f64, f64))> = vec![];
             for (k, (b, d)) in specs.iter().enumerate() {
-                let same = done.iter().find(|(j, _)| {
-                    specs[*j].1 == *d
-                        && specs[*j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = done
+                    .iter()
+                    .find(|(j, _)| super::rigid_blade::same_damper(&specs, *j, k));
                 let kc = match same {
                     Some(&(_, kc)) => kc,
                     None => {

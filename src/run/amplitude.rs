@@ -197,13 +197,7 @@ impl Blades {
         hover: Option<HoverOptions>,
     ) -> anyhow::Result<Self> {
         let file = deck.path.display().to_string();
-        let mut decks = Vec::new();
-        for k in 1..=deck.spec.rotor.blades {
-            let b = deck.blade(k)?;
-            let d = b.damper()?;
-            d.require(model)?;
-            decks.push((b, d));
-        }
+        let decks = super::rigid_blade::blade_decks(deck, model)?;
         if let Some(h) = hover {
             h.check()?;
             let (body, _) = super::air_resonance::body(deck)?;
@@ -286,11 +280,7 @@ impl Blades {
             let w_lin = w.max(0.05 * om).max(0.1);
             let mut kc: Vec<(f64, f64)> = Vec::with_capacity(self.decks.len());
             for (k, (b, d)) in self.decks.iter().enumerate() {
-                let same = (0..k).find(|&j| {
-                    self.decks[j].1 == *d
-                        && self.decks[j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = (0..k).find(|&j| super::rigid_blade::same_damper(&self.decks, j, k));
                 kc.push(match same {
                     Some(j) => kc[j],
                     None => linearise_at(

@@ -3,8 +3,34 @@
 //! spring and dashpot at the nominal speed, and the damper's arm. The ground-resonance map,
 //! its amplitude check, the air-resonance map (for the frequency at which it linearises the
 //! dampers) and the rigid run (`run --model rigid`) all reduce a blade through it.
+use crate::hydraulics::{DamperDeck, DamperModel};
 use crate::rotor::deck::RotorSpec;
+use crate::rotor::RotorDeck;
 use crate::stability::LagBlade;
+
+/// Each blade's own deck (the rotor's per-blade differences applied) with its damper deck,
+/// which must have `model`.
+pub fn blade_decks(
+    deck: &RotorDeck,
+    model: DamperModel,
+) -> anyhow::Result<Vec<(RotorDeck, DamperDeck)>> {
+    let n = deck.spec.rotor.blades;
+    let mut out = Vec::with_capacity(n);
+    for k in 1..=n {
+        let b = deck.blade(k)?;
+        let damper = b.damper()?;
+        damper.require(model)?;
+        out.push((b, damper));
+    }
+    Ok(out)
+}
+
+/// Whether blades `j` and `k` of `decks` carry the same damper on the same arm (so that one
+/// linearisation serves both).
+pub fn same_damper(decks: &[(RotorDeck, DamperDeck)], j: usize, k: usize) -> bool {
+    decks[j].1 == decks[k].1
+        && decks[j].0.spec.damper_attachment.arm_m == decks[k].0.spec.damper_attachment.arm_m
+}
 
 /// One blade reduced to a rigid body on its lag hinge.
 #[derive(Clone, Debug, PartialEq)]

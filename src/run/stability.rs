@@ -4,7 +4,7 @@
 //! range of rotor speeds. Isotropic rotors: eigenvalues of the constant-coefficient equations
 //! in multi-blade (Coleman) coordinates; rotors whose blades differ: Floquet exponents of the
 //! periodic equations over one revolution.
-use super::rigid_blade::RigidLagBlade;
+use super::rigid_blade::{blade_decks, same_damper, RigidLagBlade};
 use crate::hydraulics::bench::harmonic_run;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::io::OutDir;
@@ -240,13 +240,7 @@ pub fn stability_map(
     };
     let (x, y, mut notes) = in_plane(&af.dofs(), &file)?;
     let n = deck.spec.rotor.blades;
-    let mut specs = Vec::with_capacity(n);
-    for k in 1..=n {
-        let b = deck.blade(k)?;
-        let damper = b.damper()?;
-        damper.require(model)?;
-        specs.push((b, damper));
-    }
+    let specs = blade_decks(deck, model)?;
     notes.push("blades rigid on their lag hinges: no flap, no elastic bending; no aerodynamics (a rotor on the ground)".into());
     let mut speeds = Vec::with_capacity(speeds_rad_s.len());
     let mut nominal_blades = vec![];
@@ -262,11 +256,7 @@ pub fn stability_map(
             // identical dampers are linearised once
             let mut done: Vec<(usize, (f64, f64))> = vec![];
             for (k, (b, d)) in specs.iter().enumerate() {
-                let same = done.iter().find(|(j, _)| {
-                    specs[*j].1 == *d
-                        && specs[*j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = done.iter().find(|(j, _)| same_damper(&specs, *j, k));
                 let (lb, kc) = match same {
                     Some(&(_, kc)) => (RigidLagBlade::of(&b.spec, &b.path)?.lag_blade(kc), kc),
                     None => {
