@@ -255,13 +255,7 @@ pub fn air_resonance_map(
     opts.check()?;
     let (body, mut notes) = body(deck)?;
     let n = deck.spec.rotor.blades;
-    let mut specs = Vec::with_capacity(n);
-    for k in 1..=n {
-        let b = deck.blade(k)?;
-        let damper = b.damper()?;
-        damper.require(model)?;
-        specs.push((b, damper));
-    }
+    let specs = super::rigid_blade::blade_decks(deck, model)?;
     notes.push("blades rigid on coincident lag and flap hinges (lag inboard), no elastic bending or torsion, no pitch-flap coupling; quasi-steady strip aerodynamics with the uniform induced velocity of momentum theory frozen at the hover equilibrium (no dynamic inflow); no gravity".into());
     let air = Air {
         density_kg_m3: opts.density_kg_m3,
@@ -272,11 +266,8 @@ pub fn air_resonance_map(
     let mut nominal = vec![];
     let mut inertia = 0.0;
     for &om in speeds_rad_s {
-        let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
-        let k0 = specs[0].0.spec.bearing_lag().0;
-        let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
-            / m0.inertia_kg_m2)
-            .sqrt();
+        let mut w = super::rigid_blade::RigidLagBlade::of(&specs[0].0.spec, &specs[0].0.path)?
+            .lag_frequency_rad_s(om);
         let mut result = None;
         for _ in 0..2 {
             let w_lin = w.max(0.05 * om).max(0.1);
@@ -285,11 +276,9 @@ pub fn air_resonance_map(
             let mut airfoils = vec![];
             let mut done: Vec<(usize, (f64, f64))> = vec![];
             for (k, (b, d)) in specs.iter().enumerate() {
-                let same = done.iter().find(|(j, _)| {
-                    specs[*j].1 == *d
-                        && specs[*j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = done
+                    .iter()
+                    .find(|(j, _)| super::rigid_blade::same_damper(&specs, *j, k));
                 let kc = match same {
                     Some(&(_, kc)) => kc,
                     None => {

@@ -7,12 +7,13 @@
 //! and the linearised map's at 0.1 mm. Where the time-domain growth rate changes sign between
 //! two amplitudes there is a limit cycle.
 use super::air_resonance::HoverOptions;
+use super::rigid_blade::RigidLagBlade;
 use super::stability::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::rotor::RotorDeck;
 use crate::stability::{
     cyclic_amplitude, free_response_with_dampers, AirRotor, AirframeAxis, BladeDamper, BodyDof,
-    Hover, LagBlade, LagRotor, Mode, ModeLabel,
+    Hover, LagRotor, Mode, ModeLabel,
 };
 use anyhow::{anyhow, bail};
 use rayon::prelude::*;
@@ -196,13 +197,7 @@ impl Blades {
         hover: Option<HoverOptions>,
     ) -> anyhow::Result<Self> {
         let file = deck.path.display().to_string();
-        let mut decks = Vec::new();
-        for k in 1..=deck.spec.rotor.blades {
-            let b = deck.blade(k)?;
-            let d = b.damper()?;
-            d.require(model)?;
-            decks.push((b, d));
-        }
+        let decks = super::rigid_blade::blade_decks(deck, model)?;
         if let Some(h) = hover {
             h.check()?;
             let (body, _) = super::air_resonance::body(deck)?;
@@ -251,16 +246,8 @@ impl Blades {
             return Ok(Reduced::Air(Box::new(r), Box::new(h)));
         }
         let mut blades = Vec::with_capacity(self.decks.len());
-        for ((b, _), &(k, c)) in self.decks.iter().zip(kc) {
-            let m = b.spec.lag_moments(&b.path)?;
-            blades.push(LagBlade {
-                mass_kg: m.mass_kg,
-                first_moment_kg_m: m.first_moment_kg_m,
-                inertia_kg_m2: m.inertia_kg_m2,
-                hinge_offset_m: b.spec.retention.hinge_r_m,
-                stiffness_nm_per_rad: b.spec.bearing_lag().0 + k,
-                damping_nms_per_rad: b.spec.bearing_lag().1 + c,
-            });
+        for ((b, _), &kc) in self.decks.iter().zip(kc) {
+            blades.push(RigidLagBlade::of(&b.spec, &b.path)?.lag_blade(kc));
         }
         Ok(Reduced::Lag(LagRotor {
             blades,
@@ -280,11 +267,7 @@ impl Blades {
         w_guess: Option<f64>,
     ) -> anyhow::Result<Equivalent> {
         let (b0, _) = &self.decks[0];
-        let m0 = b0.spec.lag_moments(&b0.path)?;
-        let mut w = ((b0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om
-            + b0.spec.bearing_lag().0)
-            / m0.inertia_kg_m2)
-            .sqrt();
+        let mut w = RigidLagBlade::of(&b0.spec, &b0.path)?.lag_frequency_rad_s(om);
         let passes = match w_guess {
             Some(g) => {
                 w = g;
@@ -297,11 +280,7 @@ impl Blades {
             let w_lin = w.max(0.05 * om).max(0.1);
             let mut kc: Vec<(f64, f64)> = Vec::with_capacity(self.decks.len());
             for (k, (b, d)) in self.decks.iter().enumerate() {
-                let same = (0..k).find(|&j| {
-                    self.decks[j].1 == *d
-                        && self.decks[j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = (0..k).find(|&j| super::rigid_blade::same_damper(&self.decks, j, k));
                 kc.push(match same {
                     Some(j) => kc[j],
                     None => linearise_at(

@@ -26,6 +26,7 @@ pub mod outputs;
 pub mod periodic;
 pub mod ranges;
 pub mod report;
+pub mod rigid_blade;
 pub mod rotor;
 pub mod sdof;
 pub mod stability;

@@ -82,9 +82,8 @@ impl SdofParams {
     /// `theta = th0 + th1c cos(psi) + th1s sin(psi) + twist(r)`,
     ///
     /// N, C from the replay (revolution average, radial taper to the root cut-out and the tip),
-    /// harmonics 0..=16. `I`, `S` about the hinge from the section table plus the retention
-    /// segments outboard of the hinge (segments 2 and 3); lag spring and damping of the bearing;
-    /// damper arm of the attachment.
+    /// harmonics 0..=16. The blade's `I`, `S`, lag spring and damping and damper arm are its
+    /// [`super::rigid_blade::RigidLagBlade`].
     pub fn from_rotor(
         spec: &crate::rotor::deck::RotorSpec,
         deck_path: &std::path::Path,
@@ -93,10 +92,9 @@ impl SdofParams {
         use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
         // the record must be of this rotor, as the elastic model requires
         spec.check_record(record, deck_path)?;
-        let e = spec.retention.hinge_r_m;
+        let blade = super::rigid_blade::RigidLagBlade::of(spec, deck_path)?;
+        let e = blade.hinge_offset_m;
         let radius = spec.rotor.radius_m;
-        let lm = spec.lag_moments(deck_path)?;
-        let (s1, i2) = (lm.first_moment_kg_m, lm.inertia_kg_m2);
         let replay = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
         let controls = crate::rotor::expand::Controls::from_record(&record.meta.controls_deg);
         let twist = crate::structure::kin::TimeTable {
@@ -130,12 +128,12 @@ impl SdofParams {
             omega_rad_s: spec.rotor.omega_rad_s,
             hinge_offset_m: e,
             radius_m: radius,
-            inertia_kg_m2: i2,
-            first_moment_kg_m: s1,
-            lag_spring_n_m_per_rad: spec.bearing_lag().0,
-            damper_arm_m: spec.damper_attachment.arm_m,
+            inertia_kg_m2: blade.inertia_kg_m2,
+            first_moment_kg_m: blade.first_moment_kg_m,
+            lag_spring_n_m_per_rad: blade.lag_stiffness_nm_per_rad,
+            damper_arm_m: blade.damper_arm_m,
             moment: harmonics(&psi, &moment, 16)?,
-            lag_damping_n_m_s_per_rad: spec.bearing_lag().1,
+            lag_damping_n_m_s_per_rad: blade.lag_damping_nms_per_rad,
         })
     }
 

@@ -4,6 +4,7 @@
 //! range of rotor speeds. Isotropic rotors: eigenvalues of the constant-coefficient equations
 //! in multi-blade (Coleman) coordinates; rotors whose blades differ: Floquet exponents of the
 //! periodic equations over one revolution.
+use super::rigid_blade::{blade_decks, same_damper, RigidLagBlade};
 use crate::hydraulics::bench::harmonic_run;
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::io::OutDir;
@@ -220,19 +221,9 @@ fn blade(
     model: DamperModel,
     w: f64,
 ) -> anyhow::Result<(LagBlade, (f64, f64))> {
-    let m = spec.lag_moments(deck_path)?;
-    let (k, c) = linearise(damper, model, spec.damper_attachment.arm_m, w)?;
-    Ok((
-        LagBlade {
-            mass_kg: m.mass_kg,
-            first_moment_kg_m: m.first_moment_kg_m,
-            inertia_kg_m2: m.inertia_kg_m2,
-            hinge_offset_m: spec.retention.hinge_r_m,
-            stiffness_nm_per_rad: spec.bearing_lag().0 + k,
-            damping_nms_per_rad: spec.bearing_lag().1 + c,
-        },
-        (k, c),
-    ))
+    let r = RigidLagBlade::of(spec, deck_path)?;
+    let kc = linearise(damper, model, r.damper_arm_m, w)?;
+    Ok((r.lag_blade(kc), kc))
 }
 
 /// The stability map of `deck` (its blades' own decks, per-blade differences applied) with
@@ -249,24 +240,14 @@ pub fn stability_map(
     };
     let (x, y, mut notes) = in_plane(&af.dofs(), &file)?;
     let n = deck.spec.rotor.blades;
-    let mut specs = Vec::with_capacity(n);
-    for k in 1..=n {
-        let b = deck.blade(k)?;
-        let damper = b.damper()?;
-        damper.require(model)?;
-        specs.push((b, damper));
-    }
+    let specs = blade_decks(deck, model)?;
     notes.push("blades rigid on their lag hinges: no flap, no elastic bending; no aerodynamics (a rotor on the ground)".into());
     let mut speeds = Vec::with_capacity(speeds_rad_s.len());
     let mut nominal_blades = vec![];
     for &om in speeds_rad_s {
         // the damper linearised at the regressing lag's rotating-frame frequency: first the
         // blade's own lag frequency, then (once) the coupled mode's
-        let m0 = specs[0].0.spec.lag_moments(&specs[0].0.path)?;
-        let k0 = specs[0].0.spec.bearing_lag().0;
-        let mut w = ((specs[0].0.spec.retention.hinge_r_m * m0.first_moment_kg_m * om * om + k0)
-            / m0.inertia_kg_m2)
-            .sqrt();
+        let mut w = RigidLagBlade::of(&specs[0].0.spec, &specs[0].0.path)?.lag_frequency_rad_s(om);
         let mut result = None;
         for _ in 0..2 {
             let w_lin = w.max(0.05 * om).max(0.1);
@@ -275,26 +256,9 @@ pub fn stability_map(
             // identical dampers are linearised once
             let mut done: Vec<(usize, (f64, f64))> = vec![];
             for (k, (b, d)) in specs.iter().enumerate() {
-                let same = done.iter().find(|(j, _)| {
-                    specs[*j].1 == *d
-                        && specs[*j].0.spec.damper_attachment.arm_m
-                            == b.spec.damper_attachment.arm_m
-                });
+                let same = done.iter().find(|(j, _)| same_damper(&specs, *j, k));
                 let (lb, kc) = match same {
-                    Some(&(_, kc)) => {
-                        let m = b.spec.lag_moments(&b.path)?;
-                        (
-                            LagBlade {
-                                mass_kg: m.mass_kg,
-                                first_moment_kg_m: m.first_moment_kg_m,
-                                inertia_kg_m2: m.inertia_kg_m2,
-                                hinge_offset_m: b.spec.retention.hinge_r_m,
-                                stiffness_nm_per_rad: b.spec.bearing_lag().0 + kc.0,
-                                damping_nms_per_rad: b.spec.bearing_lag().1 + kc.1,
-                            },
-                            kc,
-                        )
-                    }
+                    Some(&(_, kc)) => (RigidLagBlade::of(&b.spec, &b.path)?.lag_blade(kc), kc),
                     None => {
                         let r = blade(&b.spec, &b.path, d, model, w_lin)
                             .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?;

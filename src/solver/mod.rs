@@ -8,6 +8,7 @@ pub mod dynamic;
 pub mod fdcheck;
 pub mod modal;
 pub mod newton;
+pub mod ode;
 pub mod snapshot;
 pub mod state;
 pub mod statics;

@@ -37,9 +37,13 @@
 //! multipliers over one revolution (RK4), matched to the mean isotropic rotor's Coleman
 //! eigenvalues by the continuation of [`super::lag_rotor`].
 use super::dampers::{coupled_step, BladeDamper, DeviceResponse, StepForces};
-use super::lag_rotor::{eigen_pairs, resolve, Mode, ModeLabel, Result, StabilityError};
+use super::lag_rotor::{
+    continued_modes, eigen_pairs, floquet_multipliers, nearest, need_blades, out_of_range,
+    unit_cyclic, upper_modes, Mode, ModeLabel, Result, StabilityError,
+};
 use crate::aero::airfoil::{Airfoil, ClampCounts};
 use crate::aero::section::{blade_element, Air};
+use crate::solver::ode::{self, OdeRhs, Rk4};
 use faer::{c64, Mat};
 use std::f64::consts::PI;
 
@@ -47,8 +51,9 @@ use std::f64::consts::PI;
 /// of degree 2, tests/stability_air.rs checks the series against a direct linearisation).
 pub const AZIMUTH_SAMPLES: usize = 8;
 
-/// Continuation stages of the Floquet labels from the mean rotor to a dissimilar one.
-pub const CONTINUATION_STAGES: usize = 8;
+/// Continuation stages of the Floquet labels from the mean rotor to a dissimilar one (the
+/// lag rotor's).
+pub use super::lag_rotor::CONTINUATION_STAGES;
 
 /// Step of the linearisation's differences [rad, m, and per s, per s^2]: the fourth-order
 /// stencil's truncation (step^4 against the trigonometric and aerodynamic scales, 0.1 rad
@@ -302,20 +307,10 @@ impl AirRotor {
             if ok && value.is_finite() {
                 Ok(())
             } else {
-                Err(StabilityError::OutOfRange {
-                    field,
-                    value,
-                    expected,
-                })
+                Err(out_of_range(field, value, expected))
             }
         };
-        if self.blades.is_empty() {
-            return Err(StabilityError::TooFewBlades {
-                what: "the air-resonance rotor",
-                count: 0,
-                min: 1,
-            });
-        }
+        need_blades("the air-resonance rotor", self.blades.len(), 1)?;
         for (k, b) in self.blades.iter().enumerate() {
             let f = |n: &str| format!("blades[{k}].{n}");
             bad(
@@ -891,13 +886,7 @@ impl AirRotor {
     /// All Coleman eigenvalues (conjugates included) with their labels, about the hover `h`.
     fn coleman_all(&self, h: &Hover) -> Result<Vec<(c64, ModeLabel)>> {
         let nb = self.blades.len();
-        if nb < 3 {
-            return Err(StabilityError::TooFewBlades {
-                what: "the Coleman transformation",
-                count: nb,
-                min: 3,
-            });
-        }
+        need_blades("the Coleman transformation", nb, 3)?;
         if !self.is_isotropic() {
             return Err(StabilityError::Numerical(
                 "the Coleman transformation needs identical blades (use Floquet)".into(),
@@ -952,13 +941,7 @@ impl AirRotor {
     /// `omega_rad_s` (isotropic rotor, N >= 3), one per conjugate pair, by frequency.
     pub fn coleman_eigenvalues(&self, omega_rad_s: f64) -> Result<(Hover, Vec<Mode>)> {
         let h = self.hover(omega_rad_s)?;
-        let mut modes: Vec<Mode> = self
-            .coleman_all(&h)?
-            .into_iter()
-            .filter(|(l, _)| l.im >= 0.0)
-            .map(|(l, label)| Mode::new(label, l))
-            .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+        let modes = upper_modes(self.coleman_all(&h)?);
         Ok((h, modes))
     }
 
@@ -975,12 +958,7 @@ impl AirRotor {
             .0;
         let [mm, cm, km] = self.coleman_matrices(h, 0.0)?;
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
-        let j = (0..lams.len())
-            .min_by(|&a, &b| {
-                (lams[a] - target)
-                    .norm()
-                    .total_cmp(&(lams[b] - target).norm())
-            })
+        let j = nearest(&lams, target)
             .ok_or_else(|| StabilityError::Numerical("no Coleman eigenvalue".into()))?;
         let lam = lams[j];
         let n = self.coordinate_count();
@@ -994,14 +972,7 @@ impl AirRotor {
                 z[n + i] += td[(i, c)] * m[c] + tt[(i, c)] * md[c];
             }
         }
-        let a = super::cyclic_amplitude(&z, self.blades.len(), h.omega_rad_s, 0.0, lam.im.abs());
-        if !(a > 0.0 && a.is_finite()) {
-            return Err(StabilityError::Numerical(format!(
-                "the {label} mode has no cyclic lag motion"
-            )));
-        }
-        z.iter_mut().for_each(|v| *v /= a);
-        Ok(z)
+        unit_cyclic(z, self.blades.len(), h.omega_rad_s, lam.im.abs(), label)
     }
 
     /// Free response of the linearised equations about the hover `h` with `dampers[k]` on
@@ -1061,29 +1032,16 @@ impl AirRotor {
             }
             table.push((a, b, g));
         }
-        let at = |half_steps: usize| &table[half_steps % (2 * steps_per_rev)];
-        let deriv = |o: &(Mat<f64>, Mat<f64>, Mat<f64>), y: &[f64], f: &[f64], out: &mut [f64]| {
-            for i in 0..n {
-                out[i] = y[n + i];
-                let mut acc = 0.0;
-                for j in 0..n {
-                    acc -= o.0[(i, j)] * y[j] + o.1[(i, j)] * y[n + j];
-                }
-                for (j, fj) in f.iter().enumerate() {
-                    acc += o.2[(i, j)] * fj;
-                }
-                out[n + i] = acc;
-            }
+        let mut sys = Tabulated {
+            table: &table,
+            half_step: 0.5 * hh,
+            at: 0,
+            n,
+            moment: vec![0.0; nb],
         };
+        let mut rk = Rk4::new(m2);
         let mut y = initial.to_vec();
         let mut trial = vec![0.0; m2];
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
-            vec![0.0; m2],
-            vec![0.0; m2],
-            vec![0.0; m2],
-            vec![0.0; m2],
-            vec![0.0; m2],
-        );
         let mut forces = StepForces::new(dampers);
         let mut time_s = Vec::with_capacity(steps + 1);
         let mut states = Vec::with_capacity((steps + 1) * m2);
@@ -1093,7 +1051,6 @@ impl AirRotor {
         let mut max_iterations = 0;
         for step in 0..steps {
             let t = step as f64 * hh;
-            let (o0, o1, o2) = (at(2 * step), at(2 * step + 1), at(2 * step + 2));
             let it = coupled_step(
                 dampers,
                 &mut forces,
@@ -1103,16 +1060,9 @@ impl AirRotor {
                 &y,
                 &mut trial,
                 |moment, trial| {
-                    deriv(o0, &y, moment, &mut k1);
-                    (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k1[i]);
-                    deriv(o1, &tmp, moment, &mut k2);
-                    (0..m2).for_each(|i| tmp[i] = y[i] + 0.5 * hh * k2[i]);
-                    deriv(o1, &tmp, moment, &mut k3);
-                    (0..m2).for_each(|i| tmp[i] = y[i] + hh * k3[i]);
-                    deriv(o2, &tmp, moment, &mut k4);
-                    for i in 0..m2 {
-                        trial[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                    }
+                    sys.moment.copy_from_slice(moment);
+                    trial.copy_from_slice(&y);
+                    rk.step(&mut sys, t, hh, trial)
                 },
             )?;
             max_iterations = max_iterations.max(it);
@@ -1138,63 +1088,21 @@ impl AirRotor {
     /// The monodromy matrix over one revolution about the hover `h` (RK4, column-major
     /// `2n x 2n`, state `[q, q']`).
     pub fn monodromy(&self, h: &Hover, steps_per_rev: usize) -> Result<Vec<f64>> {
-        use faer::linalg::solvers::Solve;
         let series = self.all_series(h);
         let omega = h.omega_rad_s;
         let n = self.coordinate_count();
-        let m2 = 2 * n;
-        let period = 2.0 * PI / omega;
-        let dt = period / steps_per_rev as f64;
-        // state matrix at t: dY/dt = A(t) Y
-        let a_at = |t: f64| -> Result<Mat<f64>> {
-            let [m, c, k] = self.matrices_at(&series, omega, t);
-            let lu = m.partial_piv_lu();
-            let mik = lu.solve(&k);
-            let mic = lu.solve(&c);
-            if (0..n).any(|i| (0..n).any(|j| !mik[(i, j)].is_finite() || !mic[(i, j)].is_finite()))
-            {
-                return Err(StabilityError::Numerical(format!(
-                    "singular mass matrix at t = {t} s"
-                )));
-            }
-            Ok(Mat::from_fn(m2, m2, |i, j| match (i < n, j < n) {
-                (true, true) => 0.0,
-                (true, false) => f64::from(u8::from(j - n == i)),
-                (false, true) => -mik[(i - n, j)],
-                (false, false) => -mic[(i - n, j - n)],
-            }))
+        let mut sys = StateMatrix {
+            rotor: self,
+            series: &series,
+            omega,
+            a: Mat::zeros(2 * n, 2 * n),
         };
-        let mut y = Mat::<f64>::identity(m2, m2);
-        for s in 0..steps_per_rev {
-            let t = s as f64 * dt;
-            let (a0, a1, a2) = (a_at(t)?, a_at(t + 0.5 * dt)?, a_at(t + dt)?);
-            let k1 = &a0 * &y;
-            let k2 = &a1 * (&y + &k1 * (0.5 * dt));
-            let k3 = &a1 * (&y + &k2 * (0.5 * dt));
-            let k4 = &a2 * (&y + &k3 * dt);
-            y = &y + (&k1 + &k2 * 2.0 + &k3 * 2.0 + &k4) * (dt / 6.0);
-        }
-        let mut out = vec![0.0; m2 * m2];
-        for j in 0..m2 {
-            for i in 0..m2 {
-                let v = y[(i, j)];
-                if !v.is_finite() {
-                    return Err(StabilityError::Numerical(
-                        "monodromy matrix is not finite".into(),
-                    ));
-                }
-                out[j * m2 + i] = v;
-            }
-        }
-        Ok(out)
+        ode::monodromy(&mut sys, 2 * n, 2.0 * PI / omega, steps_per_rev)
     }
 
     fn multipliers(&self, h: &Hover, steps_per_rev: usize) -> Result<Vec<c64>> {
         let phi = self.monodromy(h, steps_per_rev)?;
-        let m = 2 * self.coordinate_count();
-        Mat::<f64>::from_fn(m, m, |i, j| phi[j * m + i])
-            .eigenvalues()
-            .map_err(|e| StabilityError::Numerical(format!("Floquet multipliers: {e:?}")))
+        floquet_multipliers(&phi, 2 * self.coordinate_count())
     }
 
     /// The isotropic rotor with each blade the mean of the blades, and the blend `mean + s
@@ -1239,30 +1147,108 @@ impl AirRotor {
         let period = 2.0 * PI / omega_rad_s;
         let mean = self.blend_to_mean(0.0);
         let hm = mean.hover(omega_rad_s)?;
-        let mut refs: Vec<(c64, ModeLabel, bool)> = mean
-            .coleman_all(&hm)?
-            .into_iter()
-            .map(|(l, label)| (l, label, l.im >= 0.0))
-            .collect();
-        let stages: Vec<AirRotor> = if self.is_isotropic() {
-            vec![self.clone()]
-        } else {
-            (1..=CONTINUATION_STAGES)
-                .map(|k| self.blend_to_mean(k as f64 / CONTINUATION_STAGES as f64))
-                .collect()
-        };
+        let coleman = mean.coleman_all(&hm)?;
         let mut hover = hm;
-        for rotor in &stages {
+        let modes = continued_modes(coleman, period, omega_rad_s, self.is_isotropic(), |blend| {
+            let stage;
+            let rotor = match blend {
+                None => self,
+                Some(s) => {
+                    stage = self.blend_to_mean(s);
+                    &stage
+                }
+            };
             hover = rotor.hover(omega_rad_s)?;
-            let mu = rotor.multipliers(&hover, steps_per_rev)?;
-            refs = resolve(&refs, &mu, period, omega_rad_s);
-        }
-        let mut modes: Vec<Mode> = refs
-            .into_iter()
-            .filter(|r| r.2)
-            .map(|(l, label, _)| Mode::new(label, l))
-            .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+            rotor.multipliers(&hover, steps_per_rev)
+        })?;
         Ok((hover, modes))
+    }
+}
+
+/// The linearised equations `y' = A(t) y` about a hover, `A = [[0, I], [-M^-1 K, -M^-1 C]]`
+/// formed at each stage time.
+struct StateMatrix<'a> {
+    rotor: &'a AirRotor,
+    series: &'a [BladeSeries],
+    omega: f64,
+    a: Mat<f64>,
+}
+
+impl OdeRhs for StateMatrix<'_> {
+    type Error = StabilityError;
+
+    fn set_time(&mut self, t: f64) -> Result<()> {
+        use faer::linalg::solvers::Solve;
+        let n = self.rotor.coordinate_count();
+        let [m, c, k] = self.rotor.matrices_at(self.series, self.omega, t);
+        let lu = m.partial_piv_lu();
+        let mik = lu.solve(&k);
+        let mic = lu.solve(&c);
+        if (0..n).any(|i| (0..n).any(|j| !mik[(i, j)].is_finite() || !mic[(i, j)].is_finite())) {
+            return Err(StabilityError::Numerical(format!(
+                "singular mass matrix at t = {t} s"
+            )));
+        }
+        self.a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => 0.0,
+            (true, false) => f64::from(u8::from(j - n == i)),
+            (false, true) => -mik[(i - n, j)],
+            (false, false) => -mic[(i - n, j - n)],
+        });
+        Ok(())
+    }
+
+    fn rhs(&mut self, y: &[f64], dy: &mut [f64]) {
+        self.rhs_columns(y, dy, y.len());
+    }
+
+    /// `dY = A Y` by one matrix product over all columns.
+    fn rhs_columns(&mut self, y: &[f64], dy: &mut [f64], m: usize) {
+        let cols = y.len() / m;
+        faer::linalg::matmul::matmul(
+            faer::MatMut::from_column_major_slice_mut(dy, m, cols),
+            faer::Accum::Replace,
+            self.a.as_ref(),
+            faer::MatRef::from_column_major_slice(y, m, cols),
+            1.0,
+            faer::get_global_parallelism(),
+        );
+    }
+}
+
+/// The linearised equations with the operators `(M^-1 K, M^-1 C, M^-1 on the lag coordinates)`
+/// tabulated at the revolution's half steps, and the lag moments held over a step.
+struct Tabulated<'a> {
+    table: &'a [(Mat<f64>, Mat<f64>, Mat<f64>)],
+    half_step: f64,
+    /// The table entry of the last `set_time`.
+    at: usize,
+    n: usize,
+    moment: Vec<f64>,
+}
+
+impl OdeRhs for Tabulated<'_> {
+    type Error = StabilityError;
+
+    fn set_time(&mut self, t: f64) -> Result<()> {
+        // stage times are whole half steps
+        self.at = (t / self.half_step).round() as usize % self.table.len();
+        Ok(())
+    }
+
+    #[inline]
+    fn rhs(&mut self, y: &[f64], out: &mut [f64]) {
+        let (n, o) = (self.n, &self.table[self.at]);
+        for i in 0..n {
+            out[i] = y[n + i];
+            let mut acc = 0.0;
+            for j in 0..n {
+                acc -= o.0[(i, j)] * y[j] + o.1[(i, j)] * y[n + j];
+            }
+            for (j, fj) in self.moment.iter().enumerate() {
+                acc += o.2[(i, j)] * fj;
+            }
+            out[n + i] = acc;
+        }
     }
 }

@@ -9,9 +9,10 @@
 //! depends on `F_m`: a fixed point, solved to round-off in a few iterations (the damper's
 //! stroke moves by `h^2 arm^2 / I` per newton of force change, tiny at these steps).
 use super::lag_rotor::{
-    check_omega, range, LagRotor, PeriodicSystem, Result, Rk4, StabilityError, TimeResponse,
+    check_omega, range, LagRotor, PeriodicSystem, Result, StabilityError, TimeResponse,
 };
 use crate::hydraulics::Device;
+use crate::solver::ode::Rk4;
 
 /// A blade's damper: the device and its arm (stroke = `arm_m * zeta`).
 #[derive(Debug)]
@@ -71,7 +72,7 @@ pub(super) fn coupled_step(
     h: f64,
     y: &[f64],
     trial: &mut [f64],
-    mut advance: impl FnMut(&[f64], &mut [f64]),
+    mut advance: impl FnMut(&[f64], &mut [f64]) -> Result<()>,
 ) -> Result<usize> {
     let nb = dampers.len();
     // the force extrapolated from the last two steps starts the fixed point
@@ -90,7 +91,7 @@ pub(super) fn coupled_step(
         {
             *m = d.arm_m * f;
         }
-        advance(&forces.moment, trial);
+        advance(&forces.moment, trial)?;
         let mut scale = 1.0f64;
         change = 0.0;
         for (k, d) in dampers.iter_mut().enumerate() {
@@ -177,7 +178,7 @@ pub fn free_response_with_dampers(
             |moment, trial| {
                 sys.set_moments(t, h, moment, moment);
                 trial.copy_from_slice(&y);
-                rk.step(&mut sys, t, h, trial);
+                rk.step(&mut sys, t, h, trial)
             },
         )?;
         max_iterations = max_iterations.max(it);

@@ -63,6 +63,7 @@
 //! puts the frequency nearest that Coleman frequency; for a non-isotropic rotor this matching
 //! is continued from the mean rotor to the actual one in [`CONTINUATION_STAGES`] equal steps
 //! of the blade properties, each stage matched to the previous one. The label is carried over.
+use crate::solver::ode::{self, NotFinite, OdeRhs, Rk4};
 use faer::{c64, Mat};
 use std::f64::consts::PI;
 use std::fmt;
@@ -106,6 +107,12 @@ pub enum StabilityError {
 }
 
 pub type Result<T> = std::result::Result<T, StabilityError>;
+
+impl From<NotFinite> for StabilityError {
+    fn from(_: NotFinite) -> Self {
+        StabilityError::Numerical("monodromy matrix is not finite".into())
+    }
+}
 
 /// One rigid blade on a lag hinge.
 #[derive(Clone, Debug, PartialEq)]
@@ -261,11 +268,15 @@ pub(super) fn range(
     if ok {
         Ok(())
     } else {
-        Err(StabilityError::OutOfRange {
-            field,
-            value,
-            expected,
-        })
+        Err(out_of_range(field, value, expected))
+    }
+}
+
+pub(super) fn out_of_range(field: String, value: f64, expected: &'static str) -> StabilityError {
+    StabilityError::OutOfRange {
+        field,
+        value,
+        expected,
     }
 }
 
@@ -348,13 +359,7 @@ struct Hub {
 
 impl LagRotor {
     pub fn validate(&self) -> Result<()> {
-        if self.blades.is_empty() {
-            return Err(StabilityError::TooFewBlades {
-                what: "the lag rotor",
-                count: 0,
-                min: 1,
-            });
-        }
+        need_blades("the lag rotor", self.blades.len(), 1)?;
         for (k, b) in self.blades.iter().enumerate() {
             b.validate(k)?;
         }
@@ -501,14 +506,7 @@ impl LagRotor {
     /// `|zeta_1c - i zeta_1s|`) at a fixed-frame frequency above `Omega`; otherwise it is
     /// "regressing" (below `Omega`, or backward whirl in the fixed frame).
     pub fn coleman_eigenvalues(&self, omega_rad_s: f64) -> Result<Vec<Mode>> {
-        let all = self.coleman_all(omega_rad_s)?;
-        let mut modes: Vec<Mode> = all
-            .into_iter()
-            .filter(|(l, _)| l.im >= 0.0)
-            .map(|(l, label)| Mode::new(label, l))
-            .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        Ok(modes)
+        Ok(upper_modes(self.coleman_all(omega_rad_s)?))
     }
 
     /// All `2 n` Coleman eigenvalues (conjugates included) with their labels.
@@ -516,13 +514,7 @@ impl LagRotor {
         self.validate()?;
         check_omega(omega)?;
         let nb = self.blades.len();
-        if nb < 3 {
-            return Err(StabilityError::TooFewBlades {
-                what: "the Coleman transformation",
-                count: nb,
-                min: 3,
-            });
-        }
+        need_blades("the Coleman transformation", nb, 3)?;
         if let Some((blade, field)) = self.first_dissimilar() {
             return Err(StabilityError::NotIsotropic { blade, field });
         }
@@ -654,12 +646,7 @@ impl LagRotor {
             .ok_or_else(|| StabilityError::Numerical(format!("no {label} mode")))?;
         let (mm, cm, km, _) = self.cyclic_block(omega_rad_s);
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
-        let j = (0..lams.len())
-            .min_by(|&a, &b| {
-                (lams[a] - target.eigenvalue)
-                    .norm()
-                    .total_cmp(&(lams[b] - target.eigenvalue).norm())
-            })
+        let j = nearest(&lams, target.eigenvalue)
             .ok_or_else(|| StabilityError::Numerical("empty Coleman block".into()))?;
         let (lam, nh) = (lams[j], self.hubs().len());
         let q = |i: usize| u[(i, j)].re;
@@ -676,16 +663,7 @@ impl LagRotor {
             z[nb + h] = q(2 + h);
             z[n + nb + h] = v(2 + h);
         }
-        let a = cyclic_amplitude(&z, nb, omega_rad_s, 0.0, lam.im.abs());
-        if !(a > 0.0 && a.is_finite()) {
-            return Err(StabilityError::Numerical(format!(
-                "the {label} mode has no cyclic lag motion"
-            )));
-        }
-        for x in &mut z {
-            *x /= a;
-        }
-        Ok(z)
+        unit_cyclic(z, nb, omega_rad_s, lam.im.abs(), label)
     }
 
     /// Floquet characteristic exponents of the periodic equations in individual blade
@@ -711,63 +689,38 @@ impl LagRotor {
             modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
             return Ok(modes);
         }
-        // (exponent, label, Im >= 0 in the mean rotor's Coleman set)
-        let mut refs: Vec<(c64, ModeLabel, bool)> = self
-            .mean_rotor()
-            .coleman_all(omega_rad_s)?
-            .into_iter()
-            .map(|(l, label)| (l, label, l.im >= 0.0))
-            .collect();
-        let stages: Vec<LagRotor> = if self.is_isotropic() {
-            vec![self.clone()]
-        } else {
-            (1..=CONTINUATION_STAGES)
-                .map(|k| self.blend_to_mean(k as f64 / CONTINUATION_STAGES as f64))
-                .collect()
-        };
-        for rotor in &stages {
-            let mu = rotor.multipliers(omega_rad_s, steps_per_rev)?;
-            refs = resolve(&refs, &mu, period, omega_rad_s);
-        }
-        let mut modes: Vec<Mode> = refs
-            .into_iter()
-            .filter(|r| r.2)
-            .map(|(l, label, _)| Mode::new(label, l))
-            .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        Ok(modes)
+        let coleman = self.mean_rotor().coleman_all(omega_rad_s)?;
+        continued_modes(
+            coleman,
+            period,
+            omega_rad_s,
+            self.is_isotropic(),
+            |blend| match blend {
+                None => self.multipliers(omega_rad_s, steps_per_rev),
+                Some(s) => self
+                    .blend_to_mean(s)
+                    .multipliers(omega_rad_s, steps_per_rev),
+            },
+        )
     }
 
     /// Eigenvalues of the monodromy matrix over one revolution.
     fn multipliers(&self, omega: f64, steps_per_rev: usize) -> Result<Vec<c64>> {
         let phi = self.monodromy(omega, steps_per_rev)?;
-        let m = self.state_len();
-        let a = Mat::<f64>::from_fn(m, m, |i, j| phi[j * m + i]);
-        a.eigenvalues()
-            .map_err(|e| StabilityError::Numerical(format!("Floquet multipliers: {e:?}")))
+        floquet_multipliers(&phi, self.state_len())
     }
 
     /// The monodromy matrix, column-major (`state_len^2`), by RK4 on all columns at once.
     pub fn monodromy(&self, omega_rad_s: f64, steps_per_rev: usize) -> Result<Vec<f64>> {
         self.validate()?;
         check_omega(omega_rad_s)?;
-        let m = self.state_len();
         let mut sys = PeriodicSystem::new(self, omega_rad_s);
-        let mut y = vec![0.0; m * m];
-        for i in 0..m {
-            y[i * m + i] = 1.0;
-        }
-        let mut ws = Rk4::new(m * m);
-        let h = 2.0 * PI / omega_rad_s / steps_per_rev as f64;
-        for step in 0..steps_per_rev {
-            ws.step(&mut sys, step as f64 * h, h, &mut y);
-        }
-        if y.iter().any(|v| !v.is_finite()) {
-            return Err(StabilityError::Numerical(
-                "monodromy matrix is not finite".into(),
-            ));
-        }
-        Ok(y)
+        ode::monodromy(
+            &mut sys,
+            self.state_len(),
+            2.0 * PI / omega_rad_s,
+            steps_per_rev,
+        )
     }
 
     /// The uniform steps of a free response from `initial` to `t_end_s` of at most `dt_s`
@@ -831,7 +784,7 @@ impl LagRotor {
         states.extend_from_slice(&y);
         for step in 0..steps {
             let t = step as f64 * h;
-            ws.step(&mut sys, t, h, &mut y);
+            ws.step(&mut sys, t, h, &mut y)?;
             if y.iter().any(|v| !v.is_finite()) {
                 return Err(StabilityError::Numerical(format!(
                     "time response is not finite at t = {:.6} s (unstable, or dt_s too large for RK4)",
@@ -878,39 +831,85 @@ pub(super) fn eigen_pairs(
     Ok((lams, eig.U().to_owned()))
 }
 
-/// Match multipliers to reference exponents (nearest `lambda T` in the log plane, imaginary
-/// part modulo `2 pi`; greedy over all pairs, closest first) and resolve each exponent's
-/// imaginary part to the multiple of `Omega` nearest its reference.
-pub(super) fn resolve(
-    refs: &[(c64, ModeLabel, bool)],
-    mu: &[c64],
+/// At least `min` blades for `what`.
+pub(super) fn need_blades(what: &'static str, count: usize, min: usize) -> Result<()> {
+    if count < min {
+        return Err(StabilityError::TooFewBlades { what, count, min });
+    }
+    Ok(())
+}
+
+/// The index of the eigenvalue in `lams` nearest `target`.
+pub(super) fn nearest(lams: &[c64], target: c64) -> Option<usize> {
+    (0..lams.len()).min_by(|&a, &b| {
+        (lams[a] - target)
+            .norm()
+            .total_cmp(&(lams[b] - target).norm())
+    })
+}
+
+/// The mode state `z` (blade 1 at zero azimuth, whirl frequency `w`) scaled to a cyclic lag
+/// amplitude of 1 rad ([`cyclic_amplitude`]).
+pub(super) fn unit_cyclic(
+    mut z: Vec<f64>,
+    blades: usize,
+    omega: f64,
+    w: f64,
+    label: ModeLabel,
+) -> Result<Vec<f64>> {
+    let a = cyclic_amplitude(&z, blades, omega, 0.0, w);
+    if !(a > 0.0 && a.is_finite()) {
+        return Err(StabilityError::Numerical(format!(
+            "the {label} mode has no cyclic lag motion"
+        )));
+    }
+    z.iter_mut().for_each(|x| *x /= a);
+    Ok(z)
+}
+
+/// One mode per conjugate pair (`Im >= 0`) of `all`, sorted by frequency.
+pub(super) fn upper_modes(all: Vec<(c64, ModeLabel)>) -> Vec<Mode> {
+    modes_by_frequency(all.into_iter().filter(|(l, _)| l.im >= 0.0))
+}
+
+fn modes_by_frequency(all: impl Iterator<Item = (c64, ModeLabel)>) -> Vec<Mode> {
+    let mut modes: Vec<Mode> = all.map(|(l, label)| Mode::new(label, l)).collect();
+    modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    modes
+}
+
+/// Floquet multipliers of the column-major `m x m` monodromy matrix `phi`.
+pub(super) fn floquet_multipliers(phi: &[f64], m: usize) -> Result<Vec<c64>> {
+    ode::multipliers(phi, m)
+        .map_err(|e| StabilityError::Numerical(format!("Floquet multipliers: {e}")))
+}
+
+/// The Floquet modes of a rotor from the Coleman modes `coleman` (all, conjugates included)
+/// of its mean isotropic rotor, continued as in the module documentation: `multipliers(None)`
+/// of the rotor itself when it is isotropic, else `multipliers(Some(s))` of the blend
+/// `mean + s (actual - mean)` for `s = k / CONTINUATION_STAGES`, `k = 1..=CONTINUATION_STAGES`.
+/// One mode per conjugate pair of the references, sorted by frequency.
+pub(super) fn continued_modes(
+    coleman: Vec<(c64, ModeLabel)>,
     period: f64,
     omega: f64,
-) -> Vec<(c64, ModeLabel, bool)> {
-    let logs: Vec<c64> = mu.iter().map(|m| m.ln()).collect();
-    let wrap = |a: f64| a - 2.0 * PI * (a / (2.0 * PI)).round();
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(refs.len() * logs.len());
-    for (r, (l, _, _)) in refs.iter().enumerate() {
-        for (j, lg) in logs.iter().enumerate() {
-            let d = (lg.re - l.re * period).hypot(wrap(lg.im - l.im * period));
-            pairs.push((d, r, j));
-        }
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut taken_r = vec![false; refs.len()];
-    let mut taken_j = vec![false; logs.len()];
-    let mut out = refs.to_vec();
-    for (_, r, j) in pairs {
-        if taken_r[r] || taken_j[j] {
-            continue;
-        }
-        taken_r[r] = true;
-        taken_j[j] = true;
-        let lam = logs[j] / period;
-        let shift = ((refs[r].0.im - lam.im) / omega).round();
-        out[r].0 = c64::new(lam.re, lam.im + shift * omega);
-    }
-    out
+    isotropic: bool,
+    mut multipliers: impl FnMut(Option<f64>) -> Result<Vec<c64>>,
+) -> Result<Vec<Mode>> {
+    // (exponent, (label, Im >= 0 in the mean rotor's Coleman set))
+    let refs = coleman
+        .into_iter()
+        .map(|(l, label)| (l, (label, l.im >= 0.0)))
+        .collect();
+    let stages = if isotropic { 1 } else { CONTINUATION_STAGES };
+    let out = ode::continue_exponents(refs, stages, period, omega, |k| {
+        multipliers((!isotropic).then(|| (k + 1) as f64 / CONTINUATION_STAGES as f64))
+    })?;
+    Ok(modes_by_frequency(
+        out.into_iter()
+            .filter(|r| r.1 .1)
+            .map(|(l, (label, _))| (l, label)),
+    ))
 }
 
 /// The periodic equations in individual blade coordinates, evaluated in place.
@@ -970,15 +969,6 @@ impl PeriodicSystem {
         }
     }
 
-    fn set_time(&mut self, t: f64) {
-        for k in 0..self.phase.len() {
-            let (s, c) = (self.omega * t + self.phase[k]).sin_cos();
-            self.sin[k] = s;
-            self.cos[k] = c;
-            self.moment[k] = self.moment_start[k] + (t - self.moment_t0) * self.moment_slope[k];
-        }
-    }
-
     /// Mass coupling of blade `k` to hub coordinate `hub`, and the hub row's damping and
     /// stiffness coupling: `-S d2/dt2(zeta sin psi)` for x, `+S d2/dt2(zeta cos psi)` for y.
     #[inline]
@@ -992,8 +982,10 @@ impl PeriodicSystem {
         }
     }
 
-    /// `dz = f(t, z)` at the time of the last `set_time`; `z = [q, q']`.
-    fn rhs(&mut self, z: &[f64], dz: &mut [f64]) {
+    /// `dz = f(t, z)` at the time of the last `set_time`; `z = [q, q']`. Inlined into the
+    /// loop over the monodromy's columns.
+    #[inline(always)]
+    fn eval(&mut self, z: &[f64], dz: &mut [f64]) {
         let nb = self.inertia.len();
         let n = nb + self.hubs.len();
         let (q, v) = z.split_at(n);
@@ -1041,54 +1033,30 @@ impl PeriodicSystem {
             dz[n + nb + j] = a[j];
         }
     }
+}
 
-    /// `rhs` on each column of length `state_len` of `z`.
-    fn rhs_columns(&mut self, z: &[f64], dz: &mut [f64]) {
-        let m = 2 * (self.inertia.len() + self.hubs.len());
+impl OdeRhs for PeriodicSystem {
+    type Error = StabilityError;
+
+    #[inline]
+    fn set_time(&mut self, t: f64) -> Result<()> {
+        for k in 0..self.phase.len() {
+            let (s, c) = (self.omega * t + self.phase[k]).sin_cos();
+            self.sin[k] = s;
+            self.cos[k] = c;
+            self.moment[k] = self.moment_start[k] + (t - self.moment_t0) * self.moment_slope[k];
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn rhs(&mut self, z: &[f64], dz: &mut [f64]) {
+        self.eval(z, dz);
+    }
+
+    fn rhs_columns(&mut self, z: &[f64], dz: &mut [f64], m: usize) {
         for (zc, dc) in z.chunks_exact(m).zip(dz.chunks_exact_mut(m)) {
-            self.rhs(zc, dc);
-        }
-    }
-}
-
-/// Classical RK4 with its stage buffers allocated once.
-pub(super) struct Rk4 {
-    k1: Vec<f64>,
-    k2: Vec<f64>,
-    k3: Vec<f64>,
-    k4: Vec<f64>,
-    tmp: Vec<f64>,
-}
-
-impl Rk4 {
-    pub(super) fn new(len: usize) -> Self {
-        Rk4 {
-            k1: vec![0.0; len],
-            k2: vec![0.0; len],
-            k3: vec![0.0; len],
-            k4: vec![0.0; len],
-            tmp: vec![0.0; len],
-        }
-    }
-
-    pub(super) fn step(&mut self, sys: &mut PeriodicSystem, t: f64, h: f64, y: &mut [f64]) {
-        let axpy = |out: &mut [f64], y: &[f64], a: f64, k: &[f64]| {
-            for ((o, yi), ki) in out.iter_mut().zip(y).zip(k) {
-                *o = yi + a * ki;
-            }
-        };
-        sys.set_time(t);
-        sys.rhs_columns(y, &mut self.k1);
-        sys.set_time(t + 0.5 * h);
-        axpy(&mut self.tmp, y, 0.5 * h, &self.k1);
-        sys.rhs_columns(&self.tmp, &mut self.k2);
-        axpy(&mut self.tmp, y, 0.5 * h, &self.k2);
-        sys.rhs_columns(&self.tmp, &mut self.k3);
-        sys.set_time(t + h);
-        axpy(&mut self.tmp, y, h, &self.k3);
-        sys.rhs_columns(&self.tmp, &mut self.k4);
-        for (i, yi) in y.iter_mut().enumerate() {
-            *yi += h / 6.0 * (self.k1[i] + 2.0 * self.k2[i] + 2.0 * self.k3[i] + self.k4[i]);
+            self.eval(zc, dc);
         }
     }
 }
