@@ -392,33 +392,12 @@ fn rotor_check(
             model: crate::hydraulics::DamperModel::Physical,
             result: res.clone(),
         };
-        let info = RunInfo {
-            rotor: rotor_path.display().to_string(),
-            rotor_model: args.rotor_model_label().into(),
-            flight: fl.display().to_string(),
-            damper_deck: deck_label.clone(),
-            revs: opts.revs,
-            steps_per_rev: opts.steps_per_rev,
-            substeps: opts.substeps,
-            scheme: "rk4".into(),
-            newton: crate::solver::NewtonMethod::Modified.name().into(),
-            periodic: crate::run::PeriodicMethod::March.name().into(),
-            periodic_tol: crate::run::periodic::DEFAULT_TOL,
-            initial_state: None,
-            overrides: Vec::new(),
-            inputs_sha256: None,
-            synthetic: rec.meta.synthetic,
-            counter: rec.meta.counter.clone(),
-            wall_s: res.as_ref().map_or(runs.wall_s, |r| r.wall_s),
-            blades: None,
-            blade_differences: Vec::new(),
-            airframe: Vec::new(),
-            damper_oil_temperature_k: match which {
-                "baseline" => base.oil,
-                _ => extended.oil,
-            }
-            .map(|l| rec.meta.damper_oil_temperature_k.unwrap_or(l.temperature_k)),
+        let oil = match which {
+            "baseline" => base.oil,
+            _ => extended.oil,
         };
+        let wall_s = res.as_ref().map_or(runs.wall_s, |r| r.wall_s);
+        let info = check_run_info(args, &opts, (rec, fl), rotor_path, &deck_label, wall_s, oil);
         let failed = crate::run::outputs::write_outputs(&sub, &info, &[outcome], &measured)?.failed;
         if failed.is_empty() {
             sub.finish()?;
@@ -437,26 +416,7 @@ fn rotor_check(
     let gain = 1.0 - e.rms_error / b.rms_error;
     let improved = e.rms_error < b.rms_error;
     let (rb, re) = (parts[0].1, parts[1].1);
-    let periodic_note = if rb.converged() && re.converged() {
-        format!("both runs periodic after {} revolutions", opts.revs)
-    } else {
-        format!(
-            "periodicity after {} revolutions: baseline {} ({}), extended {} ({})",
-            opts.revs,
-            fmt_measure(rb.last_measure()),
-            if rb.converged() {
-                "periodic"
-            } else {
-                "NOT periodic"
-            },
-            fmt_measure(re.last_measure()),
-            if re.converged() {
-                "periodic"
-            } else {
-                "NOT periodic"
-            }
-        )
-    };
+    let periodic_note = periodic_note(rb, re, opts.revs);
     let statement = format!(
             "Rotor level ({}, physical damper, last of {} revolutions vs the record's averaged damper force): the extended deck ({cause}) {} the RMS error from {:.1} N to {:.1} N (gain {:.3}{}); peak-to-peak error {:+.0} N -> {:+.0} N; correlation {:.4} -> {:.4}; {periodic_note}.",
             args.rotor_model_label(),
@@ -471,23 +431,7 @@ fn rotor_check(
             b.correlation,
             e.correlation
     );
-    let side = |p: &(
-        &str,
-        &ModelRun,
-        String,
-        String,
-        crate::analysis::compare::Metrics,
-    ),
-                st: &Option<summary::StrokeCheck>| {
-        json!({
-            "damper_deck": p.2,
-            "command": p.3,
-            "summary": format!("rotor_check/{}/summary.json", p.0),
-            "run": run_json(p.1, &opts),
-            "metrics": summary::with_unit(serde_json::to_value(&p.4).unwrap_or_default(), "N"),
-            "stroke_check": summary::with_unit(serde_json::to_value(st).unwrap_or_default(), "m"),
-        })
-    };
+    let side = |p: &Side, st: &Option<summary::StrokeCheck>| side_json(p, st, &opts);
     let json = json!({
         "statement": statement,
         "rotor": rotor_path.display().to_string(),
@@ -509,8 +453,144 @@ fn rotor_check(
             "correlation": e.correlation - b.correlation,
         },
     });
+    let mut rows = metric_rows(b, e, gain);
+    harmonic_rows(&mut rows, b, e);
+    if let (Some(sb), Some(se)) = (&strokes[0], &strokes[1]) {
+        stroke_rows(&mut rows, sb, se);
+    }
+    rows.extend(run_rows(rb, re, runs.wall_s));
+    let curves = check_curves(meas, &parts);
+    Ok(RotorCheck {
+        json,
+        rows,
+        statement,
+        curves,
+    })
+}
+
+/// One side of the rotor check: which deck, its run, deck label, command and metrics.
+type Side<'r> = (
+    &'static str,
+    &'r ModelRun,
+    String,
+    String,
+    crate::analysis::compare::Metrics,
+);
+
+/// `rotor_check.baseline` / `.extended` of diagnosis.json.
+fn side_json(p: &Side, st: &Option<summary::StrokeCheck>, opts: &RotorRunOptions) -> Value {
+    json!({
+        "damper_deck": p.2,
+        "command": p.3,
+        "summary": format!("rotor_check/{}/summary.json", p.0),
+        "run": run_json(p.1, opts),
+        "metrics": summary::with_unit(serde_json::to_value(&p.4).unwrap_or_default(), "N"),
+        "stroke_check": summary::with_unit(serde_json::to_value(st).unwrap_or_default(), "m"),
+    })
+}
+
+/// The periodicity and wall-time rows of the two runs.
+fn run_rows(rb: &ModelRun, re: &ModelRun, wall_s: f64) -> [Vec<String>; 2] {
+    [
+        vec![
+            "periodicity (last revolution)".into(),
+            fmt_measure(rb.last_measure()),
+            fmt_measure(re.last_measure()),
+            String::new(),
+        ],
+        vec![
+            "wall time [s]".into(),
+            format!("{:.1}", rb.wall_s),
+            format!("{:.1}", re.wall_s),
+            format!("both in parallel {:.1}", wall_s),
+        ],
+    ]
+}
+
+/// The record's revolution-averaged damper force and each run's last revolution.
+fn check_curves(meas: &Measured, parts: &[Side]) -> Vec<(String, Vec<f64>, Vec<f64>)> {
+    let mut curves = vec![(
+        "measured (revolution average)".to_string(),
+        meas.azimuth_deg.clone(),
+        meas.force_n.clone(),
+    )];
+    for p in parts {
+        if let Some(fz) = p.1.channel("damper_force_N") {
+            curves.push((
+                format!("{} deck", p.0),
+                p.1.azimuth_deg.clone(),
+                fz.to_vec(),
+            ));
+        }
+    }
+    curves
+}
+
+/// What a rotor-check run writes beside its outputs (as `rotorsim run --damper physical`).
+fn check_run_info(
+    args: &Config,
+    opts: &RotorRunOptions,
+    (rec, fl): (&FlightRecord, &Path),
+    rotor_path: &Path,
+    deck_label: &str,
+    wall_s: f64,
+    oil: Option<crate::hydraulics::OilTemperature>,
+) -> RunInfo {
+    RunInfo {
+        rotor: rotor_path.display().to_string(),
+        rotor_model: args.rotor_model_label().into(),
+        flight: fl.display().to_string(),
+        damper_deck: deck_label.to_string(),
+        revs: opts.revs,
+        steps_per_rev: opts.steps_per_rev,
+        substeps: opts.substeps,
+        scheme: "rk4".into(),
+        newton: crate::solver::NewtonMethod::Modified.name().into(),
+        periodic: crate::run::PeriodicMethod::March.name().into(),
+        periodic_tol: crate::run::periodic::DEFAULT_TOL,
+        initial_state: None,
+        overrides: Vec::new(),
+        inputs_sha256: None,
+        synthetic: rec.meta.synthetic,
+        counter: rec.meta.counter.clone(),
+        wall_s,
+        blades: None,
+        blade_differences: Vec::new(),
+        airframe: Vec::new(),
+        damper_oil_temperature_k: oil
+            .map(|l| rec.meta.damper_oil_temperature_k.unwrap_or(l.temperature_k)),
+    }
+}
+
+/// Whether both rotor-check runs are periodic, or each one's last measure.
+fn periodic_note(rb: &ModelRun, re: &ModelRun, revs: usize) -> String {
+    if rb.converged() && re.converged() {
+        return format!("both runs periodic after {revs} revolutions");
+    }
+    let verdict = |r: &ModelRun| {
+        if r.converged() {
+            "periodic"
+        } else {
+            "NOT periodic"
+        }
+    };
+    format!(
+        "periodicity after {revs} revolutions: baseline {} ({}), extended {} ({})",
+        fmt_measure(rb.last_measure()),
+        verdict(rb),
+        fmt_measure(re.last_measure()),
+        verdict(re)
+    )
+}
+
+/// The (metric, baseline, extended, change) rows of the damper force's comparison.
+fn metric_rows(
+    b: &crate::analysis::compare::Metrics,
+    e: &crate::analysis::compare::Metrics,
+    gain: f64,
+) -> Vec<Vec<String>> {
     let f = |x: f64| format!("{x:.1}");
-    let mut rows = vec![
+    vec![
         vec![
             "RMS error [N]".into(),
             f(b.rms_error),
@@ -553,43 +633,7 @@ fn rotor_check(
             format!("{:.4}", e.correlation),
             format!("{:+.4}", e.correlation - b.correlation),
         ],
-    ];
-    harmonic_rows(&mut rows, b, e);
-    if let (Some(sb), Some(se)) = (&strokes[0], &strokes[1]) {
-        stroke_rows(&mut rows, sb, se);
-    }
-    rows.push(vec![
-        "periodicity (last revolution)".into(),
-        fmt_measure(rb.last_measure()),
-        fmt_measure(re.last_measure()),
-        String::new(),
-    ]);
-    rows.push(vec![
-        "wall time [s]".into(),
-        format!("{:.1}", rb.wall_s),
-        format!("{:.1}", re.wall_s),
-        format!("both in parallel {:.1}", runs.wall_s),
-    ]);
-    let mut curves = vec![(
-        "measured (revolution average)".to_string(),
-        meas.azimuth_deg.clone(),
-        meas.force_n.clone(),
-    )];
-    for p in &parts {
-        if let Some(fz) = p.1.channel("damper_force_N") {
-            curves.push((
-                format!("{} deck", p.0),
-                p.1.azimuth_deg.clone(),
-                fz.to_vec(),
-            ));
-        }
-    }
-    Ok(RotorCheck {
-        json,
-        rows,
-        statement,
-        curves,
-    })
+    ]
 }
 
 fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Result<(), PlotError> {
@@ -627,104 +671,181 @@ fn rotor_check_html(r: &mut HtmlReport, c: &RotorCheck, synthetic: bool) -> Resu
     Ok(())
 }
 
+/// The baseline deck, the data and what they are, as `run` reads them.
+struct Inputs {
+    deck: DamperDeck,
+    data: Vec<Measurement>,
+    /// What the data are (the report's first paragraph).
+    source: String,
+    stroke_info: Option<Value>,
+    /// Without a measured stroke there is no stroke channel for the force to lag: a lag
+    /// between the force and the simulated stroke is the rotor model's phase error.
+    stroke_simulated: bool,
+    record: Option<(FlightRecord, PathBuf)>,
+    deck_label: String,
+}
+
+/// A flight record: its measured damper stroke replayed, or, without one, the stroke the full
+/// rotor run simulates.
+fn flight_inputs(args: &Config, fl: &Path, say: Say) -> anyhow::Result<Inputs> {
+    let stroke_info: Option<Value>;
+    let mut stroke_simulated = false;
+    let deck_path =
+        args.deck.clone().or(args.rotor.clone()).context(
+            "--flight needs --rotor ROTOR (or --damper-deck DECK) for the baseline damper",
+        )?;
+    let deck = DamperDeck::from_file(&deck_path)?;
+    let deck_label = deck_path.display().to_string();
+    let rec = FlightRecord::read(fl)?;
+    let synth = if rec.meta.synthetic {
+        " SYNTHETIC record (labelled synthetic in its metadata)."
+    } else {
+        ""
+    };
+    let (m, src) = if rec.has_stroke() {
+        let m = flight_measurement(&rec, fl, None)?;
+        stroke_info = Some(json!({
+            "kind": "measured",
+            "statement": "The stroke is the record's measured damper stroke (stroke-driven replay).",
+        }));
+        let src = format!(
+            "Flight record {} (stroke-driven replay of the damper, Omega = {} rad/s), baseline deck {}.{synth}",
+            fl.display(),
+            rec.meta.rotor_speed_rad_s,
+            deck_path.display()
+        );
+        (m, src)
+    } else {
+        let rotor_path = args.rotor.clone().with_context(|| {
+            format!(
+                "{}: the record has no damper stroke: the stroke is simulated by the full rotor run, which needs --rotor ROTOR (a rotor deck)",
+                fl.display()
+            )
+        })?;
+        let opts = args.rotor_opts(args.revs);
+        opts.check()?;
+        let (m, info, statement) = simulated_measurement(&rec, fl, &rotor_path, &deck, &opts, say)?;
+        stroke_info = Some(info);
+        stroke_simulated = true;
+        let src = format!(
+            "Flight record {} WITHOUT damper stroke (Omega = {} rad/s), baseline deck {}. {statement}{synth}",
+            fl.display(),
+            rec.meta.rotor_speed_rad_s,
+            deck_path.display()
+        );
+        (m, src)
+    };
+    Ok(Inputs {
+        deck,
+        data: vec![m],
+        source: src,
+        stroke_info,
+        stroke_simulated,
+        record: Some((rec, fl.to_path_buf())),
+        deck_label,
+    })
+}
+
+/// Bench tests, each checked alone so that a test unfit for a diagnosis is named by its file.
+fn bench_inputs(args: &Config) -> anyhow::Result<Inputs> {
+    let deck_path = args
+        .deck
+        .clone()
+        .context("--measured needs --damper-deck DECK")?;
+    let deck = DamperDeck::from_file(&deck_path)?;
+    let data = args
+        .measured
+        .iter()
+        .map(|p| {
+            let t = read_bench_csv_with_dropouts(p)?;
+            let m = Measurement::from_bench(&t)
+                .with_context(|| format!("bench file {}", p.display()))?;
+            // a test unfit for a diagnosis is named by its file
+            let one = std::slice::from_ref(&m);
+            super::data::screen(one).with_context(|| format!("bench file {}", p.display()))?;
+            super::check_measurements(one)
+                .with_context(|| format!("bench file {}", p.display()))?;
+            Ok(m)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    // Bench files carry no metadata: a file named synthetic is labelled so (as bench does).
+    let synthetic = args.measured.iter().any(|p| {
+        p.file_name().is_some_and(|n| {
+            n.to_string_lossy()
+                .to_ascii_lowercase()
+                .contains("synthetic")
+        })
+    });
+    let src = format!(
+        "Bench tests {} (stroke-driven replay), baseline deck {}.{}",
+        args.measured
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        deck_path.display(),
+        if synthetic {
+            " SYNTHETIC tests (named synthetic)."
+        } else {
+            ""
+        }
+    );
+    Ok(Inputs {
+        deck,
+        data,
+        source: src,
+        stroke_info: None,
+        stroke_simulated: false,
+        record: None,
+        deck_label: String::new(),
+    })
+}
+
+/// The rotor-level check is not run when the extended deck is the baseline deck: no cause, or
+/// a cause that is the data acquisition's.
+fn skipped_check(cause: &str) -> Option<RotorCheck> {
+    if cause == "none" {
+        return Some(RotorCheck {
+            json: json!({
+                "statement": "No extension was chosen (cause none): the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.",
+                "skipped": true,
+            }),
+            rows: vec![],
+            statement: "Rotor-level check skipped: no extension was chosen (cause none), the extended deck is the baseline deck.".into(),
+            curves: vec![],
+        });
+    }
+    super::acquisition::only_faults(cause).then(|| RotorCheck {
+            json: json!({
+                "statement": format!("The cause is the data acquisition ({}), not the damper: the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.", cause),
+                "skipped": true,
+            }),
+            rows: vec![],
+            statement: format!("Rotor-level check skipped: the cause is the data acquisition ({}), the extended deck is the baseline deck.", cause),
+            curves: vec![],
+        })
+}
+
 /// Checks the options, reads the data, diagnoses it and writes every output into `args.out`.
 pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
     args.check()?;
-    let mut stroke_info: Option<Value> = None;
-    // Without a measured stroke there is no stroke channel for the force to lag: a lag
-    // between the force and the simulated stroke is the rotor model's phase error.
-    let mut stroke_simulated = false;
-    let mut record: Option<(FlightRecord, PathBuf)> = None;
-    let mut deck_label = String::new();
-    let (deck, data, source) = match (&args.flight, args.measured.is_empty()) {
-        (Some(fl), true) => {
-            let deck_path = args
-                .deck
-                .clone()
-                .or(args.rotor.clone())
-                .context("--flight needs --rotor ROTOR (or --damper-deck DECK) for the baseline damper")?;
-            let deck = DamperDeck::from_file(&deck_path)?;
-            deck_label = deck_path.display().to_string();
-            let rec = FlightRecord::read(fl)?;
-            let synth = if rec.meta.synthetic { " SYNTHETIC record (labelled synthetic in its metadata)." } else { "" };
-            let (m, src) = if rec.has_stroke() {
-                let m = flight_measurement(&rec, fl, None)?;
-                stroke_info = Some(json!({
-                    "kind": "measured",
-                    "statement": "The stroke is the record's measured damper stroke (stroke-driven replay).",
-                }));
-                let src = format!(
-                    "Flight record {} (stroke-driven replay of the damper, Omega = {} rad/s), baseline deck {}.{synth}",
-                    fl.display(),
-                    rec.meta.rotor_speed_rad_s,
-                    deck_path.display()
-                );
-                (m, src)
-            } else {
-                let rotor_path = args.rotor.clone().with_context(|| {
-                    format!(
-                        "{}: the record has no damper stroke: the stroke is simulated by the full rotor run, which needs --rotor ROTOR (a rotor deck)",
-                        fl.display()
-                    )
-                })?;
-                let opts = args.rotor_opts(args.revs);
-                opts.check()?;
-                let (m, info, statement) =
-                    simulated_measurement(&rec, fl, &rotor_path, &deck, &opts, say)?;
-                stroke_info = Some(info);
-                stroke_simulated = true;
-                let src = format!(
-                    "Flight record {} WITHOUT damper stroke (Omega = {} rad/s), baseline deck {}. {statement}{synth}",
-                    fl.display(),
-                    rec.meta.rotor_speed_rad_s,
-                    deck_path.display()
-                );
-                (m, src)
-            };
-            record = Some((rec, fl.clone()));
-            (deck, vec![m], src)
-        }
-        (None, false) => {
-            let deck_path = args.deck.clone().context("--measured needs --damper-deck DECK")?;
-            let deck = DamperDeck::from_file(&deck_path)?;
-            let data = args
-                .measured
-                .iter()
-                .map(|p| {
-                    let t = read_bench_csv_with_dropouts(p)?;
-                    let m = Measurement::from_bench(&t)
-                        .with_context(|| format!("bench file {}", p.display()))?;
-                    // a test unfit for a diagnosis is named by its file
-                    let one = std::slice::from_ref(&m);
-                    super::data::screen(one)
-                        .with_context(|| format!("bench file {}", p.display()))?;
-                    super::check_measurements(one)
-                        .with_context(|| format!("bench file {}", p.display()))?;
-                    Ok(m)
-                })
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            // Bench files carry no metadata: a file named synthetic is labelled so (as bench does).
-            let synthetic = args.measured.iter().any(|p| {
-                p.file_name()
-                    .is_some_and(|n| n.to_string_lossy().to_ascii_lowercase().contains("synthetic"))
-            });
-            let src = format!(
-                "Bench tests {} (stroke-driven replay), baseline deck {}.{}",
-                args.measured
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                deck_path.display(),
-                if synthetic { " SYNTHETIC tests (named synthetic)." } else { "" }
-            );
-            (deck, data, src)
-        }
+    let inputs = match (&args.flight, args.measured.is_empty()) {
+        (Some(fl), true) => flight_inputs(args, fl, say)?,
+        (None, false) => bench_inputs(args)?,
         (Some(_), false) => bail!("give either --flight or --measured, not both"),
         (None, true) => bail!(
             "nothing to diagnose: give --damper-deck DECK --measured TEST.csv [...] or --rotor ROTOR --flight RECORD"
         ),
     };
+    let Inputs {
+        deck,
+        data,
+        source,
+        stroke_info,
+        stroke_simulated,
+        record,
+        deck_label,
+    } = inputs;
     let mut opts = DiagnoseOptions {
         fit_cycles: args.fit_cycles,
         max_substep_s: args.max_substep,
@@ -765,24 +886,7 @@ pub fn run(args: &Config, say: Say) -> anyhow::Result<Report> {
     // The rotor-level before/after runs the deck as written (what `rotorsim run --damper-deck`
     // reads).
     let check = match &record {
-        Some(_) if args.rotor_check && d.cause == "none" => Some(RotorCheck {
-            json: json!({
-                "statement": "No extension was chosen (cause none): the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.",
-                "skipped": true,
-            }),
-            rows: vec![],
-            statement: "Rotor-level check skipped: no extension was chosen (cause none), the extended deck is the baseline deck.".into(),
-            curves: vec![],
-        }),
-        Some(_) if args.rotor_check && super::acquisition::only_faults(&d.cause) => Some(RotorCheck {
-            json: json!({
-                "statement": format!("The cause is the data acquisition ({}), not the damper: the extended deck is the baseline deck, so the rotor-level comparison cannot change; the rotor runs were not made.", d.cause),
-                "skipped": true,
-            }),
-            rows: vec![],
-            statement: format!("Rotor-level check skipped: the cause is the data acquisition ({}), the extended deck is the baseline deck.", d.cause),
-            curves: vec![],
-        }),
+        Some(_) if args.rotor_check && skipped_check(&d.cause).is_some() => skipped_check(&d.cause),
         Some((rec, fl)) if args.rotor_check => {
             let deck_path = args.write_deck.clone().unwrap_or(deck_file);
             Some(rotor_check(

@@ -156,6 +156,22 @@ pub fn html_with(
     noise: Option<&Signature>,
     extra: impl FnOnce(&mut HtmlReport) -> Result<(), PlotError>,
 ) -> Result<String, PlotError> {
+    let mut r = headline(d, source);
+    extra(&mut r)?;
+    evidence_section(&mut r, d, source, noise)?;
+    identifiability_section(&mut r, d);
+    not_supported_section(&mut r, d);
+    spread_section(&mut r, d);
+    candidates_section(&mut r, d);
+    per_test_section(&mut r, d);
+    for c in curves.iter().take(6) {
+        curve_plots(&mut r, c)?;
+    }
+    Ok(r.finish())
+}
+
+/// The head of the report: the cause, its gain, the limitations.
+fn headline(d: &Diagnosis, source: &str) -> HtmlReport {
     let mut r = HtmlReport::new(&format!("rotorsim diagnosis: {}", d.cause));
     if source.contains("SYNTHETIC") {
         r.banner(
@@ -172,15 +188,16 @@ pub fn html_with(
             None => format!("{k} = {v:.6e}"),
         })
         .collect();
+    let v = &d.validation;
     r.paragraph(&format!(
         "Cause: {}{}. RMS error over all compared samples: baseline {:.1} N, extended {:.1} N. Validation ({}): baseline {:.1} N, extended {:.1} N, gain {:.3}.",
         d.cause,
         if params.is_empty() { String::new() } else { format!(" ({})", params.join(", ")) },
         d.baseline_rms_N,
         d.extended_rms_N,
-        d.validation.method,
-        d.validation.baseline_rms_N,
-        d.validation.extended_rms_N,
+        v.method,
+        v.baseline_rms_N,
+        v.extended_rms_N,
         d.gain
     ));
     if let Some(l) = &d.free_play_limit {
@@ -189,7 +206,16 @@ pub fn html_with(
     for l in &d.limitations {
         r.notice(l);
     }
-    extra(&mut r)?;
+    r
+}
+
+/// The evidence and the signatures, measured beside each candidate's prediction.
+fn evidence_section(
+    r: &mut HtmlReport,
+    d: &Diagnosis,
+    source: &str,
+    noise: Option<&Signature>,
+) -> Result<(), PlotError> {
     r.heading(2, "Evidence");
     r.list(&d.evidence);
     r.heading(2, "Signatures: measured beside each candidate's prediction");
@@ -231,6 +257,11 @@ pub fn html_with(
         ),
         &grid_svg(&plots, 2, 1100, 380)?,
     );
+    Ok(())
+}
+
+/// Candidates the data cannot tell apart from the cause, and parameters they do not bound.
+fn identifiability_section(r: &mut HtmlReport, d: &Diagnosis) {
     r.heading(2, "Identifiability");
     if d.identifiability.is_empty() {
         r.paragraph("No candidate is within the margin of the cause on held-out data and every parameter of the cause is bounded by the data.");
@@ -252,6 +283,10 @@ pub fn html_with(
             .collect();
         r.table(&["not separable", "why", "test that would decide"], &rows);
     }
+}
+
+/// Candidates that pass the tests of their role but are not named.
+fn not_supported_section(r: &mut HtmlReport, d: &Diagnosis) {
     if !d.considered_not_supported.is_empty() {
         r.heading(2, "Considered, not supported");
         r.paragraph("Candidates that pass the tests of their role (first cause or companion) but are not named: the 95% interval of each parameter of at least one of their causes includes its no-effect value (a lag: lies within the timing uncertainty), so the data do not tell that cause from no effect.");
@@ -292,6 +327,10 @@ pub fn html_with(
             &rows,
         );
     }
+}
+
+/// The cause's parameters fitted test by test, and their spread.
+fn spread_section(r: &mut HtmlReport, d: &Diagnosis) {
     if !d.parameter_spread.is_empty() {
         r.heading(2, "The cause's parameters test by test");
         r.paragraph("Each parameter of the cause fitted to each test alone. A model of the right form gives every test the same value up to noise; a value that moves with amplitude or frequency stands in for something the model does not have. The spread is the standard deviation of ln x across tests beyond the noise (DerSimonian-Laird); the 95% interval above includes it.");
@@ -337,6 +376,10 @@ pub fn html_with(
         head.extend(names.iter().map(|n| n.as_str()));
         r.table(&head, &rows);
     }
+}
+
+/// Every candidate ranked by BIC, and the criterion.
+fn candidates_section(r: &mut HtmlReport, d: &Diagnosis) {
     r.heading(2, "Candidates (ranked by BIC)");
     let rows: Vec<Vec<String>> = d
         .candidates
@@ -376,6 +419,10 @@ pub fn html_with(
         "Baseline BIC {:.1}; noise sigma {:.1} N; threshold {:.1} N. {}",
         d.baseline_bic, d.noise_sigma_N, d.threshold_N, d.criterion
     ));
+}
+
+/// Baseline and extended RMS of each test.
+fn per_test_section(r: &mut HtmlReport, d: &Diagnosis) {
     r.heading(2, "Per test");
     let rows: Vec<Vec<String>> = d
         .tests
@@ -402,58 +449,60 @@ pub fn html_with(
         ],
         &rows,
     );
-    for c in curves.iter().take(6) {
-        let s = c.from;
-        let t = &c.time_s[s..];
-        let res_b: Vec<f64> = (s..c.time_s.len())
-            .map(|k| c.measured_n[k] - c.baseline_n[k])
-            .collect();
-        let res_e: Vec<f64> = (s..c.time_s.len())
-            .map(|k| c.measured_n[k] - c.extended_n[k])
-            .collect();
-        r.heading(2, &format!("{} ({})", c.name, c.role));
-        let p = Plot::new(
-            &format!("{}: residual (measured - model) vs time", c.name),
-            "time [s]",
-            "residual [N]",
-        )
-        .points("baseline", t, &res_b)
-        .points("extended", t, &res_e);
-        r.svg("residual vs time", &p.to_svg(800, 320)?);
-        let p = Plot::new(
-            &format!("{}: residual vs stroke", c.name),
-            "stroke [m]",
-            "residual [N]",
-        )
-        .points("baseline", &c.stroke_m[s..], &res_b)
-        .points("extended", &c.stroke_m[s..], &res_e);
-        r.svg("residual vs stroke", &p.to_svg(800, 320)?);
-        let p = Plot::new(
-            &format!("{}: residual vs velocity", c.name),
-            "stroke rate [m/s]",
-            "residual [N]",
-        )
-        .points("baseline", &c.velocity_m_s[s..], &res_b)
-        .points("extended", &c.velocity_m_s[s..], &res_e);
-        r.svg("residual vs velocity", &p.to_svg(800, 320)?);
-        let p = Plot::new(
-            &format!("{}: force vs stroke", c.name),
-            "stroke [m]",
-            "force [N]",
-        )
-        .points("measured", &c.stroke_m[s..], &c.measured_n[s..])
-        .line("baseline", &c.stroke_m[s..], &c.baseline_n[s..])
-        .dashed("extended", &c.stroke_m[s..], &c.extended_n[s..]);
-        r.svg("force-stroke loop", &p.to_svg(800, 420)?);
-        let p = Plot::new(
-            &format!("{}: force vs velocity", c.name),
-            "stroke rate [m/s]",
-            "force [N]",
-        )
-        .points("measured", &c.velocity_m_s[s..], &c.measured_n[s..])
-        .line("baseline", &c.velocity_m_s[s..], &c.baseline_n[s..])
-        .dashed("extended", &c.velocity_m_s[s..], &c.extended_n[s..]);
-        r.svg("force-velocity loop", &p.to_svg(800, 420)?);
-    }
-    Ok(r.finish())
+}
+
+/// Residuals and loops of one test.
+fn curve_plots(r: &mut HtmlReport, c: &Curves) -> Result<(), PlotError> {
+    let s = c.from;
+    let t = &c.time_s[s..];
+    let res_b: Vec<f64> = (s..c.time_s.len())
+        .map(|k| c.measured_n[k] - c.baseline_n[k])
+        .collect();
+    let res_e: Vec<f64> = (s..c.time_s.len())
+        .map(|k| c.measured_n[k] - c.extended_n[k])
+        .collect();
+    r.heading(2, &format!("{} ({})", c.name, c.role));
+    let p = Plot::new(
+        &format!("{}: residual (measured - model) vs time", c.name),
+        "time [s]",
+        "residual [N]",
+    )
+    .points("baseline", t, &res_b)
+    .points("extended", t, &res_e);
+    r.svg("residual vs time", &p.to_svg(800, 320)?);
+    let p = Plot::new(
+        &format!("{}: residual vs stroke", c.name),
+        "stroke [m]",
+        "residual [N]",
+    )
+    .points("baseline", &c.stroke_m[s..], &res_b)
+    .points("extended", &c.stroke_m[s..], &res_e);
+    r.svg("residual vs stroke", &p.to_svg(800, 320)?);
+    let p = Plot::new(
+        &format!("{}: residual vs velocity", c.name),
+        "stroke rate [m/s]",
+        "residual [N]",
+    )
+    .points("baseline", &c.velocity_m_s[s..], &res_b)
+    .points("extended", &c.velocity_m_s[s..], &res_e);
+    r.svg("residual vs velocity", &p.to_svg(800, 320)?);
+    let p = Plot::new(
+        &format!("{}: force vs stroke", c.name),
+        "stroke [m]",
+        "force [N]",
+    )
+    .points("measured", &c.stroke_m[s..], &c.measured_n[s..])
+    .line("baseline", &c.stroke_m[s..], &c.baseline_n[s..])
+    .dashed("extended", &c.stroke_m[s..], &c.extended_n[s..]);
+    r.svg("force-stroke loop", &p.to_svg(800, 420)?);
+    let p = Plot::new(
+        &format!("{}: force vs velocity", c.name),
+        "stroke rate [m/s]",
+        "force [N]",
+    )
+    .points("measured", &c.velocity_m_s[s..], &c.measured_n[s..])
+    .line("baseline", &c.velocity_m_s[s..], &c.baseline_n[s..])
+    .dashed("extended", &c.velocity_m_s[s..], &c.extended_n[s..]);
+    r.svg("force-velocity loop", &p.to_svg(800, 420)?);
+    Ok(())
 }

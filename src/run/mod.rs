@@ -306,16 +306,7 @@ fn drive_periodic_once(
     if o.max_revs < 1 {
         anyhow::bail!("at least one revolution is needed (got {})", o.max_revs);
     }
-    let period = sim.period_s();
-    let dt = sim.time_step_s();
-    let ratio = period / dt;
-    let n = ratio.round() as usize;
-    if n < 4 || (ratio - n as f64).abs() > 1e-6 * ratio {
-        anyhow::bail!(
-            "{}: period {period} s is not a whole number of time steps {dt} s",
-            sim.label()
-        );
-    }
+    let (period, dt, n) = steps_per_period(sim)?;
     let names = sim.channel_names();
     let nc = names.len();
     let env_channels: Vec<usize> = (0..nc)
@@ -344,24 +335,7 @@ fn drive_periodic_once(
     let can_save = sim.save_state().is_some();
     let shooting = o.method == PeriodicMethod::Shooting && can_save;
     let (mut slowest, mut step_estimate) = (None, None);
-    let mut info = PeriodicInfo {
-        method: o.method,
-        method_used: PeriodicMethod::March,
-        converged: false,
-        tolerance: o.tol,
-        residual: f64::NAN,
-        residual_by_channel: vec![f64::NAN; mon.len()],
-        residual_history: vec![],
-        revolutions_integrated: 0,
-        marched_revolutions: 0,
-        iterations: 0,
-        directions: 0,
-        rejected_trials: 0,
-        floquet_multipliers: vec![],
-        error_estimate: None,
-        message: String::new(),
-        start_t_s: 0.0,
-    };
+    let mut info = new_info(o, mon.len());
     if o.method == PeriodicMethod::Shooting && !can_save {
         info.message = format!("{} cannot save its state: marched", sim.label());
     }
@@ -458,25 +432,7 @@ fn drive_periodic_once(
             &format!("{} model, revolution {periods} (shooting)", model.name()),
         )?;
         start_state = Some(start);
-        let mut mult: Vec<_> = out
-            .ritz
-            .iter()
-            .map(|p| {
-                let mut m = p.multiplier.clone();
-                m.mode = sim.mode_label(&p.vector_re, &p.vector_im);
-                m
-            })
-            .collect();
-        // lag mode first, then least damped first
-        // (an oscillating one: a real multiplier is a decaying or half-per-rev motion)
-        if let Some(i) = mult
-            .iter()
-            .position(|m| m.mode == "lag" && m.im.abs() > 0.0 && m.frequency_per_rev < 0.5)
-        {
-            let lag = mult.remove(i);
-            mult.insert(0, lag);
-        }
-        mult.truncate(FLOQUET_REPORTED);
+        let mult = reported_multipliers(sim, &out.ritz);
         slowest = out
             .ritz
             .first()
@@ -485,13 +441,7 @@ fn drive_periodic_once(
         step_estimate = out.error_estimate;
         info.floquet_multipliers = mult;
         if !info.converged {
-            use crate::periodic::shooting::Stop;
-            let why = match &out.stop {
-                Stop::Budget => format!("the budget of {} revolutions ran out", o.max_revs),
-                Stop::LineSearch => "no step along the Newton-Picard direction decreased the residual (non-smooth valves?)".into(),
-                Stop::Failed(e) => format!("a revolution failed: {e}"),
-                Stop::Converged => String::new(),
-            };
+            let why = stop_reason(&out.stop, o.max_revs);
             push_message(
                 &mut info.message,
                 format!(
@@ -537,33 +487,13 @@ fn drive_periodic_once(
             ),
         );
     }
-    if info.method_used == PeriodicMethod::Shooting {
-        // The reported revolution starts from a shooting iterate, restored: at its first
-        // sample the accelerations are the iterate's (updated linearly, not from the
-        // equations of motion) and the device reports its last step, of the revolution run
-        // before. The revolution's end is the same point of the periodic solution (within
-        // the residual, measured above) reached by a step: its values stand for the first
-        // sample.
-        let first = |samples: &mut [Vec<f64>]| {
-            for (c, v) in samples.iter_mut().enumerate() {
-                if !env_channels.contains(&c) {
-                    v[0] = rev.end[c];
-                }
-            }
-        };
-        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
-            first(&mut k.samples);
-        }
-        first(&mut rev.samples);
-    }
-    align_envelopes(&mut rev.samples, &rev.end, &env_channels);
-    if info.method_used == PeriodicMethod::Shooting {
-        // the first step's sub-step envelope then also holds the first sample it starts from
-        widen_first_envelope(&mut rev.samples, &names, &env_channels);
-        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
-            widen_first_envelope(&mut k.samples, &names, &env_channels);
-        }
-    }
+    finish_revolution(
+        &mut rev,
+        &mut kept,
+        &names,
+        &env_channels,
+        info.method_used == PeriodicMethod::Shooting,
+    );
     let timing = sim.timing();
     let blades = sim.blades();
     let mut run = ModelRun {
@@ -593,30 +523,152 @@ fn drive_periodic_once(
         airloads: sim.airload_info(),
     };
     loads::finish(&mut run, blades);
-    // the sub-step envelope last, so the columns written before it keep their places
-    let (env, point): (Vec<usize>, Vec<usize>) = (0..run.channel_names.len())
-        .partition(|&c| crate::hydraulics::circuit::is_substep_envelope(&run.channel_names[c]));
-    if !env.is_empty() {
-        let order: Vec<usize> = point.into_iter().chain(env).collect();
-        let reorder = |v: &mut Vec<Vec<f64>>| {
-            let mut old = std::mem::take(v);
-            let n = old.len();
-            *v = order
-                .iter()
-                .filter(|&&c| c < n)
-                .map(|&c| std::mem::take(&mut old[c]))
-                .collect();
+    envelopes_last(&mut run);
+    Ok(run)
+}
+
+/// The period, the time step and the steps per period (a whole number of at least 4).
+fn steps_per_period(sim: &dyn ForcedResponse) -> anyhow::Result<(f64, f64, usize)> {
+    let period = sim.period_s();
+    let dt = sim.time_step_s();
+    let ratio = period / dt;
+    let n = ratio.round() as usize;
+    if n < 4 || (ratio - n as f64).abs() > 1e-6 * ratio {
+        anyhow::bail!(
+            "{}: period {period} s is not a whole number of time steps {dt} s",
+            sim.label()
+        );
+    }
+    Ok((period, dt, n))
+}
+
+/// The periodic search before its first revolution.
+fn new_info(o: &PeriodicOptions, monitored: usize) -> PeriodicInfo {
+    PeriodicInfo {
+        method: o.method,
+        method_used: PeriodicMethod::March,
+        converged: false,
+        tolerance: o.tol,
+        residual: f64::NAN,
+        residual_by_channel: vec![f64::NAN; monitored],
+        residual_history: vec![],
+        revolutions_integrated: 0,
+        marched_revolutions: 0,
+        iterations: 0,
+        directions: 0,
+        rejected_trials: 0,
+        floquet_multipliers: vec![],
+        error_estimate: None,
+        message: String::new(),
+        start_t_s: 0.0,
+    }
+}
+
+/// The Floquet multipliers reported, each with its mode's label: the lag mode first, then
+/// least damped first (an oscillating one: a real multiplier is a decaying or half-per-rev
+/// motion).
+fn reported_multipliers(
+    sim: &dyn ForcedResponse,
+    ritz: &[crate::periodic::floquet::RitzPair],
+) -> Vec<crate::periodic::Multiplier> {
+    let mut mult: Vec<_> = ritz
+        .iter()
+        .map(|p| {
+            let mut m = p.multiplier.clone();
+            m.mode = sim.mode_label(&p.vector_re, &p.vector_im);
+            m
+        })
+        .collect();
+    if let Some(i) = mult
+        .iter()
+        .position(|m| m.mode == "lag" && m.im.abs() > 0.0 && m.frequency_per_rev < 0.5)
+    {
+        let lag = mult.remove(i);
+        mult.insert(0, lag);
+    }
+    mult.truncate(FLOQUET_REPORTED);
+    mult
+}
+
+/// Why shooting stopped without converging.
+fn stop_reason(stop: &crate::periodic::shooting::Stop, max_revs: usize) -> String {
+    use crate::periodic::shooting::Stop;
+    match stop {
+        Stop::Budget => format!("the budget of {max_revs} revolutions ran out"),
+        Stop::LineSearch => {
+            "no step along the Newton-Picard direction decreased the residual (non-smooth valves?)"
+                .into()
+        }
+        Stop::Failed(e) => format!("a revolution failed: {e}"),
+        Stop::Converged => String::new(),
+    }
+}
+
+/// The reported revolution's sub-step envelopes aligned with its samples; after shooting
+/// (`shot`), its first sample taken from its end.
+fn finish_revolution(
+    rev: &mut Revolution,
+    kept: &mut [KeptRevolution],
+    names: &[String],
+    env_channels: &[usize],
+    shot: bool,
+) {
+    if shot {
+        // The reported revolution starts from a shooting iterate, restored: at its first
+        // sample the accelerations are the iterate's (updated linearly, not from the
+        // equations of motion) and the device reports its last step, of the revolution run
+        // before. The revolution's end is the same point of the periodic solution (within
+        // the residual, measured above) reached by a step: its values stand for the first
+        // sample.
+        let end = &rev.end;
+        let first = |samples: &mut [Vec<f64>]| {
+            for (c, v) in samples.iter_mut().enumerate() {
+                if !env_channels.contains(&c) {
+                    v[0] = end[c];
+                }
+            }
         };
-        run.channel_names = order
-            .iter()
-            .map(|&c| run.channel_names[c].clone())
-            .collect();
-        reorder(&mut run.last_rev);
-        for k in &mut run.all_revs {
-            reorder(&mut k.samples);
+        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
+            first(&mut k.samples);
+        }
+        first(&mut rev.samples);
+    }
+    align_envelopes(&mut rev.samples, &rev.end, env_channels);
+    if shot {
+        // the first step's sub-step envelope then also holds the first sample it starts from
+        widen_first_envelope(&mut rev.samples, names, env_channels);
+        if let Some(k) = kept.last_mut().filter(|k| k.start_t_s == rev.start_t_s) {
+            widen_first_envelope(&mut k.samples, names, env_channels);
         }
     }
-    Ok(run)
+}
+
+/// The sub-step envelope channels moved last, so the columns written before them keep their
+/// places.
+fn envelopes_last(run: &mut ModelRun) {
+    let (env, point): (Vec<usize>, Vec<usize>) = (0..run.channel_names.len())
+        .partition(|&c| crate::hydraulics::circuit::is_substep_envelope(&run.channel_names[c]));
+    if env.is_empty() {
+        return;
+    }
+    let order: Vec<usize> = point.into_iter().chain(env).collect();
+    let reorder = |v: &mut Vec<Vec<f64>>| {
+        let mut old = std::mem::take(v);
+        let n = old.len();
+        *v = order
+            .iter()
+            .filter(|&&c| c < n)
+            .map(|&c| std::mem::take(&mut old[c]))
+            .collect();
+    };
+    run.channel_names = order
+        .iter()
+        .map(|&c| run.channel_names[c].clone())
+        .collect();
+    reorder(&mut run.last_rev);
+    for k in &mut run.all_revs {
+        reorder(&mut k.samples);
+    }
 }
 
 /// Row 0 of each sub-step envelope (`<q>_substep_min_<unit>`, `..._max_...`) widened to hold

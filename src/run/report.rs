@@ -894,6 +894,281 @@ pub fn unreproduced(items: &[(&ModelRun, &ModelFigures)], measured: &Measured) -
     out
 }
 
+/// The findings in words: the verdict against the measurement, what no model reproduces, the
+/// relief-valve limits.
+fn findings(
+    rep: &mut HtmlReport,
+    ok: &[(&ModelRun, &ModelFigures)],
+    measured: &Result<Measured, String>,
+    rank: Option<&Ranking>,
+    syn: &str,
+) {
+    // The findings in words.
+    rep.heading(2, "Findings");
+    match (measured, rank) {
+        (Ok(m), Some(r)) => {
+            rep.paragraph(&format!(
+                "Against the {syn}measured damper force (average of {} revolutions, compared on its own {} azimuths): {}.",
+                m.revolutions,
+                m.azimuth_deg.len(),
+                r.statement
+            ));
+            rep.paragraph("What none of the models reproduces (observations on the residual model - measured; input to the diagnosis, `rotorsim diagnose`):");
+            rep.list(&unreproduced(ok, m));
+            let strokes: Vec<String> = ok
+                .iter()
+                .filter_map(|(r, f)| {
+                    f.stroke
+                        .as_ref()
+                        .map(|s| format!("{}: {}", r.label, s.statement))
+                })
+                .collect();
+            if !strokes.is_empty() {
+                rep.paragraph(&format!("The record carries the damper stroke: the rotor's part of the force error (the stroke) and the damper's (its 1/rev dynamic stiffness K* = -F1/d1 for the stroke it gets; storage K' = Re K*, loss K'' = Im K*), against the {syn}record:"));
+                rep.list(&strokes);
+            }
+        }
+        (Err(note), _) => {
+            rep.paragraph(&format!("No comparison with a measurement: {note}."));
+        }
+        (Ok(_), None) => {
+            rep.paragraph("No model completed, so there is no comparison.");
+        }
+    }
+    let lim: Vec<String> = ok
+        .iter()
+        .filter_map(|(r, f)| {
+            f.limits.map(|c| {
+                format!(
+                    "{}: force {:.0} to {:.0} N, relief-valve cracking forces {:.0} to {:.0} N: {}",
+                    r.label,
+                    f.force.min,
+                    f.force.max,
+                    c.min_limit_n,
+                    c.max_limit_n,
+                    c.statement()
+                )
+            })
+        })
+        .collect();
+    if !lim.is_empty() {
+        rep.paragraph("Relief-valve limits (cracking forces; the dashpot models have none):");
+        rep.list(&lim);
+    }
+}
+
+/// The metrics table and the damper force's harmonics.
+fn metrics_section(
+    rep: &mut HtmlReport,
+    ok: &[(&ModelRun, &ModelFigures)],
+    measured: &Result<Measured, String>,
+    syn: &str,
+) {
+    // Metrics table.
+    rep.heading(2, "Metrics");
+    let mut rows = Vec::new();
+    if let Ok(m) = measured {
+        let st = Stats::of(&m.force_n);
+        let mut row = vec![
+            format!("{syn}measured"),
+            fmt(st.min, 0),
+            fmt(st.max, 0),
+            fmt(st.peak_to_peak, 0),
+            fmt(st.rms, 0),
+        ];
+        row.extend(std::iter::repeat_n("-".to_string(), 7));
+        rows.push(row);
+    }
+    for (r, f) in ok {
+        let m = f.metrics.as_ref();
+        let t = r.timing;
+        rows.push(vec![
+            r.label.clone(),
+            fmt(f.force.min, 0),
+            fmt(f.force.max, 0),
+            fmt(f.force.peak_to_peak, 0),
+            fmt(f.force.rms, 0),
+            m.map_or("-".into(), |m| fmt(m.rms_error, 0)),
+            m.map_or("-".into(), |m| fmt(m.peak_to_peak_error, 0)),
+            m.map_or("-".into(), |m| fmt(m.correlation, 3)),
+            super::fmt_measure(r.last_measure()),
+            fmt(r.wall_s, 2),
+            fmt(t.total_s - t.hydraulics_s, 2),
+            fmt(t.hydraulics_s, 2),
+        ]);
+    }
+    rep.table(
+        &[
+            "damper force of",
+            "min [N]",
+            "max [N]",
+            "peak-to-peak [N]",
+            "RMS [N]",
+            "RMS error [N]",
+            "peak-to-peak error [N]",
+            "correlation [-]",
+            "periodicity residual [-]",
+            "wall time [s]",
+            "structure time [s]",
+            "hydraulics time [s]",
+        ],
+        &rows,
+    );
+    if let Ok(m) = measured {
+        // Harmonics table: amplitude per harmonic, measured then models.
+        let mut hrows = Vec::new();
+        let hm =
+            crate::analysis::harmonics::harmonics(&m.azimuth_deg, &m.force_n, super::N_HARMONICS)
+                .unwrap_or_default();
+        let mut row = vec![format!("{syn}measured")];
+        row.extend(hm.iter().map(|h| fmt(h.amplitude, 0)));
+        hrows.push(row);
+        for (r, f) in ok {
+            if let Some(mt) = &f.metrics {
+                let mut row = vec![r.label.clone()];
+                row.extend(mt.harmonics_model.iter().map(|h| fmt(h.amplitude, 0)));
+                hrows.push(row);
+            }
+            if let Some(res) = &f.residual {
+                let mut row = vec![format!("{} residual", r.label)];
+                row.extend(res.harmonics.iter().map(|h| fmt(h.amplitude, 0)));
+                hrows.push(row);
+            }
+        }
+        let hdr: Vec<String> = (0..=super::N_HARMONICS)
+            .map(|n| {
+                if n == 0 {
+                    "0/rev: |mean| [N]".to_string()
+                } else {
+                    format!("{n}/rev [N]")
+                }
+            })
+            .collect();
+        rep.paragraph("Damper force harmonics: the amplitude of each harmonic [N], of the measurement, of each model and of each model's residual (model - measured).");
+        let mut h: Vec<&str> = vec!["damper force of"];
+        h.extend(hdr.iter().map(|s| s.as_str()));
+        rep.table(&h, &hrows);
+    }
+}
+
+/// The damper force (without a measurement) and inside the physical damper.
+fn damper_figures(rep: &mut HtmlReport, runs: &[&ModelRun], measured: &Result<Measured, String>) {
+    // Figures.
+    // With a measurement the first figure already shows the force and the cracking forces.
+    if measured.is_err() {
+        rep.heading(2, "Damper force (paper Fig. 16)");
+        let mut pf = channel_plot(runs, "Damper force", &[("damper_force_N", "")]);
+        if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
+            pf = pf
+                .dashed(
+                    "relief-valve cracking force (max)",
+                    &[0.0, 360.0],
+                    &[hi, hi],
+                )
+                .dashed(
+                    "relief-valve cracking force (min)",
+                    &[0.0, 360.0],
+                    &[lo, lo],
+                );
+        }
+        svg(
+            rep,
+            "Damper force over the last revolution, with the relief-valve cracking forces.",
+            &[pf],
+        );
+    }
+    let phys: Vec<&ModelRun> = runs
+        .iter()
+        .copied()
+        .filter(|r| r.channel("p0_Pa").is_some())
+        .collect();
+    if phys.is_empty() {
+        rep.paragraph(
+            "No physical damper run: no internal hydraulic channels to show (Figs. 18-21).",
+        );
+    } else {
+        rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
+        svg(
+            rep,
+            "Chamber pressures (cf. Fig. 18). Chamber 0 grows with the stroke, so it is compressed (and loaded) when the damper shortens; chamber 1 when it extends (docs/formats.md). Dashed, in the chamber's colour: the pressure at which the chamber's relief valve cracks, F_p / A_front + (A_back / A_front) p_other, which follows the other chamber's pressure p_other (Eq. 5); the valve opens where its chamber's pressure reaches that line.",
+            &[pressure_plot(&phys)],
+        );
+        svg(
+            rep,
+            "Volumetric flow through the orifice, positive from chamber 0 to 1 (cf. Fig. 19).",
+            &[channel_plot(
+                &phys,
+                "Orifice flow",
+                &[("q_orifice_m3_s", "")],
+            )],
+        );
+        let (valves, how) = valve_plots(&phys);
+        svg(
+            rep,
+            &format!("Relief valve poppet displacement (top; cf. Fig. 20), velocity (middle) and flow (bottom; cf. Fig. 21). {how}"),
+            &valves,
+        );
+    }
+}
+
+/// How each model reached its periodic solution, and its Floquet multipliers.
+fn periodic_section(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+    rep.heading(2, "Periodic solution");
+    let per: Vec<Vec<String>> = runs
+        .iter()
+        .map(|r| {
+            let p = &r.periodic;
+            vec![
+                r.label.clone(),
+                p.method_used.name().to_string(),
+                if p.converged {
+                    "yes".into()
+                } else {
+                    "NO".into()
+                },
+                super::fmt_measure(Some(p.residual)),
+                p.error_estimate
+                    .map_or("-".into(), |e| super::fmt_measure(Some(e))),
+                p.revolutions_integrated.to_string(),
+                p.iterations.to_string(),
+                p.directions.to_string(),
+            ]
+        })
+        .collect();
+    rep.table(
+        &[
+            "model",
+            "method",
+            "converged",
+            "residual",
+            "error estimate",
+            "revolutions integrated",
+            "iterations",
+            "subspace directions",
+        ],
+        &per,
+    );
+    let frows = floquet_rows(runs);
+    if !frows.is_empty() {
+        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode. A multiplier is the eigenvalue of a subspace of the monodromy matrix; its residual ||M v - mu v|| / ||v|| says how far the subspace holds the mode, and one above 1% of |mu| is marked not reliable: the subspace does not guarantee it to 1% (its value is often closer than its residual, but nothing says so).");
+        rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
+        rep.table(
+            &[
+                "model",
+                "mode",
+                "kind",
+                "multiplier",
+                "decay per rev |mu|",
+                "frequency [/rev, mod 1]",
+                "damping ratio [-]",
+                "residual ||M v - mu v|| / ||v||",
+                "reliable",
+            ],
+            &frows,
+        );
+    }
+}
+
 /// The HTML report.
 #[allow(clippy::too_many_arguments)]
 pub fn report_html(
@@ -947,256 +1222,10 @@ pub fn report_html(
     rep.contents();
     top_figures(&mut rep, info, &runs, measured.as_ref().ok());
 
-    // The findings in words.
-    rep.heading(2, "Findings");
-    match (measured, rank) {
-        (Ok(m), Some(r)) => {
-            rep.paragraph(&format!(
-                "Against the {syn}measured damper force (average of {} revolutions, compared on its own {} azimuths): {}.",
-                m.revolutions,
-                m.azimuth_deg.len(),
-                r.statement
-            ));
-            rep.paragraph("What none of the models reproduces (observations on the residual model - measured; input to the diagnosis, `rotorsim diagnose`):");
-            rep.list(&unreproduced(&ok, m));
-            let strokes: Vec<String> = ok
-                .iter()
-                .filter_map(|(r, f)| {
-                    f.stroke
-                        .as_ref()
-                        .map(|s| format!("{}: {}", r.label, s.statement))
-                })
-                .collect();
-            if !strokes.is_empty() {
-                rep.paragraph(&format!("The record carries the damper stroke: the rotor's part of the force error (the stroke) and the damper's (its 1/rev dynamic stiffness K* = -F1/d1 for the stroke it gets; storage K' = Re K*, loss K'' = Im K*), against the {syn}record:"));
-                rep.list(&strokes);
-            }
-        }
-        (Err(note), _) => {
-            rep.paragraph(&format!("No comparison with a measurement: {note}."));
-        }
-        (Ok(_), None) => {
-            rep.paragraph("No model completed, so there is no comparison.");
-        }
-    }
-    let lim: Vec<String> = ok
-        .iter()
-        .filter_map(|(r, f)| {
-            f.limits.map(|c| {
-                format!(
-                    "{}: force {:.0} to {:.0} N, relief-valve cracking forces {:.0} to {:.0} N: {}",
-                    r.label,
-                    f.force.min,
-                    f.force.max,
-                    c.min_limit_n,
-                    c.max_limit_n,
-                    c.statement()
-                )
-            })
-        })
-        .collect();
-    if !lim.is_empty() {
-        rep.paragraph("Relief-valve limits (cracking forces; the dashpot models have none):");
-        rep.list(&lim);
-    }
-
-    // Metrics table.
-    rep.heading(2, "Metrics");
-    let mut rows = Vec::new();
-    if let Ok(m) = measured {
-        let st = Stats::of(&m.force_n);
-        let mut row = vec![
-            format!("{syn}measured"),
-            fmt(st.min, 0),
-            fmt(st.max, 0),
-            fmt(st.peak_to_peak, 0),
-            fmt(st.rms, 0),
-        ];
-        row.extend(std::iter::repeat_n("-".to_string(), 7));
-        rows.push(row);
-    }
-    for (r, f) in &ok {
-        let m = f.metrics.as_ref();
-        let t = r.timing;
-        rows.push(vec![
-            r.label.clone(),
-            fmt(f.force.min, 0),
-            fmt(f.force.max, 0),
-            fmt(f.force.peak_to_peak, 0),
-            fmt(f.force.rms, 0),
-            m.map_or("-".into(), |m| fmt(m.rms_error, 0)),
-            m.map_or("-".into(), |m| fmt(m.peak_to_peak_error, 0)),
-            m.map_or("-".into(), |m| fmt(m.correlation, 3)),
-            super::fmt_measure(r.last_measure()),
-            fmt(r.wall_s, 2),
-            fmt(t.total_s - t.hydraulics_s, 2),
-            fmt(t.hydraulics_s, 2),
-        ]);
-    }
-    rep.table(
-        &[
-            "damper force of",
-            "min [N]",
-            "max [N]",
-            "peak-to-peak [N]",
-            "RMS [N]",
-            "RMS error [N]",
-            "peak-to-peak error [N]",
-            "correlation [-]",
-            "periodicity residual [-]",
-            "wall time [s]",
-            "structure time [s]",
-            "hydraulics time [s]",
-        ],
-        &rows,
-    );
-    if let Ok(m) = measured {
-        // Harmonics table: amplitude per harmonic, measured then models.
-        let mut hrows = Vec::new();
-        let hm =
-            crate::analysis::harmonics::harmonics(&m.azimuth_deg, &m.force_n, super::N_HARMONICS)
-                .unwrap_or_default();
-        let mut row = vec![format!("{syn}measured")];
-        row.extend(hm.iter().map(|h| fmt(h.amplitude, 0)));
-        hrows.push(row);
-        for (r, f) in &ok {
-            if let Some(mt) = &f.metrics {
-                let mut row = vec![r.label.clone()];
-                row.extend(mt.harmonics_model.iter().map(|h| fmt(h.amplitude, 0)));
-                hrows.push(row);
-            }
-            if let Some(res) = &f.residual {
-                let mut row = vec![format!("{} residual", r.label)];
-                row.extend(res.harmonics.iter().map(|h| fmt(h.amplitude, 0)));
-                hrows.push(row);
-            }
-        }
-        let hdr: Vec<String> = (0..=super::N_HARMONICS)
-            .map(|n| {
-                if n == 0 {
-                    "0/rev: |mean| [N]".to_string()
-                } else {
-                    format!("{n}/rev [N]")
-                }
-            })
-            .collect();
-        rep.paragraph("Damper force harmonics: the amplitude of each harmonic [N], of the measurement, of each model and of each model's residual (model - measured).");
-        let mut h: Vec<&str> = vec!["damper force of"];
-        h.extend(hdr.iter().map(|s| s.as_str()));
-        rep.table(&h, &hrows);
-    }
-
-    // Figures.
-    // With a measurement the first figure already shows the force and the cracking forces.
-    if measured.is_err() {
-        rep.heading(2, "Damper force (paper Fig. 16)");
-        let mut pf = channel_plot(&runs, "Damper force", &[("damper_force_N", "")]);
-        if let Some((lo, hi)) = runs.iter().find_map(|r| r.force_limits_n) {
-            pf = pf
-                .dashed(
-                    "relief-valve cracking force (max)",
-                    &[0.0, 360.0],
-                    &[hi, hi],
-                )
-                .dashed(
-                    "relief-valve cracking force (min)",
-                    &[0.0, 360.0],
-                    &[lo, lo],
-                );
-        }
-        svg(
-            &mut rep,
-            "Damper force over the last revolution, with the relief-valve cracking forces.",
-            &[pf],
-        );
-    }
-    let phys: Vec<&ModelRun> = runs
-        .iter()
-        .copied()
-        .filter(|r| r.channel("p0_Pa").is_some())
-        .collect();
-    if phys.is_empty() {
-        rep.paragraph(
-            "No physical damper run: no internal hydraulic channels to show (Figs. 18-21).",
-        );
-    } else {
-        rep.heading(2, "Inside the physical damper (paper Figs. 18-21)");
-        svg(
-            &mut rep,
-            "Chamber pressures (cf. Fig. 18). Chamber 0 grows with the stroke, so it is compressed (and loaded) when the damper shortens; chamber 1 when it extends (docs/formats.md). Dashed, in the chamber's colour: the pressure at which the chamber's relief valve cracks, F_p / A_front + (A_back / A_front) p_other, which follows the other chamber's pressure p_other (Eq. 5); the valve opens where its chamber's pressure reaches that line.",
-            &[pressure_plot(&phys)],
-        );
-        svg(
-            &mut rep,
-            "Volumetric flow through the orifice, positive from chamber 0 to 1 (cf. Fig. 19).",
-            &[channel_plot(
-                &phys,
-                "Orifice flow",
-                &[("q_orifice_m3_s", "")],
-            )],
-        );
-        let (valves, how) = valve_plots(&phys);
-        svg(
-            &mut rep,
-            &format!("Relief valve poppet displacement (top; cf. Fig. 20), velocity (middle) and flow (bottom; cf. Fig. 21). {how}"),
-            &valves,
-        );
-    }
-
-    rep.heading(2, "Periodic solution");
-    let per: Vec<Vec<String>> = runs
-        .iter()
-        .map(|r| {
-            let p = &r.periodic;
-            vec![
-                r.label.clone(),
-                p.method_used.name().to_string(),
-                if p.converged {
-                    "yes".into()
-                } else {
-                    "NO".into()
-                },
-                super::fmt_measure(Some(p.residual)),
-                p.error_estimate
-                    .map_or("-".into(), |e| super::fmt_measure(Some(e))),
-                p.revolutions_integrated.to_string(),
-                p.iterations.to_string(),
-                p.directions.to_string(),
-            ]
-        })
-        .collect();
-    rep.table(
-        &[
-            "model",
-            "method",
-            "converged",
-            "residual",
-            "error estimate",
-            "revolutions integrated",
-            "iterations",
-            "subspace directions",
-        ],
-        &per,
-    );
-    let frows = floquet_rows(&runs);
-    if !frows.is_empty() {
-        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode. A multiplier is the eigenvalue of a subspace of the monodromy matrix; its residual ||M v - mu v|| / ||v|| says how far the subspace holds the mode, and one above 1% of |mu| is marked not reliable: the subspace does not guarantee it to 1% (its value is often closer than its residual, but nothing says so).");
-        rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
-        rep.table(
-            &[
-                "model",
-                "mode",
-                "kind",
-                "multiplier",
-                "decay per rev |mu|",
-                "frequency [/rev, mod 1]",
-                "damping ratio [-]",
-                "residual ||M v - mu v|| / ||v||",
-                "reliable",
-            ],
-            &frows,
-        );
-    }
+    findings(&mut rep, &ok, measured, rank, syn);
+    metrics_section(&mut rep, &ok, measured, syn);
+    damper_figures(&mut rep, &runs, measured);
+    periodic_section(&mut rep, &runs);
     blade_loads(&mut rep, &runs);
     airloads(&mut rep, &runs);
     whole_rotor(&mut rep, info, &runs);
