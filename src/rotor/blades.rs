@@ -322,6 +322,7 @@ impl RotorDeck {
             spec: RotorSpec::parse(&text, &file)?,
             text,
             blades: PerBlade::default(),
+            damper: Default::default(),
         })
     }
 

@@ -278,6 +278,9 @@ pub struct RotorDeck {
     text: String,
     /// The per-blade differences, applied only to the blades' decks.
     blades: blades::PerBlade,
+    /// The typed `[damper]` table, read on first use (a command that runs no damper does not
+    /// need it to be valid).
+    damper: std::sync::OnceLock<Result<DamperDeck, String>>,
 }
 
 impl RotorDeck {
@@ -322,6 +325,7 @@ impl RotorDeck {
             spec,
             text,
             blades: blades::PerBlade { table, sets },
+            damper: Default::default(),
         };
         deck.check_blades()?;
         Ok(deck)
@@ -336,10 +340,16 @@ impl RotorDeck {
     }
     /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
-        Ok(DamperDeck::from_toml_str(
-            &self.text,
-            &self.path.display().to_string(),
-        )?)
+        self.damper
+            .get_or_init(|| {
+                let root = toml::Table::from_iter(
+                    self.spec.damper.clone().map(|d| ("damper".to_string(), d)),
+                );
+                DamperDeck::from_toml_table(root, &self.path.display().to_string())
+                    .map_err(|e| e.to_string())
+            })
+            .clone()
+            .map_err(|e| anyhow::anyhow!(e))
     }
     /// The generated multibody model deck (TOML text, docs/model_deck.md).
     pub fn expand(&self, opts: &expand::ExpandOptions) -> String {
