@@ -323,6 +323,7 @@ impl RotorDeck {
             text,
             blades: PerBlade::default(),
             damper: Default::default(),
+            assumed: self.assumed.clone(),
         })
     }
 

@@ -203,6 +203,7 @@ pub struct SimState {
 }
 
 pub mod aero;
+pub mod assumed;
 pub mod blades;
 pub mod deck;
 
@@ -281,6 +282,8 @@ pub struct RotorDeck {
     /// The typed `[damper]` table, read on first use (a command that runs no damper does not
     /// need it to be valid).
     damper: std::sync::OnceLock<Result<DamperDeck, String>>,
+    /// The values the deck file labels `# ASSUMED`, read once with the deck.
+    assumed: assumed::Scan,
 }
 
 impl RotorDeck {
@@ -296,6 +299,10 @@ impl RotorDeck {
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
         let spec = deck::RotorSpec::parse(&text, &file)?;
+        let assumed = match text.parse::<toml::Table>() {
+            Ok(root) => assumed::scan(&text, &root),
+            Err(_) => assumed::Scan::default(), // RotorSpec::parse has read it: unreachable
+        };
         let (sets, overrides): (Vec<Override>, Vec<Override>) = overrides
             .iter()
             .cloned()
@@ -326,6 +333,7 @@ impl RotorDeck {
             text,
             blades: blades::PerBlade { table, sets },
             damper: Default::default(),
+            assumed,
         };
         deck.check_blades()?;
         Ok(deck)
@@ -337,6 +345,11 @@ impl RotorDeck {
         let mut v = vec![self.path.clone(), dir.join(&self.spec.blade.sections_csv)];
         v.extend(self.blade_section_files());
         v
+    }
+    /// The values the deck file labels `# ASSUMED` (keys as `--set` takes them, with the file's
+    /// values and lines; overrides do not change what is labelled).
+    pub fn assumed(&self) -> &assumed::Scan {
+        &self.assumed
     }
     /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
