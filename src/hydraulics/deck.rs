@@ -14,6 +14,7 @@ use super::temperature::{
     is_oil_temperature_k, oil_temperature_expected, OilTemperature, OIL_COEFFICIENT_MAX_PER_K,
 };
 use super::Device;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 use toml::{Table, Value};
 
@@ -22,38 +23,130 @@ pub const DEFAULT_DP_LAMINAR_PA: f64 = 1.0e3;
 /// Default cavitation band when the deck omits `p_cav_Pa`.
 pub const DEFAULT_P_CAV_PA: f64 = 1.0e4;
 
-/// Deck errors, naming the file and the key.
+/// A deck error: the file, the key (a dotted path) and what was expected of it. One type for
+/// every deck read here and above (damper, actuator, model decks).
 #[derive(Debug, thiserror::Error)]
 pub enum DeckError {
-    #[error("cannot read deck {file}: {source}")]
+    /// The file cannot be read.
+    #[error("deck {file}: cannot read: {source}")]
     Read {
         file: String,
         #[source]
         source: std::io::Error,
     },
-    #[error("deck {file} is not valid TOML: {message}")]
-    Parse { file: String, message: String },
-    #[error("deck {file}: missing table [{table}]")]
-    MissingTable { file: String, table: String },
-    #[error("deck {file}: missing key `{key}` ({expected})")]
-    MissingKey {
+    /// The file as a whole: not TOML, or a model beyond the budget.
+    #[error("deck {file}: {message}")]
+    File { file: String, message: String },
+    /// One key of the deck and what is wrong with it.
+    #[error("deck {file}{}", problem.describe(key))]
+    Key {
         file: String,
         key: String,
-        expected: String,
+        problem: Problem,
     },
-    #[error("deck {file}: unknown key `{key}` (known keys: {known})")]
-    UnknownKey {
-        file: String,
-        key: String,
-        known: String,
-    },
-    #[error("deck {file}: key `{key}` = {value}: {expected}")]
-    BadValue {
-        file: String,
-        key: String,
-        value: String,
-        expected: String,
-    },
+}
+
+/// What is wrong with a key of a deck.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Problem {
+    /// The key names a table the deck must hold.
+    MissingTable,
+    /// A key the table must hold, and what it takes.
+    Missing { expected: String },
+    /// A key the table does not know, and the keys it knows.
+    Unknown { known: String },
+    /// The value as written, and what was expected.
+    Bad { value: String, expected: String },
+    /// A rule of the deck the key breaks.
+    Invalid(String),
+}
+
+impl Problem {
+    fn describe(&self, key: &str) -> String {
+        match self {
+            Self::MissingTable => format!(": missing table [{key}]"),
+            Self::Missing { expected } => format!(": missing key `{key}` ({expected})"),
+            Self::Unknown { known } => format!(": unknown key `{key}` (known keys: {known})"),
+            Self::Bad { value, expected } if value.is_empty() => {
+                format!(": key `{key}`: {expected}")
+            }
+            Self::Bad { value, expected } => format!(": key `{key}` = {value}: {expected}"),
+            Self::Invalid(msg) => format!(", {key}: {msg}"),
+        }
+    }
+}
+
+impl DeckError {
+    pub fn key(file: &str, key: impl Into<String>, problem: Problem) -> Self {
+        Self::Key {
+            file: file.into(),
+            key: key.into(),
+            problem,
+        }
+    }
+    /// `key` breaks a rule of the deck (`msg` says which).
+    pub fn invalid(file: &str, key: impl Into<String>, msg: impl Into<String>) -> Self {
+        Self::key(file, key, Problem::Invalid(msg.into()))
+    }
+    fn bad(file: &str, key: impl Into<String>, value: String, expected: impl Into<String>) -> Self {
+        let expected = expected.into();
+        Self::key(file, key, Problem::Bad { value, expected })
+    }
+    fn missing_table(file: &str, table: &str) -> Self {
+        Self::key(file, table, Problem::MissingTable)
+    }
+    /// TOML that does not parse (the message gives the line).
+    pub fn syntax(file: &str, e: &toml::de::Error) -> Self {
+        Self::File {
+            file: file.into(),
+            message: format!("not valid TOML: {}", e.to_string().trim_end()),
+        }
+    }
+    /// A serde error of the typed tables read from a parsed TOML table: the key path it names
+    /// (the tables it sits in, then the field) and what serde expected.
+    pub fn schema(file: &str, mut e: toml::de::Error) -> Self {
+        let msg = e.message().trim_end().to_string();
+        // Without its input the error shows the keys it was raised under: `in `a.b``.
+        e.set_input(None);
+        let shown = e.to_string();
+        let path = shown
+            .lines()
+            .last()
+            .and_then(|l| l.strip_prefix("in `")?.strip_suffix('`'))
+            .unwrap_or("");
+        let join = |leaf: &str| match path {
+            "" => leaf.to_string(),
+            p => format!("{p}.{leaf}"),
+        };
+        let quoted = |s: &str| s.split('`').nth(1).map(str::to_string);
+        if let Some(rest) = msg.strip_prefix("unknown field ") {
+            let name = quoted(rest).unwrap_or_default();
+            let known = rest
+                .split_once(", expected ")
+                .map_or("", |(_, k)| k)
+                .trim_start_matches("one of ")
+                .replace('`', "");
+            return Self::key(file, join(&name), Problem::Unknown { known });
+        }
+        if let Some(rest) = msg.strip_prefix("missing field ") {
+            let name = quoted(rest).unwrap_or_default();
+            let expected = "a value".to_string();
+            return Self::key(file, join(&name), Problem::Missing { expected });
+        }
+        if let Some((found, wanted)) = msg
+            .strip_prefix("invalid type: ")
+            .and_then(|m| m.split_once(", expected "))
+        {
+            let wanted = match wanted {
+                "f64" => "a number",
+                "a sequence" => "an array",
+                w if w.starts_with("struct ") => "a table",
+                w => w,
+            };
+            return Self::bad(file, path, found.into(), format!("expected {wanted}"));
+        }
+        Self::bad(file, path, String::new(), msg)
+    }
 }
 
 /// Damper model selection.
@@ -105,15 +198,6 @@ pub struct DamperDeck {
     pub oil: Option<OilTemperature>,
 }
 
-/// Keys of `[damper.physical.oil]`.
-pub const OIL_KEYS: &[&str] = &[
-    "reference_temperature_K",
-    "temperature_K",
-    "density_thermal_coefficient_per_K",
-    "bulk_modulus_thermal_coefficient_per_K",
-    "viscosity_thermal_coefficient_per_K",
-];
-
 /// Seal friction and free play of the physical damper (default: none).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DeviceExtensions {
@@ -129,125 +213,276 @@ pub struct DeviceExtensions {
     pub link_mass: Option<LinkMass>,
 }
 
-/// Keys of `[damper.physical.extensions]` (all optional; absent or 0 = off).
-pub const EXTENSION_KEYS: &[&str] = &[
-    "seal_friction_N",
-    "stribeck_static_N",
-    "stribeck_velocity_m_s",
-    "friction_smoothing_m_s",
-    "seal_presliding_m",
-    "free_play_m",
-    "air_fraction",
-    "leakage_m3_per_s_Pa",
-    "leakage_viscosity_length_Pa_s_m",
-    "accumulator_bleed_m3_per_s_Pa",
-    "air_fraction_0",
-    "air_fraction_1",
-    "mount_stiffness_N_per_m",
-    "free_play_contact_stiffness_N_per_m",
-    "link_mass_kg",
-    "link_damping_ratio",
-];
-
-struct Ctx<'a> {
-    file: &'a str,
+/// The damper deck file as written: `[damper]` and its tables, keys with their units (other
+/// top-level tables are ignored). Read by [`DamperDeck::from_toml_str`] (serde for the shape,
+/// [`DamperDeck::from_file_tables`] for the values), written by [`DamperDeck::to_toml`].
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct DamperFile {
+    pub damper: Option<DamperTable>,
 }
 
-impl Ctx<'_> {
-    fn table<'t>(
+/// `[damper]`: the default model and the tables of the models the deck holds.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamperTable {
+    pub model: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linear: Option<LinearTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nonlinear: Option<NonlinearTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub physical: Option<PhysicalTable>,
+}
+
+/// `[damper.linear]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct LinearTable {
+    pub c_N_s_per_m: Option<f64>,
+}
+
+/// `[damper.nonlinear]`: force against velocity.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct NonlinearTable {
+    pub velocity_m_s: Option<Vec<f64>>,
+    pub force_N: Option<Vec<f64>>,
+}
+
+/// `[damper.physical]`: the two-chamber circuit (docs/formats.md). Options where the deck may
+/// leave a key out; required keys are Options too, so that a missing one is reported with
+/// what it takes.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct PhysicalTable {
+    pub A0_m2: Option<f64>,
+    pub A1_m2: Option<f64>,
+    pub V0_m3: Option<f64>,
+    pub V1_m3: Option<f64>,
+    pub rho_kg_m3: Option<f64>,
+    pub bulk_alpha_per_Pa: Option<f64>,
+    pub bulk_beta_per_Pa2: Option<f64>,
+    pub A_orf_m2: Option<f64>,
+    pub Cd: Option<f64>,
+    pub p_s_Pa: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dp_laminar_Pa: Option<f64>,
+    pub check_valve_area_m2: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub p_cav_Pa: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relief_valve_0: Option<ReliefValveTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relief_valve_1: Option<ReliefValveTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extensions: Option<ExtensionsTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub oil: Option<OilTable>,
+}
+
+/// `[damper.physical.relief_valve_K]` (Eq. 5-7; the discharge coefficient is the deck's `Cd`).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct ReliefValveTable {
+    pub m_kg: Option<f64>,
+    pub c_N_s_per_m: Option<f64>,
+    pub k_N_per_m: Option<f64>,
+    pub F_p_N: Option<f64>,
+    pub A_front_m2: Option<f64>,
+    pub A_back_m2: Option<f64>,
+    pub a_m: Option<f64>,
+    pub b: Option<f64>,
+}
+
+/// `[damper.physical.extensions]` (all optional; absent or 0 = off).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct ExtensionsTable {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seal_friction_N: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stribeck_static_N: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stribeck_velocity_m_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_smoothing_m_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seal_presliding_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub free_play_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub free_play_contact_stiffness_N_per_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mount_stiffness_N_per_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link_damping_ratio: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_fraction: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub leakage_m3_per_s_Pa: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub leakage_viscosity_length_Pa_s_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_fraction_0: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_fraction_1: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accumulator_bleed_m3_per_s_Pa: Option<f64>,
+}
+
+/// `[damper.physical.oil]`: the properties of `[damper.physical]` hold at
+/// `reference_temperature_K`; the deck runs at `temperature_K` (default: the reference).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct OilTable {
+    pub reference_temperature_K: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temperature_K: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub density_thermal_coefficient_per_K: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bulk_modulus_thermal_coefficient_per_K: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub viscosity_thermal_coefficient_per_K: Option<f64>,
+}
+
+/// The actuator deck file: `[actuator]` (paper Table 1 names with units; other top-level tables
+/// are ignored).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct ActuatorFile {
+    pub actuator: Option<ActuatorTable>,
+}
+
+/// `[actuator]` (`dp_laminar_Pa` optional).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+pub struct ActuatorTable {
+    pub A0_m2: Option<f64>,
+    pub A1_m2: Option<f64>,
+    pub V0_m3: Option<f64>,
+    pub V1_m3: Option<f64>,
+    pub p_E0_Pa: Option<f64>,
+    pub p_E1_Pa: Option<f64>,
+    pub A_orf0_m2: Option<f64>,
+    pub A_orf1_m2: Option<f64>,
+    pub Cd0: Option<f64>,
+    pub Cd1: Option<f64>,
+    pub p_s_Pa: Option<f64>,
+    pub B_Pa: Option<f64>,
+    pub rho_kg_m3: Option<f64>,
+    pub check_valve_area_m2: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dp_laminar_Pa: Option<f64>,
+}
+
+/// Parses `text` as TOML and reads its tables into `T` (serde), errors naming `file` and the key.
+pub fn read_tables<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, DeckError> {
+    let root: Table = text.parse().map_err(|e| DeckError::syntax(file, &e))?;
+    typed_tables(root, file)
+}
+
+/// Reads parsed TOML into `T` (serde), errors naming `file` and the key.
+pub fn typed_tables<T: serde::de::DeserializeOwned>(
+    root: Table,
+    file: &str,
+) -> Result<T, DeckError> {
+    Value::Table(root)
+        .try_into()
+        .map_err(|e| DeckError::schema(file, e))
+}
+
+/// Values of one table checked against what they take, errors naming the file and the key.
+struct Check<'a> {
+    file: &'a str,
+    table: &'a str,
+}
+
+impl Check<'_> {
+    fn key(&self, k: &str) -> String {
+        format!("{}.{k}", self.table)
+    }
+
+    /// A value the table must hold: finite and `ok` (`expected` says what it takes).
+    fn req(
         &self,
-        parent: &'t Table,
-        path: &str,
-        name: &str,
-    ) -> Result<Option<&'t Table>, DeckError> {
-        match parent.get(name) {
-            None => Ok(None),
-            Some(Value::Table(t)) => Ok(Some(t)),
-            Some(v) => Err(self.bad(&format!("{path}.{name}"), v, "expected a table")),
-        }
-    }
-
-    fn bad(&self, key: &str, v: &Value, expected: &str) -> DeckError {
-        DeckError::BadValue {
-            file: self.file.into(),
-            key: key.into(),
-            value: v.to_string(),
-            expected: expected.into(),
-        }
-    }
-
-    fn known(&self, t: &Table, path: &str, keys: &[&str]) -> Result<(), DeckError> {
-        for k in t.keys() {
-            if !keys.contains(&k.as_str()) {
-                return Err(DeckError::UnknownKey {
-                    file: self.file.into(),
-                    key: format!("{path}.{k}"),
-                    known: keys.join(", "),
-                });
-            }
-        }
-        Ok(())
-    }
-
-    fn num(&self, t: &Table, path: &str, key: &str, expected: &str) -> Result<f64, DeckError> {
-        let full = format!("{path}.{key}");
-        match t.get(key) {
-            None => Err(DeckError::MissingKey {
-                file: self.file.into(),
-                key: full,
-                expected: expected.into(),
-            }),
-            Some(v) => self.as_num(v, &full, expected),
-        }
-    }
-
-    fn as_num(&self, v: &Value, full: &str, expected: &str) -> Result<f64, DeckError> {
-        let x = match v {
-            Value::Float(x) => *x,
-            Value::Integer(i) => *i as f64,
-            _ => return Err(self.bad(full, v, &format!("expected a number ({expected})"))),
-        };
-        if !x.is_finite() {
-            return Err(self.bad(full, v, &format!("expected a finite number ({expected})")));
-        }
-        Ok(x)
-    }
-
-    /// Number satisfying `ok`, e.g. positive.
-    fn num_where(
-        &self,
-        t: &Table,
-        path: &str,
-        key: &str,
+        k: &str,
+        v: Option<f64>,
         expected: &str,
         ok: fn(f64) -> bool,
     ) -> Result<f64, DeckError> {
-        let x = self.num(t, path, key, expected)?;
-        if !ok(x) {
-            return Err(self.bad(
-                &format!("{path}.{key}"),
-                &t[key],
-                &format!("expected {expected}"),
+        let Some(x) = v else {
+            let expected = expected.into();
+            return Err(DeckError::key(
+                self.file,
+                self.key(k),
+                Problem::Missing { expected },
             ));
+        };
+        self.value(k, x, expected, ok)
+    }
+
+    /// A value the table may leave out.
+    fn opt(
+        &self,
+        k: &str,
+        v: Option<f64>,
+        expected: &str,
+        ok: fn(f64) -> bool,
+    ) -> Result<Option<f64>, DeckError> {
+        v.map(|x| self.value(k, x, expected, ok)).transpose()
+    }
+
+    fn value(
+        &self,
+        k: &str,
+        x: f64,
+        expected: &str,
+        ok: fn(f64) -> bool,
+    ) -> Result<f64, DeckError> {
+        if !x.is_finite() {
+            let e = format!("expected a finite number ({expected})");
+            return Err(self.bad(k, x, e));
+        }
+        if !ok(x) {
+            return Err(self.bad(k, x, format!("expected {expected}")));
         }
         Ok(x)
     }
 
-    fn array(&self, t: &Table, path: &str, key: &str) -> Result<Vec<f64>, DeckError> {
-        let full = format!("{path}.{key}");
-        match t.get(key) {
-            None => Err(DeckError::MissingKey {
-                file: self.file.into(),
-                key: full,
-                expected: "an array of numbers".into(),
-            }),
-            Some(Value::Array(a)) => a
-                .iter()
-                .map(|v| self.as_num(v, &full, "array of numbers"))
-                .collect(),
-            Some(v) => Err(self.bad(&full, v, "expected an array of numbers")),
-        }
+    fn bad(&self, k: &str, x: f64, expected: impl Into<String>) -> DeckError {
+        DeckError::bad(self.file, self.key(k), shown(x), expected)
     }
+
+    /// An array of finite numbers the table must hold.
+    fn array(&self, k: &str, v: &Option<Vec<f64>>) -> Result<Vec<f64>, DeckError> {
+        let expected = "array of numbers";
+        let Some(v) = v else {
+            let expected = "an array of numbers".into();
+            return Err(DeckError::key(
+                self.file,
+                self.key(k),
+                Problem::Missing { expected },
+            ));
+        };
+        for x in v {
+            self.value(k, *x, expected, |_| true)?;
+        }
+        Ok(v.clone())
+    }
+}
+
+/// A number as TOML writes it (for messages).
+fn shown(x: f64) -> String {
+    Value::Float(x).to_string()
 }
 
 fn positive(x: f64) -> bool {
@@ -256,36 +491,12 @@ fn positive(x: f64) -> bool {
 fn non_negative(x: f64) -> bool {
     x >= 0.0
 }
-
-const PHYSICAL_KEYS: &[&str] = &[
-    "A0_m2",
-    "A1_m2",
-    "V0_m3",
-    "V1_m3",
-    "rho_kg_m3",
-    "bulk_alpha_per_Pa",
-    "bulk_beta_per_Pa2",
-    "A_orf_m2",
-    "Cd",
-    "p_s_Pa",
-    "dp_laminar_Pa",
-    "check_valve_area_m2",
-    "p_cav_Pa",
-    "relief_valve_0",
-    "relief_valve_1",
-    "extensions",
-    "oil",
-];
-const VALVE_KEYS: &[&str] = &[
-    "m_kg",
-    "c_N_s_per_m",
-    "k_N_per_m",
-    "F_p_N",
-    "A_front_m2",
-    "A_back_m2",
-    "a_m",
-    "b",
-];
+fn discharge(x: f64) -> bool {
+    x > 0.0 && x <= 1.0
+}
+fn fraction(x: f64) -> bool {
+    (0.0..1.0).contains(&x)
+}
 
 impl DamperDeck {
     /// Reads a deck file.
@@ -300,94 +511,84 @@ impl DamperDeck {
 
     /// Parses deck text; `source_name` names it in errors.
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self, DeckError> {
-        let cx = Ctx { file: source_name };
-        let root: Table = text
-            .parse()
-            .map_err(|e: toml::de::Error| DeckError::Parse {
-                file: source_name.into(),
-                message: e.to_string().trim_end().to_string(),
-            })?;
-        let damper = cx
-            .table(&root, "", "damper")?
-            .ok_or_else(|| DeckError::MissingTable {
-                file: source_name.into(),
-                table: "damper".into(),
-            })?;
-        cx.known(
-            damper,
-            "damper",
-            &["model", "linear", "nonlinear", "physical"],
-        )?;
-        let model = match damper.get("model") {
-            None => {
-                return Err(DeckError::MissingKey {
-                    file: source_name.into(),
-                    key: "damper.model".into(),
-                    expected: "physical, linear or nonlinear".into(),
-                })
-            }
-            Some(Value::String(s)) => s
-                .parse::<DamperModel>()
-                .map_err(|e| cx.bad("damper.model", &damper["model"], &e))?,
-            Some(v) => {
-                return Err(cx.bad(
-                    "damper.model",
-                    v,
-                    "expected a string: physical, linear or nonlinear",
-                ))
-            }
-        };
+        let tables: DamperFile = read_tables(text, source_name)?;
+        Self::from_file_tables(&tables, source_name)
+    }
 
-        let linear = match cx.table(damper, "damper", "linear")? {
+    /// Reads the `[damper]` table of parsed TOML (other top-level tables are ignored).
+    pub fn from_toml_table(root: Table, source_name: &str) -> Result<Self, DeckError> {
+        let tables: DamperFile = typed_tables(root, source_name)?;
+        Self::from_file_tables(&tables, source_name)
+    }
+
+    /// The deck of the typed tables `f`, each value checked; `file` names it in errors.
+    pub fn from_file_tables(f: &DamperFile, file: &str) -> Result<Self, DeckError> {
+        let damper = f
+            .damper
+            .as_ref()
+            .ok_or_else(|| DeckError::missing_table(file, "damper"))?;
+        let model = match &damper.model {
+            None => {
+                let expected = "physical, linear or nonlinear".into();
+                let problem = Problem::Missing { expected };
+                return Err(DeckError::key(file, "damper.model", problem));
+            }
+            Some(s) => s.parse::<DamperModel>().map_err(|e| {
+                DeckError::bad(
+                    file,
+                    "damper.model",
+                    Value::String(s.clone()).to_string(),
+                    e,
+                )
+            })?,
+        };
+        let linear = match &damper.linear {
             None => None,
-            Some(t) => {
-                cx.known(t, "damper.linear", &["c_N_s_per_m"])?;
-                Some(cx.num_where(
-                    t,
-                    "damper.linear",
+            Some(t) => Some(
+                Check {
+                    file,
+                    table: "damper.linear",
+                }
+                .req(
                     "c_N_s_per_m",
+                    t.c_N_s_per_m,
                     "a non-negative damping coefficient (0: an inoperative damper)",
                     non_negative,
-                )?)
-            }
+                )?,
+            ),
         };
-
-        let nonlinear = match cx.table(damper, "damper", "nonlinear")? {
+        let nonlinear = match &damper.nonlinear {
             None => None,
             Some(t) => {
                 let p = "damper.nonlinear";
-                cx.known(t, p, &["velocity_m_s", "force_N"])?;
-                let v = cx.array(t, p, "velocity_m_s")?;
-                let f = cx.array(t, p, "force_N")?;
-                MonotoneTable::new(v.clone(), f.clone()).map_err(|e| DeckError::BadValue {
-                    file: source_name.into(),
-                    key: format!("{p}.velocity_m_s/force_N"),
-                    value: format!("{v:?} / {f:?}"),
-                    expected: e,
+                let cx = Check { file, table: p };
+                let v = cx.array("velocity_m_s", &t.velocity_m_s)?;
+                let f = cx.array("force_N", &t.force_N)?;
+                MonotoneTable::new(v.clone(), f.clone()).map_err(|e| {
+                    let key = format!("{p}.velocity_m_s/force_N");
+                    DeckError::bad(file, key, format!("{v:?} / {f:?}"), e)
                 })?;
                 Some((v, f))
             }
         };
-
-        let (physical, extensions, oil) = match cx.table(damper, "damper", "physical")? {
+        let (physical, extensions, oil) = match &damper.physical {
             None => (None, DeviceExtensions::default(), None),
             Some(t) => {
-                let mut c = Self::parse_physical(&cx, t)?;
-                let e = match cx.table(t, "damper.physical", "extensions")? {
+                let mut c = physical_params(file, t)?;
+                let e = match &t.extensions {
                     None => DeviceExtensions::default(),
-                    Some(et) => Self::parse_extensions(&cx, et, &mut c)?,
+                    Some(et) => extensions(file, et, &mut c)?,
                 };
                 // After the extensions: the leakage and bleed move with the temperature too.
-                let oil = match cx.table(t, "damper.physical", "oil")? {
+                let oil = match &t.oil {
                     None => None,
-                    Some(ot) => Some(Self::parse_oil(&cx, ot, &mut c)?),
+                    Some(ot) => Some(oil_law(file, ot, &mut c)?),
                 };
                 (Some(c), e, oil)
             }
         };
-
         let deck = Self {
-            source: source_name.into(),
+            source: file.into(),
             model,
             linear_c_n_s_per_m: linear,
             nonlinear,
@@ -399,188 +600,348 @@ impl DamperDeck {
         deck.require(model)?;
         Ok(deck)
     }
+}
 
-    fn parse_physical(cx: &Ctx, t: &Table) -> Result<CircuitParams, DeckError> {
-        let p = "damper.physical";
-        cx.known(t, p, PHYSICAL_KEYS)?;
-        let area = |k| cx.num_where(t, p, k, "a positive area in m^2", positive);
-        let vol = |k| cx.num_where(t, p, k, "a positive volume in m^3", positive);
-        let a0 = area("A0_m2")?;
-        let a1 = area("A1_m2")?;
-        let v0 = vol("V0_m3")?;
-        let v1 = vol("V1_m3")?;
-        let rho = cx.num_where(t, p, "rho_kg_m3", "a positive density in kg/m^3", positive)?;
-        let alpha = cx.num_where(
-            t,
-            p,
-            "bulk_alpha_per_Pa",
-            "a positive alpha in 1/Pa (Eq. 3)",
+/// The circuit of `[damper.physical]` (its extensions and oil are read after it).
+fn physical_params(file: &str, t: &PhysicalTable) -> Result<CircuitParams, DeckError> {
+    let p = "damper.physical";
+    let cx = Check { file, table: p };
+    let area = |k, v| cx.req(k, v, "a positive area in m^2", positive);
+    let vol = |k, v| cx.req(k, v, "a positive volume in m^3", positive);
+    let a0 = area("A0_m2", t.A0_m2)?;
+    let a1 = area("A1_m2", t.A1_m2)?;
+    let v0 = vol("V0_m3", t.V0_m3)?;
+    let v1 = vol("V1_m3", t.V1_m3)?;
+    let rho = cx.req(
+        "rho_kg_m3",
+        t.rho_kg_m3,
+        "a positive density in kg/m^3",
+        positive,
+    )?;
+    let alpha = cx.req(
+        "bulk_alpha_per_Pa",
+        t.bulk_alpha_per_Pa,
+        "a positive alpha in 1/Pa (Eq. 3)",
+        positive,
+    )?;
+    let beta = cx.req(
+        "bulk_beta_per_Pa2",
+        t.bulk_beta_per_Pa2,
+        "a non-negative beta in 1/Pa^2 (Eq. 3)",
+        non_negative,
+    )?;
+    let a_orf = cx.req(
+        "A_orf_m2",
+        t.A_orf_m2,
+        "a non-negative orifice area in m^2",
+        non_negative,
+    )?;
+    let cd = cx.req("Cd", t.Cd, "a discharge coefficient in (0, 1]", discharge)?;
+    let p_s = cx.req(
+        "p_s_Pa",
+        t.p_s_Pa,
+        "a non-negative background pressure in Pa",
+        non_negative,
+    )?;
+    let dp_l = cx
+        .opt(
+            "dp_laminar_Pa",
+            t.dp_laminar_Pa,
+            "a positive pressure in Pa",
             positive,
-        )?;
-        let beta = cx.num_where(
-            t,
-            p,
-            "bulk_beta_per_Pa2",
-            "a non-negative beta in 1/Pa^2 (Eq. 3)",
+        )?
+        .unwrap_or(DEFAULT_DP_LAMINAR_PA);
+    let p_cav = cx
+        .opt(
+            "p_cav_Pa",
+            t.p_cav_Pa,
+            "a non-negative pressure in Pa (0 disables)",
             non_negative,
-        )?;
-        let a_orf = cx.num_where(
-            t,
-            p,
-            "A_orf_m2",
-            "a non-negative orifice area in m^2",
-            non_negative,
-        )?;
-        let cd = cx.num_where(t, p, "Cd", "a discharge coefficient in (0, 1]", |x| {
-            x > 0.0 && x <= 1.0
-        })?;
-        let p_s = cx.num_where(
-            t,
-            p,
-            "p_s_Pa",
-            "a non-negative background pressure in Pa",
-            non_negative,
-        )?;
-        let dp_l = if t.contains_key("dp_laminar_Pa") {
-            cx.num_where(t, p, "dp_laminar_Pa", "a positive pressure in Pa", positive)?
-        } else {
-            DEFAULT_DP_LAMINAR_PA
-        };
-        let p_cav = if t.contains_key("p_cav_Pa") {
-            cx.num_where(
-                t,
-                p,
-                "p_cav_Pa",
-                "a non-negative pressure in Pa (0 disables)",
-                non_negative,
-            )?
-        } else {
-            DEFAULT_P_CAV_PA
-        };
-        let cva = cx.num_where(
-            t,
-            p,
-            "check_valve_area_m2",
-            "a non-negative area in m^2 (0 disables)",
-            non_negative,
-        )?;
-        let mut relief = [None, None];
-        for (k, r) in relief.iter_mut().enumerate() {
-            let name = format!("relief_valve_{k}");
-            let Some(vt) = cx.table(t, p, &name)? else {
-                continue;
-            };
-            let vp = format!("{p}.{name}");
-            cx.known(vt, &vp, VALVE_KEYS)?;
-            let pos = |key: &str, what: &str| cx.num_where(vt, &vp, key, what, positive);
-            *r = Some(ReliefValve {
-                m: pos("m_kg", "a positive poppet mass in kg")?,
-                c: cx.num_where(
-                    vt,
-                    &vp,
-                    "c_N_s_per_m",
-                    "a non-negative poppet damping in N s/m",
-                    non_negative,
-                )?,
-                k: pos("k_N_per_m", "a positive spring constant in N/m")?,
-                f_p: cx.num_where(
-                    vt,
-                    &vp,
-                    "F_p_N",
-                    "a non-negative preload in N",
-                    non_negative,
-                )?,
-                a_front: pos("A_front_m2", "a positive area in m^2")?,
-                a_back: cx.num_where(
-                    vt,
-                    &vp,
-                    "A_back_m2",
-                    "a non-negative area in m^2",
-                    non_negative,
-                )?,
-                a: cx.num_where(
-                    vt,
-                    &vp,
-                    "a_m",
-                    "a non-negative coefficient in m (Eq. 7)",
-                    non_negative,
-                )?,
-                b: cx.num_where(
-                    vt,
-                    &vp,
-                    "b",
-                    "a non-negative coefficient (Eq. 7)",
-                    non_negative,
-                )?,
-                cd,
-            });
-        }
-        Ok(CircuitParams {
-            fluid: Fluid {
-                rho,
-                alpha,
-                beta,
-                p_cav,
-            },
-            dp_laminar: dp_l,
-            chambers: [
-                Chamber {
-                    area: a0,
-                    volume0: v0,
-                    lambda: 1.0,
-                },
-                Chamber {
-                    area: a1,
-                    volume0: v1,
-                    lambda: -1.0,
-                },
-            ],
-            orifice: (a_orf > 0.0).then_some(Orifice { area: a_orf, cd }),
-            relief,
-            check: (cva > 0.0).then_some(CheckValve { area: cva, cd }),
-            entrance: None,
-            p_s,
-            p_init: [p_s; 2],
-            ext: HydraulicExtensions::default(),
-        })
+        )?
+        .unwrap_or(DEFAULT_P_CAV_PA);
+    let cva = cx.req(
+        "check_valve_area_m2",
+        t.check_valve_area_m2,
+        "a non-negative area in m^2 (0 disables)",
+        non_negative,
+    )?;
+    let mut relief = [None, None];
+    for (k, (r, vt)) in relief
+        .iter_mut()
+        .zip([&t.relief_valve_0, &t.relief_valve_1])
+        .enumerate()
+    {
+        let Some(vt) = vt else { continue };
+        let vp = format!("{p}.relief_valve_{k}");
+        let cx = Check { file, table: &vp };
+        let pos = |key, v, what: &str| cx.req(key, v, what, positive);
+        let nonneg = |key, v, what: &str| cx.req(key, v, what, non_negative);
+        *r = Some(ReliefValve {
+            m: pos("m_kg", vt.m_kg, "a positive poppet mass in kg")?,
+            c: nonneg(
+                "c_N_s_per_m",
+                vt.c_N_s_per_m,
+                "a non-negative poppet damping in N s/m",
+            )?,
+            k: pos(
+                "k_N_per_m",
+                vt.k_N_per_m,
+                "a positive spring constant in N/m",
+            )?,
+            f_p: nonneg("F_p_N", vt.F_p_N, "a non-negative preload in N")?,
+            a_front: pos("A_front_m2", vt.A_front_m2, "a positive area in m^2")?,
+            a_back: nonneg("A_back_m2", vt.A_back_m2, "a non-negative area in m^2")?,
+            a: nonneg("a_m", vt.a_m, "a non-negative coefficient in m (Eq. 7)")?,
+            b: nonneg("b", vt.b, "a non-negative coefficient (Eq. 7)")?,
+            cd,
+        });
     }
+    Ok(CircuitParams {
+        fluid: Fluid {
+            rho,
+            alpha,
+            beta,
+            p_cav,
+        },
+        dp_laminar: dp_l,
+        chambers: [
+            Chamber {
+                area: a0,
+                volume0: v0,
+                lambda: 1.0,
+            },
+            Chamber {
+                area: a1,
+                volume0: v1,
+                lambda: -1.0,
+            },
+        ],
+        orifice: (a_orf > 0.0).then_some(Orifice { area: a_orf, cd }),
+        relief,
+        check: (cva > 0.0).then_some(CheckValve { area: cva, cd }),
+        entrance: None,
+        p_s,
+        p_init: [p_s; 2],
+        ext: HydraulicExtensions::default(),
+    })
+}
 
-    /// `[damper.physical.oil]`: the properties above hold at `reference_temperature_K`; they are
-    /// moved to `temperature_K` (default: the reference).
-    fn parse_oil(cx: &Ctx, t: &Table, c: &mut CircuitParams) -> Result<OilTemperature, DeckError> {
-        let p = "damper.physical.oil";
-        cx.known(t, p, OIL_KEYS)?;
-        let kelvin = oil_temperature_expected();
-        let t_ref = cx.num_where(
-            t,
-            p,
-            "reference_temperature_K",
+/// `[damper.physical.oil]`: the properties above hold at `reference_temperature_K`; they are
+/// moved to `temperature_K` (default: the reference).
+fn oil_law(file: &str, t: &OilTable, c: &mut CircuitParams) -> Result<OilTemperature, DeckError> {
+    let cx = Check {
+        file,
+        table: "damper.physical.oil",
+    };
+    let kelvin = oil_temperature_expected();
+    let t_ref = cx.req(
+        "reference_temperature_K",
+        t.reference_temperature_K,
+        &kelvin,
+        is_oil_temperature_k,
+    )?;
+    let t_run = cx
+        .opt(
+            "temperature_K",
+            t.temperature_K,
             &kelvin,
             is_oil_temperature_k,
-        )?;
-        let t_run = if t.contains_key("temperature_K") {
-            cx.num_where(t, p, "temperature_K", &kelvin, is_oil_temperature_k)?
-        } else {
-            t_ref
-        };
-        let coef = |k: &str| -> Result<f64, DeckError> {
-            if t.contains_key(k) {
-                cx.num_where(t, p, k, "a coefficient in 1/K, 0 to 0.1", |x| {
-                    (0.0..=OIL_COEFFICIENT_MAX_PER_K).contains(&x)
-                })
-            } else {
-                Ok(0.0)
-            }
-        };
-        let law = OilTemperature {
-            temperature_k: t_ref,
-            density_per_k: coef("density_thermal_coefficient_per_K")?,
-            bulk_modulus_per_k: coef("bulk_modulus_thermal_coefficient_per_K")?,
-            viscosity_per_k: coef("viscosity_thermal_coefficient_per_K")?,
-        };
-        Ok(law.move_to(c, t_run))
-    }
+        )?
+        .unwrap_or(t_ref);
+    let coef = |k, v| -> Result<f64, DeckError> {
+        let ok = |x| (0.0..=OIL_COEFFICIENT_MAX_PER_K).contains(&x);
+        Ok(cx
+            .opt(k, v, "a coefficient in 1/K, 0 to 0.1", ok)?
+            .unwrap_or(0.0))
+    };
+    let law = OilTemperature {
+        temperature_k: t_ref,
+        density_per_k: coef(
+            "density_thermal_coefficient_per_K",
+            t.density_thermal_coefficient_per_K,
+        )?,
+        bulk_modulus_per_k: coef(
+            "bulk_modulus_thermal_coefficient_per_K",
+            t.bulk_modulus_thermal_coefficient_per_K,
+        )?,
+        viscosity_per_k: coef(
+            "viscosity_thermal_coefficient_per_K",
+            t.viscosity_thermal_coefficient_per_K,
+        )?,
+    };
+    Ok(law.move_to(c, t_run))
+}
 
+/// `[damper.physical.extensions]`: the device-level ones returned, the hydraulic ones (air,
+/// leakage, bleed) set on `c`.
+fn extensions(
+    file: &str,
+    t: &ExtensionsTable,
+    c: &mut CircuitParams,
+) -> Result<DeviceExtensions, DeckError> {
+    let p = "damper.physical.extensions";
+    let cx = Check { file, table: p };
+    let force = "a non-negative force in N";
+    let velocity = "a positive velocity in m/s";
+    let f_c = cx.opt("seal_friction_N", t.seal_friction_N, force, non_negative)?;
+    let f_s = cx.opt(
+        "stribeck_static_N",
+        t.stribeck_static_N,
+        force,
+        non_negative,
+    )?;
+    let v_s = cx.opt(
+        "stribeck_velocity_m_s",
+        t.stribeck_velocity_m_s,
+        velocity,
+        positive,
+    )?;
+    let v_eps = cx.opt(
+        "friction_smoothing_m_s",
+        t.friction_smoothing_m_s,
+        velocity,
+        positive,
+    )?;
+    let gap = cx.opt(
+        "free_play_m",
+        t.free_play_m,
+        "a non-negative gap in m",
+        non_negative,
+    )?;
+    let volume_fraction = "a volume fraction in [0, 1)";
+    let air = cx.opt("air_fraction", t.air_fraction, volume_fraction, fraction)?;
+    let conductance = "a non-negative conductance in m^3/(s Pa)";
+    let leak = cx.opt(
+        "leakage_m3_per_s_Pa",
+        t.leakage_m3_per_s_Pa,
+        conductance,
+        non_negative,
+    )?;
+    let mu_l = cx.opt(
+        "leakage_viscosity_length_Pa_s_m",
+        t.leakage_viscosity_length_Pa_s_m,
+        "a non-negative viscosity times seal land length in Pa s m",
+        non_negative,
+    )?;
+    let bleed = cx.opt(
+        "accumulator_bleed_m3_per_s_Pa",
+        t.accumulator_bleed_m3_per_s_Pa,
+        conductance,
+        non_negative,
+    )?;
+    if let Some(k) = bleed.filter(|k| *k > 0.0) {
+        c.ext.bleed = Some(Leakage { conductance: k });
+    }
+    let mut e = DeviceExtensions {
+        mount_stiffness_n_per_m: cx.opt(
+            "mount_stiffness_N_per_m",
+            t.mount_stiffness_N_per_m,
+            "a positive stiffness in N/m (absent: rigid mounts)",
+            positive,
+        )?,
+        free_play_contact_stiffness_n_per_m: cx.opt(
+            "free_play_contact_stiffness_N_per_m",
+            t.free_play_contact_stiffness_N_per_m,
+            "a positive stiffness in N/m (absent: a rigid gap)",
+            positive,
+        )?,
+        ..Default::default()
+    };
+    let mass = cx.opt(
+        "link_mass_kg",
+        t.link_mass_kg,
+        "a positive mass in kg",
+        positive,
+    )?;
+    let zeta = cx.opt(
+        "link_damping_ratio",
+        t.link_damping_ratio,
+        "a non-negative fraction of critical damping",
+        non_negative,
+    )?;
+    match (mass, zeta) {
+        (Some(m), z) => {
+            e.link_mass = Some(LinkMass {
+                mass_kg: m,
+                damping_ratio: z.unwrap_or(0.0),
+            })
+        }
+        (None, Some(z)) => {
+            return Err(cx.bad(
+                "link_damping_ratio",
+                z,
+                "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
+            ))
+        }
+        (None, None) => {}
+    }
+    let presliding = cx.opt(
+        "seal_presliding_m",
+        t.seal_presliding_m,
+        "a non-negative presliding displacement in m (0: none)",
+        non_negative,
+    )?;
+    let f_c = f_c.unwrap_or(0.0);
+    let f_s = f_s.unwrap_or(f_c);
+    if f_c > 0.0 || f_s > 0.0 {
+        let d = SealFriction::coulomb(f_c);
+        e.friction = Some(SealFriction {
+            f_c,
+            f_s,
+            v_s: v_s.unwrap_or(d.v_s),
+            v_eps: v_eps.unwrap_or(d.v_eps),
+            presliding_m: presliding.unwrap_or(0.0),
+        });
+    } else if let Some(x) = presliding.filter(|x| *x > 0.0) {
+        return Err(cx.bad(
+            "seal_presliding_m",
+            x,
+            "presliding belongs to the seal friction: give seal_friction_N too",
+        ));
+    }
+    if let Some(g) = gap.filter(|g| *g > 0.0) {
+        e.free_play = Some(FreePlay { gap: g });
+    }
+    // Entrained air is given at the background pressure, which must then be positive.
+    let p_s = c.p_s;
+    let at_p_s = |key: &str, a: f64| {
+        if p_s <= 0.0 {
+            return Err(cx.bad(
+                key,
+                a,
+                "entrained air is given at the background pressure p_s_Pa, which must then be positive",
+            ));
+        }
+        Ok(EntrainedAir {
+            fraction: a,
+            p_ref: p_s,
+        })
+    };
+    if let Some(a) = air.filter(|a| *a > 0.0) {
+        c.ext.air = Some(at_p_s("air_fraction", a)?);
+    }
+    if let Some(k) = leak.filter(|k| *k > 0.0) {
+        c.ext.leakage = Some(AnnularLeakage {
+            conductance: k,
+            viscosity_length: mu_l.unwrap_or(0.0),
+        });
+    }
+    let by_chamber = [
+        ("air_fraction_0", t.air_fraction_0),
+        ("air_fraction_1", t.air_fraction_1),
+    ];
+    for (ch, (key, v)) in by_chamber.into_iter().enumerate() {
+        if let Some(a) = cx
+            .opt(key, v, volume_fraction, fraction)?
+            .filter(|a| *a > 0.0)
+        {
+            c.ext.air_by_chamber[ch] = Some(at_p_s(key, a)?);
+        }
+    }
+    Ok(e)
+}
+
+impl DamperDeck {
     /// The deck at the oil temperature `t_k` [K] where both are known (a temperature and the
     /// deck's oil law), else the deck as it is (e.g. a flight record's or a bench test's).
     pub fn at_known_oil_temperature(
@@ -596,12 +957,9 @@ impl DamperDeck {
     /// The deck with its oil at `t_k` [K] (the properties moved by `[damper.physical.oil]`).
     pub fn at_oil_temperature(&self, t_k: f64) -> Result<DamperDeck, DeckError> {
         if !is_oil_temperature_k(t_k) {
-            return Err(DeckError::BadValue {
-                file: self.source.clone(),
-                key: "damper.physical.oil.temperature_K".into(),
-                value: format!("{t_k}"),
-                expected: oil_temperature_expected(),
-            });
+            let key = "damper.physical.oil.temperature_K";
+            let e = oil_temperature_expected();
+            return Err(DeckError::bad(&self.source, key, format!("{t_k}"), e));
         }
         let mut d = self.clone();
         match (d.physical.as_mut(), self.oil) {
@@ -609,161 +967,11 @@ impl DamperDeck {
                 d.oil = Some(law.move_to(c, t_k));
                 Ok(d)
             }
-            _ => Err(DeckError::MissingTable {
-                file: self.source.clone(),
-                table: "damper.physical.oil".into(),
-            }),
+            _ => Err(DeckError::missing_table(
+                &self.source,
+                "damper.physical.oil",
+            )),
         }
-    }
-
-    fn parse_extensions(
-        cx: &Ctx,
-        t: &Table,
-        c: &mut CircuitParams,
-    ) -> Result<DeviceExtensions, DeckError> {
-        let p = "damper.physical.extensions";
-        cx.known(t, p, EXTENSION_KEYS)?;
-        let opt = |k: &str, what: &str, ok: fn(f64) -> bool| -> Result<Option<f64>, DeckError> {
-            if t.contains_key(k) {
-                cx.num_where(t, p, k, what, ok).map(Some)
-            } else {
-                Ok(None)
-            }
-        };
-        let f_c = opt("seal_friction_N", "a non-negative force in N", non_negative)?;
-        let f_s = opt(
-            "stribeck_static_N",
-            "a non-negative force in N",
-            non_negative,
-        )?;
-        let v_s = opt(
-            "stribeck_velocity_m_s",
-            "a positive velocity in m/s",
-            positive,
-        )?;
-        let v_eps = opt(
-            "friction_smoothing_m_s",
-            "a positive velocity in m/s",
-            positive,
-        )?;
-        let gap = opt("free_play_m", "a non-negative gap in m", non_negative)?;
-        let air = opt("air_fraction", "a volume fraction in [0, 1)", |x| {
-            (0.0..1.0).contains(&x)
-        })?;
-        let leak = opt(
-            "leakage_m3_per_s_Pa",
-            "a non-negative conductance in m^3/(s Pa)",
-            non_negative,
-        )?;
-        let mu_l = opt(
-            "leakage_viscosity_length_Pa_s_m",
-            "a non-negative viscosity times seal land length in Pa s m",
-            non_negative,
-        )?;
-        let bleed = opt(
-            "accumulator_bleed_m3_per_s_Pa",
-            "a non-negative conductance in m^3/(s Pa)",
-            non_negative,
-        )?;
-        if let Some(k) = bleed.filter(|k| *k > 0.0) {
-            c.ext.bleed = Some(Leakage { conductance: k });
-        }
-        let mut e = DeviceExtensions {
-            mount_stiffness_n_per_m: opt(
-                "mount_stiffness_N_per_m",
-                "a positive stiffness in N/m (absent: rigid mounts)",
-                positive,
-            )?,
-            free_play_contact_stiffness_n_per_m: opt(
-                "free_play_contact_stiffness_N_per_m",
-                "a positive stiffness in N/m (absent: a rigid gap)",
-                positive,
-            )?,
-            ..Default::default()
-        };
-        let mass = opt("link_mass_kg", "a positive mass in kg", positive)?;
-        let zeta = opt(
-            "link_damping_ratio",
-            "a non-negative fraction of critical damping",
-            non_negative,
-        )?;
-        if let Some(m) = mass {
-            e.link_mass = Some(LinkMass {
-                mass_kg: m,
-                damping_ratio: zeta.unwrap_or(0.0),
-            });
-        } else if zeta.is_some() {
-            return Err(cx.bad(
-                &format!("{p}.link_damping_ratio"),
-                &t["link_damping_ratio"],
-                "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
-            ));
-        }
-        let presliding = opt(
-            "seal_presliding_m",
-            "a non-negative presliding displacement in m (0: none)",
-            non_negative,
-        )?;
-        let f_c = f_c.unwrap_or(0.0);
-        let f_s = f_s.unwrap_or(f_c);
-        if f_c > 0.0 || f_s > 0.0 {
-            let d = SealFriction::coulomb(f_c);
-            e.friction = Some(SealFriction {
-                f_c,
-                f_s,
-                v_s: v_s.unwrap_or(d.v_s),
-                v_eps: v_eps.unwrap_or(d.v_eps),
-                presliding_m: presliding.unwrap_or(0.0),
-            });
-        } else if presliding.is_some_and(|x| x > 0.0) {
-            return Err(cx.bad(
-                &format!("{p}.seal_presliding_m"),
-                &t["seal_presliding_m"],
-                "presliding belongs to the seal friction: give seal_friction_N too",
-            ));
-        }
-        if let Some(g) = gap.filter(|g| *g > 0.0) {
-            e.free_play = Some(FreePlay { gap: g });
-        }
-        if let Some(a) = air.filter(|a| *a > 0.0) {
-            if c.p_s <= 0.0 {
-                return Err(cx.bad(
-                    &format!("{p}.air_fraction"),
-                    &t["air_fraction"],
-                    "entrained air is given at the background pressure p_s_Pa, which must then be positive",
-                ));
-            }
-            c.ext.air = Some(EntrainedAir {
-                fraction: a,
-                p_ref: c.p_s,
-            });
-        }
-        if let Some(k) = leak.filter(|k| *k > 0.0) {
-            c.ext.leakage = Some(AnnularLeakage {
-                conductance: k,
-                viscosity_length: mu_l.unwrap_or(0.0),
-            });
-        }
-        for ch in 0..2 {
-            let key = format!("air_fraction_{ch}");
-            let v = opt(&key, "a volume fraction in [0, 1)", |x| {
-                (0.0..1.0).contains(&x)
-            })?;
-            if let Some(a) = v.filter(|a| *a > 0.0) {
-                if c.p_s <= 0.0 {
-                    return Err(cx.bad(
-                        &format!("{p}.{key}"),
-                        &t[key.as_str()],
-                        "entrained air is given at the background pressure p_s_Pa, which must then be positive",
-                    ));
-                }
-                c.ext.air_by_chamber[ch] = Some(EntrainedAir {
-                    fraction: a,
-                    p_ref: c.p_s,
-                });
-            }
-        }
-        Ok(e)
     }
 
     /// Physical values of the `[damper.physical]` table beyond the usual, each with its key and
@@ -846,10 +1054,8 @@ impl DamperDeck {
         if present {
             Ok(())
         } else {
-            Err(DeckError::MissingTable {
-                file: self.source.clone(),
-                table: format!("damper.{}", model.name()),
-            })
+            let table = format!("damper.{}", model.name());
+            Err(DeckError::missing_table(&self.source, &table))
         }
     }
 
@@ -897,12 +1103,9 @@ impl DamperDeck {
                     } else {
                         "a moving mass is integrated by RK4 only (scheme rk4)"
                     };
-                    return Err(DeckError::BadValue {
-                        file: self.source.clone(),
-                        key: "damper.physical.extensions.link_mass_kg".into(),
-                        value: format!("{}", e.link_mass.map_or(0.0, |m| m.mass_kg)),
-                        expected: why.into(),
-                    });
+                    let key = "damper.physical.extensions.link_mass_kg";
+                    let mass = format!("{}", e.link_mass.map_or(0.0, |m| m.mass_kg));
+                    return Err(DeckError::bad(&self.source, key, mass, why));
                 }
                 let dev: Box<dyn Device> = if e.friction.is_some() || rigid_play.is_some() {
                     Box::new(ExtendedDamper::new(dev, e.friction, rigid_play))
@@ -927,11 +1130,8 @@ impl DamperDeck {
             )),
             DamperModel::Nonlinear => {
                 let (v, f) = self.nonlinear.clone().unwrap_or_default();
-                let table = MonotoneTable::new(v, f).map_err(|e| DeckError::BadValue {
-                    file: self.source.clone(),
-                    key: "damper.nonlinear".into(),
-                    value: String::new(),
-                    expected: e,
+                let table = MonotoneTable::new(v, f).map_err(|e| {
+                    DeckError::bad(&self.source, "damper.nonlinear", String::new(), e)
                 })?;
                 Box::new(NonlinearDashpot::new(table))
             }
@@ -944,139 +1144,135 @@ impl DamperDeck {
         let params = self
             .physical
             .clone()
-            .ok_or_else(|| DeckError::MissingTable {
-                file: self.source.clone(),
-                table: "damper.physical".into(),
-            })?;
+            .ok_or_else(|| DeckError::missing_table(&self.source, "damper.physical"))?;
         Ok(CircuitDevice::new(params, opts))
     }
 }
 
 impl DamperDeck {
-    /// The deck as TOML (`[damper]` of docs/formats.md plus `[damper.physical.extensions]` where
-    /// any extension is on), readable by [`DamperDeck::from_toml_str`]; numbers use the shortest
-    /// round-trip formatting, so the deck reads back to the same values.
-    pub fn to_toml(&self) -> String {
-        use std::fmt::Write as _;
-        let mut s = String::new();
-        let _ = writeln!(s, "[damper]\nmodel = \"{}\"", self.model.name());
-        if let Some(c) = self.linear_c_n_s_per_m {
-            let _ = writeln!(s, "\n[damper.linear]\nc_N_s_per_m = {}", num(c));
-        }
-        if let Some((v, f)) = &self.nonlinear {
-            let _ = writeln!(
-                s,
-                "\n[damper.nonlinear]\nvelocity_m_s = {}\nforce_N = {}",
-                arr(v),
-                arr(f)
-            );
-        }
-        if let Some(c) = &self.physical {
+    /// The deck as its file's tables: what [`DamperDeck::from_file_tables`] reads back to this
+    /// deck (the oil's reference is the temperature the properties hold at).
+    pub fn to_file_tables(&self) -> DamperFile {
+        let physical = self.physical.as_ref().map(|c| {
             let cd = c
                 .orifice
                 .map(|o| o.cd)
                 .or(c.check.map(|v| v.cd))
                 .or(c.relief.iter().flatten().next().map(|r| r.cd))
                 .unwrap_or(0.611);
-            let kv = [
-                ("A0_m2", c.chambers[0].area),
-                ("A1_m2", c.chambers[1].area),
-                ("V0_m3", c.chambers[0].volume0),
-                ("V1_m3", c.chambers[1].volume0),
-                ("rho_kg_m3", c.fluid.rho),
-                ("bulk_alpha_per_Pa", c.fluid.alpha),
-                ("bulk_beta_per_Pa2", c.fluid.beta),
-                ("A_orf_m2", c.orifice.map_or(0.0, |o| o.area)),
-                ("Cd", cd),
-                ("p_s_Pa", c.p_s),
-                ("dp_laminar_Pa", c.dp_laminar),
-                ("check_valve_area_m2", c.check.map_or(0.0, |v| v.area)),
-                ("p_cav_Pa", c.fluid.p_cav),
-            ];
-            s.push_str("\n[damper.physical]\n");
-            for (k, v) in kv {
-                let _ = writeln!(s, "{k} = {}", num(v));
-            }
-            for (k, rv) in c.relief.iter().enumerate() {
-                let Some(r) = rv else { continue };
-                let _ = writeln!(s, "\n[damper.physical.relief_valve_{k}]");
-                for (key, v) in [
-                    ("m_kg", r.m),
-                    ("c_N_s_per_m", r.c),
-                    ("k_N_per_m", r.k),
-                    ("F_p_N", r.f_p),
-                    ("A_front_m2", r.a_front),
-                    ("A_back_m2", r.a_back),
-                    ("a_m", r.a),
-                    ("b", r.b),
-                ] {
-                    let _ = writeln!(s, "{key} = {}", num(v));
-                }
-            }
+            let valve = |k: usize| {
+                c.relief[k].map(|r| ReliefValveTable {
+                    m_kg: Some(r.m),
+                    c_N_s_per_m: Some(r.c),
+                    k_N_per_m: Some(r.k),
+                    F_p_N: Some(r.f_p),
+                    A_front_m2: Some(r.a_front),
+                    A_back_m2: Some(r.a_back),
+                    a_m: Some(r.a),
+                    b: Some(r.b),
+                })
+            };
             let e = &self.extensions;
-            let mut ext = Vec::new();
-            if let Some(f) = e.friction {
-                ext.push(("seal_friction_N", f.f_c));
-                ext.push(("stribeck_static_N", f.f_s));
-                ext.push(("stribeck_velocity_m_s", f.v_s));
-                ext.push(("friction_smoothing_m_s", f.v_eps));
-                if f.has_presliding() {
-                    ext.push(("seal_presliding_m", f.presliding_m));
-                }
+            let friction = e.friction;
+            let leakage = c.ext.leakage;
+            let ext = ExtensionsTable {
+                seal_friction_N: friction.map(|f| f.f_c),
+                stribeck_static_N: friction.map(|f| f.f_s),
+                stribeck_velocity_m_s: friction.map(|f| f.v_s),
+                friction_smoothing_m_s: friction.map(|f| f.v_eps),
+                seal_presliding_m: friction
+                    .filter(|f| f.has_presliding())
+                    .map(|f| f.presliding_m),
+                free_play_m: e.free_play.map(|p| p.gap),
+                free_play_contact_stiffness_N_per_m: e.free_play_contact_stiffness_n_per_m,
+                mount_stiffness_N_per_m: e.mount_stiffness_n_per_m,
+                link_mass_kg: e.link_mass.map(|m| m.mass_kg),
+                link_damping_ratio: e.link_mass.map(|m| m.damping_ratio),
+                air_fraction: c.ext.air.map(|a| a.fraction),
+                leakage_m3_per_s_Pa: leakage.map(|l| l.conductance),
+                leakage_viscosity_length_Pa_s_m: leakage
+                    .map(|l| l.viscosity_length)
+                    .filter(|x| *x > 0.0),
+                air_fraction_0: c.ext.air_by_chamber[0].map(|a| a.fraction),
+                air_fraction_1: c.ext.air_by_chamber[1].map(|a| a.fraction),
+                accumulator_bleed_m3_per_s_Pa: c.ext.bleed.map(|l| l.conductance),
+            };
+            PhysicalTable {
+                A0_m2: Some(c.chambers[0].area),
+                A1_m2: Some(c.chambers[1].area),
+                V0_m3: Some(c.chambers[0].volume0),
+                V1_m3: Some(c.chambers[1].volume0),
+                rho_kg_m3: Some(c.fluid.rho),
+                bulk_alpha_per_Pa: Some(c.fluid.alpha),
+                bulk_beta_per_Pa2: Some(c.fluid.beta),
+                A_orf_m2: Some(c.orifice.map_or(0.0, |o| o.area)),
+                Cd: Some(cd),
+                p_s_Pa: Some(c.p_s),
+                dp_laminar_Pa: Some(c.dp_laminar),
+                check_valve_area_m2: Some(c.check.map_or(0.0, |v| v.area)),
+                p_cav_Pa: Some(c.fluid.p_cav),
+                relief_valve_0: valve(0),
+                relief_valve_1: valve(1),
+                extensions: (ext != ExtensionsTable::default()).then_some(ext),
+                oil: self.oil.map(|o| OilTable {
+                    reference_temperature_K: Some(o.temperature_k),
+                    temperature_K: None,
+                    density_thermal_coefficient_per_K: Some(o.density_per_k),
+                    bulk_modulus_thermal_coefficient_per_K: Some(o.bulk_modulus_per_k),
+                    viscosity_thermal_coefficient_per_K: Some(o.viscosity_per_k),
+                }),
             }
-            if let Some(p) = e.free_play {
-                ext.push(("free_play_m", p.gap));
-            }
-            if let Some(k) = e.free_play_contact_stiffness_n_per_m {
-                ext.push(("free_play_contact_stiffness_N_per_m", k));
-            }
-            if let Some(k) = e.mount_stiffness_n_per_m {
-                ext.push(("mount_stiffness_N_per_m", k));
-            }
-            if let Some(m) = e.link_mass {
-                ext.push(("link_mass_kg", m.mass_kg));
-                ext.push(("link_damping_ratio", m.damping_ratio));
-            }
-            if let Some(a) = c.ext.air {
-                ext.push(("air_fraction", a.fraction));
-            }
-            if let Some(l) = c.ext.leakage {
-                ext.push(("leakage_m3_per_s_Pa", l.conductance));
-                if l.viscosity_length > 0.0 {
-                    ext.push(("leakage_viscosity_length_Pa_s_m", l.viscosity_length));
-                }
-            }
-            for (ch, a) in c.ext.air_by_chamber.iter().enumerate() {
-                if let Some(a) = a {
-                    ext.push((["air_fraction_0", "air_fraction_1"][ch], a.fraction));
-                }
-            }
-            if let Some(l) = c.ext.bleed {
-                ext.push(("accumulator_bleed_m3_per_s_Pa", l.conductance));
-            }
-            if !ext.is_empty() {
-                s.push_str("\n[damper.physical.extensions]\n");
-                for (k, v) in ext {
-                    let _ = writeln!(s, "{k} = {}", num(v));
-                }
-            }
-            if let Some(o) = &self.oil {
-                // The properties above hold at the law's temperature: that is their reference.
-                s.push_str("\n[damper.physical.oil]\n");
-                for (k, v) in [
-                    ("reference_temperature_K", o.temperature_k),
-                    ("density_thermal_coefficient_per_K", o.density_per_k),
-                    (
-                        "bulk_modulus_thermal_coefficient_per_K",
-                        o.bulk_modulus_per_k,
-                    ),
-                    ("viscosity_thermal_coefficient_per_K", o.viscosity_per_k),
-                ] {
-                    let _ = writeln!(s, "{k} = {}", num(v));
-                }
-            }
+        });
+        DamperFile {
+            damper: Some(DamperTable {
+                model: Some(self.model.name().into()),
+                linear: self.linear_c_n_s_per_m.map(|c| LinearTable {
+                    c_N_s_per_m: Some(c),
+                }),
+                nonlinear: self.nonlinear.clone().map(|(v, f)| NonlinearTable {
+                    velocity_m_s: Some(v),
+                    force_N: Some(f),
+                }),
+                physical,
+            }),
         }
-        s
+    }
+
+    /// The deck as TOML (`[damper]` of docs/formats.md plus `[damper.physical.extensions]` where
+    /// any extension is on), readable by [`DamperDeck::from_toml_str`]; numbers use the shortest
+    /// round-trip formatting, so the deck reads back to the same values.
+    pub fn to_toml(&self) -> String {
+        let text = toml::to_string(&self.to_file_tables()).expect("damper tables are TOML");
+        shortest_numbers(&text)
+    }
+}
+
+/// `text` (TOML written by serde) with every number of its `key = value` lines in the shortest
+/// round-trip form with an exponent where small or large (`1.8e-6`, not `0.0000018`).
+fn shortest_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        match line.split_once(" = ") {
+            Some((k, v)) if !line.starts_with('[') => {
+                out.push_str(k);
+                out.push_str(" = ");
+                out.push_str(&shortest_value(v));
+            }
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn shortest_value(v: &str) -> String {
+    if let Some(items) = v.strip_prefix('[').and_then(|s| s.strip_suffix(']')) {
+        let items: Vec<String> = items.split(", ").map(shortest_value).collect();
+        return format!("[{}]", items.join(", "));
+    }
+    match v.parse::<f64>() {
+        Ok(x) if !v.starts_with('"') => num(x),
+        _ => v.to_string(),
     }
 }
 
@@ -1090,85 +1286,100 @@ fn num(x: f64) -> String {
     }
 }
 
-fn arr(v: &[f64]) -> String {
-    format!(
-        "[{}]",
-        v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", ")
-    )
-}
-
-pub const ACTUATOR_KEYS: &[&str] = &[
-    "A0_m2",
-    "A1_m2",
-    "V0_m3",
-    "V1_m3",
-    "p_E0_Pa",
-    "p_E1_Pa",
-    "A_orf0_m2",
-    "A_orf1_m2",
-    "Cd0",
-    "Cd1",
-    "p_s_Pa",
-    "B_Pa",
-    "rho_kg_m3",
-    "check_valve_area_m2",
-    "dp_laminar_Pa",
-];
-
-/// Reads the linear actuator of an `[actuator]` table (keys: [`ACTUATOR_KEYS`]; paper Table 1
+/// Reads the linear actuator of an `[actuator]` table ([`ActuatorTable`]; paper Table 1
 /// names with units; `dp_laminar_Pa` optional). Other top-level tables are ignored.
 pub fn actuator_from_toml_str(text: &str, source_name: &str) -> Result<ActuatorParams, DeckError> {
-    let cx = Ctx { file: source_name };
-    let root: Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| DeckError::Parse {
-            file: source_name.into(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
-    let p = "actuator";
-    let t = cx
-        .table(&root, "", p)?
-        .ok_or_else(|| DeckError::MissingTable {
-            file: source_name.into(),
-            table: p.into(),
-        })?;
-    cx.known(t, p, ACTUATOR_KEYS)?;
-    let pos = |k: &str, what: &str| cx.num_where(t, p, k, what, positive);
-    let nonneg = |k: &str, what: &str| cx.num_where(t, p, k, what, non_negative);
-    let cd = |k: &str| {
-        cx.num_where(t, p, k, "a discharge coefficient in (0, 1]", |x| {
-            x > 0.0 && x <= 1.0
-        })
+    let f: ActuatorFile = read_tables(text, source_name)?;
+    let t = f
+        .actuator
+        .ok_or_else(|| DeckError::missing_table(source_name, "actuator"))?;
+    let cx = Check {
+        file: source_name,
+        table: "actuator",
     };
+    let pos = |k, v, what: &str| cx.req(k, v, what, positive);
+    let nonneg = |k, v, what: &str| cx.req(k, v, what, non_negative);
+    let cd = |k, v| cx.req(k, v, "a discharge coefficient in (0, 1]", discharge);
+    let (area, volume) = ("a positive area in m^2", "a positive volume in m^3");
+    let (pressure, orifice) = (
+        "a non-negative pressure in Pa",
+        "a non-negative area in m^2",
+    );
     Ok(ActuatorParams {
-        area_m2: [
-            pos("A0_m2", "a positive area in m^2")?,
-            pos("A1_m2", "a positive area in m^2")?,
-        ],
+        area_m2: [pos("A0_m2", t.A0_m2, area)?, pos("A1_m2", t.A1_m2, area)?],
         volume0_m3: [
-            pos("V0_m3", "a positive volume in m^3")?,
-            pos("V1_m3", "a positive volume in m^3")?,
+            pos("V0_m3", t.V0_m3, volume)?,
+            pos("V1_m3", t.V1_m3, volume)?,
         ],
         p_entrance_pa: [
-            nonneg("p_E0_Pa", "a non-negative pressure in Pa")?,
-            nonneg("p_E1_Pa", "a non-negative pressure in Pa")?,
+            nonneg("p_E0_Pa", t.p_E0_Pa, pressure)?,
+            nonneg("p_E1_Pa", t.p_E1_Pa, pressure)?,
         ],
         orifice_area_m2: [
-            nonneg("A_orf0_m2", "a non-negative area in m^2")?,
-            nonneg("A_orf1_m2", "a non-negative area in m^2")?,
+            nonneg("A_orf0_m2", t.A_orf0_m2, orifice)?,
+            nonneg("A_orf1_m2", t.A_orf1_m2, orifice)?,
         ],
-        cd: [cd("Cd0")?, cd("Cd1")?],
-        p_s_pa: nonneg("p_s_Pa", "a non-negative pressure in Pa")?,
-        bulk_modulus_pa: pos("B_Pa", "a positive bulk modulus in Pa")?,
-        rho_kg_m3: pos("rho_kg_m3", "a positive density in kg/m^3")?,
+        cd: [cd("Cd0", t.Cd0)?, cd("Cd1", t.Cd1)?],
+        p_s_pa: nonneg("p_s_Pa", t.p_s_Pa, pressure)?,
+        bulk_modulus_pa: pos("B_Pa", t.B_Pa, "a positive bulk modulus in Pa")?,
+        rho_kg_m3: pos("rho_kg_m3", t.rho_kg_m3, "a positive density in kg/m^3")?,
         check_valve_area_m2: nonneg(
             "check_valve_area_m2",
+            t.check_valve_area_m2,
             "a non-negative area in m^2 (0 disables)",
         )?,
-        dp_laminar_pa: if t.contains_key("dp_laminar_Pa") {
-            pos("dp_laminar_Pa", "a positive pressure in Pa")?
-        } else {
-            DEFAULT_DP_LAMINAR_PA
-        },
+        dp_laminar_pa: cx
+            .opt(
+                "dp_laminar_Pa",
+                t.dp_laminar_Pa,
+                "a positive pressure in Pa",
+                positive,
+            )?
+            .unwrap_or(DEFAULT_DP_LAMINAR_PA),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn written_numbers_are_shortest_and_read_back() {
+        let root = env!("CARGO_MANIFEST_DIR");
+        let d = DamperDeck::from_file(Path::new(&format!("{root}/rotors/uh60a.toml"))).unwrap();
+        let text = d.to_toml();
+        assert!(text.contains("\nA_orf_m2 = 1.8e-6\n"), "{text}");
+        assert!(text.contains("\nrho_kg_m3 = 850.0\n"), "{text}");
+        assert_eq!(DamperDeck::from_toml_str(&text, "back").unwrap(), {
+            let mut d = d.clone();
+            d.source = "back".into();
+            d
+        });
+    }
+
+    #[test]
+    fn serde_errors_name_the_key() {
+        let e = |t: &str| {
+            DamperDeck::from_toml_str(t, "d.toml")
+                .unwrap_err()
+                .to_string()
+        };
+        let m = e("[damper]\nmodel = \"linear\"\n[damper.linear]\nc_N_s_per_mm = 1.0\n");
+        assert!(
+            m.starts_with(
+                "deck d.toml: unknown key `damper.linear.c_N_s_per_mm` (known keys: c_N_s_per_m"
+            ),
+            "{m}"
+        );
+        let m = e("[damper]\nmodel = \"linear\"\n[damper.linear]\nc_N_s_per_m = \"x\"\n");
+        assert!(
+            m.contains("`damper.linear.c_N_s_per_m` = string \"x\": expected a number"),
+            "{m}"
+        );
+        let m = e("[damper]\nmodel = \"linear\"\n[damper.linear]\n");
+        assert!(
+            m.contains("missing key `damper.linear.c_N_s_per_m` (a non-negative"),
+            "{m}"
+        );
+    }
 }

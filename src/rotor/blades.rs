@@ -322,6 +322,8 @@ impl RotorDeck {
             spec: RotorSpec::parse(&text, &file)?,
             text,
             blades: PerBlade::default(),
+            damper: Default::default(),
+            assumed: self.assumed.clone(),
         })
     }
 

@@ -203,6 +203,7 @@ pub struct SimState {
 }
 
 pub mod aero;
+pub mod assumed;
 pub mod blades;
 pub mod deck;
 
@@ -278,6 +279,11 @@ pub struct RotorDeck {
     text: String,
     /// The per-blade differences, applied only to the blades' decks.
     blades: blades::PerBlade,
+    /// The typed `[damper]` table, read on first use (a command that runs no damper does not
+    /// need it to be valid).
+    damper: std::sync::OnceLock<Result<DamperDeck, String>>,
+    /// The values the deck file labels `# ASSUMED`, read once with the deck.
+    assumed: assumed::Scan,
 }
 
 impl RotorDeck {
@@ -293,6 +299,10 @@ impl RotorDeck {
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
         let spec = deck::RotorSpec::parse(&text, &file)?;
+        let assumed = match text.parse::<toml::Table>() {
+            Ok(root) => assumed::scan(&text, &root),
+            Err(_) => assumed::Scan::default(), // RotorSpec::parse has read it: unreachable
+        };
         let (sets, overrides): (Vec<Override>, Vec<Override>) = overrides
             .iter()
             .cloned()
@@ -322,6 +332,8 @@ impl RotorDeck {
             spec,
             text,
             blades: blades::PerBlade { table, sets },
+            damper: Default::default(),
+            assumed,
         };
         deck.check_blades()?;
         Ok(deck)
@@ -334,12 +346,23 @@ impl RotorDeck {
         v.extend(self.blade_section_files());
         v
     }
+    /// The values the deck file labels `# ASSUMED` (keys as `--set` takes them, with the file's
+    /// values and lines; overrides do not change what is labelled).
+    pub fn assumed(&self) -> &assumed::Scan {
+        &self.assumed
+    }
     /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {
-        Ok(DamperDeck::from_toml_str(
-            &self.text,
-            &self.path.display().to_string(),
-        )?)
+        self.damper
+            .get_or_init(|| {
+                let root = toml::Table::from_iter(
+                    self.spec.damper.clone().map(|d| ("damper".to_string(), d)),
+                );
+                DamperDeck::from_toml_table(root, &self.path.display().to_string())
+                    .map_err(|e| e.to_string())
+            })
+            .clone()
+            .map_err(|e| anyhow::anyhow!(e))
     }
     /// The generated multibody model deck (TOML text, docs/model_deck.md).
     pub fn expand(&self, opts: &expand::ExpandOptions) -> String {

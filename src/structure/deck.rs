@@ -16,26 +16,9 @@ use crate::hydraulics::{
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use thiserror::Error;
 
-#[derive(Debug, Error)]
-pub enum DeckError {
-    #[error("deck {file}: cannot read: {source}")]
-    Io {
-        file: String,
-        source: std::io::Error,
-    },
-    #[error("deck {file}: {msg}")]
-    Parse { file: String, msg: String },
-    #[error("deck {file}, {key}: {msg}")]
-    Invalid {
-        file: String,
-        key: String,
-        msg: String,
-    },
-    #[error("deck {file}: {msg}")]
-    TooLarge { file: String, msg: String },
-}
+/// The deck error of every deck reader (file, key and what was expected).
+pub use crate::hydraulics::DeckError;
 
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -489,15 +472,15 @@ pub fn load_deck_within(
     budget: impl FnOnce(&Deck) -> Result<(), String>,
 ) -> Result<(Deck, Model), DeckError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| DeckError::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| DeckError::Read {
         file: file.clone(),
         source,
     })?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut deck = deserialize(&text, &file)?;
-    budget(&deck).map_err(|msg| DeckError::TooLarge {
+    budget(&deck).map_err(|message| DeckError::File {
         file: file.clone(),
-        msg,
+        message,
     })?;
     let (model, probes) = build(&deck, &file, &base)?;
     deck.hydraulic_probes = probes;
@@ -508,16 +491,12 @@ fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
     let deck: Deck = toml::from_str(text).map_err(|e| {
         let msg = e.to_string().trim_end().to_string();
         let at = e.span().and_then(|sp| array_table_at(text, sp.start));
-        DeckError::Parse {
+        DeckError::File {
             file: file.into(),
-            msg: at.map(|t| format!("in {t}: {msg}")).unwrap_or(msg),
+            message: at.map(|t| format!("in {t}: {msg}")).unwrap_or(msg),
         }
     })?;
-    validate(&deck).map_err(|(key, msg)| DeckError::Invalid {
-        file: file.into(),
-        key,
-        msg,
-    })?;
+    validate(&deck).map_err(|(key, msg)| DeckError::invalid(file, key, msg))?;
     Ok(deck)
 }
 
@@ -916,11 +895,7 @@ pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), 
 type Probes = Vec<(String, Arc<HydraulicProbe>)>;
 
 fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError> {
-    let inv = |key: String, msg: String| DeckError::Invalid {
-        file: file.into(),
-        key,
-        msg,
-    };
+    let inv = |key: String, msg: String| DeckError::invalid(file, key, msg);
     let mut m = Model::new();
     m.gravity = d.gravity_m_s2;
     for (i, n) in d.nodes.iter().enumerate() {
@@ -1236,11 +1211,7 @@ fn hydraulic_element(
     file: &str,
     base: &Path,
 ) -> Result<(HydraulicForceElement, Arc<HydraulicProbe>), DeckError> {
-    let inv = |k: &str, msg: String| DeckError::Invalid {
-        file: file.into(),
-        key: format!("{key}.{k}"),
-        msg,
-    };
+    let inv = |k: &str, msg: String| DeckError::invalid(file, format!("{key}.{k}"), msg);
     let node = |m: &Model, k: &str, name: &str| {
         m.node_id(name).map_err(|_| {
             inv(
