@@ -174,16 +174,11 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
     }
     for (k, o) in OUTPUTS.iter().enumerate() {
         let top: Vec<String> = t
-            .ranking(k)
+            .top3(k)
             .iter()
-            .take(3)
-            .filter_map(|&i| {
-                let r = &t.rows[i];
-                Some(format!(
-                    "{} (swing {:+.4e})",
-                    r.param.name(),
-                    r.swing(k).or_else(|| r.spread(&t.nominal, k))?
-                ))
+            .map(|(r, spread)| {
+                let swing = r.swing(k).unwrap_or(*spread);
+                format!("{} (swing {swing:+.4e})", r.param.name())
             })
             .collect();
         match t.nominal.values[k] {

@@ -86,25 +86,20 @@ impl RotorModel {
 impl FromStr for RotorModel {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "uh60a" => Ok(RotorModel::Uh60a),
-            "rigid" => Ok(RotorModel::Rigid),
-            "sdof" => Ok(RotorModel::Sdof),
-            m => Err(format!(
-                "unknown rotor model '{m}' (expected uh60a, rigid or sdof)"
-            )),
-        }
+        [RotorModel::Uh60a, RotorModel::Rigid, RotorModel::Sdof]
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown rotor model '{s}' (expected uh60a, rigid or sdof)"))
     }
 }
 
 impl FromStr for PeriodicMethod {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "shooting" => Ok(PeriodicMethod::Shooting),
-            "march" => Ok(PeriodicMethod::March),
-            m => Err(format!("unknown method '{m}' (expected shooting or march)")),
-        }
+        [PeriodicMethod::Shooting, PeriodicMethod::March]
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown method '{s}' (expected shooting or march)"))
     }
 }
 
@@ -276,27 +271,11 @@ mod set_texts {
 }
 
 impl Default for RunSettings {
+    /// The command line's defaults: no option given, parsed (the `#[arg]`s are the only list).
     fn default() -> Self {
-        RunSettings {
-            rotor: DEFAULT_ROTOR.into(),
-            flight: DEFAULT_FLIGHT.into(),
-            damper: "all".into(),
-            damper_deck: None,
-            revs: DEFAULT_REVS,
-            periodic: "shooting".into(),
-            periodic_tol: run::periodic::DEFAULT_TOL,
-            initial_state: None,
-            require_periodic: false,
-            write_all_revs: false,
-            steps_per_rev: DEFAULT_STEPS_PER_REV,
-            substeps: DEFAULT_SUBSTEPS,
-            scheme: "rk4".into(),
-            model: "uh60a".into(),
-            newton: "modified".into(),
-            set: Vec::new(),
-            all_blades: false,
-            airloads: "measured".into(),
-        }
+        use clap::{Args, FromArgMatches};
+        let m = Self::augment_args(clap::Command::new("run")).get_matches_from(["run"]);
+        Self::from_arg_matches(&m).unwrap_or_else(|e| unreachable!("run without options: {e}"))
     }
 }
 
