@@ -16,6 +16,9 @@
 //! a local sweep of its first case, 2 revolutions (a stability case: its map) (docs/sweep.md); a flight record (CSV triple
 //! or MCAP): `inspect`.
 //!
+//! Each result (and what `expand` and `inspect` print) must match its golden,
+//! tests/golden/examples/<deck>-<what>.txt (tests/golden_support/mod.rs).
+//!
 //! Time: 24 s wall in release on 2 cores shared with other builds (load ~5), two runs at a time
 //! (`JOBS`); the TM-4760 fan plot is 22 s of it, the rest ~1 s each or less.
 use std::path::{Path, PathBuf};
@@ -24,6 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
+mod golden_support;
 mod support;
 use support::{read_json, root, tmp};
 
@@ -348,8 +352,32 @@ fn run(job: &Job) -> Result<f64, String> {
         }
         Ok(())
     };
+    // the golden case: the deck's path and what ran (the folder's name without its tag)
+    let deck_name = job
+        .deck
+        .strip_prefix(root())
+        .unwrap_or(&job.deck)
+        .display()
+        .to_string()
+        .replace('/', "_");
+    let golden = |dir: &Path, what: &str| {
+        let work = if matches!(job.check, Check::Status) {
+            dir
+        } else {
+            dir.parent().unwrap()
+        };
+        let paths = golden_support::Paths::new(dir, work);
+        golden_support::check(&format!("examples/{deck_name}-{what}"), dir, &paths)
+    };
+    let what_of = |dir: &Path| {
+        let n = dir.file_name().unwrap().to_str().unwrap();
+        n.split_once('-').map_or(n, |(_, w)| w).to_string()
+    };
     match &job.check {
-        Check::Folder(dir) => complete(dir)?,
+        Check::Folder(dir) => {
+            complete(dir)?;
+            golden(dir, &what_of(dir))?;
+        }
         Check::Sweep(dir) => {
             if !dir.join("sweep.csv").is_file() {
                 return Err(format!("{what}: no sweep.csv"));
@@ -364,8 +392,23 @@ fn run(job: &Job) -> Result<f64, String> {
             for c in cases {
                 complete(&c)?;
             }
+            golden(dir, &what_of(dir))?;
         }
-        Check::Status => {}
+        Check::Status => {
+            // what `expand` and `inspect` print is their result
+            let sub = job.args[0].as_str();
+            if sub == "expand" || sub == "inspect" {
+                let dir = std::env::temp_dir().join(format!(
+                    "rotorsim-shipped-{}-{deck_name}-{sub}",
+                    std::process::id()
+                ));
+                let _ = std::fs::remove_dir_all(&dir);
+                std::fs::create_dir_all(&dir).unwrap();
+                std::fs::write(dir.join("stdout.txt"), &o.stdout).unwrap();
+                golden(&dir, sub)?;
+                let _ = std::fs::remove_dir_all(&dir);
+            }
+        }
     }
     Ok(t0.elapsed().as_secs_f64())
 }
