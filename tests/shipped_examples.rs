@@ -155,7 +155,7 @@ fn jobs_for(deck: &Path, work: &Path, tag: &str) -> Result<Vec<Job>, String> {
                 "modes".into(),
                 "--rotor".into(),
                 s(deck),
-                "--speeds".into(),
+                "--speed-fractions".into(),
                 "1".into(),
                 "--count".into(),
                 "6".into(),

@@ -29,7 +29,7 @@ x = 6e-3 * np.sin(2 * np.pi * 4.3 * t) + 1.5e-3 * np.sin(2 * np.pi * 17.2 * t)
 last = t >= 1.0  # the second second: the device settled from rest
 fig, ax = plt.subplots(figsize=(6, 5))
 for model in ("linear", "nonlinear", "physical"):
-    f = rotorsim.Damper(deck, model=model).force(t, x)
+    f = rotorsim.Damper(deck, damper=model).force(t, x)
     # the force is the damper's on the stroking point: it takes out -integral of F dx
     e = -(np.trapezoid(f[last], x[last]) if hasattr(np, "trapezoid") else np.trapz(f[last], x[last]))
     print(f"{model:>9}: {e:8.1f} J dissipated over the last second")
@@ -41,7 +41,7 @@ ax.grid(True, alpha=0.3)
 ax.legend()
 save(fig, out_dir, "damper_loops.png")
 
-s = rotorsim.Damper(deck, model="physical").states(t, x)
+s = rotorsim.Damper(deck, damper="physical").states(t, x)
 pressures = [c for c in s.keys() if c.endswith("_Pa")]
 assert pressures, f"no pressure channel in {list(s.keys())}"
 fig, ax = plt.subplots(figsize=(8, 4))

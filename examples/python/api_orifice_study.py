@@ -3,7 +3,7 @@ physical damper's last-revolution force for three orifice areas over the measure
 
     python api_orifice_study.py OUT_DIR [rigid|uh60a]
 
-Runs rotorsim.run(models="physical", set={"damper.physical.A_orf_m2": A}) for each area A on the
+Runs rotorsim.run(damper="physical", set={"damper.physical.A_orf_m2": A}) for each area A on the
 shipped flight record (the rigid-blade reduction by default, a second in all; uh60a for the
 multibody rotor, a few seconds per area), prints each run's RMS error against the measurement and
 writes OUT_DIR/orifice_study.png. Run from the repository root or give the paths: the defaults
@@ -29,7 +29,7 @@ record = os.path.join(root, "flightdata", "c8534like")
 fig, ax = plt.subplots(figsize=(8, 4.5))
 synthetic = False
 for i, area in enumerate([1.6e-6, 1.8e-6, 2.0e-6]):
-    r = rotorsim.run(rotor=deck, flight=record, models="physical", rotor_model=rotor_model,
+    r = rotorsim.run(rotor=deck, flight=record, damper="physical", model=rotor_model,
                      set={"damper.physical.A_orf_m2": area}, progress=False)
     rev = r.last_rev("physical")
     m = r.summary["models"]["physical"]

@@ -1,4 +1,4 @@
-"""The Python package's overhead over the command line: `rotorsim.run(models=["physical"])` and
+"""The Python package's overhead over the command line: `rotorsim.run(damper=["physical"])` and
 `rotorsim run --damper physical`, both into a result folder, alternated in one process so that
 the machine's load falls on both alike; prints each pair's ratio (Python / CLI) and the median.
 Also `Damper.force` on a 10,000-sample stroke history (physical, 25 RK4 sub-steps).
@@ -7,7 +7,7 @@ Also `Damper.force` on a 10,000-sample stroke history (physical, 25 RK4 sub-step
 
 The whole-process comparison (starting Python and importing the package included) is
 `farm-bench --vs 'target/release/rotorsim run --damper physical --out /tmp/b' -- python -c
-"import rotorsim; rotorsim.run(models=['physical'], out='/tmp/a', progress=False)"`.
+"import rotorsim; rotorsim.run(damper=['physical'], out='/tmp/a', progress=False)"`.
 """
 import os
 import pathlib
@@ -31,7 +31,7 @@ ratios = []
 with tempfile.TemporaryDirectory() as tmp:
     for i in range(pairs):
         t0 = time.perf_counter()
-        rotorsim.run(models=["physical"], out=f"{tmp}/py{i}", progress=False)
+        rotorsim.run(damper=["physical"], out=f"{tmp}/py{i}", progress=False)
         py = time.perf_counter() - t0
         t0 = time.perf_counter()
         subprocess.run([cli, "run", "--damper", "physical", "--out", f"{tmp}/cli{i}"],

@@ -3,6 +3,7 @@
 The computations run in the rotorsim library (Rust); this package converts arrays and results.
 """
 import json as _json
+import os as _os
 import tempfile as _tempfile
 from pathlib import Path as _Path
 
@@ -25,14 +26,17 @@ def _array(x, name):
 class Damper:
     """A damper from a damper deck (any TOML file with a ``[damper]`` table).
 
-    ``Damper(deck, model="physical", substeps=25, scheme="rk4")``: ``model`` is physical,
-    linear or nonlinear; ``substeps`` hydraulic sub-steps per sample interval and ``scheme``
+    ``Damper(deck, damper="physical", substeps=25, scheme="rk4")``: ``damper`` is the damper
+    model, physical, linear or nonlinear (``model=``, its deprecated name); ``substeps`` hydraulic sub-steps per sample interval and ``scheme``
     (rk4 or implicit) as in ``rotorsim bench``. Errors in the deck raise FileNotFoundError,
     OSError or ValueError with the file and key in the message.
     """
 
-    def __init__(self, deck, model="physical", substeps=25, scheme="rk4"):
-        self._d = _native.Damper(str(deck), model, int(substeps), scheme)
+    def __init__(self, deck, damper=None, substeps=25, scheme="rk4", model=None):
+        if model is not None:
+            _deprecated("model", "damper")
+            damper = damper or model
+        self._d = _native.Damper(str(deck), damper or "physical", int(substeps), scheme)
 
     model = property(lambda self: self._d.model, doc="The damper model.")
     deck = property(lambda self: self._d.deck, doc="The deck file.")
@@ -86,7 +90,7 @@ def _damper_choice(models):
     if len(models) == 1:
         return str(models[0])
     raise ValueError(
-        f"models: a run compares one damper model or all three {list(_MODELS)} (got {models})"
+        f"damper: a run compares one damper model or all three {list(_MODELS)} (got {models})"
     )
 
 
@@ -113,32 +117,36 @@ def _tqdm_progress():
     return progress
 
 
-def run(
-    rotor=None,
-    flight=None,
-    models=None,
-    set=None,
-    all_blades=False,
-    airloads="measured",
-    out=None,
-    revs=None,
-    steps_per_rev=None,
-    substeps=None,
-    periodic="shooting",
-    periodic_tol=None,
-    rotor_model="uh60a",
-    progress=True,
-):
+# The options of ``rotorsim run`` with their defaults, from the library's one definition.
+RUN_OPTIONS = _json.loads(_native.run_options())
+
+
+def _deprecated(old, new):
+    import warnings
+
+    warnings.warn(
+        f"{old}= is deprecated: use {new}= (the name of the command line's --{new.replace('_', '-')})",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
+def run(out=None, progress=True, models=None, rotor_model=None, **options):
     """Forced response of the rotor to a flight record, as ``rotorsim run`` does.
 
-    Every option left out takes the command line's default, so ``rotorsim.run(models=["physical"])``
-    in the repository is ``rotorsim run --damper physical``: ``rotor`` (rotor deck, default
-    rotors/uh60a.toml), ``flight`` (MCAP file or CSV stem, default flightdata/c8534like),
-    ``models`` (one of linear, nonlinear, physical, or all three; default all), ``set`` (deck
-    values overridden by dotted key, ``{"damper.physical.A_orf_m2": 2e-6}``), ``all_blades``,
-    ``airloads`` (measured, computed or hybrid), ``revs``, ``steps_per_rev``, ``substeps``,
-    ``periodic`` (shooting or march), ``periodic_tol`` and ``rotor_model`` (``--model``: uh60a,
-    the multibody rotor, or rigid, its rigid-blade reduction, a run in well under a second).
+    ``options`` are the options of ``rotorsim run`` by their names (``--steps-per-rev`` is
+    ``steps_per_rev``); every one left out (or None) takes the command line's default, so
+    ``rotorsim.run(damper="physical")`` in the repository is ``rotorsim run --damper
+    physical``: ``rotor`` (rotor deck, default rotors/uh60a.toml), ``flight`` (MCAP file or CSV
+    stem, default flightdata/c8534like), ``damper`` (linear, nonlinear, physical, or all three:
+    also a list of them; default all), ``damper_deck``, ``set`` (deck values overridden by
+    dotted key, ``{"damper.physical.A_orf_m2": 2e-6}``), ``all_blades``, ``airloads``
+    (measured, computed, hybrid or hybrid-periodic), ``revs``, ``steps_per_rev``,
+    ``substeps``, ``scheme``, ``newton``, ``periodic`` (shooting or march), ``periodic_tol``,
+    ``initial_state``, ``require_periodic``, ``write_all_revs`` and ``model`` (the rotor model,
+    ``--model``: uh60a, the multibody rotor, or rigid, its rigid-blade reduction, a run in well
+    under a second). ``models`` and ``rotor_model`` are the deprecated names of ``damper`` and
+    ``model``. An unknown name raises TypeError.
     ``out``: the result folder to write (a temporary one, removed with the result, when not
     given). ``progress``: True for tqdm bars when tqdm is installed, False for none, or a callable
     taking one dict per event (``start``, ``revolution``, ``finished``).
@@ -148,30 +156,36 @@ def run(
     KeyboardInterrupt saying where it stopped; the result folder is then marked incomplete.
     Returns a :class:`RunResult`.
     """
+    if models is not None:
+        _deprecated("models", "damper")
+        options.setdefault("damper", models)
+    if rotor_model is not None:
+        _deprecated("rotor_model", "model")
+        options.setdefault("model", rotor_model)
+    unknown = sorted(k for k in options if k not in RUN_OPTIONS)
+    if unknown:
+        raise TypeError(
+            f"run() got unexpected keyword argument(s) {', '.join(unknown)} "
+            f"(the options of rotorsim run are {', '.join(RUN_OPTIONS)})"
+        )
+    settings = {k: v for k, v in options.items() if v is not None}
+    if "damper" in settings:
+        settings["damper"] = _damper_choice(settings["damper"])
+    if "set" in settings:
+        settings["set"] = _sets(settings["set"])
+    for k, v in settings.items():
+        if isinstance(v, _os.PathLike):
+            settings[k] = _os.fspath(v)
     keep = None
     if out is None:
         keep = _tempfile.TemporaryDirectory(prefix="rotorsim-run-")
         out = _Path(keep.name) / "run"
-    sets = _sets(set)
     if progress is True:
         progress = _tqdm_progress()
     elif progress is False:
         progress = None
     folder, summary, last_rev = _native.run(
-        str(out),
-        rotor=None if rotor is None else str(rotor),
-        flight=None if flight is None else str(flight),
-        damper=_damper_choice(models),
-        set=sets,
-        all_blades=bool(all_blades),
-        airloads=str(airloads),
-        revs=revs,
-        steps_per_rev=steps_per_rev,
-        substeps=substeps,
-        periodic=str(periodic),
-        periodic_tol=periodic_tol,
-        rotor_model=str(rotor_model),
-        progress=progress,
+        str(out), settings=_json.dumps(settings), progress=progress
     )
     return RunResult(folder, summary, dict(last_rev), keep)
 
@@ -472,15 +486,17 @@ class StabilityResult:
         return f"StabilityResult({str(self.folder)!r}, stable={self.stable})"
 
 
-def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=None):
+def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=None,
+          speed_fractions=None):
     """Natural frequencies and mode shapes, as ``rotorsim modes`` computes them: of a model deck
     (``deck``) about its static equilibrium, or the fan plot of a rotor deck (``rotor``).
 
     Give one of ``deck`` (a model deck; its ``[modes]`` table says how many modes and, with
     ``speeds_rad_s``, at which rotor speeds: a fan) and ``rotor`` (a rotor deck or a
     hinged-blade deck). The fan plot of a rotor deck takes, where left out, the command line's
-    defaults: ``speeds`` (fractions of the nominal speed: "START:STOP:STEP" inclusive, "a,b,c",
-    or a list of numbers; default "0:1.2:0.1"), ``reference`` (a digitized reference fan plot
+    defaults: ``speeds`` (rotor speeds in rad/s: "START:STOP:STEP" inclusive, "a,b,c", or a
+    list of numbers) or ``speed_fractions`` (fractions of the deck's nominal speed, in the same
+    forms; default "0:1.2:0.1"), ``reference`` (a digitized reference fan plot
     drawn over the model's and compared with it; default the shipped UH-60A one next to the deck,
     or a hinged-blade deck's own ``[fan_reference]``), ``count`` (modes per speed, 14). A model
     deck does not use them. ``out``: the result folder to write (a temporary one, removed with
@@ -495,6 +511,7 @@ def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=No
         deck=_opt(deck),
         rotor=_opt(rotor),
         speeds=_list(speeds),
+        speed_fractions=_list(speed_fractions),
         reference=_opt(reference),
         count=None if count is None else int(count),
     )
@@ -632,7 +649,7 @@ def _tqdm_sweep_progress():
     return progress
 
 
-def sweep(plan, out, jobs=None, shard=None, retry_failed=False, warm_start=True, progress=True):
+def sweep(plan, out, jobs=None, shard=None, retry_failed=False, warm_start=None, progress=True):
     """Batch forced-response runs from a sweep plan, as ``rotorsim sweep PLAN --out DIR`` runs
     them: every case a ``rotorsim run`` into ``DIR/cases/<id>/``, ``DIR/sweep.csv`` and
     ``DIR/sweep.html`` summarising them.
@@ -640,7 +657,8 @@ def sweep(plan, out, jobs=None, shard=None, retry_failed=False, warm_start=True,
     ``out`` is required (a sweep resumes: cases found complete are skipped). ``jobs``: cases run
     at once (default SLURM_CPUS_PER_TASK or the machine's CPUs); ``shard``: "K/N" to run one
     shard (default the Slurm array task's, when set); ``retry_failed``: run again the cases that
-    failed before; ``warm_start=False`` starts every case cold. ``progress``: a tqdm bar when
+    failed before; ``warm_start``: True or False warm-starts or starts every case cold whatever
+    the plan says (default None: as the plan's ``[sweep] warm_start``). ``progress``: a tqdm bar when
     tqdm is installed (``True``), none (``False``), or a callable given one dict per event:
     ``{"event": "start", "to_run", "total"}``, ``{"event": "case", "case", "ok", "message",
     "wall_s"}``. Ctrl-C stops the sweep (KeyboardInterrupt): running cases are marked
@@ -660,7 +678,7 @@ def sweep(plan, out, jobs=None, shard=None, retry_failed=False, warm_start=True,
         jobs=None if jobs is None else int(jobs),
         shard=None if shard is None else str(shard),
         retry_failed=bool(retry_failed),
-        warm_start=bool(warm_start),
+        warm_start=None if warm_start is None else bool(warm_start),
         progress=progress,
     )
     if failed:

@@ -11,9 +11,16 @@ _Frame = Any  # pandas.DataFrame when pandas is installed, else Dict[str, np.nda
 
 __version__: str
 
+RUN_OPTIONS: Dict[str, Any]
+
 class Damper:
     def __init__(
-        self, deck: _Path, model: str = ..., substeps: int = ..., scheme: str = ...
+        self,
+        deck: _Path,
+        damper: Optional[str] = ...,
+        substeps: int = ...,
+        scheme: str = ...,
+        model: Optional[str] = ...,
     ) -> None: ...
     @property
     def model(self) -> str: ...
@@ -43,20 +50,31 @@ class RunResult:
     def floquet(self, model: Optional[str] = ...) -> Optional[List[Dict[str, Any]]]: ...
 
 def run(
+    out: Optional[_Path] = ...,
+    progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
+    models: Union[None, str, Iterable[str]] = ...,
+    rotor_model: Optional[str] = ...,
+    *,
+    # the options of `rotorsim run` (rotorsim.RUN_OPTIONS; checked against the library by
+    # tests/run_options.rs)
     rotor: Optional[_Path] = ...,
     flight: Optional[_Path] = ...,
-    models: Union[None, str, Iterable[str]] = ...,
-    set: Optional[Mapping[str, Any]] = ...,
-    all_blades: bool = ...,
-    airloads: str = ...,
-    out: Optional[_Path] = ...,
+    damper: Union[None, str, Iterable[str]] = ...,
+    damper_deck: Optional[_Path] = ...,
     revs: Optional[int] = ...,
+    periodic: Optional[str] = ...,
+    periodic_tol: Optional[float] = ...,
+    initial_state: Optional[_Path] = ...,
+    require_periodic: Optional[bool] = ...,
+    write_all_revs: Optional[bool] = ...,
     steps_per_rev: Optional[int] = ...,
     substeps: Optional[int] = ...,
-    periodic: str = ...,
-    periodic_tol: Optional[float] = ...,
-    rotor_model: str = ...,
-    progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
+    scheme: Optional[str] = ...,
+    model: Optional[str] = ...,
+    newton: Optional[str] = ...,
+    set: Optional[Mapping[str, Any]] = ...,
+    all_blades: Optional[bool] = ...,
+    airloads: Optional[str] = ...,
 ) -> RunResult: ...
 
 class BenchResult:
@@ -125,6 +143,7 @@ def modes(
     reference: Optional[_Path] = ...,
     count: Optional[int] = ...,
     out: Optional[_Path] = ...,
+    speed_fractions: Optional[_Numbers] = ...,
 ) -> ModesResult: ...
 
 class DiagnoseResult:
@@ -170,6 +189,6 @@ def sweep(
     jobs: Optional[int] = ...,
     shard: Optional[str] = ...,
     retry_failed: bool = ...,
-    warm_start: bool = ...,
+    warm_start: Optional[bool] = ...,
     progress: Union[bool, Callable[[Dict[str, Any]], None]] = ...,
 ) -> SweepResult: ...

@@ -11,7 +11,7 @@ use rotorsim::hydraulics::{
 };
 use rotorsim::overrides::Override;
 use rotorsim::run::bench::BenchJob;
-use rotorsim::run::job::{NamedOptions, RunJob, RunObserver, RunStart};
+use rotorsim::run::job::{RunObserver, RunSettings, RunStart};
 use rotorsim::run::modes::ModesJob;
 use rotorsim::run::stability::StabilityJob;
 use rotorsim::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
@@ -315,59 +315,26 @@ fn interrupted<T>(py: Python<'_>, signal: PyErr, result: &anyhow::Result<T>) -> 
 /// A result folder's files: the folder, summary.json and each model's last_rev.csv.
 type RunFiles = (PathBuf, PathBuf, Vec<(String, PathBuf)>);
 
-/// `rotorsim run` as a library call: the CLI's defaults for every option not given, the same
-/// checks and messages; Ctrl-C stops it (KeyboardInterrupt). Returns the result folder's files:
+/// `rotorsim run` as a library call: `settings`, a JSON object of [`RunSettings`] fields (the
+/// CLI's options by their names; the CLI's default for every one not given), the same checks
+/// and messages; Ctrl-C stops it (KeyboardInterrupt). Returns the result folder's files:
 /// (folder, summary, [(model, last_rev)]).
 #[pyfunction]
-#[pyo3(signature = (out, rotor = None, flight = None, damper = "all", set = Vec::new(),
-    all_blades = false, airloads = "measured", revs = None, steps_per_rev = None,
-    substeps = None, periodic = "shooting", periodic_tol = None, rotor_model = "uh60a",
-    progress = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (out, settings = "{}", progress = None))]
 fn run(
     py: Python<'_>,
     out: PathBuf,
-    rotor: Option<PathBuf>,
-    flight: Option<PathBuf>,
-    damper: &str,
-    set: Vec<String>,
-    all_blades: bool,
-    airloads: &str,
-    revs: Option<usize>,
-    steps_per_rev: Option<usize>,
-    substeps: Option<usize>,
-    periodic: &str,
-    periodic_tol: Option<f64>,
-    rotor_model: &str,
+    settings: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<RunFiles> {
-    let mut job = RunJob::new(out);
-    if let Some(r) = rotor {
-        job.rotor = r;
-    }
-    if !job.rotor.exists() {
+    let settings = RunSettings::from_json(settings).map_err(run_error)?;
+    if !settings.rotor.exists() {
         return Err(PyFileNotFoundError::new_err(format!(
             "rotor deck {}: no such file",
-            job.rotor.display()
+            settings.rotor.display()
         )));
     }
-    if let Some(f) = flight {
-        job.flight = f;
-    }
-    job.revs = revs.unwrap_or(job.revs);
-    job.steps_per_rev = steps_per_rev.unwrap_or(job.steps_per_rev);
-    job.substeps = substeps.unwrap_or(job.substeps);
-    job.periodic_tol = periodic_tol.unwrap_or(job.periodic_tol);
-    job.all_blades = all_blades;
-    job.overrides = overrides(&set)?;
-    job.set_named(&NamedOptions {
-        damper,
-        airloads,
-        periodic,
-        model: rotor_model,
-        ..NamedOptions::default()
-    })
-    .map_err(run_error)?;
+    let job = settings.job(out).map_err(run_error)?;
     let observer = PyProgress(progress);
     let stop = StopFlag::new();
     let (result, signal) = interruptible(py, &stop, || job.execute_until(&observer, &stop));
@@ -384,6 +351,12 @@ fn run(
             .map(|(m, f)| (m.name().to_string(), f))
             .collect(),
     ))
+}
+
+/// The options of `rotorsim run` by name with their defaults, as JSON (what `run` takes).
+#[pyfunction]
+fn run_options() -> String {
+    RunSettings::defaults_json()
 }
 
 /// `rotorsim bench` as a library call: the command's defaults for every option not given, the
@@ -490,7 +463,8 @@ fn stability(
 /// Returns the result folder.
 #[pyfunction]
 #[pyo3(signature = (out, deck = None, rotor = None, speeds = None, reference = None,
-    count = None))]
+    count = None, speed_fractions = None))]
+#[allow(clippy::too_many_arguments)]
 fn modes(
     py: Python<'_>,
     out: PathBuf,
@@ -499,12 +473,19 @@ fn modes(
     speeds: Option<String>,
     reference: Option<PathBuf>,
     count: Option<usize>,
+    speed_fractions: Option<String>,
 ) -> PyResult<PathBuf> {
+    if speeds.is_some() && speed_fractions.is_some() {
+        return Err(PyValueError::new_err(
+            "speeds and speed_fractions: give one (rad/s, or fractions of the nominal speed)",
+        ));
+    }
     let d = ModesJob::new(out);
     let job = ModesJob {
         deck,
         rotor,
-        speeds: speeds.unwrap_or_else(|| d.speeds.clone()),
+        speeds: speed_fractions.unwrap_or_else(|| d.speeds.clone()),
+        speeds_rad_s: speeds,
         reference,
         count: count.unwrap_or(d.count),
         ..d
@@ -613,7 +594,7 @@ impl SweepProgress for PySweepProgress {
 /// sweep folder and the failed cases (id, reason).
 #[pyfunction]
 #[pyo3(signature = (plan, out, jobs = None, shard = None, retry_failed = false,
-    warm_start = true, progress = None))]
+    warm_start = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn sweep(
     py: Python<'_>,
@@ -622,7 +603,7 @@ fn sweep(
     jobs: Option<usize>,
     shard: Option<String>,
     retry_failed: bool,
-    warm_start: bool,
+    warm_start: Option<bool>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(PathBuf, Vec<(String, String)>)> {
     if jobs == Some(0) {
@@ -683,6 +664,7 @@ fn sweep(
 fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Damper>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(run_options, m)?)?;
     m.add_function(wrap_pyfunction!(bench_job, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(modes, m)?)?;

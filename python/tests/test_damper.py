@@ -44,7 +44,7 @@ def cli_replay(tmp_path, t, x, model):
 def test_force_is_the_bench_replay_bit_for_bit(tmp_path, model):
     t, x = stroke()
     ref = cli_replay(tmp_path, t, x, model)
-    f = rotorsim.Damper(DECK, model=model).force(t, x)
+    f = rotorsim.Damper(DECK, damper=model).force(t, x)
     assert f.dtype == np.float64 and f.shape == t.shape
     assert np.array_equal(f, ref["force_model_N"])
 
@@ -81,7 +81,7 @@ def test_a_deck_without_a_damper_table_names_file_and_table(tmp_path):
 
 def test_an_unknown_model_and_scheme_are_refused():
     with pytest.raises(ValueError, match="model magic"):
-        rotorsim.Damper(DECK, model="magic")
+        rotorsim.Damper(DECK, damper="magic")
     with pytest.raises(ValueError, match="scheme euler"):
         rotorsim.Damper(DECK, scheme="euler")
     with pytest.raises(ValueError, match="substeps"):

@@ -22,7 +22,7 @@ def progress(ev):
     if ev["event"] == "revolution" and ev["revolution"] == 2:
         print("integrating", flush=True)
 
-rotorsim.run(models="physical", periodic="march", periodic_tol=1e-14, revs=2000,
+rotorsim.run(damper="physical", periodic="march", periodic_tol=1e-14, revs=2000,
              out=sys.argv[1], progress=progress)
 print("finished", flush=True)
 """

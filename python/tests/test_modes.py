@@ -50,10 +50,10 @@ def test_model_deck_writes_the_clis_files(tmp_path):
 
 def test_rotor_fan_writes_the_clis_files(tmp_path):
     cli = tmp_path / "cli"
-    subprocess.run([CLI, "modes", "--rotor", str(UH60A), "--speeds", "0.5,1", "--count", "6",
+    subprocess.run([CLI, "modes", "--rotor", str(UH60A), "--speed-fractions", "0.5,1", "--count", "6",
                     "--out", str(cli)], check=True, capture_output=True)
     # speeds as numbers: the same list
-    r = rotorsim.modes(rotor=UH60A, speeds=[0.5, 1.0], count=6, out=tmp_path / "py")
+    r = rotorsim.modes(rotor=UH60A, speed_fractions=[0.5, 1.0], count=6, out=tmp_path / "py")
     same_files(cli, r.folder)
     assert r.shapes is None
     assert list(np.asarray(r.fan["speed_fraction"])) == [0.5, 1.0]
@@ -67,8 +67,8 @@ def test_errors_name_the_file_and_the_option(tmp_path):
         rotorsim.modes(tmp_path / "nope.toml", out=tmp_path / "a")
     with pytest.raises(FileNotFoundError, match="nope.toml"):
         rotorsim.modes(rotor=tmp_path / "nope.toml", out=tmp_path / "b")
-    with pytest.raises(ValueError, match="--speeds"):
-        rotorsim.modes(rotor=UH60A, speeds="fast", out=tmp_path / "c")
+    with pytest.raises(ValueError, match="--speed-fractions"):
+        rotorsim.modes(rotor=UH60A, speed_fractions="fast", out=tmp_path / "c")
     with pytest.raises(ValueError, match="--speeds"):
         rotorsim.modes(rotor=UH60A, speeds="0:1:0", out=tmp_path / "d")
     with pytest.raises(ValueError, match="--count 0"):
@@ -77,4 +77,7 @@ def test_errors_name_the_file_and_the_option(tmp_path):
         rotorsim.modes(out=tmp_path / "f")
     with pytest.raises(ValueError, match="not both"):
         rotorsim.modes(CANTILEVER, rotor=UH60A, out=tmp_path / "g")
-    assert not any((tmp_path / x).exists() for x in "abcdefg")
+    # rad/s that look like fractions of the nominal 27 rad/s
+    with pytest.raises(ValueError, match="27"):
+        rotorsim.modes(rotor=UH60A, speeds="0.5,1", out=tmp_path / "h")
+    assert not any((tmp_path / x).exists() for x in "abcdefgh")

@@ -27,7 +27,7 @@ def test_default_run_is_the_clis_bit_for_bit(tmp_path):
     subprocess.run([CLI, "run", "--damper", "physical", "--out", str(cli)],
                    check=True, capture_output=True)
     events = []
-    r = rotorsim.run(models=["physical"], out=tmp_path / "py", progress=events.append)
+    r = rotorsim.run(damper=["physical"], out=tmp_path / "py", progress=events.append)
     assert r.models == ["physical"]
     assert filecmp.cmp(cli / "physical" / "last_rev.csv", r.folder / "physical" / "last_rev.csv",
                        shallow=False)
@@ -52,7 +52,7 @@ def test_default_run_is_the_clis_bit_for_bit(tmp_path):
 
 
 def test_a_run_without_a_folder_leaves_none_behind():
-    r = rotorsim.run(models="linear", progress=False)
+    r = rotorsim.run(damper="linear", progress=False)
     folder = r.folder
     assert (folder / "linear" / "last_rev.csv").exists()
     del r
@@ -66,23 +66,23 @@ def test_errors_name_the_file_and_the_key(tmp_path):
     with pytest.raises(FileNotFoundError, match="nope.toml"):
         rotorsim.run(rotor=tmp_path / "nope.toml", progress=False)
     with pytest.raises(ValueError, match="damper.physical.A_orf_m2"):
-        rotorsim.run(models="physical", set={"damper.physical.A_orf_m2": -1.0},
+        rotorsim.run(damper="physical", set={"damper.physical.A_orf_m2": -1.0},
                      out=tmp_path / "bad", progress=False)
     with pytest.raises(ValueError, match="one damper model or all three"):
-        rotorsim.run(models=["linear", "physical"], progress=False)
+        rotorsim.run(damper=["linear", "physical"], progress=False)
     with pytest.raises(ValueError, match="--damper"):
-        rotorsim.run(models="viscous", progress=False)
+        rotorsim.run(damper="viscous", progress=False)
     with pytest.raises(ValueError, match="--airloads"):
-        rotorsim.run(models="linear", airloads="guessed", progress=False)
+        rotorsim.run(damper="linear", airloads="guessed", progress=False)
     with pytest.raises(ValueError, match="did not run"):
-        rotorsim.run(models="linear", steps_per_rev=64, progress=False).last_rev("physical")
+        rotorsim.run(damper="linear", steps_per_rev=64, progress=False).last_rev("physical")
 
 
 def test_the_rigid_reduction_is_the_clis_and_reads_back(tmp_path):
     cli = tmp_path / "cli"
     subprocess.run([CLI, "run", "--model", "rigid", "--revs", "30", "--out", str(cli)],
                    check=True, capture_output=True)
-    r = rotorsim.run(rotor_model="rigid", revs=30, out=tmp_path / "py", progress=False)
+    r = rotorsim.run(model="rigid", revs=30, out=tmp_path / "py", progress=False)
     assert r.models == ["linear", "nonlinear", "physical"]
     for m in r.models:
         assert filecmp.cmp(cli / m / "last_rev.csv", r.folder / m / "last_rev.csv", shallow=False)
@@ -90,6 +90,30 @@ def test_the_rigid_reduction_is_the_clis_and_reads_back(tmp_path):
     again = rotorsim.RunResult.open(cli)
     assert again.models == r.models and again.summary["models"].keys() == r.summary["models"].keys()
     with pytest.raises(ValueError, match="--model"):
-        rotorsim.run(rotor_model="flexible", progress=False)
+        rotorsim.run(model="flexible", progress=False)
     with pytest.raises(FileNotFoundError, match="summary.json"):
         rotorsim.RunResult.open(tmp_path)
+
+
+def test_every_option_of_the_command_is_a_keyword(tmp_path):
+    # rotorsim.RUN_OPTIONS is the library's one definition of the run's options
+    every = dict(rotorsim.RUN_OPTIONS)
+    assert {"scheme", "newton", "damper_deck", "initial_state", "require_periodic",
+            "write_all_revs"} <= set(every)
+    every.update(model="rigid", revs=30, damper="physical", damper_deck="rotors/uh60a.toml",
+                 set={"damper.physical.A_orf_m2": 2.0e-6}, write_all_revs=True)
+    cli = tmp_path / "cli"
+    subprocess.run([CLI, "run", "--model", "rigid", "--revs", "30", "--damper", "physical",
+                    "--damper-deck", "rotors/uh60a.toml", "--set", "damper.physical.A_orf_m2=2.0e-6",
+                    "--write-all-revs", "--out", str(cli)], check=True, capture_output=True)
+    r = rotorsim.run(out=tmp_path / "py", progress=False, **every)
+    for f in ("last_rev.csv", "all_revs.csv"):
+        assert filecmp.cmp(cli / "physical" / f, r.folder / "physical" / f, shallow=False)
+    # a state to start from, by its own name
+    again = rotorsim.run(out=tmp_path / "again", progress=False, model="rigid", revs=30,
+                         damper="physical", initial_state=cli)
+    assert again.models == ["physical"]
+    with pytest.raises(TypeError, match="stepz"):
+        rotorsim.run(stepz=3, progress=False)
+    with pytest.warns(DeprecationWarning, match="damper="):
+        rotorsim.run(models="physical", model="rigid", revs=30, progress=False)

@@ -11,7 +11,10 @@ pub struct DecayArgs {
     /// Hinged-blade rotor deck (docs/rotor_deck.md, "Hinged-blade decks").
     #[arg(long)]
     pub rotor: PathBuf,
-    /// Shaft speed [rpm] (default: the deck's `[rotor] omega_rad_s`).
+    /// Shaft speed [rad/s] (default: the deck's `[rotor] omega_rad_s`).
+    #[arg(long, conflicts_with = "rpm")]
+    pub speed_rad_s: Option<f64>,
+    /// Shaft speed in rpm instead of --speed-rad-s.
     #[arg(long)]
     pub rpm: Option<f64>,
     /// Time step [s].
@@ -59,7 +62,9 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         );
     }
     let opts = DecayRunOptions {
-        omega_rad_s: args.rpm.map(|r| r * std::f64::consts::PI / 30.0),
+        omega_rad_s: args
+            .speed_rad_s
+            .or(args.rpm.map(|r| r * std::f64::consts::PI / 30.0)),
         time_step_s: args.step_s,
         duration_s: args.duration_s,
         rotating_frame: args.frame == "rotating",
@@ -74,9 +79,9 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
         modal: !args.no_modal,
         ..Default::default()
     };
-    if let Some(r) = args.rpm {
-        if !(r.is_finite() && r > 0.0) {
-            anyhow::bail!("--rpm: expected a positive number, got {r}");
+    for (flag, v) in [("--speed-rad-s", args.speed_rad_s), ("--rpm", args.rpm)] {
+        if let Some(r) = v.filter(|r| !(r.is_finite() && *r > 0.0)) {
+            anyhow::bail!("{flag}: expected a positive number, got {r}");
         }
     }
     opts.validate(|k| {
@@ -86,7 +91,8 @@ pub fn run(args: DecayArgs) -> anyhow::Result<()> {
             "rho_inf" => "--rho-inf",
             "newton_rtol" => "--newton-rtol",
             "newton_xtol" => "--newton-xtol",
-            _ => "--rpm",
+            _ if args.rpm.is_some() => "--rpm",
+            _ => "--speed-rad-s",
         }
         .to_string()
     })?;

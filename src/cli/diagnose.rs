@@ -56,24 +56,17 @@ pub struct DiagnoseArgs {
 }
 
 impl DiagnoseArgs {
-    /// Arguments with the command-line defaults (no data given).
+    /// Arguments with the command-line defaults (no data given): `diagnose --out OUT` parsed,
+    /// so the defaults are the `#[arg]`s above only.
     pub fn new(out: PathBuf) -> Self {
-        DiagnoseArgs {
-            deck: None,
-            measured: vec![],
-            rotor: None,
-            flight: None,
-            out,
-            write_deck: None,
-            fit_cycles: 3,
-            max_substep: 3.0e-5,
-            revs: 40,
-            steps_per_rev: 256,
-            substeps: 25,
-            rotor_check: false,
-            check_revs: 75,
-            rotor_model: "uh60a".into(),
-        }
+        use clap::FromArgMatches;
+        let cmd = <Self as Args>::augment_args(clap::Command::new("diagnose"));
+        let m = cmd.get_matches_from([
+            std::ffi::OsStr::new("diagnose"),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
+        Self::from_arg_matches(&m).unwrap_or_else(|e| unreachable!("diagnose --out: {e}"))
     }
 }
 
@@ -108,14 +101,10 @@ pub fn run(args: DiagnoseArgs) -> anyhow::Result<()> {
     for (k, v) in &d.parameters {
         outln!("  {k} = {v:.6e}");
     }
+    let (v, gain) = (&d.validation, d.gain);
     outln!(
-        "RMS error: baseline {:.1} N, extended {:.1} N; held-out ({}): baseline {:.1} N, extended {:.1} N, gain {:.3}",
-        d.baseline_rms_N,
-        d.extended_rms_N,
-        d.validation.method,
-        d.validation.baseline_rms_N,
-        d.validation.extended_rms_N,
-        d.gain
+        "RMS error: baseline {:.1} N, extended {:.1} N; held-out ({}): baseline {:.1} N, extended {:.1} N, gain {gain:.3}",
+        d.baseline_rms_N, d.extended_rms_N, v.method, v.baseline_rms_N, v.extended_rms_N
     );
     outln!(
         "{:<18} {:>3} {:>14} {:>12} {:>14}",

@@ -74,25 +74,36 @@ pub mod static_cmd;
 pub mod sweep;
 pub mod verify;
 
-/// Exit status, the same for every command (also in docs/run.md).
+/// Exit status, the same for every command (also in docs/run.md); `run` adds the case of its
+/// own --require-periodic.
 macro_rules! exit_note {
     () => {
-        "Exit status: 0 when the command did what was asked; 1 when it could not (bad input, a \
-failed model, a numerical failure, a run that is not periodic under --require-periodic, stdout \
-lost), with the reason on stderr; 2 for a command line that cannot be parsed (unknown option, \
-missing value)."
+        exit_note!("")
+    };
+    ($extra:literal) => {
+        concat!(
+            "Exit status: 0 when the command did what was asked; 1 when it could not (bad input, \
+a failed model, a numerical failure, ",
+            $extra,
+            "stdout lost), with the reason on stderr; 2 for a command line that cannot be parsed \
+(unknown option, missing value)."
+        )
     };
 }
 
-/// A command's outputs, then what every result folder holds, then the exit status.
+/// A command's outputs, then what every result folder holds, then the exit status (with the
+/// command's own causes of exit 1, if any).
 macro_rules! writes {
     ($own:literal) => {
+        writes!($own, "")
+    };
+    ($own:literal, $extra:literal) => {
         concat!(
             $own,
             "\n\nEvery result folder also holds manifest.json (inputs and outputs with their \
 sha256, command line, version, `complete`); a folder that did not finish holds an INCOMPLETE \
 marker.\n\n",
-            exit_note!()
+            exit_note!($extra)
         )
     };
 }
@@ -185,7 +196,8 @@ FILE.mcap)."))]
 (every figure, with provenance), result.mcap (for a viewer such as Foxglove), and per damper \
 model <model>/last_rev.csv (the periodic revolution with the measurement), \
 <model>/periodic_state.json (for --initial-state) and, with --write-all-revs, \
-<model>/all_revs.csv. The last lines printed are the verdict and the files to open."
+<model>/all_revs.csv. The last lines printed are the verdict and the files to open.",
+        "a run that is not periodic under --require-periodic, "
     ))]
     Run(run_cmd::RunArgs),
     /// Find what a damper model gets wrong in measured data, name the cause, extend the model.

@@ -1,6 +1,6 @@
 //! `rotorsim modes`: natural frequencies and mode shapes of a model deck, about the
 //! static equilibrium, optionally in a frame rotating at each of `[modes] speeds_rad_s` (fan).
-//! `rotorsim modes --rotor DECK --speeds 0:1.2:0.1`: fan plot of a rotor deck with
+//! `rotorsim modes --rotor DECK --speed-fractions 0:1.2:0.1`: fan plot of a rotor deck with
 //! the digitized UH-60A reference over it (src/rotor/fan.rs). The run is the library's
 //! [`ModesJob`] (src/run/modes.rs); this file turns the options into one and prints.
 use crate::run::modes::{ModesAnalysis, ModesJob, SpeedModes};
@@ -12,13 +12,17 @@ pub struct ModesArgs {
     /// Model deck (TOML, see docs/model_deck.md); or give --rotor.
     #[arg(required_unless_present = "rotor", conflicts_with = "rotor")]
     pub deck: Option<PathBuf>,
-    /// Rotor deck (docs/rotor_deck.md): fan plot over the speeds of --speeds.
+    /// Rotor deck (docs/rotor_deck.md): fan plot over the speeds of --speeds or
+    /// --speed-fractions.
     #[arg(long)]
     pub rotor: Option<PathBuf>,
-    /// Rotor speeds as fractions of the nominal Omega, START:STOP:STEP (inclusive) or a
-    /// comma-separated list.
+    /// Rotor speeds [rad/s], START:STOP:STEP (inclusive) or a comma-separated list.
+    #[arg(long, conflicts_with = "speed_fractions")]
+    pub speeds: Option<String>,
+    /// Rotor speeds as fractions of the deck's nominal speed (rotor.omega_rad_s) instead of
+    /// --speeds, START:STOP:STEP (inclusive) or a comma-separated list.
     #[arg(long, default_value = crate::run::modes::DEFAULT_SPEEDS)]
-    pub speeds: String,
+    pub speed_fractions: String,
     /// Digitized reference fan plot drawn over the model's (default: the UH-60A fan plot of
     /// ../shared/data/uh60a/raw/ next to the source tree, when present).
     #[arg(long)]
@@ -37,7 +41,8 @@ impl ModesArgs {
         ModesJob {
             deck: self.deck.clone(),
             rotor: self.rotor.clone(),
-            speeds: self.speeds.clone(),
+            speeds: self.speed_fractions.clone(),
+            speeds_rad_s: self.speeds.clone(),
             reference: self.reference.clone(),
             count: self.count,
             out: self.out.clone(),

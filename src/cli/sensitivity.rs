@@ -5,7 +5,7 @@ use super::sweep::{check_with_progress, BatchArgs, Console};
 use crate::sensitivity::{self, table::OUTPUTS, SensitivityOptions, Vary};
 use crate::sweep::job::{default_jobs, env_shard};
 use crate::sweep::{self, JobRunner, SweepOptions};
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -39,14 +39,11 @@ pub struct SensitivityArgs {
     /// `damper.model`).
     #[arg(long)]
     pub damper: Option<String>,
+    // --warm-start starts the cases of each group of 3 from its seed's periodic state (the
+    // nominal case and the seeds cold): faster, but a warm-started case's Floquet multipliers
+    // can differ from a cold run's beyond its periodicity tolerance, hence cold by default.
     #[command(flatten)]
     pub batch: BatchArgs,
-    /// Start the cases of each warm-start group of 3 from its seed's periodic state (the
-    /// nominal case and the seeds start cold). Faster, but a warm-started case's Floquet
-    /// multipliers, the lag damping among them, can differ from a cold run's well beyond its
-    /// periodicity tolerance: by default every case starts cold, as a plain `rotorsim run`.
-    #[arg(long)]
-    pub warm_start: bool,
 }
 
 fn parse_vary(s: &str) -> Result<Vary, String> {
@@ -73,7 +70,7 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
             shard,
             retry_failed: args.batch.retry_failed,
         },
-        warm_start: args.warm_start,
+        warm_start: args.batch.warm_start() == Some(true),
     };
     let runner = JobRunner::default();
     let setup = sensitivity::setup(&opts, &runner)?;
@@ -112,35 +109,9 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(script) = &args.batch.emit_slurm {
-        let groups = plan.groups().len();
-        let shards = args.batch.shards.unwrap_or(groups.clamp(1, 64));
-        let cwd = std::env::current_dir().context("current folder")?;
-        let abs = |p: &std::path::Path| {
-            if p.is_absolute() {
-                p.to_path_buf()
-            } else {
-                cwd.join(p)
-            }
-        };
-        let exe = std::env::current_exe().context("locating the rotorsim executable")?;
-        sweep::prepare(&abs(&args.out), &plan)?;
-        let extra: Vec<String> = args
+        let shards = args
             .batch
-            .retry_failed
-            .then(|| "--retry-failed".to_string())
-            .into_iter()
-            .collect();
-        let text = sweep::slurm_script(
-            &exe,
-            &cwd,
-            &abs(&plan_path),
-            &abs(&args.out),
-            shards,
-            args.batch.cpus_per_task,
-            &extra,
-        );
-        crate::io::write_atomic(script, text.as_bytes())
-            .with_context(|| format!("writing {}", script.display()))?;
+            .emit_slurm(&plan, &plan_path, &args.out, script)?;
         outln!(
             "wrote {}: a job array of {shards} task(s) over {} case(s); submit with `sbatch {}`, then run this command again without --emit-slurm (it finds the cases complete and writes the tables)",
             script.display(),
@@ -203,16 +174,11 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
     }
     for (k, o) in OUTPUTS.iter().enumerate() {
         let top: Vec<String> = t
-            .ranking(k)
+            .top3(k)
             .iter()
-            .take(3)
-            .filter_map(|&i| {
-                let r = &t.rows[i];
-                Some(format!(
-                    "{} (swing {:+.4e})",
-                    r.param.name(),
-                    r.swing(k).or_else(|| r.spread(&t.nominal, k))?
-                ))
+            .map(|(r, spread)| {
+                let swing = r.swing(k).unwrap_or(*spread);
+                format!("{} (swing {swing:+.4e})", r.param.name())
             })
             .collect();
         match t.nominal.values[k] {

@@ -24,9 +24,6 @@ pub struct SweepArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub batch: BatchArgs,
-    /// Start every case cold, ignoring the plan's warm starts (for comparisons).
-    #[arg(long)]
-    pub no_warm_start: bool,
 }
 
 /// How the cases of a batch (a sweep, a sensitivity study) run: together on this machine, as one
@@ -56,6 +53,69 @@ pub struct BatchArgs {
     /// CPUs per array task of the emitted script, at least 1.
     #[arg(long, default_value_t = 1, value_parser = at_least_one)]
     pub cpus_per_task: usize,
+    /// Start the cases of each warm-start group from its seed's periodic state (default: as
+    /// the plan says; a sweep plan warm-starts unless `[sweep] warm_start = false`, a
+    /// sensitivity study starts every case cold).
+    #[arg(long, overrides_with = "no_warm_start")]
+    pub warm_start: bool,
+    /// Start every case cold, whatever the plan says.
+    #[arg(long, overrides_with = "warm_start")]
+    pub no_warm_start: bool,
+}
+
+impl BatchArgs {
+    /// Warm starts as asked (None: as the plan says).
+    pub fn warm_start(&self) -> Option<bool> {
+        match (self.warm_start, self.no_warm_start) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        }
+    }
+
+    /// Writes the sbatch script `script` running the cases of `plan` (read from `plan_path`)
+    /// into `out` as job-array shards, `out` prepared; returns the shards. The script's
+    /// commands repeat the batch options that change what a shard runs.
+    pub(crate) fn emit_slurm(
+        &self,
+        plan: &Plan,
+        plan_path: &Path,
+        out: &Path,
+        script: &Path,
+    ) -> anyhow::Result<usize> {
+        let shards = self.shards.unwrap_or(plan.groups().len().clamp(1, 64));
+        let cwd = std::env::current_dir().context("current folder")?;
+        let abs = |p: &Path| {
+            if p.is_absolute() {
+                p.to_path_buf()
+            } else {
+                cwd.join(p)
+            }
+        };
+        let exe = std::env::current_exe().context("locating the rotorsim executable")?;
+        sweep::prepare(&abs(out), plan)?;
+        let mut extra = Vec::new();
+        match self.warm_start() {
+            Some(true) => extra.push("--warm-start".to_string()),
+            Some(false) => extra.push("--no-warm-start".to_string()),
+            None => {}
+        }
+        if self.retry_failed {
+            extra.push("--retry-failed".to_string());
+        }
+        let text = sweep::slurm_script(
+            &exe,
+            &cwd,
+            &abs(plan_path),
+            &abs(out),
+            shards,
+            self.cpus_per_task,
+            &extra,
+        );
+        crate::io::write_atomic(script, text.as_bytes())
+            .with_context(|| format!("writing {}", script.display()))?;
+        Ok(shards)
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -144,7 +204,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
         jobs: args.batch.jobs,
         shard: sweep::job::resolve_shard(args.batch.shard.as_deref())?,
         retry_failed: args.batch.retry_failed,
-        warm_start: !args.no_warm_start,
+        warm_start: args.batch.warm_start(),
         ..SweepJob::new(plan_path, out)
     };
     let plan = job.read_plan()?;
@@ -319,35 +379,7 @@ fn emit_slurm(
     script: &Path,
 ) -> anyhow::Result<()> {
     let groups = plan.groups().len();
-    let shards = args.batch.shards.unwrap_or(groups.clamp(1, 64));
-    let cwd = std::env::current_dir().context("current folder")?;
-    let abs = |p: &Path| {
-        if p.is_absolute() {
-            p.to_path_buf()
-        } else {
-            cwd.join(p)
-        }
-    };
-    let exe = std::env::current_exe().context("locating the rotorsim executable")?;
-    sweep::prepare(&abs(out), plan)?;
-    let mut extra = Vec::new();
-    if args.no_warm_start {
-        extra.push("--no-warm-start".to_string());
-    }
-    if args.batch.retry_failed {
-        extra.push("--retry-failed".to_string());
-    }
-    let text = sweep::slurm_script(
-        &exe,
-        &cwd,
-        &abs(plan_path),
-        &abs(out),
-        shards,
-        args.batch.cpus_per_task,
-        &extra,
-    );
-    crate::io::write_atomic(script, text.as_bytes())
-        .with_context(|| format!("writing {}", script.display()))?;
+    let shards = args.batch.emit_slurm(plan, plan_path, out, script)?;
     outln!(
         "wrote {}: a job array of {shards} task(s) over {} case(s) in {groups} warm-start group(s); submit with `sbatch {}`, then `rotorsim sweep merge {}`",
         script.display(),
@@ -356,4 +388,36 @@ fn emit_slurm(
         out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Cli, Command};
+    use clap::Parser;
+
+    /// `sweep` and `sensitivity` take the same warm-start flags, the last one given winning;
+    /// without either the plan decides.
+    #[test]
+    fn one_warm_start_flag_pair_for_every_batch() {
+        for base in [
+            vec!["rotorsim", "sweep", "p.toml", "--out", "o"],
+            vec!["rotorsim", "sensitivity", "--out", "o"],
+        ] {
+            for (extra, want) in [
+                (vec![], None),
+                (vec!["--warm-start"], Some(true)),
+                (vec!["--no-warm-start"], Some(false)),
+                (vec!["--warm-start", "--no-warm-start"], Some(false)),
+                (vec!["--no-warm-start", "--warm-start"], Some(true)),
+            ] {
+                let argv: Vec<&str> = base.iter().chain(&extra).copied().collect();
+                let batch = match Cli::try_parse_from(&argv).unwrap().command {
+                    Command::Sweep(a) => a.batch,
+                    Command::Sensitivity(a) => a.batch,
+                    _ => unreachable!(),
+                };
+                assert_eq!(batch.warm_start(), want, "{argv:?}");
+            }
+        }
+    }
 }

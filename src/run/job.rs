@@ -86,25 +86,20 @@ impl RotorModel {
 impl FromStr for RotorModel {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "uh60a" => Ok(RotorModel::Uh60a),
-            "rigid" => Ok(RotorModel::Rigid),
-            "sdof" => Ok(RotorModel::Sdof),
-            m => Err(format!(
-                "unknown rotor model '{m}' (expected uh60a, rigid or sdof)"
-            )),
-        }
+        [RotorModel::Uh60a, RotorModel::Rigid, RotorModel::Sdof]
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown rotor model '{s}' (expected uh60a, rigid or sdof)"))
     }
 }
 
 impl FromStr for PeriodicMethod {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "shooting" => Ok(PeriodicMethod::Shooting),
-            "march" => Ok(PeriodicMethod::March),
-            m => Err(format!("unknown method '{m}' (expected shooting or march)")),
-        }
+        [PeriodicMethod::Shooting, PeriodicMethod::March]
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown method '{s}' (expected shooting or march)"))
     }
 }
 
@@ -161,6 +156,176 @@ impl Default for NamedOptions<'_> {
             model: "uh60a",
             airloads: "measured",
         }
+    }
+}
+
+/// Every option of a run but its result folder, as given: `rotorsim run`'s flags (clap), a
+/// sweep plan's keys (serde) and the Python package's keyword arguments (serde, through JSON)
+/// are this one type, so a new run option is a field here and where [`RunSettings::job`] reads
+/// it (docs/architecture.md). [`RunSettings::default`] gives the command line's defaults.
+#[derive(clap::Args, serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct RunSettings {
+    /// Rotor deck (docs/rotor_deck.md).
+    #[arg(long, default_value = DEFAULT_ROTOR)]
+    pub rotor: PathBuf,
+    /// Flight record: MCAP file or CSV stem (docs/formats.md).
+    #[arg(long, default_value = DEFAULT_FLIGHT)]
+    pub flight: PathBuf,
+    /// Damper model: linear, nonlinear, physical, or all (the three in parallel).
+    #[arg(long, default_value = "all")]
+    pub damper: String,
+    /// Damper deck overriding the rotor deck's [damper] table (e.g. from `diagnose --write-deck`).
+    #[arg(long)]
+    pub damper_deck: Option<PathBuf>,
+    /// Most rotor revolutions integrated per model (shooting: perturbed and trial revolutions
+    /// included); the run stops earlier once periodic. The reported revolution is the last
+    /// accepted one.
+    #[arg(long, default_value_t = DEFAULT_REVS)]
+    pub revs: usize,
+    /// Periodic solver: shooting (Newton-Picard on the revolution map, falling back to
+    /// marching when it cannot converge) or march (revolution after revolution).
+    #[arg(long, default_value = "shooting")]
+    pub periodic: String,
+    /// Periodicity residual at which a model stops: per monitored channel (damper force, tip
+    /// flap, lag, twist) the change over one revolution relative to its peak-to-peak.
+    #[arg(long, default_value_t = run::periodic::DEFAULT_TOL)]
+    pub periodic_tol: f64,
+    /// Start from a saved periodic state: a periodic_state.json, or the directory of an
+    /// earlier run (then each model starts from its own <model>/periodic_state.json).
+    #[arg(long)]
+    pub initial_state: Option<PathBuf>,
+    /// Exit non-zero when a model does not reach the periodicity tolerance.
+    #[arg(long)]
+    pub require_periodic: bool,
+    /// Also write <model>/all_revs.csv: every revolution integrated on the way to the periodic
+    /// solution (marched revolutions and accepted shooting iterates, not perturbed ones).
+    #[arg(long)]
+    pub write_all_revs: bool,
+    /// Structural steps per revolution.
+    #[arg(long, default_value_t = DEFAULT_STEPS_PER_REV)]
+    pub steps_per_rev: usize,
+    /// Hydraulic sub-steps per structural step.
+    #[arg(long, default_value_t = DEFAULT_SUBSTEPS)]
+    pub substeps: usize,
+    /// Hydraulic sub-step scheme: rk4 or implicit.
+    #[arg(long, default_value = "rk4")]
+    pub scheme: String,
+    /// Rotor model: uh60a (the multibody model of the rotor deck), rigid (the rotor deck's blade
+    /// rigid on its lag hinge, airloads projected with the control pitch: the reduced model of
+    /// docs/rotor_model.md, "Rigid-blade reduction") or sdof (a fast TEST DOUBLE of the
+    /// pipeline, not a rotor model).
+    #[arg(long, default_value = "uh60a")]
+    pub model: String,
+    /// Newton method of the structural step: modified (the iteration matrix is factored once
+    /// and reused across iterations and steps in the frame turning with the shaft, refreshed
+    /// when it stops contracting) or full (factored at every iteration). Both converge to the
+    /// same residual test.
+    #[arg(long, default_value = "modified")]
+    pub newton: String,
+    /// Override a rotor-deck or damper-deck value by its dotted path, unit in the name
+    /// (repeatable): `--set damper.physical.A_orf_m2=2.0e-6`. Applied before validation, so
+    /// checked like the deck; `damper.*` keys go to `--damper-deck` when one is given.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
+    #[serde(with = "set_texts")]
+    pub set: Vec<Override>,
+    /// Run every blade of the rotor on its driven hub, each its own model at its own azimuth
+    /// (blade k (k-1) 360/N ahead of blade 1), the hub loads summed from their root loads;
+    /// implied by per-blade differences (`[blades.K...]` in the deck, `--set blades.K...`).
+    /// A deck with an `[airframe]` puts the hub on it: the blades then run as one model.
+    /// Writes <model>/blade<K>/ for every blade (docs/run.md).
+    #[arg(long)]
+    pub all_blades: bool,
+    /// Where the blade's airloads come from: measured (the record's, replayed), computed (a
+    /// lifting line with the deck's [aero] table and an inflow model, under the record's
+    /// controls: a prediction), hybrid (the record's airloads plus the lifting line's
+    /// difference between the blade's motion and the record's measured blade motion, or the
+    /// periodic solution's where the record has none) or hybrid-periodic (that difference
+    /// from the periodic solution under the measured airloads: the measured answer, with
+    /// aerodynamic damping of transients and in the Floquet multipliers).
+    /// docs/aerodynamics.md.
+    #[arg(long, default_value = "measured")]
+    pub airloads: String,
+}
+
+/// `--set KEY=VALUE` as clap parses it.
+pub fn parse_set(s: &str) -> Result<Override, String> {
+    Override::parse(s).map_err(|e| format!("{e:#}"))
+}
+
+/// Overrides as `KEY=VALUE` texts (serde), each parsed as `--set` parses it.
+mod set_texts {
+    use crate::overrides::Override;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(set: &[Override], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(set.iter().map(|o| format!("{}={}", o.key, o.value_text())))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Override>, D::Error> {
+        Vec::<String>::deserialize(d)?
+            .iter()
+            .map(|t| super::parse_set(t).map_err(serde::de::Error::custom))
+            .collect()
+    }
+}
+
+impl Default for RunSettings {
+    /// The command line's defaults: no option given, parsed (the `#[arg]`s are the only list).
+    fn default() -> Self {
+        use clap::{Args, FromArgMatches};
+        let m = Self::augment_args(clap::Command::new("run")).get_matches_from(["run"]);
+        Self::from_arg_matches(&m).unwrap_or_else(|e| unreachable!("run without options: {e}"))
+    }
+}
+
+impl RunSettings {
+    /// The run these settings ask for into `out`, checked as far as the settings go.
+    pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<RunJob> {
+        let mut job = RunJob {
+            rotor: self.rotor.clone(),
+            flight: self.flight.clone(),
+            damper_deck: self.damper_deck.clone(),
+            revs: self.revs,
+            periodic_tol: self.periodic_tol,
+            initial_state: self.initial_state.clone(),
+            require_periodic: self.require_periodic,
+            write_all_revs: self.write_all_revs,
+            steps_per_rev: self.steps_per_rev,
+            substeps: self.substeps,
+            overrides: self.set.clone(),
+            all_blades: self.all_blades,
+            ..RunJob::new(out)
+        };
+        job.set_named(&NamedOptions {
+            damper: &self.damper,
+            scheme: &self.scheme,
+            newton: &self.newton,
+            periodic: &self.periodic,
+            model: &self.model,
+            airloads: &self.airloads,
+        })?;
+        Ok(job)
+    }
+
+    /// Settings given as a JSON object of fields (the Python package's keyword arguments),
+    /// every other the default; an unknown name or a wrong type is an error naming it.
+    pub fn from_json(text: &str) -> anyhow::Result<Self> {
+        serde_json::from_str(text).map_err(|e| anyhow!("run options: {e}"))
+    }
+
+    /// [`RunSettings::defaults_map`] as JSON text.
+    pub fn defaults_json() -> String {
+        serde_json::Value::Object(Self::defaults_map()).to_string()
+    }
+
+    /// The settings' names with their default values (JSON): what a plan, the Python package
+    /// and the command line each accept.
+    pub fn defaults_map() -> serde_json::Map<String, serde_json::Value> {
+        serde_json::to_value(RunSettings::default())
+            .ok()
+            .and_then(|v| v.as_object().cloned())
+            .unwrap_or_default()
     }
 }
 

@@ -15,7 +15,7 @@ use crate::structure::deck::load_deck_within;
 use anyhow::{anyhow, bail};
 use std::path::{Path, PathBuf};
 
-/// Speed fractions of a rotor deck's fan plot by default (`--speeds`).
+/// Speed fractions of a rotor deck's fan plot by default (`--speed-fractions`).
 pub const DEFAULT_SPEEDS: &str = "0:1.2:0.1";
 /// Modes per speed of a rotor deck's fan plot by default (`--count`).
 pub const DEFAULT_COUNT: usize = 14;
@@ -30,8 +30,10 @@ pub struct ModesJob {
     /// Rotor deck (or hinged-blade deck): its fan plot over `speeds`.
     pub rotor: Option<PathBuf>,
     /// Rotor decks: speeds as fractions of the nominal, START:STOP:STEP (inclusive) or a
-    /// comma-separated list.
+    /// comma-separated list (unless `speeds_rad_s`).
     pub speeds: String,
+    /// Rotor decks: speeds in rad/s instead of `speeds`.
+    pub speeds_rad_s: Option<String>,
     /// Rotor decks: the digitized reference fan plot drawn over the model's (None: the default
     /// one, [`default_reference`], when present; a hinged-blade deck's own `[fan_reference]`).
     pub reference: Option<PathBuf>,
@@ -95,6 +97,7 @@ impl ModesJob {
             deck: None,
             rotor: None,
             speeds: DEFAULT_SPEEDS.to_string(),
+            speeds_rad_s: None,
             reference: None,
             count: DEFAULT_COUNT,
             out: out.into(),
@@ -268,14 +271,7 @@ impl ModesJob {
             return self.hinged_fan(path, on_speed);
         }
         let deck = crate::rotor::RotorDeck::from_file(path)?;
-        let fractions = parse_speeds(&self.speeds)?;
-        check_fractions(
-            &fractions,
-            deck.spec.rotor.omega_rad_s,
-            "rad/s",
-            path,
-            "rotor.omega_rad_s",
-        )?;
+        let fractions = self.fractions(deck.spec.rotor.omega_rad_s, path)?;
         let (ndof, _) = deck.spec.size_estimate();
         let one = crate::solver::budget::dense_modal_of(ndof);
         deck.spec.check_budget(
@@ -424,15 +420,8 @@ impl ModesJob {
     ) -> anyhow::Result<ModesOutcome> {
         use crate::rotor::hinged::{fan, read_reference, HingedSpec, TRACKED};
         let spec = HingedSpec::from_file(path)?;
-        let mut fractions = parse_speeds(&self.speeds)?;
+        let mut fractions = self.fractions(spec.rotor.omega_rad_s, path)?;
         let rpm_n = spec.rpm();
-        check_fractions(
-            &fractions,
-            spec.rotor.omega_rad_s,
-            "rad/s",
-            path,
-            "rotor.omega_rad_s",
-        )?;
         let mut inputs = vec![path.to_path_buf()];
         let ref_path = self.reference.clone().or_else(|| spec.reference_path(path));
         let label = spec
@@ -657,8 +646,13 @@ fn mode_rows(ms: &[Mode]) -> Vec<Vec<f64>> {
 /// Parse `START:STOP:STEP` (inclusive, rounded to the step) or `a,b,c`: the speed fractions of
 /// `--speeds`, finite and non-negative.
 pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
+    parse_speeds_as("--speed-fractions", s)
+}
+
+/// [`parse_speeds`] of the option `flag`.
+fn parse_speeds_as(flag: &str, s: &str) -> anyhow::Result<Vec<f64>> {
     let v = super::ranges::parse_range(
-        "--speeds",
+        flag,
         s,
         "expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0",
         MAX_SPEEDS,
@@ -666,9 +660,9 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
     )?;
     if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
         return Err(super::ranges::range_error(
-            "--speeds",
+            flag,
             s,
-            "fractions must be finite and non-negative",
+            "speeds must be finite and non-negative",
             "expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0",
         ));
     }
@@ -678,23 +672,30 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
 /// Speeds of one fan plot at most: each is a static solve and an eigen-analysis.
 const MAX_SPEEDS: usize = 10_000;
 
-/// Refuses speed fractions far beyond the deck's nominal speed (`key` in `deck`).
-fn check_fractions(
-    fractions: &[f64],
-    nominal: f64,
-    unit: &str,
-    deck: &Path,
-    key: &str,
-) -> anyhow::Result<()> {
-    if let Some(&f) = fractions.iter().find(|&&f| f > MAX_SPEED_FRACTION) {
-        bail!(
-            "--speeds: fraction {f} of the nominal speed ({} {key} = {nominal} {unit}) is beyond \
-             sense: expected at most {MAX_SPEED_FRACTION} (the speeds are fractions of the \
-             nominal, not {unit})",
-            deck.display()
-        );
+impl ModesJob {
+    /// The fan's speeds as fractions of the deck's nominal speed `nominal` [rad/s] (the
+    /// `rotor.omega_rad_s` of `deck`): `speeds_rad_s` over it, else `speeds`; refused far
+    /// beyond it, and speeds in rad/s that look like fractions.
+    fn fractions(&self, nominal: f64, deck: &Path) -> anyhow::Result<Vec<f64>> {
+        const KEY: &str = "rotor.omega_rad_s";
+        let (flag, fractions) = match &self.speeds_rad_s {
+            Some(text) => {
+                let w = parse_speeds_as("--speeds", text)?;
+                super::ranges::check_not_fractions("--speeds", &w, nominal, deck, KEY)?;
+                ("--speeds", w.iter().map(|w| w / nominal).collect())
+            }
+            None => ("--speed-fractions", parse_speeds(&self.speeds)?),
+        };
+        if let Some(&f) = fractions.iter().find(|&&f| f > MAX_SPEED_FRACTION) {
+            bail!(
+                "{flag}: {} times the nominal speed ({} {KEY} = {nominal} rad/s) is beyond sense: \
+                 expected at most {MAX_SPEED_FRACTION} times",
+                f,
+                deck.display()
+            );
+        }
+        Ok(fractions)
     }
-    Ok(())
 }
 
 /// Refuses a modal solution with a non-finite frequency (a zero-frequency mode may have an

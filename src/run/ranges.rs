@@ -74,3 +74,28 @@ pub fn check_increasing(name: &str, v: &[f64], unit: &str, noun: &str) -> anyhow
     }
     Ok(())
 }
+
+/// Refuses rotor speeds `name` [rad/s] that look like fractions of the nominal speed (every one
+/// below a tenth of `nominal_rad_s`, `key` of `deck`): a map of them would answer for a rotor
+/// barely turning, "stable", without saying why.
+pub fn check_not_fractions(
+    name: &str,
+    speeds_rad_s: &[f64],
+    nominal_rad_s: f64,
+    deck: &std::path::Path,
+    key: &str,
+) -> anyhow::Result<()> {
+    let top = speeds_rad_s
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    if top < 0.1 * nominal_rad_s {
+        anyhow::bail!(
+            "{name}: every speed is below a tenth of the nominal speed ({} {key} = {nominal_rad_s} \
+             rad/s; the highest given is {top} rad/s): {name} is in rad/s, not a fraction of the \
+             nominal (fraction 1 is {nominal_rad_s} rad/s)",
+            deck.display()
+        );
+    }
+    Ok(())
+}

@@ -335,6 +335,12 @@ pub fn parse_speeds(name: &str, s: &str) -> anyhow::Result<Vec<f64>> {
     Ok(v)
 }
 
+/// Refuses speeds `name` [rad/s] that look like fractions of `deck`'s nominal speed.
+pub fn check_rad_s(name: &str, speeds: &[f64], deck: &RotorDeck) -> anyhow::Result<()> {
+    let nominal = deck.spec.rotor.omega_rad_s;
+    super::ranges::check_not_fractions(name, speeds, nominal, &deck.path, "rotor.omega_rad_s")
+}
+
 /// Speeds `name` in rad/s: finite, positive, strictly increasing.
 pub fn check_speeds(name: &str, s: &[f64]) -> anyhow::Result<()> {
     super::ranges::check_increasing(name, s, "rad/s", "rotor speed")
@@ -1174,6 +1180,7 @@ impl StabilityJob {
     pub fn execute(&self, say: &mut dyn FnMut(&str)) -> anyhow::Result<StabilityOutcome> {
         let speeds = parse_speeds("--speeds", &self.speeds)?;
         let deck = RotorDeck::from_file_with(&self.rotor, &self.set)?;
+        check_rad_s("--speeds", &speeds, &deck)?;
         let model = match &self.damper {
             Some(d) => d
                 .parse::<DamperModel>()
@@ -1188,6 +1195,7 @@ impl StabilityJob {
         let mut time_speeds: Vec<f64> = vec![];
         if let Some(t) = &self.time_speeds {
             time_speeds = parse_speeds("--time", t)?;
+            check_rad_s("--time", &time_speeds, &deck)?;
             for &w in &time_speeds {
                 time_opts.check(w)?;
             }

@@ -229,6 +229,18 @@ impl Sensitivity {
         idx.sort_by(|a, b| key(b).total_cmp(&key(a)).then(a.cmp(b)));
         idx
     }
+    /// The three rows output `k` is most sensitive to (by [`Sensitivity::ranking`]), each with
+    /// its name and spread (rows without one left out).
+    pub fn top3(&self, k: usize) -> Vec<(&Row, f64)> {
+        self.ranking(k)
+            .iter()
+            .take(3)
+            .filter_map(|&i| {
+                let r = &self.rows[i];
+                Some((r, r.spread(&self.nominal, k)?))
+            })
+            .collect()
+    }
     /// Cases that failed or did not run, with the reason.
     pub fn failures(&self) -> Vec<(String, String)> {
         std::iter::once(&self.nominal)
@@ -551,14 +563,9 @@ pub fn html(t: &Sensitivity) -> String {
     let mut lines = Vec::new();
     for (k, o) in OUTPUTS.iter().enumerate() {
         let top: Vec<String> = t
-            .ranking(k)
+            .top3(k)
             .iter()
-            .take(3)
-            .filter_map(|&i| {
-                let r = &t.rows[i];
-                let s = r.spread(&t.nominal, k)?;
-                Some(format!("{} ({})", r.param.name(), show(o, Some(s))))
-            })
+            .map(|(r, s)| format!("{} ({})", r.param.name(), show(o, Some(*s))))
             .collect();
         if !top.is_empty() {
             let unit = if o.unit.is_empty() {

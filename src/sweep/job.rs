@@ -20,8 +20,8 @@ pub struct SweepJob {
     pub shard: Option<(usize, usize)>,
     /// Run again the cases that failed in an earlier run into `out`.
     pub retry_failed: bool,
-    /// Start cases from their group's seed as the plan says (false: every case cold).
-    pub warm_start: bool,
+    /// Warm starts: on or off whatever the plan says (None: as the plan says).
+    pub warm_start: Option<bool>,
     /// Raised: the running cases stop (published incomplete: failed, run again with
     /// `retry_failed`) and no other starts.
     pub stop: StopFlag,
@@ -48,16 +48,16 @@ impl SweepJob {
             jobs: None,
             shard: None,
             retry_failed: false,
-            warm_start: true,
+            warm_start: None,
             stop: StopFlag::default(),
         }
     }
 
-    /// The plan as this job runs it (its warm starts off unless `warm_start`).
+    /// The plan as this job runs it (its warm starts as `warm_start` says).
     pub fn read_plan(&self) -> anyhow::Result<Plan> {
         let mut plan = Plan::from_file(&self.plan)?;
-        if !self.warm_start {
-            plan.warm_start = false;
+        if let Some(w) = self.warm_start {
+            plan.warm_start = w;
         }
         Ok(plan)
     }

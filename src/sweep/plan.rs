@@ -3,31 +3,40 @@
 //! own structure and the types of run options; deck values and records are checked case by case
 //! by the caller before any case runs.
 use crate::overrides::{check_key, Override};
+use crate::run::job::RunSettings;
 use anyhow::{anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use toml::{Table, Value};
 
-/// Run options a plan may set (those of `rotorsim run` but `--out` and `--initial-state`,
-/// which the sweep decides), with the type each takes.
-pub const RUN_OPTIONS: &[(&str, OptionType)] = &[
-    ("rotor", OptionType::Text),
-    ("flight", OptionType::Text),
-    ("model", OptionType::Text),
-    ("damper", OptionType::Text),
-    ("damper_deck", OptionType::Text),
-    ("revs", OptionType::Count),
-    ("periodic", OptionType::Text),
-    ("periodic_tol", OptionType::Number),
-    ("require_periodic", OptionType::Flag),
-    ("steps_per_rev", OptionType::Count),
-    ("substeps", OptionType::Count),
-    ("scheme", OptionType::Text),
-    ("newton", OptionType::Text),
-    // a ground-resonance map instead of a run (`rotorsim stability --speeds`)
-    ("stability_speeds", OptionType::Text),
-];
+/// Run options a plan may not set: the sweep decides the folder and the warm start, and deck
+/// values are the plan's dotted keys (not `set`).
+pub const NOT_PLAN_OPTIONS: &[&str] = &["out", "initial_state", "set"];
+
+/// A plan key that is no run option: a ground-resonance map instead of a run (`rotorsim
+/// stability --speeds`).
+pub const STABILITY_SPEEDS: &str = "stability_speeds";
+
+/// Run options a plan may set (every [`RunSettings`] field but [`NOT_PLAN_OPTIONS`], then
+/// [`STABILITY_SPEEDS`]), with the type each takes, read from the settings' defaults.
+pub fn run_options() -> Vec<(String, OptionType)> {
+    let mut v: Vec<(String, OptionType)> = RunSettings::defaults_map()
+        .into_iter()
+        .filter(|(k, _)| !NOT_PLAN_OPTIONS.contains(&k.as_str()))
+        .map(|(k, d)| {
+            let ty = match d {
+                serde_json::Value::Bool(_) => OptionType::Flag,
+                serde_json::Value::Number(n) if n.is_u64() => OptionType::Count,
+                serde_json::Value::Number(_) => OptionType::Number,
+                _ => OptionType::Text,
+            };
+            (k, ty)
+        })
+        .collect();
+    v.push((STABILITY_SPEEDS.to_string(), OptionType::Text));
+    v
+}
 
 /// Cases a plan may hold. Each case is a run of seconds at least, its settings and its folder
 /// kept for the whole sweep: beyond a million cases a plan is a typo (one list too many, a
@@ -154,6 +163,7 @@ impl Plan {
                 Some(v) => Err(bad(name, format!("expected a table, found {v}"))),
             }
         };
+        let options = run_options();
         let check_setting = |where_: &str, k: &str, v: &Value| -> anyhow::Result<()> {
             let key = format!("{where_} \"{k}\"");
             if k.contains('.') {
@@ -163,7 +173,7 @@ impl Plan {
                 }
                 return Ok(());
             }
-            match RUN_OPTIONS.iter().find(|(n, _)| *n == k) {
+            match options.iter().find(|(n, _)| n == k) {
                 Some((_, ty)) if ty.check(v) => Ok(()),
                 Some((_, ty)) => Err(bad(&key, format!("expected {}, found {v}", ty.expected()))),
                 None if k == "out" || k == "initial_state" => Err(bad(
@@ -171,11 +181,15 @@ impl Plan {
                     "set by the sweep (each case's folder, the warm start), not by the plan"
                         .into(),
                 )),
+                None if k == "set" => Err(bad(
+                    &key,
+                    "a plan sets deck values by their dotted keys (e.g. \"damper.physical.A_orf_m2\" = 2.0e-6), not by `set`".into(),
+                )),
                 None => Err(bad(
                     &key,
                     format!(
                         "unknown key: expected a run option ({}) or a dotted deck key with its unit (e.g. damper.physical.A_orf_m2)",
-                        RUN_OPTIONS.iter().map(|o| o.0).collect::<Vec<_>>().join(", ")
+                        options.iter().map(|o| o.0.as_str()).collect::<Vec<_>>().join(", ")
                     ),
                 )),
             }

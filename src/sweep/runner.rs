@@ -1,7 +1,7 @@
 //! A sweep's cases run as [`RunJob`]s in this process, showing nothing.
 use super::{Case, CaseRunner};
 use crate::flight::FlightRecord;
-use crate::run::job::{self, NamedOptions, RunJob};
+use crate::run::job::{self, RunJob, RunSettings};
 use crate::run::stop::StopFlag;
 use crate::run::Silent;
 use anyhow::{anyhow, bail};
@@ -44,6 +44,11 @@ fn stability_case(case: &Case) -> Option<anyhow::Result<StabilityCase>> {
             _ => PathBuf::from(job::DEFAULT_ROTOR),
         };
         let deck = crate::rotor::RotorDeck::from_file_with(&rotor, &case.overrides())?;
+        crate::run::stability::check_rad_s(
+            &format!("case {}: stability_speeds", case.id),
+            &speeds,
+            &deck,
+        )?;
         if deck.spec.airframe.is_none() {
             bail!(
                 "case {}: rotor deck {} has no [airframe]: a stability case needs the airframe under the hub (docs/stability.md)",
@@ -67,45 +72,30 @@ fn stability_case(case: &Case) -> Option<anyhow::Result<StabilityCase>> {
 }
 
 /// The run of `case` into `out`, starting from the periodic states of the result folder
-/// `initial` when given. The plan has checked the settings' names and types.
+/// `initial` when given. The plan has checked the settings' names and types; its run options
+/// are [`RunSettings`] fields, read as the command line reads them.
 pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result<RunJob> {
-    let mut job = RunJob::new(out);
-    let mut named = NamedOptions::default();
-    let count = |k: &str, i: i64| {
-        usize::try_from(i).map_err(|_| anyhow!("{k}: expected a positive integer, found {i}"))
-    };
-    let path = |k: &str, s: &str| -> anyhow::Result<PathBuf> {
-        if s.trim().is_empty() {
-            bail!("case {}: `{k}` is empty (expected a file path)", case.id);
-        }
-        Ok(s.into())
-    };
+    let known = RunSettings::defaults_map();
+    let mut given = serde_json::Map::new();
     for (k, v) in &case.settings {
         if k.contains('.') {
             continue; // a deck value: job.overrides below
         }
-        match (k.as_str(), v) {
-            ("rotor", Value::String(s)) => job.rotor = path(k, s)?,
-            ("flight", Value::String(s)) => job.flight = path(k, s)?,
-            ("damper_deck", Value::String(s)) => job.damper_deck = Some(path(k, s)?),
-            ("damper", Value::String(s)) => named.damper = s,
-            ("scheme", Value::String(s)) => named.scheme = s,
-            ("newton", Value::String(s)) => named.newton = s,
-            ("periodic", Value::String(s)) => named.periodic = s,
-            ("model", Value::String(s)) => named.model = s,
-            ("airloads", Value::String(s)) => named.airloads = s,
-            ("revs", Value::Integer(i)) => job.revs = count(k, *i)?,
-            ("steps_per_rev", Value::Integer(i)) => job.steps_per_rev = count(k, *i)?,
-            ("substeps", Value::Integer(i)) => job.substeps = count(k, *i)?,
-            ("periodic_tol", Value::Float(x)) => job.periodic_tol = *x,
-            ("periodic_tol", Value::Integer(i)) => job.periodic_tol = *i as f64,
-            ("require_periodic", Value::Boolean(b)) => job.require_periodic = *b,
-            (k, v) => bail!("case {}: `{k} = {v}` is not a run option", case.id),
+        if crate::sweep::plan::NOT_PLAN_OPTIONS.contains(&k.as_str()) || !known.contains_key(k) {
+            bail!("case {}: `{k} = {v}` is not a run option", case.id);
         }
+        if matches!(k.as_str(), "rotor" | "flight" | "damper_deck")
+            && v.as_str().is_some_and(|s| s.trim().is_empty())
+        {
+            bail!("case {}: `{k}` is empty (expected a file path)", case.id);
+        }
+        given.insert(k.clone(), serde_json::to_value(v)?);
     }
+    let settings: RunSettings = serde_json::from_value(serde_json::Value::Object(given))
+        .map_err(|e| anyhow!("case {}: {e}", case.id))?;
+    let mut job = settings.job(out)?;
     job.overrides = case.overrides();
     job.initial_state = initial.map(Path::to_path_buf);
-    job.set_named(&named)?;
     Ok(job)
 }
 
