@@ -339,11 +339,11 @@ fn discrete_work_identity_holds_to_round_off_over_every_step() {
 struct CentralDiff(Box<dyn Device>);
 
 impl Device for CentralDiff {
-    fn trial_step_path(
+    fn step_along(
         &mut self,
         t_i: f64,
         path: &rotorsim::hydraulics::StrokePath,
-    ) -> Result<rotorsim::hydraulics::StepForce, rotorsim::hydraulics::HydraulicError> {
+    ) -> rotorsim::hydraulics::StepResult {
         let h = 1e-10;
         let (d_i, d_f) = (path.d_i, path.d_f);
         let p = self

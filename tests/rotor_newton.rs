@@ -9,7 +9,7 @@ use rotorsim::hydraulics::DamperModel;
 use rotorsim::rotor::sim::RTOL;
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions};
 use rotorsim::run::loads::is_load_channel;
-use rotorsim::run::{run_models, ModelRun, Silent};
+use rotorsim::run::{run_units, ModelRun, Silent};
 use rotorsim::solver::NewtonMethod;
 use std::path::PathBuf;
 
@@ -30,7 +30,7 @@ fn runs(models: &[DamperModel], newton: NewtonMethod, rtol: f64, revs: usize) ->
         rotorsim::rotor::build(&rotor, &deck, m, &rec, &opts)
     };
     let opts = vec![rotorsim::run::PeriodicOptions::march(revs); models.len()];
-    run_models(models, &opts, &build, &Silent)
+    run_units(models, &opts, &|i: usize| build(models[i]), &Silent)
         .into_iter()
         .map(|o| o.result.unwrap())
         .collect()

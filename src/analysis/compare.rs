@@ -32,6 +32,13 @@ pub struct Periodic<'a> {
     pub value: &'a [f64],
 }
 
+impl<'a> Periodic<'a> {
+    /// Values at azimuths [deg].
+    pub fn new(psi_deg: &'a [f64], value: &'a [f64]) -> Self {
+        Periodic { psi_deg, value }
+    }
+}
+
 fn check(what: &'static str, s: Periodic<'_>, needed: usize) -> Result<(), CompareError> {
     if s.psi_deg.len() != s.value.len() {
         return Err(CompareError::Length {
@@ -209,11 +216,7 @@ mod tests {
     fn interpolation_is_exact_at_samples_and_periodic() {
         let psi = grid(8);
         let v: Vec<f64> = (0..8).map(|i| (i * i) as f64).collect();
-        let f = PeriodicInterp::new(Periodic {
-            psi_deg: &psi,
-            value: &v,
-        })
-        .unwrap();
+        let f = PeriodicInterp::new(Periodic::new(&psi, &v)).unwrap();
         for (p, x) in psi.iter().zip(&v) {
             assert_eq!(f.at(*p), *x);
             assert_eq!(f.at(*p + 360.0), *x);
@@ -228,10 +231,7 @@ mod tests {
     fn identical_signals_have_zero_error_and_unit_correlation() {
         let psi = grid(256);
         let y: Vec<f64> = psi.iter().map(|p| p.to_radians().sin() * 1e4).collect();
-        let s = Periodic {
-            psi_deg: &psi,
-            value: &y,
-        };
+        let s = Periodic::new(&psi, &y);
         let m = compare(s, s, 10).unwrap();
         assert_eq!(m.rms_error, 0.0);
         assert!((m.correlation - 1.0).abs() < 1e-12);
@@ -245,18 +245,7 @@ mod tests {
         let psi = grid(360);
         let meas: Vec<f64> = psi.iter().map(|p| p.to_radians().sin()).collect();
         let model: Vec<f64> = meas.iter().map(|v| 2.0 * v + 1.0).collect();
-        let m = compare(
-            Periodic {
-                psi_deg: &psi,
-                value: &model,
-            },
-            Periodic {
-                psi_deg: &psi,
-                value: &meas,
-            },
-            10,
-        )
-        .unwrap();
+        let m = compare(Periodic::new(&psi, &model), Periodic::new(&psi, &meas), 10).unwrap();
         assert!((m.rms_error - 1.5f64.sqrt()).abs() < 1e-12);
         assert!((m.peak_to_peak_error - 2.0).abs() < 1e-12);
         assert!((m.correlation - 1.0).abs() < 1e-12);
@@ -272,14 +261,8 @@ mod tests {
         let psi_meas: Vec<f64> = (0..100).map(|i| 1.0 + 3.3 * i as f64).collect();
         let meas: Vec<f64> = psi_meas.iter().map(|p| 3.0 * p).collect();
         let m = compare(
-            Periodic {
-                psi_deg: &psi_model,
-                value: &model,
-            },
-            Periodic {
-                psi_deg: &psi_meas,
-                value: &meas,
-            },
+            Periodic::new(&psi_model, &model),
+            Periodic::new(&psi_meas, &meas),
             3,
         )
         .unwrap();

@@ -7,7 +7,7 @@ use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
 use super::extensions::HydraulicExtensions;
 use super::fluid::Fluid;
 use super::integrators::{integrate, IntegratorOptions, OdeSystem, Scheme};
-use super::{Device, HydraulicError, StepForce, StrokePath};
+use super::{Device, HydraulicError, StepForce, StepResult, StrokePath};
 use nalgebra::{SMatrix, SVector};
 use std::sync::Arc;
 
@@ -919,12 +919,7 @@ impl CircuitDevice {
 }
 
 impl Device for CircuitDevice {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
         let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         let explicit = self.opts.scheme == Scheme::Rk4;
         let mut sys = StepSystem::new(&self.params, t_i, *path, explicit);

@@ -2,7 +2,7 @@
 //! `F = -sign(v) f(|v|)` with `f` a monotone (Fritsch-Carlson) interpolation of a table.
 //! On a straight step the stroke rate is constant, so `F_m` is exact; on a replay's Hermite
 //! path the force at the step's end is the law at the end's rate.
-use super::{Device, HydraulicError, StepForce, StrokePath};
+use super::{Device, HydraulicError, StepForce, StepResult, StrokePath};
 use std::sync::Arc;
 
 const CHANNELS: &[&str] = &["velocity_m_s"];
@@ -25,13 +25,42 @@ impl LinearDashpot {
     }
 }
 
+/// The state of a dashpot, the committed stroke rate (and the trial's), its channel and its
+/// protocol: the same `Device` methods for both dashpots.
+macro_rules! rate_state {
+    () => {
+        fn commit(&mut self) {
+            if let Some(v) = self.trial_v.take() {
+                self.committed_v = v;
+            }
+        }
+        fn channel_names(&self) -> &'static [&'static str] {
+            CHANNELS
+        }
+        fn channels(&self, out: &mut [f64]) {
+            out[0] = self.committed_v;
+        }
+        fn clone_device(&self) -> Box<dyn Device> {
+            Box::new(self.clone())
+        }
+        fn state_values(&self) -> Vec<f64> {
+            vec![self.committed_v]
+        }
+        fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
+            super::check_state_len("dashpot", v, 1)?;
+            self.committed_v = v[0];
+            self.trial_v = None;
+            Ok(())
+        }
+        fn reset(&mut self) {
+            self.committed_v = 0.0;
+            self.trial_v = None;
+        }
+    };
+}
+
 impl Device for LinearDashpot {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, _t_i: f64, path: &StrokePath) -> StepResult {
         // the mean rate is the chord's on any path
         let v = path.chord_rate();
         let v_end = path.end_rate();
@@ -42,36 +71,10 @@ impl Device for LinearDashpot {
             force_end: -self.c * v_end,
         })
     }
-    fn commit(&mut self) {
-        if let Some(v) = self.trial_v.take() {
-            self.committed_v = v;
-        }
-    }
-    fn channel_names(&self) -> &'static [&'static str] {
-        CHANNELS
-    }
-    fn channels(&self, out: &mut [f64]) {
-        out[0] = self.committed_v;
-    }
     fn committed_force(&self) -> f64 {
         -self.c * self.committed_v
     }
-    fn clone_device(&self) -> Box<dyn Device> {
-        Box::new(self.clone())
-    }
-    fn state_values(&self) -> Vec<f64> {
-        vec![self.committed_v]
-    }
-    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        super::check_state_len("dashpot", v, 1)?;
-        self.committed_v = v[0];
-        self.trial_v = None;
-        Ok(())
-    }
-    fn reset(&mut self) {
-        self.committed_v = 0.0;
-        self.trial_v = None;
-    }
+    rate_state!();
 }
 
 /// Monotone piecewise-cubic interpolant (Fritsch-Carlson) of a non-decreasing table, extended
@@ -195,12 +198,7 @@ impl NonlinearDashpot {
 }
 
 impl Device for NonlinearDashpot {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, _t_i: f64, path: &StrokePath) -> StepResult {
         let v = path.chord_rate();
         let (f, df) = self.force(v);
         let v_end = path.end_rate();
@@ -215,36 +213,10 @@ impl Device for NonlinearDashpot {
             },
         })
     }
-    fn commit(&mut self) {
-        if let Some(v) = self.trial_v.take() {
-            self.committed_v = v;
-        }
-    }
-    fn channel_names(&self) -> &'static [&'static str] {
-        CHANNELS
-    }
-    fn channels(&self, out: &mut [f64]) {
-        out[0] = self.committed_v;
-    }
     fn committed_force(&self) -> f64 {
         self.force(self.committed_v).0
     }
-    fn clone_device(&self) -> Box<dyn Device> {
-        Box::new(self.clone())
-    }
-    fn state_values(&self) -> Vec<f64> {
-        vec![self.committed_v]
-    }
-    fn set_state_values(&mut self, v: &[f64]) -> Result<(), HydraulicError> {
-        super::check_state_len("dashpot", v, 1)?;
-        self.committed_v = v[0];
-        self.trial_v = None;
-        Ok(())
-    }
-    fn reset(&mut self) {
-        self.committed_v = 0.0;
-        self.trial_v = None;
-    }
+    rate_state!();
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@
 use super::circuit::CircuitDevice;
 use super::fluid::Fluid;
 use super::link::Link;
-use super::{Device, HydraulicError, StepForce, StrokePath};
+use super::{Device, HydraulicError, StepForce, StepResult, StrokePath};
 
 /// Seal friction: `F = -[F_c + (F_s - F_c) exp(-(v/v_s)^2)] tanh(v/v_eps)` with v the piston
 /// velocity. `tanh(v/v_eps)` regularises the Coulomb sign so that the law stays continuous;
@@ -322,12 +322,7 @@ impl ExtendedDamper {
 }
 
 impl Device for ExtendedDamper {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
         let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i;
@@ -523,12 +518,7 @@ impl SeriesMount {
 }
 
 impl Device for SeriesMount {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
         let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i + self.inner.committed_force() / self.k;
@@ -710,12 +700,7 @@ impl CompliantFreePlay {
 }
 
 impl Device for CompliantFreePlay {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
         let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         if self.fresh {
             self.d_h = d_i + self.link.deflection_of(self.inner.committed_force());

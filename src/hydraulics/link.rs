@@ -27,7 +27,7 @@
 use super::circuit::{CircuitDevice, CircuitParams, State, IIMP, IP0, IP1, IV0, IV1, IX0, IX1, NS};
 use super::elements::Chamber;
 use super::integrators::{explicit_step, OdeSystem, RK4};
-use super::{Device, HydraulicError, StepForce, StrokePath};
+use super::{Device, HydraulicError, StepForce, StepResult, StrokePath};
 use nalgebra::{SMatrix, SVector};
 
 /// Size of the linked state: the circuit's and the link deflection.
@@ -490,12 +490,7 @@ impl LinkedCircuit {
 }
 
 impl Device for LinkedCircuit {
-    fn trial_step_path(
-        &mut self,
-        t_i: f64,
-        path: &StrokePath,
-    ) -> Result<StepForce, HydraulicError> {
-        path.check(t_i)?;
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
         let (dt, d_i, d_f) = (path.dt, path.d_i, path.d_f);
         let d_dot = (d_f - d_i) / dt;
         if self.fresh {

@@ -159,6 +159,9 @@ fn stability_advice(h: f64, rate: f64) -> String {
         .into()
 }
 
+/// What a device's step gives: the force over the step, or why it could not step.
+pub type StepResult = Result<StepForce, HydraulicError>;
+
 /// A hydraulic (or dashpot) device connecting two structural points, as seen by the structure.
 ///
 /// Protocol: `trial_step` advances from the committed state and keeps the result as a trial
@@ -167,8 +170,13 @@ fn stability_advice(h: f64, rate: f64) -> String {
 pub trait Device: Send + Sync + std::fmt::Debug {
     /// Advance from the committed state at `t_i` along `path` (the stroke over the step). The
     /// result is kept as the trial state.
-    fn trial_step_path(&mut self, t_i: f64, path: &StrokePath)
-        -> Result<StepForce, HydraulicError>;
+    fn trial_step_path(&mut self, t_i: f64, path: &StrokePath) -> StepResult {
+        path.check(t_i)?;
+        self.step_along(t_i, path)
+    }
+    /// [`Device::trial_step_path`] on a path already checked against `t_i`: what each device
+    /// implements.
+    fn step_along(&mut self, t_i: f64, path: &StrokePath) -> StepResult;
     /// Advance from the committed state at `t_i` over `dt`, the stroke moving linearly from
     /// `d_i` to `d_f` (constant rate): what a structural step knows.
     fn trial_step(

@@ -705,21 +705,6 @@ fn align_envelopes(samples: &mut [Vec<f64>], end: &[f64], env: &[usize]) {
     }
 }
 
-/// Builds and drives one simulation per model in parallel. A failed model (build or run) is
-/// returned as an error message; the others are unaffected.
-/// `opts[i]` for `models[i]`.
-pub fn run_models<B>(
-    models: &[DamperModel],
-    opts: &[PeriodicOptions],
-    build: &B,
-    progress: &dyn Progress,
-) -> Vec<ModelOutcome>
-where
-    B: Fn(DamperModel) -> anyhow::Result<Box<dyn ForcedResponse>> + Sync,
-{
-    run_units(models, opts, &|i: usize| build(models[i]), progress)
-}
-
 /// Builds and drives one simulation per unit in parallel (a model, or a blade of a whole
 /// rotor: `build(i)` builds unit `i`, of damper model `models[i]`). A failed unit (build or
 /// run) is returned as an error message; the others are unaffected.

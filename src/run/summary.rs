@@ -268,10 +268,7 @@ pub fn stroke_check(run: &ModelRun, meas: &Measured) -> anyhow::Result<Option<St
         return Ok(None);
     };
     let on = |v: &[f64]| -> anyhow::Result<Vec<f64>> {
-        let i = PeriodicInterp::new(Periodic {
-            psi_deg: &run.azimuth_deg,
-            value: v,
-        })?;
+        let i = PeriodicInterp::new(Periodic::new(&run.azimuth_deg, v))?;
         Ok(meas.azimuth_deg.iter().map(|p| i.at(*p)).collect())
     };
     let (d_mod, f_mod) = (on(d)?, on(f)?);
@@ -436,14 +433,8 @@ pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<Mo
     };
     let (metrics, residual) = match measured {
         Some(m) => {
-            let model = Periodic {
-                psi_deg: &run.azimuth_deg,
-                value: f,
-            };
-            let meas = Periodic {
-                psi_deg: &m.azimuth_deg,
-                value: &m.force_n,
-            };
+            let model = Periodic::new(&run.azimuth_deg, f);
+            let meas = Periodic::new(&m.azimuth_deg, &m.force_n);
             (
                 Some(compare(model, meas, N_HARMONICS)?),
                 Some(residual(model, meas)?),
@@ -1088,17 +1079,7 @@ mod tests {
         let model: Vec<f64> = psi.iter().map(|p| p.to_radians().sin()).collect();
         // Measurement lags the model by 10 deg.
         let meas: Vec<f64> = psi.iter().map(|p| (p - 10.0).to_radians().sin()).collect();
-        let r = residual(
-            Periodic {
-                psi_deg: &psi,
-                value: &model,
-            },
-            Periodic {
-                psi_deg: &psi,
-                value: &meas,
-            },
-        )
-        .unwrap();
+        let r = residual(Periodic::new(&psi, &model), Periodic::new(&psi, &meas)).unwrap();
         assert!(
             (r.best_shift_deg - 10.0).abs() < 0.051,
             "{}",

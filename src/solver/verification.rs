@@ -27,12 +27,7 @@ pub fn uniform_section(
         i1,
         i2,
         i3,
-        cm2: 0.0,
-        cm3: 0.0,
-        sc2: 0.0,
-        sc3: 0.0,
-        ca2: 0.0,
-        ca3: 0.0,
+        ..Default::default()
     })
 }
 

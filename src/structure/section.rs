@@ -50,8 +50,9 @@ pub const SECTION_COLUMNS: [&str; 17] = [
     "ca3_m",
 ];
 
-/// One spanwise station of sectional data (SI units).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+/// One spanwise station of sectional data (SI units). `Default` is all zeros: for the offsets
+/// of a section on its reference line (`..Default::default()`), never for stiffness or mass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SectionProps {
     #[serde(default)]
@@ -388,12 +389,7 @@ mod tests {
             i1: 0.5,
             i2: 0.1,
             i3: 0.4,
-            cm2: 0.0,
-            cm3: 0.0,
-            sc2: 0.0,
-            sc3: 0.0,
-            ca2: 0.0,
-            ca3: 0.0,
+            ..Default::default()
         }
     }
 
