@@ -94,7 +94,7 @@ const MODES_R: &[&str] = &[
     "modes",
     "--rotor",
     "{T}/r.toml",
-    "--speeds",
+    "--speed-fractions",
     "1",
     "--out",
     "{T}/out",
