@@ -88,7 +88,7 @@ fn golden(case: &str) {
             None => a.clone(),
         })
         .collect();
-    let mut c = Command::new(env!("CARGO_BIN_EXE_rotorsim"));
+    let mut c = Command::new(golden_support::bin());
     c.current_dir(root()).args(&args);
     for v in [
         "SLURM_ARRAY_TASK_ID",

@@ -320,7 +320,7 @@ fn jobs_for(deck: &Path, work: &Path, tag: &str) -> Result<Vec<Job>, String> {
 /// the deck, the command and why.
 fn run(job: &Job) -> Result<f64, String> {
     let t0 = Instant::now();
-    let mut c = Command::new(env!("CARGO_BIN_EXE_rotorsim"));
+    let mut c = Command::new(golden_support::bin());
     c.current_dir(root()).args(&job.args);
     for v in [
         "SLURM_ARRAY_TASK_ID",

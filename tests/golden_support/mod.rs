@@ -16,8 +16,9 @@
 //!
 //! Normalised: the binary's, the result folder's, the work folder's and the repository's paths
 //! become `<BIN>`, `<OUT>`, `<WORK>`, `<REPO>`; what differs from run to run or build to build
-//! is left out (wall times, run ids, start and end times, the version and git commit, and the
-//! sha256 and size of outputs in manifest.json).
+//! is left out (wall times, run ids, start and end times, the version and git commit, the
+//! command line: how a result was asked for, not what it is; and the sha256 and size of
+//! outputs in manifest.json).
 //!
 //! A file whose hash differs passes only if its fingerprint agrees within 1e-9 relative (each
 //! line against its own largest magnitude) and the case is listed, with the reason, in
@@ -35,8 +36,9 @@ const SAMPLES: usize = 5;
 const MAX_GROUPS: usize = 64;
 
 /// Keys whose values differ from run to run (and any key ending in `_wall_time_s`).
-const VOLATILE_KEYS: [&str; 8] = [
+const VOLATILE_KEYS: [&str; 9] = [
     "git_commit",
+    "command_line",
     "wall_time_s",
     "cost_per_step_s",
     "start_time",
@@ -47,6 +49,12 @@ const VOLATILE_KEYS: [&str; 8] = [
 ];
 /// CSV columns whose values differ from run to run.
 const VOLATILE_COLUMNS: [&str; 1] = ["wall_time_s"];
+
+/// The binary under test: this build's, or `ROTORSIM_GOLDEN_BIN` (a reference build, to write
+/// the goldens from the code before a change).
+pub fn bin() -> String {
+    std::env::var("ROTORSIM_GOLDEN_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_rotorsim").into())
+}
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -75,7 +83,7 @@ pub struct Paths {
 impl Paths {
     pub fn new(out: &Path, work: &Path) -> Self {
         let mut subs = vec![
-            (env!("CARGO_BIN_EXE_rotorsim").to_string(), "<BIN>"),
+            (bin(), "<BIN>"),
             (out.display().to_string(), "<OUT>"),
             (work.display().to_string(), "<WORK>"),
             (repo().display().to_string(), "<REPO>"),
