@@ -182,6 +182,7 @@ const CASES: &[Case] = &[
     case("modes rotor deck of 200000 elements", rotor!("elements = 13 ", "elements = 200000 "), MODES_R, &["r.toml", "blade.elements = 200000", "memory"]),
     case("decay duration 1e9 s", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--duration-s", "1e9", "--out", "{T}/out"], &["tm4760.toml", "--duration-s 1e9", "memory"]),
     case("decay rotor speed 1000x nominal", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rpm", "660000", "--out", "{T}/out"], &["--rpm 660000", "tm4760.toml", "rotor.omega_rad_s", "beyond sense"]),
+    case("decay --speed-rad-s 1000x nominal", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--speed-rad-s", "69115", "--out", "{T}/out"], &["--speed-rad-s 69115", "tm4760.toml", "rotor.omega_rad_s", "beyond sense"]),
     case("decay step 1e-12 s", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--step-s", "1e-12", "--out", "{T}/out"], &["tm4760.toml", "--step-s 1e-12"]),
     case("decay rho_inf above 1", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rho-inf", "1.5", "--out", "{T}/out"], &["--rho-inf", "expected a number in [0, 1]", "got 1.5"]),
     case("decay rho_inf NaN", &[], &["decay", "--rotor", "{R}/rotors/tm4760.toml", "--rho-inf", "nan", "--out", "{T}/out"], &["--rho-inf", "expected a number in [0, 1]", "got NaN"]),

@@ -188,9 +188,10 @@ pub fn run_decay(file: &Path, opts: &DecayRunOptions) -> anyhow::Result<DecayRun
     let nominal = spec.rotor.omega_rad_s;
     if om > MAX_SPEED_FRACTION * nominal {
         anyhow::bail!(
-            "--rpm {}: {:.3} times the nominal speed of {} (rotor.omega_rad_s = {} rad/s, \
-             {} rpm), beyond sense: expected at most {MAX_SPEED_FRACTION} times (rotors run \
-             within about 1.2 of their nominal speed)",
+            "--speed-rad-s {} (--rpm {}): {:.3} times the nominal speed of {} \
+             (rotor.omega_rad_s = {} rad/s, {} rpm), beyond sense: expected at most \
+             {MAX_SPEED_FRACTION} times (rotors run within about 1.2 of their nominal speed)",
+            round6(om),
             round6(om * 30.0 / std::f64::consts::PI),
             om / nominal,
             file.display(),
