@@ -425,6 +425,43 @@ pub fn build_rotor_sim(
     build_parts(&parts, true, file, model_kind, record, opts)
 }
 
+/// The lifting lines' shared air, state and clamp counts (computed and hybrid airloads).
+type AeroCommon = (
+    crate::aero::lifting_line::RotorAir,
+    Arc<Mutex<crate::aero::lifting_line::AeroShared>>,
+    Arc<crate::aero::airfoil::ClampCounts>,
+);
+
+/// What the stages of [`build_parts`] share: the inputs and the run's timing, controls and flags.
+struct BuildCtx<'a> {
+    whole: bool,
+    file: &'a Path,
+    model_kind: DamperModel,
+    record: &'a FlightRecord,
+    opts: &'a RunOptions,
+    period: f64,
+    base_controls: Controls,
+    t_ramp: f64,
+    scale: Arc<AtomicU64>,
+    source: super::aero::AirloadSource,
+    aero_active: Arc<std::sync::atomic::AtomicBool>,
+    reference_adopted: Arc<std::sync::atomic::AtomicBool>,
+    physical: bool,
+}
+
+/// A blade's damper and swashplate as added to the model, before the initial state is known.
+struct Pending {
+    prefix: String,
+    controls: Controls,
+    swash: usize,
+    probe: Arc<HydraulicProbe>,
+    dev_names: Vec<String>,
+    damper_nodes: [usize; 2],
+    limits: Option<(f64, f64)>,
+    regulation: Option<[super::ReliefRegulation; 2]>,
+}
+
+/// Builds the rotor simulation's parts from the deck, stage by stage.
 fn build_parts(
     blades: &[(&RotorSpec, &DamperDeck, f64)],
     whole: bool,
@@ -444,7 +481,83 @@ fn build_parts(
     let period = 2.0 * std::f64::consts::PI / om;
     let h = period / opts.steps_per_rev as f64;
     let base_controls = Controls::from_record(&record.meta.controls_deg);
-    let mut model = if whole {
+    let mut model = initial_model(blades, whole, file, base_controls)?;
+    let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
+    let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
+    // the lifting lines' shared state (computed and hybrid airloads); off in the statics
+    let source = opts.airloads;
+    let aero_active = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    // the hybrid's periodic reference: recorded first, adopted once the run has found it
+    let reference_adopted = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let aero_common = aero_common(spec, record, file, source)?;
+    let physical = model_kind == DamperModel::Physical;
+    let ctx = BuildCtx {
+        whole,
+        file,
+        model_kind,
+        record,
+        opts,
+        period,
+        base_controls,
+        t_ramp,
+        scale,
+        source,
+        aero_active,
+        reference_adopted,
+        physical,
+    };
+    let mut pending = Vec::with_capacity(blades.len());
+    for (k, &(bspec, damper, ahead_deg)) in blades.iter().enumerate() {
+        pending.push(add_blade(
+            &ctx,
+            &mut model,
+            k,
+            (bspec, damper, ahead_deg),
+            &aero_common,
+        )?);
+    }
+    let mut st = initial_state(&mut model, &ctx.scale, om)?;
+    ctx.aero_active.store(true, Ordering::Relaxed);
+    let hub = model.node_id(names::HUB)?;
+    let airframe = airframe_part(spec, whole, &model, &mut st)?;
+    let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
+    let parts = blade_parts(pending, blades, whole, &model)?;
+    let solver = dynamic_solver(model, st, h, opts, source)?;
+    let aero = aero_run(&ctx, blades, spec, aero_common)?;
+    Ok(RotorSim {
+        label: model_kind.name().to_string(),
+        solver,
+        period,
+        omega: om,
+        h,
+        physical,
+        parts,
+        airframe,
+        hub,
+        total_s: 0.0,
+        relaxed_steps: 0,
+        rtol: opts.newton_rtol,
+        step_tol: f64::NAN,
+        r0,
+        t_ramp,
+        output_channels: true,
+        in_whole_rotor: whole || opts.blade_azimuth_deg.is_some(),
+        aero,
+        reference_adopted: (source == super::aero::AirloadSource::HybridPeriodic
+            || (source == super::aero::AirloadSource::Hybrid && record.motion.is_none()))
+        .then_some(ctx.reference_adopted),
+    })
+}
+
+/// Expands the deck(s) into the structural model: the whole rotor or one blade.
+fn initial_model(
+    blades: &[(&RotorSpec, &DamperDeck, f64)],
+    whole: bool,
+    file: &Path,
+    base_controls: Controls,
+) -> anyhow::Result<Model> {
+    let spec = blades[0].0;
+    Ok(if whole {
         let specs: Vec<RotorSpec> = blades.iter().map(|b| b.0.clone()).collect();
         let xo = ExpandOptions {
             controls: base_controls,
@@ -460,15 +573,17 @@ fn build_parts(
             ..Default::default()
         };
         expanded_model(spec, &xo, file)?
-    };
-    let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
-    let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
-    // the lifting lines' shared state (computed and hybrid airloads); off in the statics
-    let source = opts.airloads;
-    let aero_active = Arc::new(std::sync::atomic::AtomicBool::new(false));
-    // the hybrid's periodic reference: recorded first, adopted once the run has found it
-    let reference_adopted = Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let aero_common = if source.aerodynamic() {
+    })
+}
+
+/// Sets up the lifting lines' shared air and inflow (computed and hybrid airloads only).
+fn aero_common(
+    spec: &RotorSpec,
+    record: &FlightRecord,
+    file: &Path,
+    source: super::aero::AirloadSource,
+) -> anyhow::Result<Option<AeroCommon>> {
+    Ok(if source.aerodynamic() {
         use crate::aero::inflow::Inflow;
         let air = super::aero::rotor_air(spec, record)?;
         let cond = super::aero::flight_condition(&air);
@@ -488,164 +603,183 @@ fn build_parts(
         ))
     } else {
         None
+    })
+}
+
+/// Adds blade k's swashplate setting, damper element and airloads to the model.
+fn add_blade(
+    ctx: &BuildCtx,
+    model: &mut Model,
+    k: usize,
+    (bspec, damper, ahead_deg): (&RotorSpec, &DamperDeck, f64),
+    aero_common: &Option<AeroCommon>,
+) -> anyhow::Result<Pending> {
+    let prefix = if ctx.whole && k > 0 {
+        format!("b{}.", k + 1)
+    } else if ctx.whole {
+        "b1.".to_string()
+    } else {
+        String::new()
     };
-    let physical = model_kind == DamperModel::Physical;
-    struct Pending {
-        prefix: String,
-        controls: Controls,
-        swash: usize,
-        probe: Arc<HydraulicProbe>,
-        dev_names: Vec<String>,
-        damper_nodes: [usize; 2],
-        limits: Option<(f64, f64)>,
-        regulation: Option<[super::ReliefRegulation; 2]>,
-    }
-    let mut pending = Vec::with_capacity(blades.len());
-    for (k, &(bspec, damper, ahead_deg)) in blades.iter().enumerate() {
-        let prefix = if whole && k > 0 {
-            format!("b{}.", k + 1)
-        } else if whole {
-            "b1.".to_string()
-        } else {
-            String::new()
-        };
-        let nm = |s: &str| format!("{prefix}{s}");
-        let controls = base_controls.ahead_by(ahead_deg);
-        let swash = joint_id(&model, &nm(names::SWASH_DRIVE))?;
-        set_swash(
-            &mut model,
-            swash,
-            &[(0.0, bspec.swash_z(bspec.pitch_rad(&controls, 0.0)))],
-        );
-        let device = damper.build(model_kind, opts.hydraulics)?;
-        let dev_names: Vec<String> = device
-            .channel_names()
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-        let n_hub_end = model.node_id(&nm(names::DAMPER_HUB_END))?;
-        let n_blade_end = model.node_id(&nm(names::DAMPER_BLADE_END))?;
-        // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
-        // the step mean F_m is unstable with generalized-alpha for stiff devices).
-        let elem = HydraulicForceElement::new(nm("damper"), n_hub_end, n_blade_end, device)
-            .with_reference_length(bspec.damper_attachment.reference_length_m);
-        let probe = elem.probe();
-        model.add_step_element(Box::new(elem))?;
-        let full = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
-        let mean = AirloadReplay::new(
-            record,
-            ReplayMode::Average,
-            ReplayOptions {
-                harmonics: Some(0),
-                ..Default::default()
-            },
-        )?;
-        let airloads = BladeAirloads {
-            full,
-            mean,
-            ahead_deg,
-            root_r_m: bspec.blade.root_r_m,
-            t_ramp,
-            scale: scale.clone(),
-            control_pitch: match bspec.blade.airload_frame {
-                AirloadFrame::Deformed => None,
-                AirloadFrame::ControlPitch => Some(ControlPitch::new(
-                    bspec,
-                    controls,
-                    &model,
-                    &nm(names::BLADE),
-                )?),
-            },
-        };
-        let load: Box<dyn DistributedLoad> = match &aero_common {
-            None => super::transient::blade_load(
-                airloads,
-                &model,
-                &nm(names::BLADE),
+    let nm = |s: &str| format!("{prefix}{s}");
+    let controls = ctx.base_controls.ahead_by(ahead_deg);
+    let swash = joint_id(model, &nm(names::SWASH_DRIVE))?;
+    set_swash(
+        model,
+        swash,
+        &[(0.0, bspec.swash_z(bspec.pitch_rad(&controls, 0.0)))],
+    );
+    let device = damper.build(ctx.model_kind, ctx.opts.hydraulics)?;
+    let dev_names: Vec<String> = device
+        .channel_names()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let n_hub_end = model.node_id(&nm(names::DAMPER_HUB_END))?;
+    let n_blade_end = model.node_id(&nm(names::DAMPER_BLADE_END))?;
+    // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
+    // the step mean F_m is unstable with generalized-alpha for stiff devices).
+    let elem = HydraulicForceElement::new(nm("damper"), n_hub_end, n_blade_end, device)
+        .with_reference_length(bspec.damper_attachment.reference_length_m);
+    let probe = elem.probe();
+    model.add_step_element(Box::new(elem))?;
+    let record = ctx.record;
+    let full = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;
+    let mean = AirloadReplay::new(
+        record,
+        ReplayMode::Average,
+        ReplayOptions {
+            harmonics: Some(0),
+            ..Default::default()
+        },
+    )?;
+    let airloads = BladeAirloads {
+        full,
+        mean,
+        ahead_deg,
+        root_r_m: bspec.blade.root_r_m,
+        t_ramp: ctx.t_ramp,
+        scale: ctx.scale.clone(),
+        control_pitch: match bspec.blade.airload_frame {
+            AirloadFrame::Deformed => None,
+            AirloadFrame::ControlPitch => Some(ControlPitch::new(
                 bspec,
-                record,
-                opts.steps_per_rev,
-                opts.perturbation_damping,
-            )?,
-            // the lifting line's damping replaces the perturbation damping
-            Some((air, shared, clamps)) => {
-                use super::aero::{AirloadSource, ComputedLoad, HybridLoad};
-                let (geometry, _) = super::aero::blade_geometry(bspec, file)?;
-                let ahead = ahead_deg.to_radians();
-                let model_turn = if whole { ahead } else { 0.0 };
-                let line = crate::aero::lifting_line::LiftingLine::new(
-                    &model,
-                    &nm(names::BLADE),
-                    &geometry,
-                    *air,
-                    clamps.clone(),
-                    shared.clone(),
-                    k,
-                )?
-                .with_turn(ahead - model_turn);
-                if source.hybrid() {
-                    let stations = line.stations();
-                    let reference = if source == AirloadSource::Hybrid && record.motion.is_some() {
-                        super::aero::Reference::Record(Box::new(super::aero::reference_motion(
-                            record,
-                            bspec,
-                            &model,
-                            &nm(names::BLADE),
-                            &line,
-                            ahead,
-                            model_turn,
-                        )?))
-                    } else {
-                        super::aero::Reference::Periodic(super::aero::PeriodicReference::new(
-                            stations,
-                            opts.steps_per_rev,
-                            period / opts.steps_per_rev as f64,
-                            reference_adopted.clone(),
-                        ))
-                    };
-                    Box::new(HybridLoad {
-                        measured: airloads,
-                        line,
-                        reference,
-                        reference_cache: vec![(f64::NAN, Default::default()); stations],
-                        t_ramp,
-                        active: aero_active.clone(),
-                    })
+                controls,
+                model,
+                &nm(names::BLADE),
+            )?),
+        },
+    };
+    let load = blade_distributed_load(
+        ctx,
+        model,
+        k,
+        &nm(names::BLADE),
+        bspec,
+        ahead_deg,
+        airloads,
+        aero_common,
+    )?;
+    model.add_distributed_load(&nm(names::BLADE), load)?;
+    Ok(Pending {
+        prefix,
+        controls,
+        swash,
+        probe,
+        dev_names,
+        damper_nodes: [n_hub_end, n_blade_end],
+        limits: if ctx.physical {
+            relief_limits(damper)
+        } else {
+            None
+        },
+        regulation: if ctx.physical {
+            damper
+                .physical
+                .as_ref()
+                .and_then(super::ReliefRegulation::of)
+        } else {
+            None
+        },
+    })
+}
+
+/// Makes blade k's airload provider: the replay, or a computed or hybrid lifting line.
+#[allow(clippy::too_many_arguments)]
+fn blade_distributed_load(
+    ctx: &BuildCtx,
+    model: &Model,
+    k: usize,
+    blade: &str,
+    bspec: &RotorSpec,
+    ahead_deg: f64,
+    airloads: BladeAirloads,
+    aero_common: &Option<AeroCommon>,
+) -> anyhow::Result<Box<dyn DistributedLoad>> {
+    let (record, opts, source, t_ramp) = (ctx.record, ctx.opts, ctx.source, ctx.t_ramp);
+    Ok(match aero_common {
+        None => super::transient::blade_load(
+            airloads,
+            model,
+            blade,
+            bspec,
+            record,
+            opts.steps_per_rev,
+            opts.perturbation_damping,
+        )?,
+        // the lifting line's damping replaces the perturbation damping
+        Some((air, shared, clamps)) => {
+            use super::aero::{AirloadSource, ComputedLoad, HybridLoad};
+            let (geometry, _) = super::aero::blade_geometry(bspec, ctx.file)?;
+            let ahead = ahead_deg.to_radians();
+            let model_turn = if ctx.whole { ahead } else { 0.0 };
+            let line = crate::aero::lifting_line::LiftingLine::new(
+                model,
+                blade,
+                &geometry,
+                *air,
+                clamps.clone(),
+                shared.clone(),
+                k,
+            )?
+            .with_turn(ahead - model_turn);
+            if source.hybrid() {
+                let stations = line.stations();
+                let reference = if source == AirloadSource::Hybrid && record.motion.is_some() {
+                    super::aero::Reference::Record(Box::new(super::aero::reference_motion(
+                        record, bspec, model, blade, &line, ahead, model_turn,
+                    )?))
                 } else {
-                    Box::new(ComputedLoad {
-                        statics: airloads,
-                        line,
-                        active: aero_active.clone(),
-                        t_ramp,
-                    })
-                }
+                    super::aero::Reference::Periodic(super::aero::PeriodicReference::new(
+                        stations,
+                        opts.steps_per_rev,
+                        ctx.period / opts.steps_per_rev as f64,
+                        ctx.reference_adopted.clone(),
+                    ))
+                };
+                Box::new(HybridLoad {
+                    measured: airloads,
+                    line,
+                    reference,
+                    reference_cache: vec![(f64::NAN, Default::default()); stations],
+                    t_ramp,
+                    active: ctx.aero_active.clone(),
+                })
+            } else {
+                Box::new(ComputedLoad {
+                    statics: airloads,
+                    line,
+                    active: ctx.aero_active.clone(),
+                    t_ramp,
+                })
             }
-        };
-        model.add_distributed_load(&nm(names::BLADE), load)?;
-        pending.push(Pending {
-            prefix,
-            controls,
-            swash,
-            probe,
-            dev_names,
-            damper_nodes: [n_hub_end, n_blade_end],
-            limits: if physical {
-                relief_limits(damper)
-            } else {
-                None
-            },
-            regulation: if physical {
-                damper
-                    .physical
-                    .as_ref()
-                    .and_then(super::ReliefRegulation::of)
-            } else {
-                None
-            },
-        });
-    }
-    // initial state: rotating static equilibrium under the mean loads and the collective
-    let mut st = State::from_model(&model);
+        }
+    })
+}
+
+/// Solves the initial state: rotating static equilibrium under the mean loads and collective.
+fn initial_state(model: &mut Model, scale: &AtomicU64, om: f64) -> anyhow::Result<State> {
+    let mut st = State::from_model(model);
     let sopts = StaticOptions {
         load_steps: 1,
         omega: Some([0.0, 0.0, om]),
@@ -656,7 +790,7 @@ fn build_parts(
     const STEPS: usize = 8;
     for k in 0..=STEPS {
         scale.store((k as f64 / STEPS as f64).to_bits(), Ordering::Relaxed);
-        static_solve(&mut model, &mut st, &sopts, |_, _, _, _| {})
+        static_solve(model, &mut st, &sopts, |_, _, _, _| {})
         .map_err(|e| {
             anyhow::anyhow!(
                 "rotating equilibrium at t = 0 under {:.0}% of the mean airloads (initial state): {e}",
@@ -665,9 +799,17 @@ fn build_parts(
         })?;
     }
     st.set_rigid_rotation([0.0; 3], [0.0, 0.0, om]);
-    aero_active.store(true, Ordering::Relaxed);
-    let hub = model.node_id(names::HUB)?;
-    let airframe = match (&spec.airframe, whole) {
+    Ok(st)
+}
+
+/// Finds the whole rotor's airframe chain and mount, and starts the airframe at rest.
+fn airframe_part(
+    spec: &RotorSpec,
+    whole: bool,
+    model: &Model,
+    st: &mut State,
+) -> anyhow::Result<Option<AirframePart>> {
+    Ok(match (&spec.airframe, whole) {
         (Some(a), true) => {
             let dofs = super::expand::airframe_chain(a);
             let chain = dofs
@@ -681,7 +823,7 @@ fn build_parts(
                 st.a[i] = [0.0; 3];
                 st.al[i] = [0.0; 3];
             }
-            let mount = match &model.elements[joint_id(&model, names::SHAFT)?] {
+            let mount = match &model.elements[joint_id(model, names::SHAFT)?] {
                 Element::Joint(j) => j.node_a,
                 _ => None,
             }
@@ -696,8 +838,16 @@ fn build_parts(
             })
         }
         _ => None,
-    };
-    let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
+    })
+}
+
+/// Completes each pending blade into its output part: tip, root, frame and load channels.
+fn blade_parts(
+    pending: Vec<Pending>,
+    blades: &[(&RotorSpec, &DamperDeck, f64)],
+    whole: bool,
+    model: &Model,
+) -> anyhow::Result<Vec<BladePart>> {
     let mut parts = Vec::with_capacity(pending.len());
     for (p, &(bspec, _, ahead_deg)) in pending.into_iter().zip(blades) {
         let nm = |s: &str| format!("{}{s}", p.prefix);
@@ -714,12 +864,8 @@ fn build_parts(
         let frame = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
         let tip_ref = mtv(&frame, model.nodes[tip].x0);
         let twist_ref = rel_twist(&model.node_r0(root), &model.node_r0(tip));
-        let loads = super::loads::LoadChannels::for_blade(
-            bspec,
-            &model,
-            &p.prefix,
-            ahead_deg.to_radians(),
-        )?;
+        let loads =
+            super::loads::LoadChannels::for_blade(bspec, model, &p.prefix, ahead_deg.to_radians())?;
         let scratch = Mutex::new(vec![0.0; p.probe.channel_names().len()]);
         parts.push(BladePart {
             prefix: p.prefix,
@@ -741,6 +887,17 @@ fn build_parts(
             regulation: p.regulation,
         });
     }
+    Ok(parts)
+}
+
+/// Creates the generalized-alpha solver with the run's Newton settings and initial accelerations.
+fn dynamic_solver(
+    model: Model,
+    st: State,
+    h: f64,
+    opts: &RunOptions,
+    source: super::aero::AirloadSource,
+) -> anyhow::Result<DynamicSolver> {
     let mut solver = DynamicSolver::new(model, st, h, opts.rho_inf)?;
     // ||r|| <= 1e-7 ||r_0||: r_0 is the predictor residual (inertia of the whole blade, ~1e6);
     // the hydraulic force is only piecewise smooth (valve seat contact), and its
@@ -753,7 +910,18 @@ fn build_parts(
         solver.newton.max_iterations = 50;
     }
     solver.init_accelerations()?;
-    let aero = match aero_common {
+    Ok(solver)
+}
+
+/// Assembles the run's aerodynamic bookkeeping (computed and hybrid airloads only).
+fn aero_run(
+    ctx: &BuildCtx,
+    blades: &[(&RotorSpec, &DamperDeck, f64)],
+    spec: &RotorSpec,
+    aero_common: Option<AeroCommon>,
+) -> anyhow::Result<Option<AeroRun>> {
+    let (record, opts, source) = (ctx.record, ctx.opts, ctx.source);
+    Ok(match aero_common {
         None => None,
         Some((air, shared, clamps)) => Some(AeroRun {
             source,
@@ -786,7 +954,7 @@ fn build_parts(
                 vec![]
             },
             blades: spec.rotor.blades,
-            airfoils: super::aero::blade_geometry(spec, file)?
+            airfoils: super::aero::blade_geometry(spec, ctx.file)?
                 .0
                 .airfoils
                 .iter()
@@ -795,29 +963,6 @@ fn build_parts(
             record_ct_over_sigma: record.meta.thrust_coefficient_over_solidity,
             record_synthetic: record.meta.synthetic,
         }),
-    };
-    Ok(RotorSim {
-        label: model_kind.name().to_string(),
-        solver,
-        period,
-        omega: om,
-        h,
-        physical,
-        parts,
-        airframe,
-        hub,
-        total_s: 0.0,
-        relaxed_steps: 0,
-        rtol: opts.newton_rtol,
-        step_tol: f64::NAN,
-        r0,
-        t_ramp,
-        output_channels: true,
-        in_whole_rotor: whole || opts.blade_azimuth_deg.is_some(),
-        aero,
-        reference_adopted: (source == super::aero::AirloadSource::HybridPeriodic
-            || (source == super::aero::AirloadSource::Hybrid && record.motion.is_none()))
-        .then_some(reference_adopted),
     })
 }
 
