@@ -296,6 +296,62 @@ pub fn drive_periodic(
     Ok(run)
 }
 
+/// What every stage of [`drive_periodic_once`] reads: the options, the channels it watches.
+struct DriveCtx<'a> {
+    model: DamperModel,
+    o: &'a PeriodicOptions,
+    progress: &'a dyn Fn(usize, Option<f64>),
+    /// Indices of the [`MONITORED`] channels.
+    mon: Vec<usize>,
+    /// Indices of the sub-step envelope channels.
+    env_channels: Vec<usize>,
+    can_save: bool,
+    /// Shooting asked for, and the simulation can save its state.
+    shooting: bool,
+    /// Model time from which a revolution counts as periodic (half a step early).
+    periodic_from: f64,
+}
+
+impl DriveCtx<'_> {
+    /// The progress label of marched revolution `p`.
+    fn march_label(&self, p: usize) -> String {
+        format!(
+            "{} model, revolution {p} of at most {}",
+            self.model.name(),
+            self.o.max_revs
+        )
+    }
+
+    /// Keep `rev` (envelopes aligned) when every revolution is asked for.
+    fn keep(&self, kept: &mut Vec<KeptRevolution>, rev: &Revolution, iterate: usize) {
+        if self.o.keep_all_revs {
+            kept.push(KeptRevolution {
+                shooting_iterate: iterate,
+                start_t_s: rev.start_t_s,
+                samples: {
+                    let mut v = rev.samples.clone();
+                    align_envelopes(&mut v, &rev.end, &self.env_channels);
+                    v
+                },
+            });
+        }
+    }
+}
+
+/// The periodic search as it goes: the last revolution, its start state, the counts.
+struct DriveState {
+    info: PeriodicInfo,
+    rev: Revolution,
+    kept: Vec<KeptRevolution>,
+    start_state: Option<SimState>,
+    periods: usize,
+    /// Shooting's slowest decaying multiplier magnitude (below 1).
+    slowest: Option<f64>,
+    /// Shooting's own error estimate.
+    step_estimate: Option<f64>,
+}
+
+/// Drive one simulation to its periodic solution: march, then shoot (or not), then report.
 fn drive_periodic_once(
     sim: &mut dyn ForcedResponse,
     model: DamperModel,
@@ -312,19 +368,7 @@ fn drive_periodic_once(
     let env_channels: Vec<usize> = (0..nc)
         .filter(|&c| crate::hydraulics::circuit::is_substep_envelope(&names[c]))
         .collect();
-    let idx = |name: &str| -> anyhow::Result<usize> {
-        names.iter().position(|n| n == name).ok_or_else(|| {
-            anyhow::anyhow!(
-                "{}: channel {name} missing (channels: {})",
-                sim.label(),
-                names.join(", ")
-            )
-        })
-    };
-    let mon: Vec<usize> = MONITORED
-        .iter()
-        .map(|(n, _)| idx(n))
-        .collect::<anyhow::Result<_>>()?;
+    let mon = monitored_channels(sim, &names)?;
     let mut warm_note = None;
     if let Some(f) = &o.initial_state {
         let (s, note) = f.start_state(sim, model.name(), o.inputs_sha256.as_deref())?;
@@ -334,7 +378,6 @@ fn drive_periodic_once(
     }
     let can_save = sim.save_state().is_some();
     let shooting = o.method == PeriodicMethod::Shooting && can_save;
-    let (mut slowest, mut step_estimate) = (None, None);
     let mut info = new_info(o, mon.len());
     if o.method == PeriodicMethod::Shooting && !can_save {
         info.message = format!("{} cannot save its state: marched", sim.label());
@@ -343,172 +386,53 @@ fn drive_periodic_once(
         push_message(&mut info.message, n);
     }
     let periodic_from = sim.periodic_from_s() - 0.5 * dt;
-    let mut rev = Revolution::new(nc, n);
-    let mut start_state: Option<SimState> = None;
-    let mut periods = 0;
-    let mut in_periodic = 0;
-    let march_label = |p: usize| {
-        format!(
-            "{} model, revolution {p} of at most {}",
-            model.name(),
-            o.max_revs
-        )
+    let c = DriveCtx {
+        model,
+        o,
+        progress,
+        mon,
+        env_channels,
+        can_save,
+        shooting,
+        periodic_from,
     };
-    let mut kept: Vec<KeptRevolution> = vec![];
-    let keep = |kept: &mut Vec<KeptRevolution>, rev: &Revolution, iterate: usize| {
-        if o.keep_all_revs {
-            kept.push(KeptRevolution {
-                shooting_iterate: iterate,
-                start_t_s: rev.start_t_s,
-                samples: {
-                    let mut v = rev.samples.clone();
-                    align_envelopes(&mut v, &rev.end, &env_channels);
-                    v
-                },
-            });
-        }
+    let mut s = DriveState {
+        info,
+        rev: Revolution::new(nc, n),
+        kept: vec![],
+        start_state: None,
+        periods: 0,
+        slowest: None,
+        step_estimate: None,
     };
     // March: all of it, or until shooting starts.
-    let mut shoot_from: Option<SimState> = None;
-    while periods < o.max_revs {
-        let periodic = sim.time_s() >= periodic_from;
-        let st0 = if can_save { sim.save_state() } else { None };
-        integrate(sim, &mut rev, &march_label(periods + 1), &o.stop)?;
-        keep(&mut kept, &rev, 0);
-        periods += 1;
-        in_periodic += usize::from(periodic);
-        info.residual_by_channel = rev.residual(&mon);
-        let r = max_nan(&info.residual_by_channel);
-        info.residual_history.push(r);
-        progress(periods, Some(r));
-        start_state = st0;
-        if periodic && r <= o.tol {
-            info.converged = true;
-            if o.stop_early {
-                // periodic already: shooting only for the Floquet multipliers asked for
-                if shooting && o.min_floquet_dirs > 0 {
-                    shoot_from = start_state.clone();
-                }
-                break;
-            }
-        } else {
-            info.converged = false;
-        }
-        if shooting && in_periodic >= MARCH_BEFORE_SHOOTING {
-            shoot_from = start_state.clone();
-            break;
-        }
+    let shoot_from = march_until_shooting(sim, &c, &mut s)?;
+    if let Some(st0) = shoot_from.filter(|_| !s.info.converged || o.min_floquet_dirs > 0) {
+        s = shoot_stage(sim, &c, s, st0)?;
     }
-    info.marched_revolutions = periods;
-    if let Some(st0) = shoot_from.filter(|_| !info.converged || o.min_floquet_dirs > 0) {
-        let end = sim
-            .save_state()
-            .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
-        let label = format!("{} model", model.name());
-        let mut map = SimMap::new(sim, mon.clone(), st0, end, rev, periods, progress, label);
-        map.stop = o.stop.clone();
-        if o.keep_all_revs {
-            map.kept = Some(vec![]);
-        }
-        info.residual_history = vec![max_nan(&map.residual_by_channel)];
-        let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
-        periods = map.periods;
-        info.iterations = out.iterations;
-        info.directions = out.directions;
-        info.rejected_trials = out.rejected_trials;
-        info.residual_history = out.residual_history.clone();
-        info.residual_by_channel = map.residual_by_channel.clone();
-        info.converged = out.converged();
-        info.method_used = PeriodicMethod::Shooting;
-        let (start, end) = (map.start.clone(), map.end.clone());
-        rev = std::mem::replace(&mut map.rev, Revolution::new(0, 0));
-        for (k, r) in map.kept.take().unwrap_or_default().iter().enumerate() {
-            keep(&mut kept, r, k + 1);
-        }
-        drop(map);
-        // shooting reports a stopped revolution as a failed one: stop here, not march on
-        o.stop.check(
-            sim.time_s(),
-            &format!("{} model, revolution {periods} (shooting)", model.name()),
-        )?;
-        start_state = Some(start);
-        let mult = reported_multipliers(sim, &out.ritz);
-        slowest = out
-            .ritz
-            .first()
-            .map(|p| p.multiplier.magnitude)
-            .filter(|m| *m < 1.0);
-        step_estimate = out.error_estimate;
-        info.floquet_multipliers = mult;
-        if !info.converged {
-            let why = stop_reason(&out.stop, o.max_revs);
-            push_message(
-                &mut info.message,
-                format!(
-                    "shooting did not converge ({why}; residual {:.2e}); marching on from its best state",
-                    max_nan(&info.residual_by_channel)
-                ),
-            );
-            // march on from the end of the best revolution
-            sim.restore_state(&end)?;
-            while periods < o.max_revs {
-                let st0 = sim.save_state();
-                integrate(sim, &mut rev, &march_label(periods + 1), &o.stop)?;
-                keep(&mut kept, &rev, 0);
-                periods += 1;
-                info.residual_by_channel = rev.residual(&mon);
-                let r = max_nan(&info.residual_by_channel);
-                info.residual_history.push(r);
-                progress(periods, Some(r));
-                start_state = st0;
-                info.method_used = PeriodicMethod::March;
-                if r <= o.tol {
-                    info.converged = true;
-                    break;
-                }
-            }
-        }
-    }
-    info.residual = max_nan(&info.residual_by_channel);
-    // shooting: from the last step and the contraction it achieved; marching: a slow mode
-    // decaying by |mu_1| per revolution is residual / (1 - |mu_1|) from its end
-    info.error_estimate = match info.method_used {
-        PeriodicMethod::Shooting => step_estimate,
-        PeriodicMethod::March => slowest.map(|m| info.residual / (1.0 - m)),
-    };
-    info.revolutions_integrated = periods;
-    info.start_t_s = rev.start_t_s;
-    if !info.converged && !info.message.contains("did not converge") {
-        push_message(
-            &mut info.message,
-            format!(
-                "not periodic: residual {:.2e} after {periods} revolutions, above the tolerance {:.0e}",
-                info.residual, o.tol
-            ),
-        );
-    }
+    conclude_info(&mut s, o);
     finish_revolution(
-        &mut rev,
-        &mut kept,
+        &mut s.rev,
+        &mut s.kept,
         &names,
-        &env_channels,
-        info.method_used == PeriodicMethod::Shooting,
+        &c.env_channels,
+        s.info.method_used == PeriodicMethod::Shooting,
     );
     let timing = sim.timing();
     let blades = sim.blades();
     let mut run = ModelRun {
         model: model.name().to_string(),
         label: sim.label().to_string(),
-        revolutions: periods,
+        revolutions: s.periods,
         steps_per_rev: n,
         period_s: period,
-        periodic: info,
-        periodic_state: start_state,
+        periodic: s.info,
+        periodic_state: s.start_state,
         channel_names: names,
-        time_s: (0..n).map(|j| rev.start_t_s + j as f64 * dt).collect(),
-        azimuth_deg: rev.azimuth,
-        last_rev: rev.samples,
-        all_revs: kept,
+        time_s: (0..n).map(|j| s.rev.start_t_s + j as f64 * dt).collect(),
+        azimuth_deg: s.rev.azimuth,
+        last_rev: s.rev.samples,
+        all_revs: s.kept,
         force_limits_n: sim.force_limits_n(),
         relief_regulation: sim.relief_regulation(),
         timing,
@@ -525,6 +449,187 @@ fn drive_periodic_once(
     loads::finish(&mut run, blades);
     envelopes_last(&mut run);
     Ok(run)
+}
+
+/// The indices of the [`MONITORED`] channels among `names` (an error naming a missing one).
+fn monitored_channels(sim: &dyn ForcedResponse, names: &[String]) -> anyhow::Result<Vec<usize>> {
+    let idx = |name: &str| -> anyhow::Result<usize> {
+        names.iter().position(|n| n == name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: channel {name} missing (channels: {})",
+                sim.label(),
+                names.join(", ")
+            )
+        })
+    };
+    MONITORED
+        .iter()
+        .map(|(n, _)| idx(n))
+        .collect::<anyhow::Result<_>>()
+}
+
+/// March revolution by revolution until periodic, out of revolutions, or time to shoot;
+/// returns the state to shoot from, if shooting is to follow.
+fn march_until_shooting(
+    sim: &mut dyn ForcedResponse,
+    c: &DriveCtx,
+    s: &mut DriveState,
+) -> anyhow::Result<Option<SimState>> {
+    let o = c.o;
+    let mut in_periodic = 0;
+    let mut shoot_from: Option<SimState> = None;
+    while s.periods < o.max_revs {
+        let periodic = sim.time_s() >= c.periodic_from;
+        let st0 = if c.can_save { sim.save_state() } else { None };
+        integrate(sim, &mut s.rev, &c.march_label(s.periods + 1), &o.stop)?;
+        c.keep(&mut s.kept, &s.rev, 0);
+        s.periods += 1;
+        in_periodic += usize::from(periodic);
+        s.info.residual_by_channel = s.rev.residual(&c.mon);
+        let r = max_nan(&s.info.residual_by_channel);
+        s.info.residual_history.push(r);
+        (c.progress)(s.periods, Some(r));
+        s.start_state = st0;
+        if periodic && r <= o.tol {
+            s.info.converged = true;
+            if o.stop_early {
+                // periodic already: shooting only for the Floquet multipliers asked for
+                if c.shooting && o.min_floquet_dirs > 0 {
+                    shoot_from = s.start_state.clone();
+                }
+                break;
+            }
+        } else {
+            s.info.converged = false;
+        }
+        if c.shooting && in_periodic >= MARCH_BEFORE_SHOOTING {
+            shoot_from = s.start_state.clone();
+            break;
+        }
+    }
+    s.info.marched_revolutions = s.periods;
+    Ok(shoot_from)
+}
+
+/// Shoot from `st0` (the start of the last marched revolution): the periodic state and the
+/// Floquet multipliers; if it does not converge, march on from its best state.
+fn shoot_stage(
+    sim: &mut dyn ForcedResponse,
+    c: &DriveCtx,
+    mut s: DriveState,
+    st0: SimState,
+) -> anyhow::Result<DriveState> {
+    let o = c.o;
+    let model = c.model;
+    let end = sim
+        .save_state()
+        .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
+    let label = format!("{} model", model.name());
+    let mut map = SimMap::new(
+        sim,
+        c.mon.clone(),
+        st0,
+        end,
+        s.rev,
+        s.periods,
+        c.progress,
+        label,
+    );
+    map.stop = o.stop.clone();
+    if o.keep_all_revs {
+        map.kept = Some(vec![]);
+    }
+    s.info.residual_history = vec![max_nan(&map.residual_by_channel)];
+    let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
+    s.periods = map.periods;
+    s.info.iterations = out.iterations;
+    s.info.directions = out.directions;
+    s.info.rejected_trials = out.rejected_trials;
+    s.info.residual_history = out.residual_history.clone();
+    s.info.residual_by_channel = map.residual_by_channel.clone();
+    s.info.converged = out.converged();
+    s.info.method_used = PeriodicMethod::Shooting;
+    let (start, end) = (map.start.clone(), map.end.clone());
+    s.rev = std::mem::replace(&mut map.rev, Revolution::new(0, 0));
+    for (k, r) in map.kept.take().unwrap_or_default().iter().enumerate() {
+        c.keep(&mut s.kept, r, k + 1);
+    }
+    drop(map);
+    // shooting reports a stopped revolution as a failed one: stop here, not march on
+    let periods = s.periods;
+    o.stop.check(
+        sim.time_s(),
+        &format!("{} model, revolution {periods} (shooting)", model.name()),
+    )?;
+    s.start_state = Some(start);
+    let mult = reported_multipliers(sim, &out.ritz);
+    s.slowest = out
+        .ritz
+        .first()
+        .map(|p| p.multiplier.magnitude)
+        .filter(|m| *m < 1.0);
+    s.step_estimate = out.error_estimate;
+    s.info.floquet_multipliers = mult;
+    if !s.info.converged {
+        let why = stop_reason(&out.stop, o.max_revs);
+        push_message(
+            &mut s.info.message,
+            format!(
+                "shooting did not converge ({why}; residual {:.2e}); marching on from its best state",
+                max_nan(&s.info.residual_by_channel)
+            ),
+        );
+        // march on from the end of the best revolution
+        sim.restore_state(&end)?;
+        march_on(sim, c, &mut s)?;
+    }
+    Ok(s)
+}
+
+/// After shooting that did not converge: march on until periodic or out of revolutions.
+fn march_on(sim: &mut dyn ForcedResponse, c: &DriveCtx, s: &mut DriveState) -> anyhow::Result<()> {
+    let o = c.o;
+    while s.periods < o.max_revs {
+        let st0 = sim.save_state();
+        integrate(sim, &mut s.rev, &c.march_label(s.periods + 1), &o.stop)?;
+        c.keep(&mut s.kept, &s.rev, 0);
+        s.periods += 1;
+        s.info.residual_by_channel = s.rev.residual(&c.mon);
+        let r = max_nan(&s.info.residual_by_channel);
+        s.info.residual_history.push(r);
+        (c.progress)(s.periods, Some(r));
+        s.start_state = st0;
+        s.info.method_used = PeriodicMethod::March;
+        if r <= o.tol {
+            s.info.converged = true;
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// The search's closing figures: residual, error estimate, counts, and why not periodic.
+fn conclude_info(s: &mut DriveState, o: &PeriodicOptions) {
+    let info = &mut s.info;
+    info.residual = max_nan(&info.residual_by_channel);
+    // shooting: from the last step and the contraction it achieved; marching: a slow mode
+    // decaying by |mu_1| per revolution is residual / (1 - |mu_1|) from its end
+    info.error_estimate = match info.method_used {
+        PeriodicMethod::Shooting => s.step_estimate,
+        PeriodicMethod::March => s.slowest.map(|m| info.residual / (1.0 - m)),
+    };
+    let periods = s.periods;
+    info.revolutions_integrated = periods;
+    info.start_t_s = s.rev.start_t_s;
+    if !info.converged && !info.message.contains("did not converge") {
+        push_message(
+            &mut info.message,
+            format!(
+                "not periodic: residual {:.2e} after {periods} revolutions, above the tolerance {:.0e}",
+                info.residual, o.tol
+            ),
+        );
+    }
 }
 
 /// The period, the time step and the steps per period (a whole number of at least 4).
