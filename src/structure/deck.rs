@@ -894,132 +894,206 @@ pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), 
 
 type Probes = Vec<(String, Arc<HydraulicProbe>)>;
 
+/// What every build stage needs: the deck file (named in errors) and the base directory.
+struct Ctx<'a> {
+    file: &'a str,
+    base: &'a Path,
+}
+
+impl Ctx<'_> {
+    /// An invalid-value error at `key` of this deck.
+    fn inv(&self, key: String, msg: String) -> DeckError {
+        DeckError::invalid(self.file, key, msg)
+    }
+
+    /// The id of node `name`, or an error at `key` if it does not exist.
+    fn node(&self, m: &Model, key: &str, name: &str) -> Result<usize, DeckError> {
+        m.node_id(name).map_err(|_| self.inv(key.into(), format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)")))
+    }
+}
+
+/// Builds the structural model from a checked deck, stage by stage in deck-section order.
 fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError> {
-    let inv = |key: String, msg: String| DeckError::invalid(file, key, msg);
+    let ctx = Ctx { file, base };
     let mut m = Model::new();
     m.gravity = d.gravity_m_s2;
+    add_nodes(&ctx, &mut m, d)?;
+    for (i, b) in d.beams.iter().enumerate() {
+        add_beam(&ctx, &mut m, i, b)?;
+    }
+    add_rigid_bodies(&ctx, &mut m, d)?;
+    for (i, j) in d.joints.iter().enumerate() {
+        add_joint(&ctx, &mut m, i, j)?;
+    }
+    add_loads(&ctx, &mut m, d)?;
+    let probes = add_hydraulics(&ctx, &mut m, d)?;
+    for (i, s) in d.sensors.iter().enumerate() {
+        add_sensor(&ctx, &mut m, i, s)?;
+    }
+    check_connected(&ctx, &m)?;
+    Ok((m, probes))
+}
+
+/// Adds the `[[node]]` nodes.
+fn add_nodes(ctx: &Ctx, m: &mut Model, d: &Deck) -> Result<(), DeckError> {
     for (i, n) in d.nodes.iter().enumerate() {
         let r = exp_map(n.rotation_vector_rad);
         m.add_node(&n.name, n.position_m, r)
-            .map_err(|e| inv(format!("node[{i}] `{}`", n.name), e.to_string()))?;
+            .map_err(|e| ctx.inv(format!("node[{i}] `{}`", n.name), e.to_string()))?;
     }
-    let node = |m: &Model, key: &str, name: &str| -> Result<usize, DeckError> {
-        m.node_id(name).map_err(|_| inv(key.into(), format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)")))
+    Ok(())
+}
+
+/// Reads the section table of one beam (from exactly one of its three section keys).
+fn beam_sections(ctx: &Ctx, b: &BeamDeck, key: &str) -> Result<SectionTable, DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    let (file, base, key) = (ctx.file, ctx.base, key.to_string());
+    let sec = match (&b.sections_csv, &b.section, &b.sections) {
+        (Some(p), None, None) => {
+            let pb = PathBuf::from(p);
+            let pb = if pb.is_absolute() { pb } else { base.join(pb) };
+            SectionTable::from_csv(&pb).map_err(|e| inv(format!("{key}.sections_csv"), e.to_string()))?
+        }
+        (None, Some(s), None) => SectionTable::new(vec![*s], file).map_err(|e| inv(format!("{key}.section"), e.to_string()))?,
+        (None, None, Some(v)) => SectionTable::new(v.clone(), file).map_err(|e| inv(format!("{key}.sections"), e.to_string()))?,
+        (None, None, None) => return Err(inv(key, "missing section data: give exactly one of `sections_csv`, `section` (uniform) or `sections` (inline table)".into())),
+        _ => return Err(inv(key, "give only one of `sections_csv`, `section`, `sections`".into())),
     };
-    for (i, b) in d.beams.iter().enumerate() {
-        let key = format!("beam[{i}] `{}`", b.name);
-        let sec = match (&b.sections_csv, &b.section, &b.sections) {
-            (Some(p), None, None) => {
-                let pb = PathBuf::from(p);
-                let pb = if pb.is_absolute() { pb } else { base.join(pb) };
-                SectionTable::from_csv(&pb).map_err(|e| inv(format!("{key}.sections_csv"), e.to_string()))?
-            }
-            (None, Some(s), None) => SectionTable::new(vec![*s], file).map_err(|e| inv(format!("{key}.section"), e.to_string()))?,
-            (None, None, Some(v)) => SectionTable::new(v.clone(), file).map_err(|e| inv(format!("{key}.sections"), e.to_string()))?,
-            (None, None, None) => return Err(inv(key, "missing section data: give exactly one of `sections_csv`, `section` (uniform) or `sections` (inline table)".into())),
-            _ => return Err(inv(key, "give only one of `sections_csv`, `section`, `sections`".into())),
-        };
-        let first = match &b.start_node {
-            Some(n) => Some(node(&m, &format!("{key}.start_node"), n)?),
-            None => None,
-        };
-        if b.elements == 0 {
-            return Err(inv(format!("{key}.elements"), "must be at least 1".into()));
-        }
-        if b.twist_deg.is_some() && b.arc.is_some() {
-            return Err(inv(
-                format!("{key}.twist_deg"),
-                "only straight beams (`start_m`, `end_m`) take a twist table".into(),
-            ));
-        }
-        let res = match (&b.arc, b.start_m, b.end_m) {
-            (None, Some(a), Some(e)) if b.twist_deg.is_some() => {
-                let tw = twist_table(b.twist_deg.as_deref().unwrap_or_default())
-                    .map_err(|msg| inv(format!("{key}.twist_deg"), msg))?;
-                let d = sub(e, a);
-                let len = dot(d, d).sqrt();
-                let r = frame_from_axis(d, b.e2_direction);
-                let curve = move |s: f64| {
-                    let r_tw = mm(&r, &exp_map([tw.eval(s).to_radians(), 0.0, 0.0]));
-                    (add(a, fmul(s / len, d)), r_tw)
-                };
-                m.add_beam(
-                    &b.name,
-                    b.elements,
-                    len,
-                    &curve,
-                    &sec,
-                    b.damping_mu_s,
-                    first,
-                )
-            }
-            (None, Some(a), Some(e)) => m.add_straight_beam(
+    Ok(sec)
+}
+
+/// Adds one `[[beam]]` (straight, twisted straight or arc) and checks its start node.
+fn add_beam(ctx: &Ctx, m: &mut Model, i: usize, b: &BeamDeck) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    let key = format!("beam[{i}] `{}`", b.name);
+    let sec = beam_sections(ctx, b, &key)?;
+    let first = match &b.start_node {
+        Some(n) => Some(ctx.node(m, &format!("{key}.start_node"), n)?),
+        None => None,
+    };
+    if b.elements == 0 {
+        return Err(inv(format!("{key}.elements"), "must be at least 1".into()));
+    }
+    if b.twist_deg.is_some() && b.arc.is_some() {
+        return Err(inv(
+            format!("{key}.twist_deg"),
+            "only straight beams (`start_m`, `end_m`) take a twist table".into(),
+        ));
+    }
+    let res = match (&b.arc, b.start_m, b.end_m) {
+        (None, Some(a), Some(e)) if b.twist_deg.is_some() => {
+            let tw = twist_table(b.twist_deg.as_deref().unwrap_or_default())
+                .map_err(|msg| inv(format!("{key}.twist_deg"), msg))?;
+            let (len, curve) = twisted_curve(a, e, b.e2_direction, tw);
+            m.add_beam(
                 &b.name,
                 b.elements,
-                a,
-                e,
-                b.e2_direction,
+                len,
+                &curve,
                 &sec,
                 b.damping_mu_s,
                 first,
-            ),
-            (Some(arc), None, None) => {
-                let n = arc.normal;
-                let nn = fmul(1.0 / dot(n, n).sqrt(), n);
-                let u0 = sub(arc.zero_direction, fmul(dot(arc.zero_direction, nn), nn));
-                let u = fmul(1.0 / dot(u0, u0).sqrt(), u0);
-                let v = cross(nn, u);
-                let (a0, a1) = (arc.start_deg.to_radians(), arc.end_deg.to_radians());
-                let sgn = if a1 >= a0 { 1.0 } else { -1.0 };
-                let r = arc.radius_m;
-                let c = arc.center_m;
-                let len = r * (a1 - a0).abs();
-                let curve = move |s: f64| {
-                    let p = a0 + sgn * s / r;
-                    let x = add(c, add(fmul(r * p.cos(), u), fmul(r * p.sin(), v)));
-                    let t = fmul(sgn, add(fmul(-p.sin(), u), fmul(p.cos(), v)));
-                    let e2 = cross(nn, t);
-                    (
-                        [x[0], x[1], x[2]],
-                        [
-                            [t[0], e2[0], nn[0]],
-                            [t[1], e2[1], nn[1]],
-                            [t[2], e2[2], nn[2]],
-                        ],
-                    )
-                };
-                m.add_beam(
-                    &b.name,
-                    b.elements,
-                    len,
-                    &curve,
-                    &sec,
-                    b.damping_mu_s,
-                    first,
-                )
-            }
-            _ => {
-                return Err(inv(
-                    key,
-                    "give either `start_m` and `end_m` (straight) or `arc`".into(),
-                ))
-            }
-        };
-        let ids = res.map_err(|e| inv(key.clone(), e.to_string()))?;
-        if let (Some(f), Some(a)) = (first, b.start_m) {
-            let d = sub(m.nodes[f].x0, a);
-            if dot(d, d).sqrt() > 1e-9 * (1.0 + dot(a, a).sqrt()) {
-                return Err(inv(
-                    format!("{key}.start_node"),
-                    "start node position differs from start_m".into(),
-                ));
-            }
+            )
         }
-        let _ = ids;
+        (None, Some(a), Some(e)) => m.add_straight_beam(
+            &b.name,
+            b.elements,
+            a,
+            e,
+            b.e2_direction,
+            &sec,
+            b.damping_mu_s,
+            first,
+        ),
+        (Some(arc), None, None) => {
+            let (len, curve) = arc_curve(arc);
+            m.add_beam(
+                &b.name,
+                b.elements,
+                len,
+                &curve,
+                &sec,
+                b.damping_mu_s,
+                first,
+            )
+        }
+        _ => {
+            return Err(inv(
+                key,
+                "give either `start_m` and `end_m` (straight) or `arc`".into(),
+            ))
+        }
+    };
+    let ids = res.map_err(|e| inv(key.clone(), e.to_string()))?;
+    if let (Some(f), Some(a)) = (first, b.start_m) {
+        let d = sub(m.nodes[f].x0, a);
+        if dot(d, d).sqrt() > 1e-9 * (1.0 + dot(a, a).sqrt()) {
+            return Err(inv(
+                format!("{key}.start_node"),
+                "start node position differs from start_m".into(),
+            ));
+        }
     }
+    let _ = ids;
+    Ok(())
+}
+
+/// A beam curve's point: position and frame.
+type Pose = ([f64; 3], [[f64; 3]; 3]);
+
+/// Length and curve (position, frame at arc length s) of a straight beam from `a` to `e`
+/// twisted by the table `tw`.
+fn twisted_curve(
+    a: [f64; 3],
+    e: [f64; 3],
+    e2_direction: [f64; 3],
+    tw: TimeTable,
+) -> (f64, impl Fn(f64) -> Pose) {
+    let d = sub(e, a);
+    let len = dot(d, d).sqrt();
+    let r = frame_from_axis(d, e2_direction);
+    let curve = move |s: f64| {
+        let r_tw = mm(&r, &exp_map([tw.eval(s).to_radians(), 0.0, 0.0]));
+        (add(a, fmul(s / len, d)), r_tw)
+    };
+    (len, curve)
+}
+
+/// Length and curve (position, frame at arc length s) of a circular-arc beam.
+fn arc_curve(arc: &ArcDeck) -> (f64, impl Fn(f64) -> Pose) {
+    let n = arc.normal;
+    let nn = fmul(1.0 / dot(n, n).sqrt(), n);
+    let u0 = sub(arc.zero_direction, fmul(dot(arc.zero_direction, nn), nn));
+    let u = fmul(1.0 / dot(u0, u0).sqrt(), u0);
+    let v = cross(nn, u);
+    let (a0, a1) = (arc.start_deg.to_radians(), arc.end_deg.to_radians());
+    let sgn = if a1 >= a0 { 1.0 } else { -1.0 };
+    let r = arc.radius_m;
+    let c = arc.center_m;
+    let len = r * (a1 - a0).abs();
+    let curve = move |s: f64| {
+        let p = a0 + sgn * s / r;
+        let x = add(c, add(fmul(r * p.cos(), u), fmul(r * p.sin(), v)));
+        let t = fmul(sgn, add(fmul(-p.sin(), u), fmul(p.cos(), v)));
+        let e2 = cross(nn, t);
+        (
+            [x[0], x[1], x[2]],
+            [
+                [t[0], e2[0], nn[0]],
+                [t[1], e2[1], nn[1]],
+                [t[2], e2[2], nn[2]],
+            ],
+        )
+    };
+    (len, curve)
+}
+
+/// Adds the `[[rigid_body]]` elements.
+fn add_rigid_bodies(ctx: &Ctx, m: &mut Model, d: &Deck) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
     for (i, r) in d.rigid_bodies.iter().enumerate() {
         let key = format!("rigid_body[{i}] `{}`", r.name);
-        let n = node(&m, &format!("{key}.node"), &r.node)?;
+        let n = ctx.node(m, &format!("{key}.node"), &r.node)?;
         if r.mass_kg < 0.0 {
             return Err(inv(format!("{key}.mass_kg"), "must be non-negative".into()));
         }
@@ -1032,83 +1106,105 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
         }))
         .map_err(|e| inv(key, e.to_string()))?;
     }
-    for (i, j) in d.joints.iter().enumerate() {
-        let key = format!("joint[{i}] `{}`", j.name);
-        let kind = match j.kind.as_str() {
-            "clamp" | "prescribed" => JointKind::Clamp,
-            "revolute" => JointKind::Revolute,
-            "universal" => JointKind::Universal,
-            "spherical" => JointKind::Spherical,
-            "bushing" => JointKind::Bushing,
-            other => return Err(inv(format!("{key}.type"), format!("unknown joint type `{other}` (expected clamp, revolute, universal, spherical, prescribed, bushing)"))),
+    Ok(())
+}
+
+/// Adds one `[[joint]]` (kind, nodes, frame), then sets its properties.
+fn add_joint(ctx: &Ctx, m: &mut Model, i: usize, j: &JointDeck) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    let key = format!("joint[{i}] `{}`", j.name);
+    let kind = match j.kind.as_str() {
+        "clamp" | "prescribed" => JointKind::Clamp,
+        "revolute" => JointKind::Revolute,
+        "universal" => JointKind::Universal,
+        "spherical" => JointKind::Spherical,
+        "bushing" => JointKind::Bushing,
+        other => return Err(inv(format!("{key}.type"), format!("unknown joint type `{other}` (expected clamp, revolute, universal, spherical, prescribed, bushing)"))),
+    };
+    let a = match j.node_a.as_deref() {
+        None | Some("ground") => None,
+        Some(n) => Some(ctx.node(m, &format!("{key}.node_a"), n)?),
+    };
+    let b = ctx.node(m, &format!("{key}.node_b"), &j.node_b)?;
+    let p = j.position_m.unwrap_or(m.nodes[b].x0);
+    let q = frame_from_axis(j.axis, j.x_direction);
+    // frame_from_axis gives columns (axis, ~x, .): reorder to (x, y, z = axis)
+    let q = [
+        [q[0][1], q[0][2], q[0][0]],
+        [q[1][1], q[1][2], q[1][0]],
+        [q[2][1], q[2][2], q[2][0]],
+    ];
+    let id = m
+        .add_joint(&j.name, kind, a, b, p, q)
+        .map_err(|e| inv(key.clone(), e.to_string()))?;
+    joint_properties(ctx, m, id, j, kind, &key)
+}
+
+/// Sets the springs, dampers, bushing, prescribed motion and elastomer of joint element `id`.
+fn joint_properties(
+    ctx: &Ctx,
+    m: &mut Model,
+    id: usize,
+    j: &JointDeck,
+    kind: JointKind,
+    key: &str,
+) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    if let Element::Joint(jj) = &mut m.elements[id] {
+        jj.spring_nm_per_rad = j.stiffness;
+        jj.damper_nms_per_rad = j.damping;
+        jj.bushing = BushingCoeffs {
+            k_n_per_m: axes3(&j.stiffness_t),
+            c_ns_per_m: axes3(&j.damping_t),
+            k_nm_per_rad: axes3(&j.stiffness_r),
+            c_nms_per_rad: axes3(&j.damping_r),
         };
-        let a = match j.node_a.as_deref() {
-            None | Some("ground") => None,
-            Some(n) => Some(node(&m, &format!("{key}.node_a"), n)?),
-        };
-        let b = node(&m, &format!("{key}.node_b"), &j.node_b)?;
-        let p = j.position_m.unwrap_or(m.nodes[b].x0);
-        let q = frame_from_axis(j.axis, j.x_direction);
-        // frame_from_axis gives columns (axis, ~x, .): reorder to (x, y, z = axis)
-        let q = [
-            [q[0][1], q[0][2], q[0][0]],
-            [q[1][1], q[1][2], q[1][0]],
-            [q[2][1], q[2][2], q[2][0]],
-        ];
-        let id = m
-            .add_joint(&j.name, kind, a, b, p, q)
-            .map_err(|e| inv(key.clone(), e.to_string()))?;
-        if let Element::Joint(jj) = &mut m.elements[id] {
-            jj.spring_nm_per_rad = j.stiffness;
-            jj.damper_nms_per_rad = j.damping;
-            jj.bushing = BushingCoeffs {
-                k_n_per_m: axes3(&j.stiffness_t),
-                c_ns_per_m: axes3(&j.damping_t),
-                k_nm_per_rad: axes3(&j.stiffness_r),
-                c_nms_per_rad: axes3(&j.damping_r),
-            };
-            jj.bushing_locked = locked_axes(&j.locked);
-            if j.omega_rad_s.is_some() || j.angle_table.is_some() {
-                if !matches!(kind, JointKind::Revolute | JointKind::Clamp) {
-                    return Err(inv(
-                        format!("{key}.omega_rad_s"),
-                        "prescribed rotation needs a revolute or prescribed joint".into(),
-                    ));
-                }
-                jj.prescribed_angle = Some(AngleLaw {
-                    omega_rad_s: j.omega_rad_s.unwrap_or(0.0),
-                    table: j.angle_table.as_ref().map(|_| table(&j.angle_table)),
-                });
+        jj.bushing_locked = locked_axes(&j.locked);
+        if j.omega_rad_s.is_some() || j.angle_table.is_some() {
+            if !matches!(kind, JointKind::Revolute | JointKind::Clamp) {
+                return Err(inv(
+                    format!("{key}.omega_rad_s"),
+                    "prescribed rotation needs a revolute or prescribed joint".into(),
+                ));
             }
-            if let Some(u) = j.displacement_m {
-                jj.displacement_m = Some((u, table(&j.displacement_table)));
+            jj.prescribed_angle = Some(AngleLaw {
+                omega_rad_s: j.omega_rad_s.unwrap_or(0.0),
+                table: j.angle_table.as_ref().map(|_| table(&j.angle_table)),
+            });
+        }
+        if let Some(u) = j.displacement_m {
+            jj.displacement_m = Some((u, table(&j.displacement_table)));
+        }
+        if let Some(el) = &j.elastomer {
+            let ek = format!("{key}.elastomer");
+            if kind != JointKind::Revolute || jj.prescribed_angle.is_some() {
+                return Err(inv(
+                    ek,
+                    "an elastomer acts about a free revolute axis (type = \"revolute\" without omega_rad_s or angle_table)".into(),
+                ));
             }
-            if let Some(el) = &j.elastomer {
-                let ek = format!("{key}.elastomer");
-                if kind != JointKind::Revolute || jj.prescribed_angle.is_some() {
-                    return Err(inv(
-                        ek,
-                        "an elastomer acts about a free revolute axis (type = \"revolute\" without omega_rad_s or angle_table)".into(),
-                    ));
-                }
-                if j.stiffness.is_nan() || j.stiffness <= 0.0 {
-                    return Err(inv(
-                        format!("{key}.stiffness_Nm_per_rad"),
-                        "an elastomer needs its storage stiffness here: expected > 0".into(),
-                    ));
-                }
-                let [lo, hi] = el.band_rad_s;
-                let chain =
-                    MaxwellChain::fit(j.stiffness, el.loss_factor, lo, hi, el.reference_rad_s)
-                        .map_err(|e| inv(ek, e))?;
-                jj.spring_nm_per_rad = 0.0;
-                jj.elastomer = Some(Elastomer::new(chain));
+            if j.stiffness.is_nan() || j.stiffness <= 0.0 {
+                return Err(inv(
+                    format!("{key}.stiffness_Nm_per_rad"),
+                    "an elastomer needs its storage stiffness here: expected > 0".into(),
+                ));
             }
+            let [lo, hi] = el.band_rad_s;
+            let chain = MaxwellChain::fit(j.stiffness, el.loss_factor, lo, hi, el.reference_rad_s)
+                .map_err(|e| inv(ek, e))?;
+            jj.spring_nm_per_rad = 0.0;
+            jj.elastomer = Some(Elastomer::new(chain));
         }
     }
+    Ok(())
+}
+
+/// Adds the `[[load]]` point loads and the `[[distributed_load]]` beam loads.
+fn add_loads(ctx: &Ctx, m: &mut Model, d: &Deck) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
     for (i, l) in d.loads.iter().enumerate() {
         let key = format!("load[{i}] `{}`", l.name);
-        let n = node(&m, &format!("{key}.node"), &l.node)?;
+        let n = ctx.node(m, &format!("{key}.node"), &l.node)?;
         m.add_element(Element::Load(PointLoad {
             name: l.name.clone(),
             node: n,
@@ -1132,62 +1228,88 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
         )
         .map_err(|e| inv(format!("{key}.beam"), e.to_string()))?;
     }
+    Ok(())
+}
+
+/// Adds the `[[hydraulic]]` step elements and returns their probes.
+fn add_hydraulics(ctx: &Ctx, m: &mut Model, d: &Deck) -> Result<Probes, DeckError> {
     let mut probes = vec![];
     for (i, h) in d.hydraulics.iter().enumerate() {
         let key = format!("hydraulic[{i}] `{}`", h.name);
-        let (elem, probe) = hydraulic_element(&mut m, h, &key, file, base)?;
+        let (elem, probe) = hydraulic_element(m, h, &key, ctx.file, ctx.base)?;
         m.add_step_element(Box::new(elem))
-            .map_err(|e| inv(key, e.to_string()))?;
+            .map_err(|e| ctx.inv(key, e.to_string()))?;
         probes.push((h.name.clone(), probe));
     }
-    for (i, s) in d.sensors.iter().enumerate() {
-        let key = format!("sensor[{i}] `{}`", s.name);
-        let kind = match (&s.node, &s.joint, &s.beam) {
-            (Some(n), None, None) => SensorKind::Node(node(&m, &format!("{key}.node"), n)?),
-            (None, Some(j), None) => {
-                let id = m
-                    .element_id(j)
-                    .filter(|&id| matches!(m.elements[id], Element::Joint(_)))
-                    .ok_or_else(|| {
-                        inv(
-                            format!("{key}.joint"),
-                            format!("joint `{j}` does not exist"),
-                        )
-                    })?;
-                SensorKind::Joint(id)
-            }
-            (None, None, Some(b)) => {
-                let ids = m.beams.get(b).cloned().ok_or_else(|| {
-                    inv(format!("{key}.beam"), format!("beam `{b}` does not exist"))
+    Ok(probes)
+}
+
+/// Adds one `[[sensor]]` on a node, a joint or a beam section.
+fn add_sensor(ctx: &Ctx, m: &mut Model, i: usize, s: &SensorDeck) -> Result<(), DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    let key = format!("sensor[{i}] `{}`", s.name);
+    let kind = match (&s.node, &s.joint, &s.beam) {
+        (Some(n), None, None) => SensorKind::Node(ctx.node(m, &format!("{key}.node"), n)?),
+        (None, Some(j), None) => {
+            let id = m
+                .element_id(j)
+                .filter(|&id| matches!(m.elements[id], Element::Joint(_)))
+                .ok_or_else(|| {
+                    inv(
+                        format!("{key}.joint"),
+                        format!("joint `{j}` does not exist"),
+                    )
                 })?;
-                let s_m = s.s_m.unwrap_or(0.0);
-                let len = ids
-                    .iter()
-                    .filter_map(|&id| match &m.elements[id] {
-                        Element::Beam(e) => Some(e.s_range[1]),
-                        _ => None,
-                    })
-                    .fold(0.0, f64::max);
-                if s_m > len * (1.0 + 1e-9) {
-                    return Err(inv(
-                        format!("{key}.s_m"),
-                        format!("{s_m}: expected a station on beam `{b}`, 0 to {len} m"),
-                    ));
-                }
-                SensorKind::Section {
-                    elements: ids,
-                    s_m: s.s_m.unwrap_or(0.0),
-                }
-            }
-            _ => {
-                return Err(inv(
-                    key,
-                    "give exactly one of `node`, `joint`, `beam` (with `s_m`)".into(),
-                ))
-            }
-        };
-        m.add_sensor(&s.name, kind);
+            SensorKind::Joint(id)
+        }
+        (None, None, Some(b)) => section_sensor(ctx, m, &key, s, b)?,
+        _ => {
+            return Err(inv(
+                key,
+                "give exactly one of `node`, `joint`, `beam` (with `s_m`)".into(),
+            ))
+        }
+    };
+    m.add_sensor(&s.name, kind);
+    Ok(())
+}
+
+/// The section sensor at station `s_m` of beam `b` (checked to lie on the beam).
+fn section_sensor(
+    ctx: &Ctx,
+    m: &Model,
+    key: &str,
+    s: &SensorDeck,
+    b: &str,
+) -> Result<SensorKind, DeckError> {
+    let inv = |k: String, msg: String| ctx.inv(k, msg);
+    let ids = m
+        .beams
+        .get(b)
+        .cloned()
+        .ok_or_else(|| inv(format!("{key}.beam"), format!("beam `{b}` does not exist")))?;
+    let s_m = s.s_m.unwrap_or(0.0);
+    let len = ids
+        .iter()
+        .filter_map(|&id| match &m.elements[id] {
+            Element::Beam(e) => Some(e.s_range[1]),
+            _ => None,
+        })
+        .fold(0.0, f64::max);
+    if s_m > len * (1.0 + 1e-9) {
+        return Err(inv(
+            format!("{key}.s_m"),
+            format!("{s_m}: expected a station on beam `{b}`, 0 to {len} m"),
+        ));
     }
+    Ok(SensorKind::Section {
+        elements: ids,
+        s_m: s.s_m.unwrap_or(0.0),
+    })
+}
+
+/// Fails on the first node that no element or joint uses.
+fn check_connected(ctx: &Ctx, m: &Model) -> Result<(), DeckError> {
     let mut used = vec![false; m.nodes.len()];
     for e in &m.elements {
         for n in e.node_list() {
@@ -1195,12 +1317,12 @@ fn build(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError
         }
     }
     if let Some(i) = used.iter().position(|u| !u) {
-        return Err(inv(
+        return Err(ctx.inv(
             format!("node `{}`", m.nodes[i].name),
             "not connected to any element or joint (it would have no mass and no stiffness)".into(),
         ));
     }
-    Ok((m, probes))
+    Ok(())
 }
 
 /// Builds the element of one `[[hydraulic]]` table (creating and clamping its ground node).
