@@ -494,6 +494,197 @@ fn build(file: &str, table: &str, mach: Vec<Num>, rows: Vec<Vec<Num>>) -> Result
     })
 }
 
+/// The aerofoil's name, the six counts ML NL MD ND MM NM, whether the file is free-format and
+/// the header's line number, from the header line.
+fn header_counts(
+    file: &str,
+    header: &str,
+    first: usize,
+) -> Result<(String, [usize; 6], bool, usize), C81Error> {
+    let header_line = first + 1;
+    let count_names = ["ML", "NL", "MD", "ND", "MM", "NM"];
+    let count_error = |at: String, k: usize, found: &str| C81Error::Field {
+        file: file.to_string(),
+        line: header_line,
+        at,
+        expected: format!(
+            "the count {} ({} of the {} table), a whole number of at least 1",
+            count_names[k],
+            if k.is_multiple_of(2) {
+                "Mach numbers"
+            } else {
+                "angles of attack"
+            },
+            TABLES[k / 2]
+        ),
+        found: quote(found),
+    };
+    let mut n = [0usize; 6];
+    let free = first == 1 || header.contains(';');
+    let name;
+    if free {
+        let Some((nm, rest)) = header.split_once(';') else {
+            return Err(C81Error::Field {
+                file: file.to_string(),
+                line: header_line,
+                at: "column 1".to_string(),
+                expected: "a free-format header `name; ML NL MD ND MM NM`".to_string(),
+                found: quote(header),
+            });
+        };
+        name = nm.trim().to_string();
+        let toks = Free::new(file, &[rest], 0).tokens;
+        let offset = nm.chars().count() + 1;
+        for (k, slot) in n.iter_mut().enumerate() {
+            let Some(&(_, _, col, text)) = toks.get(k) else {
+                let c = header.chars().count() + 1;
+                return Err(count_error(format!("column {c}"), k, ""));
+            };
+            let at = format!(
+                "columns {}-{}",
+                col + offset,
+                col + offset + text.chars().count() - 1
+            );
+            *slot = text
+                .parse::<usize>()
+                .ok()
+                .filter(|&v| v >= 1)
+                .ok_or_else(|| count_error(at, k, text))?;
+        }
+        if let Some(&(_, _, col, text)) = toks.get(6) {
+            return Err(C81Error::Field {
+                file: file.to_string(),
+                line: header_line,
+                at: format!(
+                    "columns {}-{}",
+                    col + offset,
+                    col + offset + text.chars().count() - 1
+                ),
+                expected: "the end of the header after its six counts".to_string(),
+                found: quote(text),
+            });
+        }
+    } else {
+        let chars: Vec<char> = header.chars().collect();
+        name = chars.iter().take(30).collect::<String>().trim().to_string();
+        for (k, slot) in n.iter_mut().enumerate() {
+            let a = (30 + 2 * k).min(chars.len());
+            let b = (32 + 2 * k).min(chars.len());
+            let text: String = chars[a..b].iter().collect();
+            let at = format!("columns {}-{}", 31 + 2 * k, 32 + 2 * k);
+            *slot = text
+                .trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&v| v >= 1)
+                .ok_or_else(|| count_error(at, k, &text))?;
+        }
+    }
+    Ok((name, n, free, header_line))
+}
+
+/// The three tables of a free-format file, after its header.
+fn free_tables(
+    file: &str,
+    lines: &[&str],
+    header_line: usize,
+    counts: &Counts,
+) -> Result<Vec<Table2>, C81Error> {
+    let mut tables = Vec::with_capacity(3);
+    let mut rd = Free::new(file, lines, header_line);
+    for (t, &(nm, na)) in counts.n.iter().enumerate() {
+        let table = TABLES[t];
+        let mut mach = Vec::with_capacity(nm);
+        for j in 0..nm {
+            mach.push(rd.number(&format!(
+                "a number (the {table} table's Mach number {} of {nm})",
+                j + 1
+            ))?);
+        }
+        let mut rows = Vec::with_capacity(na);
+        for i in 0..na {
+            let mut row = Vec::with_capacity(nm + 1);
+            row.push(rd.number(&format!(
+                "a number (the {table} table's angle of attack of row {} of {na})",
+                i + 1
+            ))?);
+            for j in 0..nm {
+                row.push(rd.number(&format!(
+                    "a number (the {table} table's row {} of {na}, coefficient {} of {nm})",
+                    i + 1,
+                    j + 1
+                ))?);
+            }
+            rows.push(row);
+        }
+        tables.push(build(file, table, mach, rows)?);
+    }
+    if let Some(&(line, field, col, text)) = rd.tokens.get(rd.next) {
+        return Err(C81Error::Field {
+            file: file.to_string(),
+            line,
+            at: format!(
+                "field {field} (columns {col}-{})",
+                col + text.chars().count() - 1
+            ),
+            expected: "the end of the file after the moment table".to_string(),
+            found: quote(text),
+        });
+    }
+    Ok(tables)
+}
+
+/// The three tables of a fixed-format (C81 columns) file, after its header.
+fn fixed_tables(
+    file: &str,
+    lines: &[&str],
+    header_line: usize,
+    counts: &Counts,
+) -> Result<Vec<Table2>, C81Error> {
+    let mut tables = Vec::with_capacity(3);
+    let mut rd = Fixed {
+        file,
+        lines: lines.to_vec(),
+        next: header_line,
+    };
+    for (t, &(nm, na)) in counts.n.iter().enumerate() {
+        let table = TABLES[t];
+        let mach = rd.record(nm, true, &format!("{table} table's Mach row"), &|j| {
+            format!("Mach number {} of {nm}", j + 1)
+        })?;
+        let mut rows = Vec::with_capacity(na);
+        for i in 0..na {
+            let row = rd.record(
+                nm + 1,
+                false,
+                &format!("{table} table's row {} of {na}", i + 1),
+                &|k| {
+                    if k == 0 {
+                        "the angle of attack".to_string()
+                    } else {
+                        format!("coefficient {k} of {nm}")
+                    }
+                },
+            )?;
+            rows.push(row);
+        }
+        tables.push(build(file, table, mach, rows)?);
+    }
+    for (k, l) in lines.iter().enumerate().skip(rd.next) {
+        if !l.trim().is_empty() {
+            let lead = l.len() - l.trim_start().len();
+            return Err(C81Error::Field {
+                file: file.to_string(),
+                line: k + 1,
+                at: format!("column {}", l[..lead].chars().count() + 1),
+                expected: "the end of the file after the moment table".to_string(),
+                found: quote(l.split_whitespace().next().unwrap_or("")),
+            });
+        }
+    }
+    Ok(tables)
+}
+
 impl C81Table {
     /// Reads a C81 table from its text; `file` names it in messages and in `source`.
     pub fn parse(text: &str, file: &str) -> Result<Self, C81Error> {
@@ -522,173 +713,16 @@ impl C81Table {
                     .to_string(),
             });
         };
-        let header_line = first + 1;
-        let count_names = ["ML", "NL", "MD", "ND", "MM", "NM"];
-        let count_error = |at: String, k: usize, found: &str| C81Error::Field {
-            file: file.to_string(),
-            line: header_line,
-            at,
-            expected: format!(
-                "the count {} ({} of the {} table), a whole number of at least 1",
-                count_names[k],
-                if k.is_multiple_of(2) {
-                    "Mach numbers"
-                } else {
-                    "angles of attack"
-                },
-                TABLES[k / 2]
-            ),
-            found: quote(found),
-        };
-        let mut n = [0usize; 6];
-        let free = first == 1 || header.contains(';');
-        let name;
-        if free {
-            let Some((nm, rest)) = header.split_once(';') else {
-                return Err(C81Error::Field {
-                    file: file.to_string(),
-                    line: header_line,
-                    at: "column 1".to_string(),
-                    expected: "a free-format header `name; ML NL MD ND MM NM`".to_string(),
-                    found: quote(header),
-                });
-            };
-            name = nm.trim().to_string();
-            let toks = Free::new(file, &[rest], 0).tokens;
-            let offset = nm.chars().count() + 1;
-            for (k, slot) in n.iter_mut().enumerate() {
-                let Some(&(_, _, col, text)) = toks.get(k) else {
-                    let c = header.chars().count() + 1;
-                    return Err(count_error(format!("column {c}"), k, ""));
-                };
-                let at = format!(
-                    "columns {}-{}",
-                    col + offset,
-                    col + offset + text.chars().count() - 1
-                );
-                *slot = text
-                    .parse::<usize>()
-                    .ok()
-                    .filter(|&v| v >= 1)
-                    .ok_or_else(|| count_error(at, k, text))?;
-            }
-            if let Some(&(_, _, col, text)) = toks.get(6) {
-                return Err(C81Error::Field {
-                    file: file.to_string(),
-                    line: header_line,
-                    at: format!(
-                        "columns {}-{}",
-                        col + offset,
-                        col + offset + text.chars().count() - 1
-                    ),
-                    expected: "the end of the header after its six counts".to_string(),
-                    found: quote(text),
-                });
-            }
-        } else {
-            let chars: Vec<char> = header.chars().collect();
-            name = chars.iter().take(30).collect::<String>().trim().to_string();
-            for (k, slot) in n.iter_mut().enumerate() {
-                let a = (30 + 2 * k).min(chars.len());
-                let b = (32 + 2 * k).min(chars.len());
-                let text: String = chars[a..b].iter().collect();
-                let at = format!("columns {}-{}", 31 + 2 * k, 32 + 2 * k);
-                *slot = text
-                    .trim()
-                    .parse::<usize>()
-                    .ok()
-                    .filter(|&v| v >= 1)
-                    .ok_or_else(|| count_error(at, k, &text))?;
-            }
-        }
+        let (name, n, free, header_line) = header_counts(file, header, first)?;
         let counts = Counts {
             n: [(n[0], n[1]), (n[2], n[3]), (n[4], n[5])],
         };
 
-        let mut tables = Vec::with_capacity(3);
-        if free {
-            let mut rd = Free::new(file, &lines, header_line);
-            for (t, &(nm, na)) in counts.n.iter().enumerate() {
-                let table = TABLES[t];
-                let mut mach = Vec::with_capacity(nm);
-                for j in 0..nm {
-                    mach.push(rd.number(&format!(
-                        "a number (the {table} table's Mach number {} of {nm})",
-                        j + 1
-                    ))?);
-                }
-                let mut rows = Vec::with_capacity(na);
-                for i in 0..na {
-                    let mut row = Vec::with_capacity(nm + 1);
-                    row.push(rd.number(&format!(
-                        "a number (the {table} table's angle of attack of row {} of {na})",
-                        i + 1
-                    ))?);
-                    for j in 0..nm {
-                        row.push(rd.number(&format!(
-                            "a number (the {table} table's row {} of {na}, coefficient {} of {nm})",
-                            i + 1,
-                            j + 1
-                        ))?);
-                    }
-                    rows.push(row);
-                }
-                tables.push(build(file, table, mach, rows)?);
-            }
-            if let Some(&(line, field, col, text)) = rd.tokens.get(rd.next) {
-                return Err(C81Error::Field {
-                    file: file.to_string(),
-                    line,
-                    at: format!(
-                        "field {field} (columns {col}-{})",
-                        col + text.chars().count() - 1
-                    ),
-                    expected: "the end of the file after the moment table".to_string(),
-                    found: quote(text),
-                });
-            }
+        let mut tables = if free {
+            free_tables(file, &lines, header_line, &counts)?
         } else {
-            let mut rd = Fixed {
-                file,
-                lines: lines.clone(),
-                next: header_line,
-            };
-            for (t, &(nm, na)) in counts.n.iter().enumerate() {
-                let table = TABLES[t];
-                let mach = rd.record(nm, true, &format!("{table} table's Mach row"), &|j| {
-                    format!("Mach number {} of {nm}", j + 1)
-                })?;
-                let mut rows = Vec::with_capacity(na);
-                for i in 0..na {
-                    let row = rd.record(
-                        nm + 1,
-                        false,
-                        &format!("{table} table's row {} of {na}", i + 1),
-                        &|k| {
-                            if k == 0 {
-                                "the angle of attack".to_string()
-                            } else {
-                                format!("coefficient {k} of {nm}")
-                            }
-                        },
-                    )?;
-                    rows.push(row);
-                }
-                tables.push(build(file, table, mach, rows)?);
-            }
-            for (k, l) in lines.iter().enumerate().skip(rd.next) {
-                if !l.trim().is_empty() {
-                    let lead = l.len() - l.trim_start().len();
-                    return Err(C81Error::Field {
-                        file: file.to_string(),
-                        line: k + 1,
-                        at: format!("column {}", l[..lead].chars().count() + 1),
-                        expected: "the end of the file after the moment table".to_string(),
-                        found: quote(l.split_whitespace().next().unwrap_or("")),
-                    });
-                }
-            }
-        }
+            fixed_tables(file, &lines, header_line, &counts)?
+        };
         let cm = tables.pop().expect("three tables");
         let cd = tables.pop().expect("three tables");
         let cl = tables.pop().expect("three tables");

@@ -408,6 +408,22 @@ pub fn read_mcap(path: &Path) -> Result<FlightRecord, FlightError> {
     read_mcap_from(&mut file, len, path)
 }
 
+/// What the reader has collected from the records so far.
+struct Collected {
+    schemas: HashMap<u16, (String, String, Vec<u8>)>,
+    channels: HashMap<u16, ChannelInfo>,
+    meta: Option<FlightMeta>,
+    rows: AirloadAssembler,
+    damper: Vec<DamperSample>,
+    damper_locs: Vec<Loc>,
+    // (kind, message index, log time, revolution, azimuth), checked once Omega is known.
+    times: Vec<(Kind, u64, u64, u32, f64)>,
+    // Motion rows (revolution, azimuth, [flap, lag, pitch] deg, message index), placed on the
+    // airloads' grid once that is known.
+    motion_rows: Vec<(u32, f64, [f64; 3], u64)>,
+    seen: [bool; 4],
+}
+
 /// Reads an MCAP flight record from any byte source of `len` bytes (used for files and tests);
 /// `path` names the source in errors.
 pub fn read_mcap_from(
@@ -419,11 +435,6 @@ pub fn read_mcap_from(
         path: path.to_path_buf(),
         msg,
     };
-    let chan_err = |kind: Kind, msg: String| FlightError::Channel {
-        path: path.to_path_buf(),
-        channel: kind.topic().into(),
-        msg,
-    };
     // No record can be longer than the file, nor a chunk decompress to more than 100 times it:
     // bounds the buffers a corrupt length field could make the reader allocate.
     let limit = (len.saturating_mul(100)).clamp(1 << 20, 1 << 32) as usize;
@@ -433,19 +444,17 @@ pub fn read_mcap_from(
             .with_validate_data_section_crc(true)
             .with_record_length_limit(limit),
     );
-    let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
-    let mut channels: HashMap<u16, ChannelInfo> = HashMap::new();
-    let mut meta: Option<FlightMeta> = None;
-    let mut rows = AirloadAssembler::new(false);
-    let mut damper = Vec::new();
-    let mut damper_locs = Vec::new();
-    // (kind, message index, log time, revolution, azimuth), checked once Omega is known.
-    let mut times: Vec<(Kind, u64, u64, u32, f64)> = Vec::new();
-    // Motion rows (revolution, azimuth, [flap, lag, pitch] deg, message index), placed on the
-    // airloads' grid once that is known.
-    let mut motion_rows: Vec<(u32, f64, [f64; 3], u64)> = Vec::new();
-    let mut seen = [false; 4];
-
+    let mut c = Collected {
+        schemas: HashMap::new(),
+        channels: HashMap::new(),
+        meta: None,
+        rows: AirloadAssembler::new(false),
+        damper: Vec::new(),
+        damper_locs: Vec::new(),
+        times: Vec::new(),
+        motion_rows: Vec::new(),
+        seen: [false; 4],
+    };
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| corrupt(e.to_string()))? {
             LinearReadEvent::ReadRequest(n) => {
@@ -459,187 +468,228 @@ pub fn read_mcap_from(
             LinearReadEvent::Record { data, opcode } => {
                 let record = ::mcap::parse_record(opcode, data)
                     .map_err(|e| corrupt(format!("record with opcode {opcode:#04x}: {e}")))?;
-                match record {
-                    Record::Schema { header, data } => {
-                        schemas
-                            .insert(header.id, (header.name, header.encoding, data.into_owned()));
-                    }
-                    Record::Channel(ch) => {
-                        let kind = Kind::of(&ch.topic);
-                        if let Some(k) = kind {
-                            let schema = (ch.schema_id != 0)
-                                .then(|| schemas.get(&ch.schema_id))
-                                .flatten();
-                            check_schema(k, schema, &ch.message_encoding)
-                                .map_err(|m| chan_err(k, m))?;
-                            seen[k as usize] = true;
-                        }
-                        let count = channels.get(&ch.id).map_or(0, |c| c.count);
-                        channels.insert(ch.id, ChannelInfo { kind, count });
-                    }
-                    Record::Message { header, data } => {
-                        let Some(ch) = channels.get_mut(&header.channel_id) else {
-                            return Err(corrupt(format!(
-                                "message on channel id {} that was never declared",
-                                header.channel_id
-                            )));
-                        };
-                        let index = ch.count;
-                        ch.count += 1;
-                        let Some(kind) = ch.kind else { continue };
-                        let msg_err = |msg: String| FlightError::Message {
-                            path: path.to_path_buf(),
-                            channel: kind.topic().into(),
-                            index,
-                            msg,
-                        };
-                        let bad_json = |e: serde_json::Error| {
-                            msg_err(format!("does not match schema `{}`: {e}", kind.schema().0))
-                        };
-                        // a sample's azimuth, checked, and its time stamp (every sampled channel)
-                        let log_time = header.log_time;
-                        let mut stamp = |revolution: u32, azimuth_deg: f64| {
-                            if !(0.0..360.0).contains(&azimuth_deg) {
-                                return Err(msg_err(format!(
-                                    "azimuth_deg {azimuth_deg} is outside [0, 360)"
-                                )));
-                            }
-                            times.push((kind, index, log_time, revolution, azimuth_deg));
-                            Ok(())
-                        };
-                        match kind {
-                            Kind::Meta => {
-                                if meta.is_some() {
-                                    return Err(msg_err(
-                                        "a second metadata message; expected exactly one".into(),
-                                    ));
-                                }
-                                let v: serde_json::Map<String, serde_json::Value> =
-                                    serde_json::from_slice(&data).map_err(bad_json)?;
-                                meta = Some(FlightMeta::from_json(v, path)?);
-                            }
-                            Kind::Airloads => {
-                                let m: AirloadsIn =
-                                    serde_json::from_slice(&data).map_err(bad_json)?;
-                                let n = m.r_over_r.len();
-                                if n == 0
-                                    || m.normal.len() != n
-                                    || m.chord.len() != n
-                                    || m.moment.len() != n
-                                {
-                                    return Err(msg_err(format!(
-                                        "arrays of lengths r_over_R {}, normal {}, chord {}, moment {}; expected equal, non-zero lengths",
-                                        n,
-                                        m.normal.len(),
-                                        m.chord.len(),
-                                        m.moment.len()
-                                    )));
-                                }
-                                stamp(m.revolution, m.azimuth_deg)?;
-                                if let Some(r) =
-                                    m.r_over_r.iter().find(|&&r| !(r > 0.0 && r <= 1.0))
-                                {
-                                    return Err(msg_err(format!("r_over_R {r} is outside (0, 1]")));
-                                }
-                                for k in 0..n {
-                                    rows.push(
-                                        m.revolution,
-                                        m.azimuth_deg,
-                                        m.r_over_r[k],
-                                        [m.normal[k], m.chord[k], m.moment[k]],
-                                        index,
-                                    );
-                                }
-                            }
-                            Kind::Damper => {
-                                let m: DamperMsg =
-                                    serde_json::from_slice(&data).map_err(bad_json)?;
-                                stamp(m.revolution, m.azimuth_deg)?;
-                                damper.push(DamperSample {
-                                    revolution: m.revolution,
-                                    azimuth_deg: m.azimuth_deg,
-                                    force_N: m.force,
-                                    stroke_m: m.stroke,
-                                });
-                                damper_locs.push(Loc::Message(index));
-                            }
-                            Kind::Motion => {
-                                let m: MotionMsg =
-                                    serde_json::from_slice(&data).map_err(bad_json)?;
-                                stamp(m.revolution, m.azimuth_deg)?;
-                                motion_rows.push((
-                                    m.revolution,
-                                    m.azimuth_deg,
-                                    [m.flap_deg, m.lag_deg, m.pitch_deg],
-                                    index,
-                                ));
-                            }
-                        }
-                    }
-                    _ => {}
-                }
+                c.record(record, path)?;
             }
         }
     }
-    for k in [Kind::Meta, Kind::Airloads, Kind::Damper] {
-        if !seen[k as usize] {
+    c.finish(path)
+}
+
+fn channel_error(path: &Path, kind: Kind, msg: String) -> FlightError {
+    FlightError::Channel {
+        path: path.to_path_buf(),
+        channel: kind.topic().into(),
+        msg,
+    }
+}
+
+impl Collected {
+    /// Takes one record: schemas and channels are declared, messages read.
+    fn record(&mut self, record: Record<'_>, path: &Path) -> Result<(), FlightError> {
+        match record {
+            Record::Schema { header, data } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding, data.into_owned()));
+            }
+            Record::Channel(ch) => {
+                let kind = Kind::of(&ch.topic);
+                if let Some(k) = kind {
+                    let schema = (ch.schema_id != 0)
+                        .then(|| self.schemas.get(&ch.schema_id))
+                        .flatten();
+                    check_schema(k, schema, &ch.message_encoding)
+                        .map_err(|m| channel_error(path, k, m))?;
+                    self.seen[k as usize] = true;
+                }
+                let count = self.channels.get(&ch.id).map_or(0, |c| c.count);
+                self.channels.insert(ch.id, ChannelInfo { kind, count });
+            }
+            Record::Message { header, data } => {
+                let Some(ch) = self.channels.get_mut(&header.channel_id) else {
+                    return Err(FlightError::McapCorrupt {
+                        path: path.to_path_buf(),
+                        msg: format!(
+                            "message on channel id {} that was never declared",
+                            header.channel_id
+                        ),
+                    });
+                };
+                let index = ch.count;
+                ch.count += 1;
+                if let Some(kind) = ch.kind {
+                    self.message(kind, index, header.log_time, &data, path)?;
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Reads message `index` of a channel of `kind`.
+    fn message(
+        &mut self,
+        kind: Kind,
+        index: u64,
+        log_time: u64,
+        data: &[u8],
+        path: &Path,
+    ) -> Result<(), FlightError> {
+        let msg_err = |msg: String| FlightError::Message {
+            path: path.to_path_buf(),
+            channel: kind.topic().into(),
+            index,
+            msg,
+        };
+        let bad_json = |e: serde_json::Error| {
+            msg_err(format!("does not match schema `{}`: {e}", kind.schema().0))
+        };
+        // a sample's azimuth, checked, and its time stamp (every sampled channel)
+        let times = &mut self.times;
+        let mut stamp = |revolution: u32, azimuth_deg: f64| {
+            if !(0.0..360.0).contains(&azimuth_deg) {
+                return Err(msg_err(format!(
+                    "azimuth_deg {azimuth_deg} is outside [0, 360)"
+                )));
+            }
+            times.push((kind, index, log_time, revolution, azimuth_deg));
+            Ok(())
+        };
+        match kind {
+            Kind::Meta => {
+                if self.meta.is_some() {
+                    return Err(msg_err(
+                        "a second metadata message; expected exactly one".into(),
+                    ));
+                }
+                let v: serde_json::Map<String, serde_json::Value> =
+                    serde_json::from_slice(data).map_err(bad_json)?;
+                self.meta = Some(FlightMeta::from_json(v, path)?);
+            }
+            Kind::Airloads => {
+                let m: AirloadsIn = serde_json::from_slice(data).map_err(bad_json)?;
+                let n = m.r_over_r.len();
+                if n == 0 || m.normal.len() != n || m.chord.len() != n || m.moment.len() != n {
+                    return Err(msg_err(format!(
+                        "arrays of lengths r_over_R {}, normal {}, chord {}, moment {}; expected equal, non-zero lengths",
+                        n,
+                        m.normal.len(),
+                        m.chord.len(),
+                        m.moment.len()
+                    )));
+                }
+                stamp(m.revolution, m.azimuth_deg)?;
+                if let Some(r) = m.r_over_r.iter().find(|&&r| !(r > 0.0 && r <= 1.0)) {
+                    return Err(msg_err(format!("r_over_R {r} is outside (0, 1]")));
+                }
+                for k in 0..n {
+                    self.rows.push(
+                        m.revolution,
+                        m.azimuth_deg,
+                        m.r_over_r[k],
+                        [m.normal[k], m.chord[k], m.moment[k]],
+                        index,
+                    );
+                }
+            }
+            Kind::Damper => {
+                let m: DamperMsg = serde_json::from_slice(data).map_err(bad_json)?;
+                stamp(m.revolution, m.azimuth_deg)?;
+                self.damper.push(DamperSample {
+                    revolution: m.revolution,
+                    azimuth_deg: m.azimuth_deg,
+                    force_N: m.force,
+                    stroke_m: m.stroke,
+                });
+                self.damper_locs.push(Loc::Message(index));
+            }
+            Kind::Motion => {
+                let m: MotionMsg = serde_json::from_slice(data).map_err(bad_json)?;
+                stamp(m.revolution, m.azimuth_deg)?;
+                self.motion_rows.push((
+                    m.revolution,
+                    m.azimuth_deg,
+                    [m.flap_deg, m.lag_deg, m.pitch_deg],
+                    index,
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The record from every message read: channels present, time stamps checked against
+    /// the rotor speed, motion placed on the airloads' grid.
+    fn finish(self, path: &Path) -> Result<FlightRecord, FlightError> {
+        let chan_err = |kind: Kind, msg: String| channel_error(path, kind, msg);
+        let Collected {
+            meta,
+            rows,
+            damper,
+            damper_locs,
+            times,
+            mut motion_rows,
+            seen,
+            ..
+        } = self;
+        for k in [Kind::Meta, Kind::Airloads, Kind::Damper] {
+            if !seen[k as usize] {
+                return Err(chan_err(
+                    k,
+                    format!(
+                        "missing; expected channel {} with schema `{}`",
+                        k.topic(),
+                        k.schema().0
+                    ),
+                ));
+            }
+        }
+        let Some(meta) = meta else {
             return Err(chan_err(
-                k,
-                format!(
-                    "missing; expected channel {} with schema `{}`",
-                    k.topic(),
-                    k.schema().0
-                ),
+                Kind::Meta,
+                "no message; expected exactly one".into(),
             ));
+        };
+        if rows.is_empty() {
+            return Err(chan_err(Kind::Airloads, "no messages".into()));
         }
-    }
-    let Some(meta) = meta else {
-        return Err(chan_err(
-            Kind::Meta,
-            "no message; expected exactly one".into(),
-        ));
-    };
-    if rows.is_empty() {
-        return Err(chan_err(Kind::Airloads, "no messages".into()));
-    }
-    if damper.is_empty() {
-        return Err(chan_err(Kind::Damper, "no messages".into()));
-    }
-    let omega_deg_s = meta.rotor_speed_deg_s();
-    for &(kind, index, t, rev, psi) in &times {
-        let expect = ((rev as f64 * 360.0 + psi) / omega_deg_s * 1e9).round();
-        if (t as f64 - expect).abs() > LOG_TIME_TOLERANCE_NS as f64 {
-            return Err(FlightError::Message {
-                path: path.to_path_buf(),
-                channel: kind.topic().into(),
-                index,
-                msg: format!(
-                    "log time {t} ns does not match revolution {rev}, azimuth {psi} deg at Omega = {} rad/s (expected {expect} ns)",
-                    meta.rotor_speed_rad_s
-                ),
-            });
+        if damper.is_empty() {
+            return Err(chan_err(Kind::Damper, "no messages".into()));
         }
-    }
-    let mut rec = FlightRecord::from_rows(meta, rows, path, damper, &damper_locs, path)?;
-    if seen[Kind::Motion as usize] {
-        // Messages of a file not in log-time order are placed in order first.
-        if !motion_rows
-            .windows(2)
-            .all(|w| (w[0].0, w[0].1) <= (w[1].0, w[1].1))
-        {
-            motion_rows.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let omega_deg_s = meta.rotor_speed_deg_s();
+        for &(kind, index, t, rev, psi) in &times {
+            let expect = ((rev as f64 * 360.0 + psi) / omega_deg_s * 1e9).round();
+            if (t as f64 - expect).abs() > LOG_TIME_TOLERANCE_NS as f64 {
+                return Err(FlightError::Message {
+                    path: path.to_path_buf(),
+                    channel: kind.topic().into(),
+                    index,
+                    msg: format!(
+                        "log time {t} ns does not match revolution {rev}, azimuth {psi} deg at Omega = {} rad/s (expected {expect} ns)",
+                        meta.rotor_speed_rad_s
+                    ),
+                });
+            }
         }
-        let mut asm = MotionAssembler::new(rec.azimuths_deg());
-        for &(rev, psi, v, index) in &motion_rows {
-            asm.push(rev, psi, v).map_err(|e| FlightError::Message {
-                path: path.to_path_buf(),
-                channel: TOPIC_MOTION.into(),
-                index,
-                msg: format!("field `{}`: {}", e.column, e.msg),
-            })?;
+        let mut rec = FlightRecord::from_rows(meta, rows, path, damper, &damper_locs, path)?;
+        if seen[Kind::Motion as usize] {
+            // Messages of a file not in log-time order are placed in order first.
+            if !motion_rows
+                .windows(2)
+                .all(|w| (w[0].0, w[0].1) <= (w[1].0, w[1].1))
+            {
+                motion_rows.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            }
+            let mut asm = MotionAssembler::new(rec.azimuths_deg());
+            for &(rev, psi, v, index) in &motion_rows {
+                asm.push(rev, psi, v).map_err(|e| FlightError::Message {
+                    path: path.to_path_buf(),
+                    channel: TOPIC_MOTION.into(),
+                    index,
+                    msg: format!("field `{}`: {}", e.column, e.msg),
+                })?;
+            }
+            let motion = asm.finish().map_err(|msg| chan_err(Kind::Motion, msg))?;
+            rec.motion = Some(motion);
         }
-        let motion = asm.finish().map_err(|msg| chan_err(Kind::Motion, msg))?;
-        rec.motion = Some(motion);
+        Ok(rec)
     }
-    Ok(rec)
 }

@@ -847,34 +847,7 @@ fn extensions(
         )?,
         ..Default::default()
     };
-    let mass = cx.opt(
-        "link_mass_kg",
-        t.link_mass_kg,
-        "a positive mass in kg",
-        positive,
-    )?;
-    let zeta = cx.opt(
-        "link_damping_ratio",
-        t.link_damping_ratio,
-        "a non-negative fraction of critical damping",
-        non_negative,
-    )?;
-    match (mass, zeta) {
-        (Some(m), z) => {
-            e.link_mass = Some(LinkMass {
-                mass_kg: m,
-                damping_ratio: z.unwrap_or(0.0),
-            })
-        }
-        (None, Some(z)) => {
-            return Err(cx.bad(
-                "link_damping_ratio",
-                z,
-                "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
-            ))
-        }
-        (None, None) => {}
-    }
+    e.link_mass = link_mass(&cx, t)?;
     let presliding = cx.opt(
         "seal_presliding_m",
         t.seal_presliding_m,
@@ -902,6 +875,48 @@ fn extensions(
     if let Some(g) = gap.filter(|g| *g > 0.0) {
         e.free_play = Some(FreePlay { gap: g });
     }
+    hydraulic_extensions(&cx, t, c, air, leak, mu_l)?;
+    Ok(e)
+}
+
+/// The link's moving mass and its damping (a fraction of critical against that mass).
+fn link_mass(cx: &Check, t: &ExtensionsTable) -> Result<Option<LinkMass>, DeckError> {
+    let mass = cx.opt(
+        "link_mass_kg",
+        t.link_mass_kg,
+        "a positive mass in kg",
+        positive,
+    )?;
+    let zeta = cx.opt(
+        "link_damping_ratio",
+        t.link_damping_ratio,
+        "a non-negative fraction of critical damping",
+        non_negative,
+    )?;
+    match (mass, zeta) {
+        (Some(m), z) => Ok(Some(LinkMass {
+            mass_kg: m,
+            damping_ratio: z.unwrap_or(0.0),
+        })),
+        (None, Some(z)) => Err(cx.bad(
+                "link_damping_ratio",
+                z,
+                "the link's damping is a fraction of critical against its moving mass: give link_mass_kg too",
+            )),
+        (None, None) => Ok(None),
+    }
+}
+
+/// Entrained air (whole damper and by chamber) and annular leakage, set on `c`.
+fn hydraulic_extensions(
+    cx: &Check,
+    t: &ExtensionsTable,
+    c: &mut CircuitParams,
+    air: Option<f64>,
+    leak: Option<f64>,
+    mu_l: Option<f64>,
+) -> Result<(), DeckError> {
+    let volume_fraction = "a volume fraction in [0, 1)";
     // Entrained air is given at the background pressure, which must then be positive.
     let p_s = c.p_s;
     let at_p_s = |key: &str, a: f64| {
@@ -938,7 +953,7 @@ fn extensions(
             c.ext.air_by_chamber[ch] = Some(at_p_s(key, a)?);
         }
     }
-    Ok(e)
+    Ok(())
 }
 
 impl DamperDeck {

@@ -436,6 +436,47 @@ impl Plot {
         ((longest as u32) * 8 + 44).min((width * 7 / 20).max(190).min(width / 2))
     }
 
+    /// Width of the y tick labels' area [px]: row names need room (13 px DejaVu Sans: about
+    /// 7.5 px a character).
+    fn y_label_width(&self, w: u32) -> u32 {
+        match &self.y_categories {
+            Some(c) => {
+                let longest = c.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+                ((longest as f64 * 7.5) as u32 + 16).clamp(70, w / 2)
+            }
+            None => 70,
+        }
+    }
+
+    fn count_of(&self, kind: SeriesKind) -> usize {
+        self.series.iter().filter(|s| s.kind == kind).count()
+    }
+
+    /// Tick positions and label decimals of the x and y axes (category rows: one tick a row,
+    /// row i from the top at y = ncat - 1 - i).
+    #[allow(clippy::type_complexity)]
+    fn ticks(
+        &self,
+        (x0, x1): (f64, f64),
+        (y0, y1): (f64, f64),
+    ) -> ((Vec<f64>, usize), (Vec<f64>, usize)) {
+        let x = match self.x_step {
+            Some(s) => (ticks_at(x0, x1, s), decimals_for(s)),
+            None => {
+                let (t, s) = nice_ticks(x0, x1, 8);
+                (t, decimals_for(s))
+            }
+        };
+        let y = match &self.y_categories {
+            Some(c) => ((0..c.len()).map(|k| k as f64).collect(), 0),
+            None => {
+                let (t, s) = nice_ticks(y0, y1, 6);
+                (t, decimals_for(s))
+            }
+        };
+        (x, y)
+    }
+
     fn draw_on<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, plotters::coord::Shift>,
@@ -448,23 +489,9 @@ impl Plot {
         let (w, _) = area.dim_in_pixel();
         let lw = self.legend_width(w);
         let (plot_area, legend_area) = area.split_horizontally(w - lw);
-        let (xt, dx) = match self.x_step {
-            Some(s) => (ticks_at(x0, x1, s), decimals_for(s)),
-            None => {
-                let (t, s) = nice_ticks(x0, x1, 8);
-                (t, decimals_for(s))
-            }
-        };
+        let ((xt, dx), (yt, dy)) = self.ticks((x0, x1), (y0, y1));
         let cats = self.y_categories.clone();
         let ncat = cats.as_ref().map_or(0, Vec::len);
-        let (yt, dy) = match &cats {
-            // row i from the top sits at y = ncat - 1 - i
-            Some(_) => ((0..ncat).map(|k| k as f64).collect(), 0),
-            None => {
-                let (t, s) = nice_ticks(y0, y1, 6);
-                (t, decimals_for(s))
-            }
-        };
         let xfmt = move |v: &f64| tick_label(*v, dx);
         let yfmt = move |v: &f64| match &cats {
             Some(c) => {
@@ -477,14 +504,7 @@ impl Plot {
             }
             None => tick_label(*v, dy),
         };
-        // Row names need room (13 px DejaVu Sans: about 7.5 px a character).
-        let y_area = match &self.y_categories {
-            Some(c) => {
-                let longest = c.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-                ((longest as f64 * 7.5) as u32 + 16).clamp(70, w / 2)
-            }
-            None => 70,
-        };
+        let y_area = self.y_label_width(w);
         let mut chart = ChartBuilder::on(&plot_area)
             .caption(&self.title, ("sans-serif", 18))
             .margin(10)
@@ -504,20 +524,9 @@ impl Plot {
             .draw()
             .map_err(|e| err(&e))?;
         let colours = self.colours();
-        let nbars = self
-            .series
-            .iter()
-            .filter(|s| s.kind == SeriesKind::Bars)
-            .count()
-            .max(1);
-        let mut jbar = 0usize;
-        let nhbars = self
-            .series
-            .iter()
-            .filter(|s| s.kind == SeriesKind::HBars)
-            .count()
-            .max(1);
-        let mut jhbar = 0usize;
+        let nbars = self.count_of(SeriesKind::Bars).max(1);
+        let nhbars = self.count_of(SeriesKind::HBars).max(1);
+        let (mut jbar, mut jhbar) = (0usize, 0usize);
         let (sx, sy) = (self.x_scale, self.y_scale);
         let fy = |y: f64| {
             if ncat > 0 {
@@ -610,63 +619,76 @@ impl Plot {
             }
         }
         if lw > 0 {
-            let max_chars = ((lw.saturating_sub(44)) / 8).max(4) as usize;
-            let mut y = 40i32;
-            for (s, &color) in self.series.iter().zip(&colours) {
-                if s.name.is_empty() {
-                    continue;
-                }
-                let (x0, x1) = (6i32, 30i32);
-                let st = color.stroke_width(2);
-                let r = match s.kind {
-                    SeriesKind::Line => {
-                        legend_area.draw(&PathElement::new(vec![(x0, y), (x1, y)], st))
-                    }
-                    SeriesKind::Dashed | SeriesKind::Dotted => {
-                        let (on, off) = if s.kind == SeriesKind::Dashed {
-                            (6, 4)
-                        } else {
-                            (2, 3)
-                        };
-                        let mut xa = x0;
-                        let mut r = Ok(());
-                        while xa < x1 && r.is_ok() {
-                            r = legend_area
-                                .draw(&PathElement::new(vec![(xa, y), ((xa + on).min(x1), y)], st));
-                            xa += on + off;
-                        }
-                        r
-                    }
-                    SeriesKind::Points | SeriesKind::Dots => {
-                        legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 3, color.filled()))
-                    }
-                    SeriesKind::Rings => {
-                        legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 5, color.stroke_width(2)))
-                    }
-                    SeriesKind::Band => legend_area.draw(&Rectangle::new(
-                        [(x0, y - 5), (x1, y + 5)],
-                        color.mix(0.12).filled(),
-                    )),
-                    SeriesKind::Bars | SeriesKind::HBars => legend_area.draw(&Rectangle::new(
-                        [(x0 + 4, y - 5), (x1 - 4, y + 5)],
-                        color.filled(),
-                    )),
-                };
-                r.map_err(|e| err(&e))?;
-                let mut name: String = s.name.chars().take(max_chars).collect();
-                if s.name.chars().count() > max_chars {
-                    name.pop();
-                    name.push('…');
-                }
-                legend_area
-                    .draw(&Text::new(
-                        name,
-                        (x1 + 6, y - 7),
-                        ("sans-serif", 13).into_font().color(&BLACK),
-                    ))
-                    .map_err(|e| err(&e))?;
-                y += 20;
+            self.draw_legend(&legend_area, lw, &colours)?;
+        }
+        Ok(())
+    }
+
+    /// The legend column: each named series' marker and its name, cut to fit `lw` px.
+    fn draw_legend<DB: DrawingBackend>(
+        &self,
+        legend_area: &DrawingArea<DB, plotters::coord::Shift>,
+        lw: u32,
+        colours: &[RGBColor],
+    ) -> Result<(), PlotError> {
+        let err = |e: &dyn std::fmt::Display| PlotError::Draw {
+            title: self.title.clone(),
+            message: e.to_string(),
+        };
+        let max_chars = ((lw.saturating_sub(44)) / 8).max(4) as usize;
+        let mut y = 40i32;
+        for (s, &color) in self.series.iter().zip(colours) {
+            if s.name.is_empty() {
+                continue;
             }
+            let (x0, x1) = (6i32, 30i32);
+            let st = color.stroke_width(2);
+            let r = match s.kind {
+                SeriesKind::Line => legend_area.draw(&PathElement::new(vec![(x0, y), (x1, y)], st)),
+                SeriesKind::Dashed | SeriesKind::Dotted => {
+                    let (on, off) = if s.kind == SeriesKind::Dashed {
+                        (6, 4)
+                    } else {
+                        (2, 3)
+                    };
+                    let mut xa = x0;
+                    let mut r = Ok(());
+                    while xa < x1 && r.is_ok() {
+                        r = legend_area
+                            .draw(&PathElement::new(vec![(xa, y), ((xa + on).min(x1), y)], st));
+                        xa += on + off;
+                    }
+                    r
+                }
+                SeriesKind::Points | SeriesKind::Dots => {
+                    legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 3, color.filled()))
+                }
+                SeriesKind::Rings => {
+                    legend_area.draw(&Circle::new(((x0 + x1) / 2, y), 5, color.stroke_width(2)))
+                }
+                SeriesKind::Band => legend_area.draw(&Rectangle::new(
+                    [(x0, y - 5), (x1, y + 5)],
+                    color.mix(0.12).filled(),
+                )),
+                SeriesKind::Bars | SeriesKind::HBars => legend_area.draw(&Rectangle::new(
+                    [(x0 + 4, y - 5), (x1 - 4, y + 5)],
+                    color.filled(),
+                )),
+            };
+            r.map_err(|e| err(&e))?;
+            let mut name: String = s.name.chars().take(max_chars).collect();
+            if s.name.chars().count() > max_chars {
+                name.pop();
+                name.push('…');
+            }
+            legend_area
+                .draw(&Text::new(
+                    name,
+                    (x1 + 6, y - 7),
+                    ("sans-serif", 13).into_font().color(&BLACK),
+                ))
+                .map_err(|e| err(&e))?;
+            y += 20;
         }
         Ok(())
     }

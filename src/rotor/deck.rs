@@ -1043,24 +1043,17 @@ impl RotorSpec {
     }
 
     fn validate(&self, file: &str) -> anyhow::Result<()> {
-        let bad = |key: &str, msg: &str| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
-        let pos = |key: &str, v: f64| -> anyhow::Result<()> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(bad(key, &format!("expected a positive number, found {v}")))
-            }
-        };
-        let nonneg = |key: &str, v: f64| -> anyhow::Result<()> {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(bad(
-                    key,
-                    &format!("expected a non-negative number, found {v}"),
-                ))
-            }
-        };
+        self.check_parts(file)?;
+        self.check_geometry(file)?;
+        self.check_values(file)?;
+        self.check_outputs(file)
+    }
+
+    /// Rotor speed, airframe, aerodynamics, blade count, sections and the finite values.
+    fn check_parts(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: &str| deck_error(file, key, msg);
+        let pos = |key: &str, v: f64| check_positive(file, key, v);
+        let nonneg = |key: &str, v: f64| check_non_negative(file, key, v);
         pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
         if let Some(a) = &self.airframe {
             a.check().map_err(|(k, what)| bad(&k, &what))?;
@@ -1128,6 +1121,13 @@ impl RotorSpec {
                 &format!("expected finite [r_m, deg] pairs, found {p:?}"),
             ));
         }
+        Ok(())
+    }
+
+    /// Radii in order and element counts.
+    fn check_geometry(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: &str| deck_error(file, key, msg);
+        let pos = |key: &str, v: f64| check_positive(file, key, v);
         pos("rotor.radius_m", self.rotor.radius_m)?;
         let r = &self.retention;
         pos("retention.hinge_r_m", r.hinge_r_m)?;
@@ -1160,6 +1160,14 @@ impl RotorSpec {
                 "expected at least 1 revolution",
             ));
         }
+        Ok(())
+    }
+
+    /// Bearing, masses, lengths and the pitch horn and twist tables.
+    fn check_values(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: &str| deck_error(file, key, msg);
+        let pos = |key: &str, v: f64| check_positive(file, key, v);
+        let nonneg = |key: &str, v: f64| check_non_negative(file, key, v);
         let b = &self.bearing;
         for (k, v) in [
             ("bearing.lag_stiffness_Nm_per_rad", b.lag_k),
@@ -1215,6 +1223,12 @@ impl RotorSpec {
         if tw.windows(2).any(|w| w[1][0] <= w[0][0]) {
             return Err(bad("blade.twist_deg", "r_m must be strictly increasing"));
         }
+        Ok(())
+    }
+
+    /// Output stations and section channels.
+    fn check_outputs(&self, file: &str) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: &str| deck_error(file, key, msg);
         let o = &self.outputs;
         let lo = self.retention.hinge_r_m / self.rotor.radius_m;
         for x in &o.stations_r_over_r {
@@ -1254,5 +1268,33 @@ impl RotorSpec {
             ));
         }
         Ok(())
+    }
+}
+
+fn deck_error(file: &str, key: &str, msg: &str) -> anyhow::Error {
+    anyhow::anyhow!("rotor deck {file}, {key}: {msg}")
+}
+
+fn check_positive(file: &str, key: &str, v: f64) -> anyhow::Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(deck_error(
+            file,
+            key,
+            &format!("expected a positive number, found {v}"),
+        ))
+    }
+}
+
+fn check_non_negative(file: &str, key: &str, v: f64) -> anyhow::Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(deck_error(
+            file,
+            key,
+            &format!("expected a non-negative number, found {v}"),
+        ))
     }
 }

@@ -475,6 +475,110 @@ pub fn damper_deck_with(path: &Path, overrides: &[Override]) -> anyhow::Result<D
     Ok(DamperDeck::from_toml_str(&text, &file)?)
 }
 
+/// The units that run side by side: one per damper model, or per model and blade (separate
+/// blades; a rotor on an airframe is one model, its blades coupled through the hub).
+fn run_units_of(
+    models: &[DamperModel],
+    nb: usize,
+    coupled: bool,
+) -> Vec<(DamperModel, Option<usize>)> {
+    models
+        .iter()
+        .flat_map(|&m| -> Vec<(DamperModel, Option<usize>)> {
+            if nb == 0 || coupled {
+                vec![(m, None)]
+            } else {
+                (1..=nb).map(|k| (m, Some(k))).collect()
+            }
+        })
+        .collect()
+}
+
+/// The folder published incomplete and an error when a stop was requested and a unit
+/// stopped; else the folder, to be written.
+fn stopped(out: OutDir, stop: &StopFlag, outcomes: &[ModelOutcome]) -> anyhow::Result<OutDir> {
+    if stop.requested() {
+        // units that ended before the request keep nothing either: the run is not whole
+        let stopped: Vec<&str> = outcomes
+            .iter()
+            .filter_map(|o| o.result.as_ref().err())
+            .filter(|e| e.starts_with(STOPPED_PREFIX))
+            .map(String::as_str)
+            .collect();
+        if !stopped.is_empty() {
+            let message = stopped.join("; ");
+            out.mark_incomplete(&message)?;
+            let folder = out.path().to_path_buf();
+            drop(out); // published incomplete
+            return Err(anyhow::Error::new(RunStopped { message, folder }));
+        }
+    }
+    Ok(out)
+}
+
+/// The outcomes as reported: a physical model's failure names the unusual deck values behind
+/// it; a coupled rotor's result split by blade; separate blades combined into the whole rotor.
+fn reviewed_outcomes(
+    mut outcomes: Vec<ModelOutcome>,
+    units: &[(DamperModel, Option<usize>)],
+    deck: &DamperDeck,
+    blades: &[(RotorDeck, DamperDeck)],
+    coupled: bool,
+) -> Vec<ModelOutcome> {
+    let nb = blades.len();
+    // a failure of the physical model names the deck values behind it, where they are
+    // unusual
+    for (o, (_, blade)) in outcomes.iter_mut().zip(units) {
+        if o.model != DamperModel::Physical {
+            continue;
+        }
+        let d = blade.map_or(deck, |k| &blades[k - 1].1);
+        if let Err(e) = &mut o.result {
+            *e = d.with_review(std::mem::take(e));
+        }
+    }
+    if coupled {
+        for o in &mut outcomes {
+            let limits: Vec<Option<(f64, f64)>> = blades
+                .iter()
+                .map(|(_, d)| {
+                    (o.model == DamperModel::Physical)
+                        .then(|| crate::rotor::sim::relief_limits(d))
+                        .flatten()
+                })
+                .collect();
+            let taken = std::mem::replace(&mut o.result, Err(String::new()));
+            o.result = taken.and_then(|r| {
+                run::rotor::combine_coupled(r, nb, &limits).map_err(|e| format!("{e:#}"))
+            });
+        }
+    } else if nb > 0 {
+        outcomes = whole_rotor_outcomes(outcomes, units);
+    }
+    outcomes
+}
+
+/// Where the run's published files are.
+fn published(out: &OutDir, outcomes: &[ModelOutcome]) -> Published {
+    let published = |name: &str| out.published_path(&out.file(name));
+    Published {
+        folder: out.path().to_path_buf(),
+        report: published("report.html"),
+        summary: published("summary.json"),
+        mcap: published("result.mcap"),
+        last_rev: outcomes
+            .iter()
+            .filter(|o| o.result.is_ok())
+            .map(|o| {
+                (
+                    o.model,
+                    published(&format!("{}/last_rev.csv", o.model.name())),
+                )
+            })
+            .collect(),
+    }
+}
+
 /// A unit's periodic_state.json in the result folder `dir` of an earlier run.
 fn state_file(dir: &Path, (m, blade): (DamperModel, Option<usize>)) -> PathBuf {
     let folder = dir.join(m.name());
@@ -797,16 +901,7 @@ impl RunJob {
         // a rotor on an airframe is one model: its blades are coupled through the hub
         let coupled = nb > 0 && rotor.as_ref().is_some_and(|r| r.spec.airframe.is_some());
         // the units that run side by side: one per model, or per model and blade
-        let units: Vec<(DamperModel, Option<usize>)> = models
-            .iter()
-            .flat_map(|&m| -> Vec<(DamperModel, Option<usize>)> {
-                if nb == 0 || coupled {
-                    vec![(m, None)]
-                } else {
-                    (1..=nb).map(|k| (m, Some(k))).collect()
-                }
-            })
-            .collect();
+        let units = run_units_of(&models, nb, coupled);
         self.check_rotor(rotor.as_ref(), &record, units.len())?;
         let initial = self.initial_states(&units)?;
         let hydraulics = IntegratorOptions {
@@ -865,6 +960,71 @@ impl RunJob {
             }
         };
         let measured = Measured::from_record(&record);
+        let (inputs, inputs_sha256) = self.inputs(rotor.as_ref(), &units)?;
+        let out = OutDir::create(&self.out, &inputs)?;
+        observer.start(&RunStart {
+            units: units
+                .iter()
+                .map(|(m, b)| match b {
+                    Some(k) => format!("{} b{k}", m.name()),
+                    None => m.name().to_string(),
+                })
+                .collect(),
+            blades: (nb > 0).then_some(nb),
+            airframe: coupled,
+            models: models.clone(),
+            method,
+            tol: self.periodic_tol,
+            revs: self.revs,
+            steps_per_rev: self.steps_per_rev,
+            model: self.model,
+        });
+        let popts = self.periodic_options(initial, method, &inputs_sha256, stop);
+        let unit_models: Vec<DamperModel> = units.iter().map(|u| u.0).collect();
+        let outcomes = run::run_units(&unit_models, &popts, &build, observer);
+        let out = stopped(out, stop, &outcomes)?;
+        let outcomes = reviewed_outcomes(outcomes, &units, &deck, &blades, coupled);
+        let mut info = self.info(sdof, rigid, inputs_sha256, &record, t0);
+        info.damper_oil_temperature_k = deck.oil.map(|l| l.temperature_k);
+        if nb > 0 {
+            info.blades = Some(nb);
+            info.blade_differences = rotor
+                .as_ref()
+                .map(|r| r.blade_differences())
+                .unwrap_or_default();
+            if coupled {
+                info.airframe = rotor
+                    .as_ref()
+                    .and_then(|r| r.spec.airframe.as_ref())
+                    .map(crate::rotor::deck::AirframeTable::describe)
+                    .unwrap_or_default();
+            }
+        }
+        let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
+        let published = published(&out, &outcomes);
+        let outcome = RunOutcome {
+            outcomes,
+            measured,
+            verdict,
+            failed,
+            published,
+        };
+        match self.publish(out, &outcome) {
+            Ok(()) => Ok(outcome),
+            Err(error) => Err(anyhow::Error::new(RunFailed {
+                outcome: Box::new(outcome),
+                error,
+            })),
+        }
+    }
+
+    /// The run's input files (for the result folder's manifest) and their fingerprint (the
+    /// files and the overrides; a saved initial state is listed, not fingerprinted).
+    fn inputs(
+        &self,
+        rotor: Option<&RotorDeck>,
+        units: &[(DamperModel, Option<usize>)],
+    ) -> anyhow::Result<(Vec<PathBuf>, String)> {
         let mut inputs = FlightRecord::files(&self.flight)?;
         match (&rotor, &self.damper_deck) {
             (Some(r), _) => inputs.extend(r.input_files()),
@@ -886,25 +1046,18 @@ impl RunJob {
             Some(p) => inputs.push(p.clone()),
             None => {}
         }
-        let out = OutDir::create(&self.out, &inputs)?;
-        observer.start(&RunStart {
-            units: units
-                .iter()
-                .map(|(m, b)| match b {
-                    Some(k) => format!("{} b{k}", m.name()),
-                    None => m.name().to_string(),
-                })
-                .collect(),
-            blades: (nb > 0).then_some(nb),
-            airframe: coupled,
-            models: models.clone(),
-            method,
-            tol: self.periodic_tol,
-            revs: self.revs,
-            steps_per_rev: self.steps_per_rev,
-            model: self.model,
-        });
-        let popts: Vec<run::PeriodicOptions> = initial
+        Ok((inputs, inputs_sha256))
+    }
+
+    /// Each unit's periodic-solution options, from its initial state.
+    fn periodic_options(
+        &self,
+        initial: Vec<Option<run::PeriodicStateFile>>,
+        method: PeriodicMethod,
+        inputs_sha256: &str,
+        stop: &StopFlag,
+    ) -> Vec<run::PeriodicOptions> {
+        initial
             .into_iter()
             .map(|init| run::PeriodicOptions {
                 method,
@@ -914,105 +1067,10 @@ impl RunJob {
                 initial_state: init,
                 min_floquet_dirs: 0,
                 keep_all_revs: self.write_all_revs,
-                inputs_sha256: Some(inputs_sha256.clone()),
+                inputs_sha256: Some(inputs_sha256.to_string()),
                 stop: stop.clone(),
             })
-            .collect();
-        let unit_models: Vec<DamperModel> = units.iter().map(|u| u.0).collect();
-        let mut outcomes = run::run_units(&unit_models, &popts, &build, observer);
-        if stop.requested() {
-            // units that ended before the request keep nothing either: the run is not whole
-            let stopped: Vec<&str> = outcomes
-                .iter()
-                .filter_map(|o| o.result.as_ref().err())
-                .filter(|e| e.starts_with(STOPPED_PREFIX))
-                .map(String::as_str)
-                .collect();
-            if !stopped.is_empty() {
-                let message = stopped.join("; ");
-                out.mark_incomplete(&message)?;
-                let folder = out.path().to_path_buf();
-                drop(out); // published incomplete
-                return Err(anyhow::Error::new(RunStopped { message, folder }));
-            }
-        }
-        // a failure of the physical model names the deck values behind it, where they are
-        // unusual
-        for (o, (_, blade)) in outcomes.iter_mut().zip(&units) {
-            if o.model != DamperModel::Physical {
-                continue;
-            }
-            let d = blade.map_or(&deck, |k| &blades[k - 1].1);
-            if let Err(e) = &mut o.result {
-                *e = d.with_review(std::mem::take(e));
-            }
-        }
-        if coupled {
-            for o in &mut outcomes {
-                let limits: Vec<Option<(f64, f64)>> = blades
-                    .iter()
-                    .map(|(_, d)| {
-                        (o.model == DamperModel::Physical)
-                            .then(|| crate::rotor::sim::relief_limits(d))
-                            .flatten()
-                    })
-                    .collect();
-                let taken = std::mem::replace(&mut o.result, Err(String::new()));
-                o.result = taken.and_then(|r| {
-                    run::rotor::combine_coupled(r, nb, &limits).map_err(|e| format!("{e:#}"))
-                });
-            }
-        } else if nb > 0 {
-            outcomes = whole_rotor_outcomes(outcomes, &units);
-        }
-        let mut info = self.info(sdof, rigid, inputs_sha256, &record, t0);
-        info.damper_oil_temperature_k = deck.oil.map(|l| l.temperature_k);
-        if nb > 0 {
-            info.blades = Some(nb);
-            info.blade_differences = rotor
-                .as_ref()
-                .map(|r| r.blade_differences())
-                .unwrap_or_default();
-            if coupled {
-                info.airframe = rotor
-                    .as_ref()
-                    .and_then(|r| r.spec.airframe.as_ref())
-                    .map(crate::rotor::deck::AirframeTable::describe)
-                    .unwrap_or_default();
-            }
-        }
-        let Written { failed, verdict } = write_outputs(&out, &info, &outcomes, &measured)?;
-        let published = |name: &str| out.published_path(&out.file(name));
-        let published = Published {
-            folder: out.path().to_path_buf(),
-            report: published("report.html"),
-            summary: published("summary.json"),
-            mcap: published("result.mcap"),
-            last_rev: outcomes
-                .iter()
-                .filter(|o| o.result.is_ok())
-                .map(|o| {
-                    (
-                        o.model,
-                        published(&format!("{}/last_rev.csv", o.model.name())),
-                    )
-                })
-                .collect(),
-        };
-        let outcome = RunOutcome {
-            outcomes,
-            measured,
-            verdict,
-            failed,
-            published,
-        };
-        match self.publish(out, &outcome) {
-            Ok(()) => Ok(outcome),
-            Err(error) => Err(anyhow::Error::new(RunFailed {
-                outcome: Box::new(outcome),
-                error,
-            })),
-        }
+            .collect()
     }
 
     /// Publishes the folder: complete, or incomplete when a model failed; an error when a

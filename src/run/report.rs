@@ -254,8 +254,17 @@ fn top_figures(
     measured: Option<&Measured>,
 ) {
     let syn = if info.synthetic { "SYNTHETIC " } else { "" };
+    force_figures(rep, syn, runs, measured);
+    loop_figures(rep, syn, runs, measured);
+    stroke_figures(rep, syn, runs, measured);
+    harmonics_figure(rep, syn, runs, measured);
+    periodicity_figures(rep, runs);
+    tip_figures(rep, runs);
+}
+
+/// The damper models over the measurement, and the residual.
+fn force_figures(rep: &mut HtmlReport, syn: &str, runs: &[&ModelRun], measured: Option<&Measured>) {
     let mlabel = |_: &Measured| format!("{syn}measured");
-    // 1. Models over the measurement, and the residual.
     if let Some(m) = measured {
         rep.heading(2, "The damper models over the measurement (paper Fig. 22)");
         let mut p = Plot::new(
@@ -316,7 +325,11 @@ fn top_figures(
             &[p, pr],
         );
     }
-    // 2. Loops.
+}
+
+/// Force-stroke and force-velocity loops.
+fn loop_figures(rep: &mut HtmlReport, syn: &str, runs: &[&ModelRun], measured: Option<&Measured>) {
+    let mlabel = |_: &Measured| format!("{syn}measured");
     let mut fs = Plot::new("Force-stroke loops", "stroke [mm]", "damper force [kN]")
         .x_scale(1e3)
         .y_scale(1e-3);
@@ -359,7 +372,16 @@ fn top_figures(
             &[fs, fv],
         );
     }
-    // 3. Stroke: the record's over the models'.
+}
+
+/// Stroke: the record's over the models'.
+fn stroke_figures(
+    rep: &mut HtmlReport,
+    syn: &str,
+    runs: &[&ModelRun],
+    measured: Option<&Measured>,
+) {
+    let mlabel = |_: &Measured| format!("{syn}measured");
     let mut ps = channel_plot(runs, "Damper stroke", &[("damper_stroke_m", "")]);
     let mut pv = channel_plot(
         runs,
@@ -380,7 +402,15 @@ fn top_figures(
         "Damper stroke (top) and stroke rate (bottom), last revolution, with the record's where it has a stroke.",
         &[ps, pv],
     );
-    // 4. Harmonics bar chart.
+}
+
+/// Harmonics bar chart.
+fn harmonics_figure(
+    rep: &mut HtmlReport,
+    syn: &str,
+    runs: &[&ModelRun],
+    measured: Option<&Measured>,
+) {
     let nh = super::N_HARMONICS;
     let ns: Vec<f64> = (0..=nh).map(|n| n as f64).collect();
     let mut ph = Plot::new(
@@ -412,6 +442,10 @@ fn top_figures(
             &[ph],
         );
     }
+}
+
+/// Periodicity history.
+fn periodicity_figures(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     // 5. Periodicity history. A shooting iterate integrates several revolutions (the marched
     // ones before it, then one per subspace direction and trial), so the legend says how many.
     rep.heading(2, "Periodicity");
@@ -483,7 +517,10 @@ fn top_figures(
         .collect();
     rep.paragraph("The periodicity residual of the reported revolution is the largest change of the damper force and the blade tip flap, lag and twist over the revolution, end against start, relative to their peak-to-peak:");
     rep.list(&per);
-    // 6. Tip motion.
+}
+
+/// Tip motion.
+fn tip_figures(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     rep.heading(2, "Blade tip motion");
     svg(
         rep,

@@ -527,35 +527,7 @@ pub fn html(t: &Sensitivity) -> String {
             "SYNTHETIC flight record: the \"measured\" damper force is synthetic data (the record's metadata says synthetic), not a flight-test measurement; the RMS error is against it.",
         );
     }
-    let failures = t.failures();
-    let np = t.not_periodic();
-    if !failures.is_empty() {
-        h.banner(
-            Banner::Bad,
-            &format!(
-                "NOT complete: {} case(s) failed or have not run: {} (their outputs are empty below; the reasons are under \"failed cases\")",
-                failures.len(),
-                failures
-                    .iter()
-                    .map(|(id, _)| id.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        );
-    } else if !np.is_empty() {
-        h.banner(
-            Banner::Bad,
-            &format!(
-                "NOT periodic: {} - their reported revolution is the best one, not a periodic solution",
-                np.join(", ")
-            ),
-        );
-    } else {
-        h.banner(
-            Banner::Ok,
-            &format!("every case ran and is periodic ({} cases)", t.cases),
-        );
-    }
+    status_banners(&mut h, t);
     h.paragraph(&format!(
         "Rotor deck {}, flight record {}, rotor model {}, damper model {}: {} parameter(s), each moved to a low and a high value with the others at their nominal value ({} cases, {:.0} s). Default range of a value the deck labels ASSUMED: x0.5 to x2 of its nominal value (a side the deck's validation refuses falls back to x0.8 or x1.25, then x0.95 or x1.05); --vary KEY=LOW:HIGH states its own.",
         t.rotor, t.flight, t.model, t.damper, t.rows.len(), t.cases, t.wall_s
@@ -587,72 +559,120 @@ pub fn html(t: &Sensitivity) -> String {
     }
     h.contents();
     for (k, o) in OUTPUTS.iter().enumerate() {
-        h.heading(2, o.title);
-        match tornado(t, k) {
-            None if o.multibody_only && t.model != "uh60a" => {
-                h.paragraph(&format!(
-                    "Not available: the {} model does not give blade loads (the multibody model does: --model uh60a).",
-                    t.model
-                ));
-                continue;
-            }
-            None => {
-                h.paragraph("Not available from these runs (no nominal value, or no parameter case with a value).");
-                continue;
-            }
-            Some(Ok(svg)) => {
-                h.svg(
-                    &format!(
-                        "tornado: {} at the low and high value of each parameter, in % of the nominal value, largest spread at the top",
-                        o.title
-                    ),
-                    &svg,
-                );
-            }
-            Some(Err(e)) => {
-                h.paragraph(&format!("not plotted: {e}"));
-            }
-        }
-        let unit = if o.unit.is_empty() { "-" } else { o.unit };
-        let rows: Vec<Vec<String>> = t
-            .ranking(k)
-            .iter()
-            .enumerate()
-            .map(|(n, &i)| {
-                let r = &t.rows[i];
-                let nom = t.nominal.values[k];
-                vec![
-                    (n + 1).to_string(),
-                    r.param.name(),
-                    format!("{} .. {}", short(r.param.low), short(r.param.high)),
-                    show(o, r.low.values[k]),
-                    show(o, r.high.values[k]),
-                    pct(change(r.low.values[k], nom)),
-                    pct(change(r.high.values[k], nom)),
-                    match o.unit.is_empty() {
-                        true => r.swing(k).map_or("-".into(), |s| format!("{s:+.4}")),
-                        false => r.swing(k).map_or("-".into(), |s| format!("{s:+.0}")),
-                    },
-                ]
-            })
-            .collect();
-        let h_low = format!("output at low [{unit}]");
-        let h_high = format!("output at high [{unit}]");
-        let h_swing = format!("swing high - low [{unit}]");
-        h.table(
-            &[
-                "rank",
-                "parameter",
-                "low .. high value",
-                &h_low,
-                &h_high,
-                "change at low",
-                "change at high",
-                &h_swing,
-            ],
-            &rows,
+        output_section(&mut h, t, k, o);
+    }
+    parameter_tables(&mut h, t);
+    h.paragraph(&format!(
+        "Every case is a complete run folder under cases/ (cases/{NOMINAL}/ the nominal one); sweep.csv has one row per case, sensitivity.csv one per parameter (docs/formats.md)."
+    ));
+    h.finish()
+}
+
+/// The banner: failed cases, cases not periodic, or all well.
+fn status_banners(h: &mut HtmlReport, t: &Sensitivity) {
+    let failures = t.failures();
+    let np = t.not_periodic();
+    if !failures.is_empty() {
+        h.banner(
+            Banner::Bad,
+            &format!(
+                "NOT complete: {} case(s) failed or have not run: {} (their outputs are empty below; the reasons are under \"failed cases\")",
+                failures.len(),
+                failures
+                    .iter()
+                    .map(|(id, _)| id.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    } else if !np.is_empty() {
+        h.banner(
+            Banner::Bad,
+            &format!(
+                "NOT periodic: {} - their reported revolution is the best one, not a periodic solution",
+                np.join(", ")
+            ),
+        );
+    } else {
+        h.banner(
+            Banner::Ok,
+            &format!("every case ran and is periodic ({} cases)", t.cases),
         );
     }
+}
+
+/// One output's tornado and ranking table.
+fn output_section(h: &mut HtmlReport, t: &Sensitivity, k: usize, o: &OutputDef) {
+    h.heading(2, o.title);
+    match tornado(t, k) {
+        None if o.multibody_only && t.model != "uh60a" => {
+            h.paragraph(&format!(
+                "Not available: the {} model does not give blade loads (the multibody model does: --model uh60a).",
+                t.model
+            ));
+            return;
+        }
+        None => {
+            h.paragraph("Not available from these runs (no nominal value, or no parameter case with a value).");
+            return;
+        }
+        Some(Ok(svg)) => {
+            h.svg(
+                &format!(
+                    "tornado: {} at the low and high value of each parameter, in % of the nominal value, largest spread at the top",
+                    o.title
+                ),
+                &svg,
+            );
+        }
+        Some(Err(e)) => {
+            h.paragraph(&format!("not plotted: {e}"));
+        }
+    }
+    let unit = if o.unit.is_empty() { "-" } else { o.unit };
+    let rows: Vec<Vec<String>> = t
+        .ranking(k)
+        .iter()
+        .enumerate()
+        .map(|(n, &i)| {
+            let r = &t.rows[i];
+            let nom = t.nominal.values[k];
+            vec![
+                (n + 1).to_string(),
+                r.param.name(),
+                format!("{} .. {}", short(r.param.low), short(r.param.high)),
+                show(o, r.low.values[k]),
+                show(o, r.high.values[k]),
+                pct(change(r.low.values[k], nom)),
+                pct(change(r.high.values[k], nom)),
+                match o.unit.is_empty() {
+                    true => r.swing(k).map_or("-".into(), |s| format!("{s:+.4}")),
+                    false => r.swing(k).map_or("-".into(), |s| format!("{s:+.0}")),
+                },
+            ]
+        })
+        .collect();
+    let h_low = format!("output at low [{unit}]");
+    let h_high = format!("output at high [{unit}]");
+    let h_swing = format!("swing high - low [{unit}]");
+    h.table(
+        &[
+            "rank",
+            "parameter",
+            "low .. high value",
+            &h_low,
+            &h_high,
+            "change at low",
+            "change at high",
+            &h_swing,
+        ],
+        &rows,
+    );
+}
+
+/// The parameters, the failed cases and the ASSUMED labels not varied.
+fn parameter_tables(h: &mut HtmlReport, t: &Sensitivity) {
+    let failures = t.failures();
     h.heading(2, "parameters");
     let rows: Vec<Vec<String>> = t
         .rows
@@ -709,10 +729,6 @@ pub fn html(t: &Sensitivity) -> String {
             .collect();
         h.table(&["deck line", "key", "text", "why not varied"], &rows);
     }
-    h.paragraph(&format!(
-        "Every case is a complete run folder under cases/ (cases/{NOMINAL}/ the nominal one); sweep.csv has one row per case, sensitivity.csv one per parameter (docs/formats.md)."
-    ));
-    h.finish()
 }
 
 /// A parameter value in short form (6 significant digits; sensitivity.csv has every digit).

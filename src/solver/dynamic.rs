@@ -574,10 +574,8 @@ impl DynamicSolver {
 
     /// Advance one step of size `h`. On error the state is left at the last converged step.
     pub fn step(&mut self) -> Result<StepInfo, NewtonError> {
-        let p = self.params;
         let h = self.h;
         let n = self.model.nodes.len();
-        let nn = 6 * n;
         let t_n = self.state.t;
         let t = t_n + h;
         let (cv, ca) = self.coeffs();
@@ -692,19 +690,7 @@ impl DynamicSolver {
                 *r = -*r;
             }
             self.solve_corotated(angle_t);
-            let mut dmax: f64 = 0.0;
-            for i in 0..n {
-                for k in 0..6 {
-                    let d = self.res[6 * i + k];
-                    self.dq[i][k] += d;
-                    v_new[i][k] += cv * d;
-                    vd_new[i][k] += ca * d;
-                    dmax = dmax.max((h * d).abs());
-                }
-            }
-            for (k, l) in lam_hat.iter_mut().enumerate() {
-                *l += self.res[nn + k];
-            }
+            let dmax = self.correct(&mut v_new, &mut vd_new, &mut lam_hat, cv, ca);
             it += 1;
             if !dmax.is_finite() {
                 return Err(NewtonError::NonFinite {
@@ -715,26 +701,7 @@ impl DynamicSolver {
             }
             tiny = dmax <= self.newton.xtol * self.size;
         }
-        // accept
-        self.prev_vd.resize(n, [0.0; 6]);
-        for i in 0..n {
-            self.prev_vd[i] = cat(self.state.a[i], self.state.al[i]);
-        }
-        self.prev_lam.clone_from(&self.lam_hat);
-        for i in 0..n {
-            let vdn = cat(self.state.a[i], self.state.al[i]);
-            for k in 0..6 {
-                self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k]
-                    - p.alpha_m * self.acc[i][k])
-                    / (1.0 - p.alpha_m);
-            }
-            self.state.x[i] = x_new[i];
-            self.state.q[i] = q_new[i];
-            self.state.v[i] = [v_new[i][0], v_new[i][1], v_new[i][2]];
-            self.state.w[i] = [v_new[i][3], v_new[i][4], v_new[i][5]];
-            self.state.a[i] = [vd_new[i][0], vd_new[i][1], vd_new[i][2]];
-            self.state.al[i] = [vd_new[i][3], vd_new[i][4], vd_new[i][5]];
-        }
+        self.accept(&x_new, &q_new, &v_new, &vd_new);
         self.ws_lam = std::mem::replace(&mut self.lam_hat, lam_hat);
         self.ws_a = a_new;
         self.ws_vd = vd_new;
@@ -755,6 +722,68 @@ impl DynamicSolver {
             iterations: it,
             residual: r0,
         })
+    }
+
+    /// Apply the Newton correction in `res` to the increments, velocities and accelerations
+    /// (Newmark-like coefficients `cv`, `ca`) and the scaled multipliers; the largest
+    /// displacement correction `h |d|`.
+    fn correct(
+        &mut self,
+        v_new: &mut [[f64; 6]],
+        vd_new: &mut [[f64; 6]],
+        lam_hat: &mut [f64],
+        cv: f64,
+        ca: f64,
+    ) -> f64 {
+        let h = self.h;
+        let n = self.model.nodes.len();
+        let nn = 6 * n;
+        let mut dmax: f64 = 0.0;
+        for i in 0..n {
+            for k in 0..6 {
+                let d = self.res[6 * i + k];
+                self.dq[i][k] += d;
+                v_new[i][k] += cv * d;
+                vd_new[i][k] += ca * d;
+                dmax = dmax.max((h * d).abs());
+            }
+        }
+        for (k, l) in lam_hat.iter_mut().enumerate() {
+            *l += self.res[nn + k];
+        }
+        dmax
+    }
+
+    /// Accept the converged iterate: the state takes it, the algorithmic accelerations and
+    /// the extrapolation history move on.
+    fn accept(
+        &mut self,
+        x_new: &[[f64; 3]],
+        q_new: &[nalgebra::UnitQuaternion<f64>],
+        v_new: &[[f64; 6]],
+        vd_new: &[[f64; 6]],
+    ) {
+        let p = self.params;
+        let n = self.model.nodes.len();
+        self.prev_vd.resize(n, [0.0; 6]);
+        for i in 0..n {
+            self.prev_vd[i] = cat(self.state.a[i], self.state.al[i]);
+        }
+        self.prev_lam.clone_from(&self.lam_hat);
+        for i in 0..n {
+            let vdn = cat(self.state.a[i], self.state.al[i]);
+            for k in 0..6 {
+                self.acc[i][k] = ((1.0 - p.alpha_f) * vd_new[i][k] + p.alpha_f * vdn[k]
+                    - p.alpha_m * self.acc[i][k])
+                    / (1.0 - p.alpha_m);
+            }
+            self.state.x[i] = x_new[i];
+            self.state.q[i] = q_new[i];
+            self.state.v[i] = [v_new[i][0], v_new[i][1], v_new[i][2]];
+            self.state.w[i] = [v_new[i][3], v_new[i][4], v_new[i][5]];
+            self.state.a[i] = [vd_new[i][0], vd_new[i][1], vd_new[i][2]];
+            self.state.al[i] = [vd_new[i][3], vd_new[i][4], vd_new[i][5]];
+        }
     }
 
     /// What the last step's Newton iterations had to reach: `||r|| <= rtol r_ref` [N] (the

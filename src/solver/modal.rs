@@ -71,8 +71,38 @@ fn dense_block(asm: &Assembler, n: usize, rows: std::ops::Range<usize>) -> DMatr
     DMatrix::from_fn(rows.len(), n, |i, j| d[r0 + i][j])
 }
 
+/// The linearised matrices about a state: `K`, `G`, `M` (displacement rows) and the
+/// constraint gradient `B`, with the node kinematics they were taken at.
+struct Linearised {
+    k: DMatrix<f64>,
+    g: DMatrix<f64>,
+    m: DMatrix<f64>,
+    b: DMatrix<f64>,
+    kin: Vec<NodeKin<f64>>,
+}
+
 /// Compute modes at the (equilibrium) state `st`.
 pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<Mode>, ModalError> {
+    let lin = linearise(model, st, opts)?;
+    let nn = 6 * model.nodes.len();
+    let nsp = null_space(&lin.b, nn)?;
+    let kr = nsp.transpose() * &lin.k * &nsp;
+    let gr = nsp.transpose() * &lin.g * &nsp;
+    let mr = nsp.transpose() * &lin.m * &nsp;
+    let (s, u) = eigen_first_order(&kr, &gr, &mr, opts.shift_rad_s)?;
+    let mut idx: Vec<usize> = (0..s.len())
+        .filter(|&i| s[i].im > 1e-9 * (1.0 + s[i].re.abs()))
+        .collect();
+    idx.sort_by(|&x, &y| s[x].norm().partial_cmp(&s[y].norm()).unwrap());
+    let rots: Vec<[[f64; 3]; 3]> = lin.kin.iter().map(|k| k.r).collect();
+    Ok(idx
+        .iter()
+        .take(opts.n_modes)
+        .map(|&i| mode_at(s[i], u.col(i), &nsp, &lin.m, &rots))
+        .collect())
+}
+
+fn linearise(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Linearised, ModalError> {
     let fail = |e: String| ModalError::Failed(e);
     let mut asm = Assembler::new(model).map_err(|e| fail(e.to_string()))?;
     let om = opts.omega.unwrap_or([0.0; 3]);
@@ -161,43 +191,53 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
             }
         }
     })?;
-    // null space of B
-    let nsp = if b.nrows() == 0 {
-        DMatrix::identity(nn, nn)
-    } else {
-        // Right singular vectors of B padded to a square matrix: the columns with zero singular
-        // value span the null space (eigen solvers of B^T B failed to converge on the rotor
-        // model's 480-dof B^T B, which has many exactly-zero rows).
-        let mut bp = DMatrix::<f64>::zeros(nn.max(b.nrows()), nn);
-        bp.view_mut((0, 0), (b.nrows(), nn)).copy_from(&b);
-        let svd = bp.svd(false, true);
-        let vt = svd
-            .v_t
-            .ok_or_else(|| fail("SVD of the constraint gradient failed".into()))?;
-        let sv = &svd.singular_values;
-        let mx = sv.iter().cloned().fold(0.0, f64::max);
-        let evals: Vec<f64> = sv.iter().map(|v| v * v).collect();
-        let mx = mx * mx;
-        let cols: Vec<usize> = (0..nn).filter(|&i| evals[i] <= 1e-10 * mx).collect();
-        if nn - cols.len() != b.nrows() {
-            return Err(fail(format!(
-                "constraint gradient has rank {} for {} constraints (redundant or singular constraint set)",
-                nn - cols.len(),
-                b.nrows()
-            )));
-        }
-        DMatrix::from_fn(nn, cols.len(), |i, j| vt[(cols[j], i)])
-    };
-    let nr = nsp.ncols();
-    let kr = nsp.transpose() * &k * &nsp;
-    let gr = nsp.transpose() * &g * &nsp;
-    let mr = nsp.transpose() * &m * &nsp;
+    Ok(Linearised { k, g, m, b, kin })
+}
+
+/// A basis of the null space of `B` (`nn` columns of displacement).
+fn null_space(b: &DMatrix<f64>, nn: usize) -> Result<DMatrix<f64>, ModalError> {
+    let fail = |e: String| ModalError::Failed(e);
+    if b.nrows() == 0 {
+        return Ok(DMatrix::identity(nn, nn));
+    }
+    // Right singular vectors of B padded to a square matrix: the columns with zero singular
+    // value span the null space (eigen solvers of B^T B failed to converge on the rotor
+    // model's 480-dof B^T B, which has many exactly-zero rows).
+    let mut bp = DMatrix::<f64>::zeros(nn.max(b.nrows()), nn);
+    bp.view_mut((0, 0), (b.nrows(), nn)).copy_from(b);
+    let svd = bp.svd(false, true);
+    let vt = svd
+        .v_t
+        .ok_or_else(|| fail("SVD of the constraint gradient failed".into()))?;
+    let sv = &svd.singular_values;
+    let mx = sv.iter().cloned().fold(0.0, f64::max);
+    let evals: Vec<f64> = sv.iter().map(|v| v * v).collect();
+    let mx = mx * mx;
+    let cols: Vec<usize> = (0..nn).filter(|&i| evals[i] <= 1e-10 * mx).collect();
+    if nn - cols.len() != b.nrows() {
+        return Err(fail(format!(
+            "constraint gradient has rank {} for {} constraints (redundant or singular constraint set)",
+            nn - cols.len(),
+            b.nrows()
+        )));
+    }
+    Ok(DMatrix::from_fn(nn, cols.len(), |i, j| vt[(cols[j], i)]))
+}
+
+/// Eigenvalues `s` and eigenvectors of the reduced first-order problem.
+fn eigen_first_order(
+    kr: &DMatrix<f64>,
+    gr: &DMatrix<f64>,
+    mr: &DMatrix<f64>,
+    sig: f64,
+) -> Result<(Vec<faer::c64>, faer::Mat<faer::c64>), ModalError> {
+    let fail = |e: String| ModalError::Failed(e);
+    let nr = kr.nrows();
     // Shift-invert form when K is regular: eigenvalues 1/s of
     // A^-1 = [-K^-1 G, -K^-1 M; I, 0] resolve the lowest modes to full relative precision even
     // with very stiff axial/shear modes; otherwise the direct form [0 I; -M^-1 K, -M^-1 G].
-    let sig = opts.shift_rad_s;
     let (kr_s, gr_s) = if sig != 0.0 {
-        (&kr + &gr * sig + &mr * (sig * sig), &gr + &mr * (2.0 * sig))
+        (kr + gr * sig + mr * (sig * sig), gr + mr * (2.0 * sig))
     } else {
         (kr.clone(), gr.clone())
     };
@@ -209,7 +249,7 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     let inverted = kinv.is_some();
     if let Some(ki) = kinv {
         let kig = &ki * &gr_s;
-        let kim = &ki * &mr;
+        let kim = &ki * mr;
         for i in 0..nr {
             a[(nr + i, i)] = 1.0;
             for j in 0..nr {
@@ -220,10 +260,10 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
     } else {
         let mlu = mr.clone().lu();
         let mik = mlu
-            .solve(&kr)
+            .solve(kr)
             .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
         let mig = mlu
-            .solve(&gr)
+            .solve(gr)
             .ok_or_else(|| fail("singular reduced mass matrix".into()))?;
         for i in 0..nr {
             a[(i, nr + i)] = 1.0;
@@ -237,7 +277,6 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
         .eigen()
         .map_err(|e| fail(format!("eigen solver: {e:?}")))?;
     let s_raw = eig.S();
-    let u = eig.U();
     let s: Vec<faer::c64> = (0..2 * nr)
         .map(|i| {
             let z = s_raw[i];
@@ -252,71 +291,74 @@ pub fn modes(model: &mut Model, st: &State, opts: &ModalOptions) -> Result<Vec<M
             }
         })
         .collect();
-    let mut idx: Vec<usize> = (0..2 * nr)
-        .filter(|&i| s[i].im > 1e-9 * (1.0 + s[i].re.abs()))
-        .collect();
-    idx.sort_by(|&x, &y| s[x].norm().partial_cmp(&s[y].norm()).unwrap());
-    let mut out = vec![];
-    let rots: Vec<[[f64; 3]; 3]> = kin.iter().map(|k| k.r).collect();
-    for &i in idx.iter().take(opts.n_modes) {
-        let sv = s[i];
-        let wabs = sv.norm();
-        // displacement part, phase-normalised
-        let mut full = vec![faer::c64::new(0.0, 0.0); nn];
-        for r in 0..nn {
-            let mut acc = faer::c64::new(0.0, 0.0);
-            for j in 0..nr {
-                acc += u[(j, i)] * nsp[(r, j)];
-            }
-            full[r] = acc;
+    Ok((s, eig.U().to_owned()))
+}
+
+/// The mode of eigenvalue `sv` and reduced eigenvector `u`: its real shape (phase-normalised
+/// displacement) and its mass-weighted flap/lag/torsion/axial fractions.
+fn mode_at(
+    sv: faer::c64,
+    u: faer::ColRef<'_, faer::c64>,
+    nsp: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+    rots: &[[[f64; 3]; 3]],
+) -> Mode {
+    let (nn, nr) = (nsp.nrows(), nsp.ncols());
+    let wabs = sv.norm();
+    // displacement part, phase-normalised
+    let mut full = vec![faer::c64::new(0.0, 0.0); nn];
+    for r in 0..nn {
+        let mut acc = faer::c64::new(0.0, 0.0);
+        for j in 0..nr {
+            acc += u[j] * nsp[(r, j)];
         }
-        let (imax, _) =
-            full.iter().enumerate().fold(
-                (0, 0.0),
-                |b, (k, z)| if z.norm() > b.1 { (k, z.norm()) } else { b },
-            );
-        let ph = full[imax].conj() / full[imax].norm();
-        let re: Vec<f64> = full
-            .iter()
-            .map(|z| (*z * ph).re / full[imax].norm())
-            .collect();
-        let mut fr = [0.0; 4];
-        let mut shape = vec![[0.0; 6]; model.nodes.len()];
-        for (nd, r) in rots.iter().enumerate() {
-            let t = [re[6 * nd], re[6 * nd + 1], re[6 * nd + 2]];
-            let th = [re[6 * nd + 3], re[6 * nd + 4], re[6 * nd + 5]];
-            shape[nd] = [t[0], t[1], t[2], th[0], th[1], th[2]];
-            let tl = mtv(r, t);
-            let rl = mtv(r, th);
-            let mt = m[(6 * nd, 6 * nd)];
-            let mr3: [f64; 3] = std::array::from_fn(|k| rots_inertia(&m, r, nd, k));
-            fr[0] += mt * tl[2] * tl[2] + mr3[1] * rl[1] * rl[1];
-            fr[1] += mt * tl[1] * tl[1] + mr3[2] * rl[2] * rl[2];
-            fr[2] += mr3[0] * rl[0] * rl[0];
-            fr[3] += mt * tl[0] * tl[0];
-        }
-        let tot: f64 = fr.iter().sum::<f64>().max(1e-300);
-        let fr = fr.map(|v| v / tot);
-        let kinds = [
-            ModeKind::Flap,
-            ModeKind::Lag,
-            ModeKind::Torsion,
-            ModeKind::Axial,
-        ];
-        let (kmax, _) = fr
-            .iter()
-            .enumerate()
-            .fold((0, -1.0), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
-        out.push(Mode {
-            freq_hz: wabs / (2.0 * std::f64::consts::PI),
-            omega_rad_s: wabs,
-            damping_ratio: -sv.re / wabs,
-            kind: kinds[kmax],
-            fractions: fr,
-            shape,
-        });
+        full[r] = acc;
     }
-    Ok(out)
+    let (imax, _) =
+        full.iter().enumerate().fold(
+            (0, 0.0),
+            |b, (k, z)| if z.norm() > b.1 { (k, z.norm()) } else { b },
+        );
+    let ph = full[imax].conj() / full[imax].norm();
+    let re: Vec<f64> = full
+        .iter()
+        .map(|z| (*z * ph).re / full[imax].norm())
+        .collect();
+    let mut fr = [0.0; 4];
+    let mut shape = vec![[0.0; 6]; rots.len()];
+    for (nd, r) in rots.iter().enumerate() {
+        let t = [re[6 * nd], re[6 * nd + 1], re[6 * nd + 2]];
+        let th = [re[6 * nd + 3], re[6 * nd + 4], re[6 * nd + 5]];
+        shape[nd] = [t[0], t[1], t[2], th[0], th[1], th[2]];
+        let tl = mtv(r, t);
+        let rl = mtv(r, th);
+        let mt = m[(6 * nd, 6 * nd)];
+        let mr3: [f64; 3] = std::array::from_fn(|k| rots_inertia(m, r, nd, k));
+        fr[0] += mt * tl[2] * tl[2] + mr3[1] * rl[1] * rl[1];
+        fr[1] += mt * tl[1] * tl[1] + mr3[2] * rl[2] * rl[2];
+        fr[2] += mr3[0] * rl[0] * rl[0];
+        fr[3] += mt * tl[0] * tl[0];
+    }
+    let tot: f64 = fr.iter().sum::<f64>().max(1e-300);
+    let fr = fr.map(|v| v / tot);
+    let kinds = [
+        ModeKind::Flap,
+        ModeKind::Lag,
+        ModeKind::Torsion,
+        ModeKind::Axial,
+    ];
+    let (kmax, _) = fr
+        .iter()
+        .enumerate()
+        .fold((0, -1.0), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
+    Mode {
+        freq_hz: wabs / (2.0 * std::f64::consts::PI),
+        omega_rad_s: wabs,
+        damping_ratio: -sv.re / wabs,
+        kind: kinds[kmax],
+        fractions: fr,
+        shape,
+    }
 }
 
 /// Mass-matrix diagonal of rotation about section axis k of node nd (e_k^T R^T M_rr R e_k).

@@ -155,22 +155,10 @@ fn solve(
     };
     mk_kin(st, &mut kin);
     model.update_distributed_loads(t, &kin);
-    asm.assemble(
-        model,
-        &kin,
-        &lam_hat,
-        &ctx,
-        &seed,
-        Some((t, 0.0, &st.x)),
-        true,
-        &mut res,
-    )
-    .map_err(|source| NewtonError::Element {
-        t,
-        iteration: 0,
-        residual: f64::NAN,
-        source,
-    })?;
+    let at = (t, 0, f64::NAN);
+    tangent(
+        &mut asm, model, &kin, &lam_hat, &ctx, &seed, &st.x, at, &mut res,
+    )?;
     ctx.cscale = diag_scale(&asm);
     for (l, lp) in lam_hat.iter_mut().zip(&st.lambda) {
         *l = lp / ctx.cscale;
@@ -205,22 +193,10 @@ fn solve(
             mk_kin(st, &mut kin);
             model.update_distributed_loads(t, &kin);
             xi.copy_from_slice(&st.x);
-            asm.assemble(
-                model,
-                &kin,
-                &lam_hat,
-                &ctx,
-                &seed,
-                Some((t, 0.0, &xi)),
-                true,
-                &mut res,
-            )
-            .map_err(|source| NewtonError::Element {
-                t,
-                iteration: it,
-                residual: r_last,
-                source,
-            })?;
+            let at = (t, it, r_last);
+            tangent(
+                &mut asm, model, &kin, &lam_hat, &ctx, &seed, &xi, at, &mut res,
+            )?;
             let rn = norm(&res);
             if !rn.is_finite() {
                 return Err(NewtonError::NonFinite {
@@ -255,31 +231,7 @@ fn solve(
                 *r = -*r;
             }
             asm.solve(&mut res);
-            if let Some(cap) = max_rotation {
-                let rot = (0..model.nodes.len())
-                    .flat_map(|i| res[6 * i + 3..6 * i + 6].iter())
-                    .fold(0.0f64, |m, v| m.max(v.abs()));
-                if rot > cap {
-                    let f = cap / rot;
-                    res.iter_mut().for_each(|r| *r *= f);
-                }
-            }
-            let mut dmax: f64 = 0.0;
-            for i in 0..model.nodes.len() {
-                let dx = [res[6 * i], res[6 * i + 1], res[6 * i + 2]];
-                let dth = [res[6 * i + 3], res[6 * i + 4], res[6 * i + 5]];
-                st.x[i] = add(st.x[i], dx);
-                st.q[i] = update_left(&st.q[i], dth);
-                dmax = dmax.max(
-                    dx.iter()
-                        .chain(dth.iter())
-                        .fold(0.0f64, |m, v| m.max(v.abs()))
-                        / 1.0,
-                );
-            }
-            for (k, l) in lam_hat.iter_mut().enumerate() {
-                *l += res[nn + k];
-            }
+            let dmax = apply_correction(st, &mut res, &mut lam_hat, max_rotation);
             it += 1;
             if !dmax.is_finite() {
                 return Err(NewtonError::NonFinite {
@@ -304,6 +256,66 @@ fn solve(
     let kin_c: Vec<NodeKin<f64>> = (0..st.x.len()).map(|i| st.node_kin(i)).collect();
     commit(model, &kin_c, 0.0);
     Ok(report)
+}
+
+/// Residual and tangent at positions `x`; an element's failure names time, iteration and the
+/// last residual `at`.
+#[allow(clippy::too_many_arguments)]
+fn tangent(
+    asm: &mut Assembler,
+    model: &mut Model,
+    kin: &[NodeKin<f64>],
+    lam_hat: &[f64],
+    ctx: &EvalCtx,
+    seed: &dyn Fn(usize, usize) -> Seed,
+    x: &[[f64; 3]],
+    (t, iteration, residual): (f64, usize, f64),
+    res: &mut [f64],
+) -> Result<(), NewtonError> {
+    asm.assemble(model, kin, lam_hat, ctx, seed, Some((t, 0.0, x)), true, res)
+        .map_err(|source| NewtonError::Element {
+            t,
+            iteration,
+            residual,
+            source,
+        })
+}
+
+/// Apply the Newton correction `res` (scaled to at most `max_rotation` of node rotation) to the
+/// nodes and the scaled multipliers; the largest component applied.
+fn apply_correction(
+    st: &mut State,
+    res: &mut [f64],
+    lam_hat: &mut [f64],
+    max_rotation: Option<f64>,
+) -> f64 {
+    let n = st.x.len();
+    let nn = 6 * n;
+    if let Some(cap) = max_rotation {
+        let rot = (0..n)
+            .flat_map(|i| res[6 * i + 3..6 * i + 6].iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        if rot > cap {
+            let f = cap / rot;
+            res.iter_mut().for_each(|r| *r *= f);
+        }
+    }
+    let mut dmax: f64 = 0.0;
+    for i in 0..n {
+        let dx = [res[6 * i], res[6 * i + 1], res[6 * i + 2]];
+        let dth = [res[6 * i + 3], res[6 * i + 4], res[6 * i + 5]];
+        st.x[i] = add(st.x[i], dx);
+        st.q[i] = update_left(&st.q[i], dth);
+        dmax = dmax.max(
+            dx.iter()
+                .chain(dth.iter())
+                .fold(0.0f64, |m, v| m.max(v.abs())),
+        );
+    }
+    for (k, l) in lam_hat.iter_mut().enumerate() {
+        *l += res[nn + k];
+    }
+    dmax
 }
 
 /// Commit the converged state at the end of a step of `dt` [s] (0: statics): joints update
