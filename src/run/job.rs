@@ -254,7 +254,7 @@ pub fn parse_set(s: &str) -> Result<Override, String> {
 }
 
 /// Overrides as `KEY=VALUE` texts (serde), each parsed as `--set` parses it.
-mod set_texts {
+pub(crate) mod set_texts {
     use crate::overrides::Override;
     use serde::{Deserialize, Deserializer, Serializer};
 
