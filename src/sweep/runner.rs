@@ -2,6 +2,7 @@
 use super::{plan, Case, CaseRunner};
 use crate::flight::FlightRecord;
 use crate::run::job::{self, RunJob, RunSettings};
+use crate::run::settings::JobSettings;
 use crate::run::stability::StabilitySettings;
 use crate::run::stop::StopFlag;
 use crate::run::Silent;
