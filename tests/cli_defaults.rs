@@ -1,6 +1,6 @@
-//! The command line's defaults are the library jobs' own: the Python package runs the jobs with
-//! the defaults their `new` gives, so a command given only what it requires must ask for the
-//! same job, or the two would drift apart.
+//! The command line's defaults are the library jobs' own: a job's `new` (what library callers
+//! start from) and its settings type's defaults (the command line, sweep plans, Python) must
+//! ask for the same job, or the two would drift apart.
 use clap::Parser;
 use rotorsim::cli::{Cli, Command};
 
@@ -16,7 +16,10 @@ fn bench_defaults_are_the_jobs() {
         panic!("not a bench command");
     };
     let job = rotorsim::run::bench::BenchJob::new("d.toml", "o");
-    assert_eq!(format!("{:?}", a.job()), format!("{job:?}"));
+    assert_eq!(
+        format!("{:?}", a.settings.job(&a.out).unwrap()),
+        format!("{job:?}")
+    );
 }
 
 #[test]
@@ -33,7 +36,10 @@ fn stability_defaults_are_the_jobs() {
         panic!("not a stability command");
     };
     let job = rotorsim::run::stability::StabilityJob::new("r.toml", "1:2:1", "o");
-    assert_eq!(format!("{:?}", a.job()), format!("{job:?}"));
+    assert_eq!(
+        format!("{:?}", a.settings.job(&a.out).unwrap()),
+        format!("{job:?}")
+    );
 }
 
 #[test]
@@ -45,7 +51,10 @@ fn modes_defaults_are_the_jobs() {
         rotor: Some("r.toml".into()),
         ..rotorsim::run::modes::ModesJob::new("o")
     };
-    assert_eq!(format!("{:?}", a.job()), format!("{job:?}"));
+    assert_eq!(
+        format!("{:?}", a.settings.job(&a.out).unwrap()),
+        format!("{job:?}")
+    );
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! keys, the written deck through `rotorsim bench`, and the clear errors.
 use rotorsim::cli::bench::{run as bench, BenchArgs};
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
+use rotorsim::run::bench::BenchSettings;
 use std::path::PathBuf;
 mod support;
 use support::{assert_diagnosis_keys, read_json, root, tmp};
@@ -63,18 +64,12 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
     let text = std::fs::read_to_string(&deck).unwrap();
     assert!(text.contains("[damper.physical.extensions]"));
     bench(BenchArgs {
-        deck,
-        damper: None,
-        omega: 27.02,
-        peak_velocity: vec![2.0],
-        velocity_unit: "in/s".into(),
-        cycles: 2,
-        steps_per_cycle: 256,
-        substeps: 25,
-        integrator: "rk4".into(),
-        measured: vec![],
-        output_rate: None,
-        skip_cycles: 0,
+        settings: BenchSettings {
+            damper_deck: Some(deck),
+            peak_velocity: vec![2.0],
+            cycles: 2,
+            ..Default::default()
+        },
         out: dir.join("bench"),
     })
     .unwrap();

@@ -4,6 +4,7 @@
 use clap::Parser;
 use rotorsim::cli::{Cli, Command};
 use rotorsim::run::job::RunSettings;
+use rotorsim::run::settings::JobSettings;
 use rotorsim::sweep::plan::NOT_PLAN_OPTIONS;
 use rotorsim::sweep::Plan;
 use std::path::PathBuf;

@@ -131,6 +131,32 @@ def _deprecated(old, new):
     )
 
 
+# The options of the other jobs with their defaults, from the library's one definition each.
+BENCH_OPTIONS = _json.loads(_native.job_options("bench"))
+STABILITY_OPTIONS = _json.loads(_native.job_options("stability"))
+MODES_OPTIONS = _json.loads(_native.job_options("modes"))
+
+
+def _settings(job, known, options):
+    """Keyword arguments of ``job`` as the JSON its settings type reads (None left out)."""
+    unknown = sorted(k for k in options if k not in known)
+    if unknown:
+        raise TypeError(
+            f"{job}() got unexpected keyword argument(s) {', '.join(unknown)} "
+            f"(the options of rotorsim {job} are {', '.join(known)})"
+        )
+    settings = {}
+    for k, v in options.items():
+        if v is None:
+            continue
+        if isinstance(v, _os.PathLike):
+            v = _os.fspath(v)
+        elif isinstance(v, _np.generic):
+            v = v.item()
+        settings[k] = v
+    return _json.dumps(settings)
+
+
 def run(out=None, progress=True, models=None, rotor_model=None, **options):
     """Forced response of the rotor to a flight record, as ``rotorsim run`` does.
 
@@ -309,52 +335,41 @@ def _paths(xs):
     return [str(x) for x in xs]
 
 
-def bench(
-    deck,
-    damper=None,
-    omega=None,
-    peak_velocity=None,
-    velocity_unit=None,
-    cycles=None,
-    steps_per_cycle=None,
-    substeps=None,
-    scheme=None,
-    output_rate=None,
-    measured=None,
-    skip_cycles=None,
-    out=None,
-):
+def bench(damper_deck=None, *, out=None, deck=None, **options):
     """The damper bench of a damper deck, as ``rotorsim bench`` runs it.
 
-    ``deck``: any TOML file with a ``[damper]`` table. Every option left out takes the command
-    line's default: ``damper`` (physical, linear, nonlinear or all; default the deck's
-    ``model``), ``omega`` (27.02 rad/s), ``peak_velocity`` (0.5, 1, 2, 3, 4, 6, 8, 10),
-    ``velocity_unit`` (in/s, m/s or ft/s), ``cycles`` (10), ``steps_per_cycle`` (256),
-    ``substeps`` (25), ``scheme`` (rk4 or implicit), ``output_rate`` (samples per second of the
-    sweep; one per step by default). ``measured``: bench CSV file(s) to replay instead of the
-    harmonic sweep, ``skip_cycles`` cycles of each left out of the error metrics.
+    ``damper_deck``: any TOML file with a ``[damper]`` table (``deck`` is its deprecated name).
+    ``options`` are the options of ``rotorsim bench`` by their names (rotorsim.BENCH_OPTIONS);
+    every one left out takes the command line's default: ``damper`` (physical, linear,
+    nonlinear or all; default the deck's ``model``), ``omega`` (27.02 rad/s), ``peak_velocity``
+    (0.5, 1, 2, 3, 4, 6, 8, 10), ``velocity_unit`` (in/s, m/s or ft/s), ``cycles`` (10),
+    ``steps_per_cycle`` (256), ``substeps`` (25), ``scheme`` (rk4 or implicit),
+    ``output_rate`` (samples per second of the sweep; one per step by default). ``measured``:
+    bench CSV file(s) to replay instead of the harmonic sweep, ``skip_cycles`` cycles of each
+    left out of the error metrics. An unknown name raises TypeError.
     ``out``: the result folder to write (a temporary one, removed with the result, when not
     given).
 
     Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
     line does. Returns a :class:`BenchResult`.
     """
+    if deck is not None:
+        _deprecated("deck", "damper_deck")
+        damper_deck = deck if damper_deck is None else damper_deck
+    options["damper_deck"] = damper_deck
+    if options.get("damper") is not None:
+        options["damper"] = str(options["damper"])
+    if options.get("omega") is not None:
+        options["omega"] = float(options["omega"])
+    if options.get("peak_velocity") is not None:
+        options["peak_velocity"] = [float(v) for v in _np.atleast_1d(options["peak_velocity"])]
+    if options.get("output_rate") is not None:
+        options["output_rate"] = float(options["output_rate"])
+    if "measured" in options:
+        options["measured"] = _paths(options["measured"])
     out, keep = _out_folder(out, "rotorsim-bench-")
-    folder = _native.bench(
-        str(deck),
-        str(out),
-        damper=None if damper is None else str(damper),
-        omega=None if omega is None else float(omega),
-        peak_velocity=None if peak_velocity is None else [float(v) for v in _np.atleast_1d(peak_velocity)],
-        velocity_unit=velocity_unit,
-        cycles=cycles,
-        steps_per_cycle=steps_per_cycle,
-        substeps=substeps,
-        scheme=scheme,
-        output_rate=None if output_rate is None else float(output_rate),
-        measured=_paths(measured),
-        skip_cycles=skip_cycles,
-    )
+    settings = _settings("bench", BENCH_OPTIONS, options)
+    folder = _native.bench(str(out), settings=settings)
     return BenchResult(folder, keep)
 
 
@@ -404,58 +419,36 @@ def _list(x):
     return ",".join(repr(float(v)) for v in _np.atleast_1d(x))
 
 
-def stability(
-    rotor,
-    speeds,
-    damper=None,
-    time=None,
-    kick_m_s=None,
-    time_duration_s=None,
-    steps_per_rev=None,
-    amplitudes_m=None,
-    amplitude_at_rad_s=None,
-    hover=False,
-    collective_deg=None,
-    density_kg_m3=None,
-    speed_of_sound_m_s=None,
-    strips=None,
-    set=None,
-    out=None,
-):
+def stability(rotor, speeds, *, out=None, **options):
     """Ground (or, ``hover=True``, air) resonance of a rotor deck on its airframe over rotor
     speeds, as ``rotorsim stability`` computes it.
 
-    ``speeds`` [rad/s]: "START:STOP:STEP" (inclusive), "a,b,c", or a list of numbers. Every
-    option left out takes the command line's default: ``damper`` (the deck's model), ``time``
-    (speeds of whole-rotor time-domain runs) with ``kick_m_s`` (1e-4), ``time_duration_s`` (20)
-    and ``steps_per_rev`` (512); ``amplitudes_m`` (stroke amplitudes of the nonlinear amplitude
-    check, a list or "default") at ``amplitude_at_rad_s`` (the deck's speed); ``hover`` with
-    ``collective_deg`` (8), ``density_kg_m3`` (1.225), ``speed_of_sound_m_s`` (340.3) and
-    ``strips``; ``set`` (deck values by dotted key). ``out``: the result folder to write (a
-    temporary one, removed with the result, when not given).
+    ``speeds`` [rad/s]: "START:STOP:STEP" (inclusive), "a,b,c", or a list of numbers.
+    ``options`` are the options of ``rotorsim stability`` by their names
+    (rotorsim.STABILITY_OPTIONS); every one left out takes the command line's default:
+    ``damper`` (the deck's model), ``time`` (speeds of whole-rotor time-domain runs) with
+    ``kick_m_s`` (1e-4), ``time_duration_s`` (20) and ``steps_per_rev`` (512); ``amplitudes_m``
+    (stroke amplitudes of the nonlinear amplitude check, a list or "default") at
+    ``amplitude_at_rad_s`` (the deck's speed); ``hover`` with ``collective_deg`` (8),
+    ``density_kg_m3`` (1.225), ``speed_of_sound_m_s`` (340.3) and ``strips``; ``set`` (deck
+    values by dotted key). An unknown name raises TypeError. ``out``: the result folder to
+    write (a temporary one, removed with the result, when not given).
 
     Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
     line does. Returns a :class:`StabilityResult`.
     """
+    options.update(rotor=rotor, speeds=_list(speeds))
+    for k in ("time", "amplitudes_m"):
+        options[k] = _list(options.get(k))
+    if options.get("damper") is not None:
+        options["damper"] = str(options["damper"])
+    if options.get("hover") is not None:
+        options["hover"] = bool(options["hover"])
+    if "set" in options:
+        options["set"] = _sets(options["set"])
     out, keep = _out_folder(out, "rotorsim-stability-")
-    folder = _native.stability(
-        str(rotor),
-        _list(speeds),
-        str(out),
-        damper=None if damper is None else str(damper),
-        time=_list(time),
-        kick_m_s=kick_m_s,
-        time_duration_s=time_duration_s,
-        steps_per_rev=steps_per_rev,
-        amplitudes_m=_list(amplitudes_m),
-        amplitude_at_rad_s=amplitude_at_rad_s,
-        hover=bool(hover),
-        collective_deg=collective_deg,
-        density_kg_m3=density_kg_m3,
-        speed_of_sound_m_s=speed_of_sound_m_s,
-        strips=strips,
-        set=_sets(set),
-    )
+    settings = _settings("stability", STABILITY_OPTIONS, options)
+    folder = _native.stability(str(out), settings=settings)
     return StabilityResult(folder, keep)
 
 
@@ -486,35 +479,36 @@ class StabilityResult:
         return f"StabilityResult({str(self.folder)!r}, stable={self.stable})"
 
 
-def modes(deck=None, rotor=None, speeds=None, reference=None, count=None, out=None,
-          speed_fractions=None):
+def modes(deck=None, rotor=None, *, out=None, **options):
     """Natural frequencies and mode shapes, as ``rotorsim modes`` computes them: of a model deck
     (``deck``) about its static equilibrium, or the fan plot of a rotor deck (``rotor``).
 
     Give one of ``deck`` (a model deck; its ``[modes]`` table says how many modes and, with
     ``speeds_rad_s``, at which rotor speeds: a fan) and ``rotor`` (a rotor deck or a
-    hinged-blade deck). The fan plot of a rotor deck takes, where left out, the command line's
-    defaults: ``speeds`` (rotor speeds in rad/s: "START:STOP:STEP" inclusive, "a,b,c", or a
-    list of numbers) or ``speed_fractions`` (fractions of the deck's nominal speed, in the same
-    forms; default "0:1.2:0.1"), ``reference`` (a digitized reference fan plot
-    drawn over the model's and compared with it; default the shipped UH-60A one next to the deck,
-    or a hinged-blade deck's own ``[fan_reference]``), ``count`` (modes per speed, 14). A model
-    deck does not use them. ``out``: the result folder to write (a temporary one, removed with
-    the result, when not given).
+    hinged-blade deck). ``options`` are the other options of ``rotorsim modes`` by their names
+    (rotorsim.MODES_OPTIONS); the fan plot of a rotor deck takes, where left out, the command
+    line's defaults: ``speeds`` (rotor speeds in rad/s: "START:STOP:STEP" inclusive, "a,b,c",
+    or a list of numbers) or ``speed_fractions`` (fractions of the deck's nominal speed, in the
+    same forms; default "0:1.2:0.1"), ``reference`` (a digitized reference fan plot drawn over
+    the model's and compared with it; default the shipped UH-60A one next to the deck, or a
+    hinged-blade deck's own ``[fan_reference]``), ``count`` (modes per speed, 14). A model deck
+    does not use them. An unknown name raises TypeError. ``out``: the result folder to write (a
+    temporary one, removed with the result, when not given).
 
     Bad input raises FileNotFoundError or ValueError naming the file and option, as the command
     line does. Returns a :class:`ModesResult`.
     """
+    if options.get("speeds") is not None and options.get("speed_fractions") is not None:
+        raise ValueError(
+            "speeds and speed_fractions: give one (rad/s, or fractions of the nominal speed)"
+        )
+    options.update(deck=deck, rotor=rotor)
+    for k in ("speeds", "speed_fractions"):
+        options[k] = _list(options.get(k))
+    if options.get("count") is not None:
+        options["count"] = int(options["count"])
     out, keep = _out_folder(out, "rotorsim-modes-")
-    folder = _native.modes(
-        str(out),
-        deck=_opt(deck),
-        rotor=_opt(rotor),
-        speeds=_list(speeds),
-        speed_fractions=_list(speed_fractions),
-        reference=_opt(reference),
-        count=None if count is None else int(count),
-    )
+    folder = _native.modes(str(out), settings=_settings("modes", MODES_OPTIONS, options))
     return ModesResult(folder, keep)
 
 

@@ -12,6 +12,9 @@ _Frame = Any  # pandas.DataFrame when pandas is installed, else Dict[str, np.nda
 __version__: str
 
 RUN_OPTIONS: Dict[str, Any]
+BENCH_OPTIONS: Dict[str, Any]
+STABILITY_OPTIONS: Dict[str, Any]
+MODES_OPTIONS: Dict[str, Any]
 
 class Damper:
     def __init__(
@@ -84,7 +87,12 @@ class BenchResult:
     def history(self, peak_velocity_m_s: float, model: Optional[str] = ...) -> _Frame: ...
 
 def bench(
-    deck: _Path,
+    damper_deck: Optional[_Path] = ...,
+    *,
+    out: Optional[_Path] = ...,
+    deck: Optional[_Path] = ...,
+    # the other options of `rotorsim bench` (rotorsim.BENCH_OPTIONS; checked against the
+    # library by tests/job_options.rs)
     damper: Optional[str] = ...,
     omega: Optional[float] = ...,
     peak_velocity: Union[None, float, Iterable[float]] = ...,
@@ -96,7 +104,6 @@ def bench(
     output_rate: Optional[float] = ...,
     measured: Union[None, _Path, Iterable[_Path]] = ...,
     skip_cycles: Optional[int] = ...,
-    out: Optional[_Path] = ...,
 ) -> BenchResult: ...
 
 class StabilityResult:
@@ -112,6 +119,10 @@ _Numbers = Union[str, float, Iterable[float]]
 def stability(
     rotor: _Path,
     speeds: _Numbers,
+    *,
+    out: Optional[_Path] = ...,
+    # the other options of `rotorsim stability` (rotorsim.STABILITY_OPTIONS; checked against
+    # the library by tests/job_options.rs)
     damper: Optional[str] = ...,
     time: Optional[_Numbers] = ...,
     kick_m_s: Optional[float] = ...,
@@ -119,13 +130,12 @@ def stability(
     steps_per_rev: Optional[int] = ...,
     amplitudes_m: Optional[_Numbers] = ...,
     amplitude_at_rad_s: Optional[float] = ...,
-    hover: bool = ...,
+    hover: Optional[bool] = ...,
     collective_deg: Optional[float] = ...,
     density_kg_m3: Optional[float] = ...,
     speed_of_sound_m_s: Optional[float] = ...,
     strips: Optional[int] = ...,
     set: Optional[Mapping[str, Any]] = ...,
-    out: Optional[_Path] = ...,
 ) -> StabilityResult: ...
 
 class ModesResult:
@@ -139,11 +149,14 @@ class ModesResult:
 def modes(
     deck: Optional[_Path] = ...,
     rotor: Optional[_Path] = ...,
+    *,
+    out: Optional[_Path] = ...,
+    # the other options of `rotorsim modes` (rotorsim.MODES_OPTIONS; checked against the
+    # library by tests/job_options.rs)
     speeds: Optional[_Numbers] = ...,
+    speed_fractions: Optional[_Numbers] = ...,
     reference: Optional[_Path] = ...,
     count: Optional[int] = ...,
-    out: Optional[_Path] = ...,
-    speed_fractions: Optional[_Numbers] = ...,
 ) -> ModesResult: ...
 
 class DiagnoseResult:

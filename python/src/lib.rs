@@ -9,11 +9,11 @@ use rotorsim::hydraulics::bench::{self as damper_bench, BenchTest};
 use rotorsim::hydraulics::{
     DamperDeck, DamperModel, DeckError, Device, HydraulicError, IntegratorOptions, Scheme,
 };
-use rotorsim::overrides::Override;
-use rotorsim::run::bench::BenchJob;
+use rotorsim::run::bench::BenchSettings;
 use rotorsim::run::job::{RunObserver, RunSettings, RunStart};
-use rotorsim::run::modes::ModesJob;
-use rotorsim::run::stability::StabilityJob;
+use rotorsim::run::modes::ModesSettings;
+use rotorsim::run::settings::JobSettings;
+use rotorsim::run::stability::StabilitySettings;
 use rotorsim::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
 use rotorsim::run::Progress;
 use rotorsim::sweep::job::{resolve_shard, SweepJob};
@@ -359,137 +359,58 @@ fn run_options() -> String {
     RunSettings::defaults_json()
 }
 
-/// `rotorsim bench` as a library call: the command's defaults for every option not given, the
-/// same checks and messages. Returns the result folder.
+/// The options of each job by name with their defaults, as JSON (what its function takes):
+/// `run`, `bench`, `stability` or `modes`.
 #[pyfunction]
-#[pyo3(signature = (deck, out, damper = None, omega = None, peak_velocity = None,
-    velocity_unit = None, cycles = None, steps_per_cycle = None, substeps = None, scheme = None,
-    output_rate = None, measured = Vec::new(), skip_cycles = None))]
-#[pyo3(name = "bench")]
-#[allow(clippy::too_many_arguments)]
-fn bench_job(
-    py: Python<'_>,
-    deck: PathBuf,
-    out: PathBuf,
-    damper: Option<String>,
-    omega: Option<f64>,
-    peak_velocity: Option<Vec<f64>>,
-    velocity_unit: Option<String>,
-    cycles: Option<usize>,
-    steps_per_cycle: Option<usize>,
-    substeps: Option<usize>,
-    scheme: Option<String>,
-    output_rate: Option<f64>,
-    measured: Vec<PathBuf>,
-    skip_cycles: Option<usize>,
-) -> PyResult<PathBuf> {
-    let d = BenchJob::new(deck, out);
-    let job = BenchJob {
-        damper,
-        omega: omega.unwrap_or(d.omega),
-        peak_velocity: peak_velocity.unwrap_or_else(|| d.peak_velocity.clone()),
-        velocity_unit: velocity_unit.unwrap_or_else(|| d.velocity_unit.clone()),
-        cycles: cycles.unwrap_or(d.cycles),
-        steps_per_cycle: steps_per_cycle.unwrap_or(d.steps_per_cycle),
-        substeps: substeps.unwrap_or(d.substeps),
-        scheme: scheme.unwrap_or_else(|| d.scheme.clone()),
-        output_rate,
-        measured,
-        skip_cycles: skip_cycles.unwrap_or(d.skip_cycles),
-        ..d
-    };
+fn job_options(job: &str) -> PyResult<String> {
+    match job {
+        "run" => Ok(RunSettings::defaults_json()),
+        "bench" => Ok(BenchSettings::defaults_json()),
+        "stability" => Ok(StabilitySettings::defaults_json()),
+        "modes" => Ok(ModesSettings::defaults_json()),
+        _ => Err(PyValueError::new_err(format!(
+            "job {job}: expected run, bench, stability or modes"
+        ))),
+    }
+}
+
+/// `rotorsim bench` as a library call: `settings`, a JSON object of [`BenchSettings`] fields
+/// (the command's options by their names; its default for every one not given), the same
+/// checks and messages. Returns the result folder.
+#[pyfunction]
+#[pyo3(name = "bench", signature = (out, settings = "{}"))]
+fn bench_job(py: Python<'_>, out: PathBuf, settings: &str) -> PyResult<PathBuf> {
+    let job = BenchSettings::from_json(settings)
+        .and_then(|s| s.job(out))
+        .map_err(run_error)?;
     py.detach(|| job.execute(&mut |_, _, _| {}, &mut |_| {}))
         .map_err(run_error)?;
     Ok(job.out)
 }
 
-/// Deck overrides given as `key=value` text, parsed as `--set` is.
-fn overrides(set: &[String]) -> PyResult<Vec<Override>> {
-    set.iter()
-        .map(|s| Override::parse(s))
-        .collect::<anyhow::Result<_>>()
-        .map_err(run_error)
-}
-
-/// `rotorsim stability` as a library call: the command's defaults for every option not given,
-/// the same checks and messages. Returns the result folder.
+/// `rotorsim stability` as a library call: `settings`, a JSON object of [`StabilitySettings`]
+/// fields (the command's options by their names; its default for every one not given), the
+/// same checks and messages. Returns the result folder.
 #[pyfunction]
-#[pyo3(signature = (rotor, speeds, out, damper = None, time = None, kick_m_s = None,
-    time_duration_s = None, steps_per_rev = None, amplitudes_m = None, amplitude_at_rad_s = None,
-    hover = false, collective_deg = None, density_kg_m3 = None, speed_of_sound_m_s = None,
-    strips = None, set = Vec::new()))]
-#[allow(clippy::too_many_arguments)]
-fn stability(
-    py: Python<'_>,
-    rotor: PathBuf,
-    speeds: String,
-    out: PathBuf,
-    damper: Option<String>,
-    time: Option<String>,
-    kick_m_s: Option<f64>,
-    time_duration_s: Option<f64>,
-    steps_per_rev: Option<usize>,
-    amplitudes_m: Option<String>,
-    amplitude_at_rad_s: Option<f64>,
-    hover: bool,
-    collective_deg: Option<f64>,
-    density_kg_m3: Option<f64>,
-    speed_of_sound_m_s: Option<f64>,
-    strips: Option<usize>,
-    set: Vec<String>,
-) -> PyResult<PathBuf> {
-    let mut job = StabilityJob::new(rotor, &speeds, out);
-    job.damper = damper;
-    job.time_speeds = time;
-    let t = &mut job.time;
-    t.kick_m_s = kick_m_s.unwrap_or(t.kick_m_s);
-    t.duration_s = time_duration_s.unwrap_or(t.duration_s);
-    t.steps_per_rev = steps_per_rev.unwrap_or(t.steps_per_rev);
-    job.amplitudes_m = amplitudes_m;
-    job.amplitude_at_rad_s = amplitude_at_rad_s;
-    job.hover = hover;
-    let h = &mut job.hover_options;
-    h.collective_deg = collective_deg.unwrap_or(h.collective_deg);
-    h.density_kg_m3 = density_kg_m3.unwrap_or(h.density_kg_m3);
-    h.speed_of_sound_m_s = speed_of_sound_m_s.unwrap_or(h.speed_of_sound_m_s);
-    h.strips = strips.unwrap_or(h.strips);
-    job.set = overrides(&set)?;
+#[pyo3(signature = (out, settings = "{}"))]
+fn stability(py: Python<'_>, out: PathBuf, settings: &str) -> PyResult<PathBuf> {
+    let job = StabilitySettings::from_json(settings)
+        .and_then(|s| s.job(out))
+        .map_err(run_error)?;
     py.detach(|| job.execute(&mut |_| {})).map_err(run_error)?;
     Ok(job.out)
 }
 
-/// `rotorsim modes` as a library call: the command's defaults for every option not given, the
-/// same checks and messages. Give `deck` (a model deck) or `rotor` (a rotor deck's fan plot).
+/// `rotorsim modes` as a library call: `settings`, a JSON object of [`ModesSettings`] fields
+/// (the command's options by their names; its default for every one not given), the same
+/// checks and messages. Give `deck` (a model deck) or `rotor` (a rotor deck's fan plot).
 /// Returns the result folder.
 #[pyfunction]
-#[pyo3(signature = (out, deck = None, rotor = None, speeds = None, reference = None,
-    count = None, speed_fractions = None))]
-#[allow(clippy::too_many_arguments)]
-fn modes(
-    py: Python<'_>,
-    out: PathBuf,
-    deck: Option<PathBuf>,
-    rotor: Option<PathBuf>,
-    speeds: Option<String>,
-    reference: Option<PathBuf>,
-    count: Option<usize>,
-    speed_fractions: Option<String>,
-) -> PyResult<PathBuf> {
-    if speeds.is_some() && speed_fractions.is_some() {
-        return Err(PyValueError::new_err(
-            "speeds and speed_fractions: give one (rad/s, or fractions of the nominal speed)",
-        ));
-    }
-    let d = ModesJob::new(out);
-    let job = ModesJob {
-        deck,
-        rotor,
-        speeds: speed_fractions.unwrap_or_else(|| d.speeds.clone()),
-        speeds_rad_s: speeds,
-        reference,
-        count: count.unwrap_or(d.count),
-        ..d
-    };
+#[pyo3(signature = (out, settings = "{}"))]
+fn modes(py: Python<'_>, out: PathBuf, settings: &str) -> PyResult<PathBuf> {
+    let job = ModesSettings::from_json(settings)
+        .and_then(|s| s.job(out))
+        .map_err(run_error)?;
     py.detach(|| job.execute(&mut |_| {})).map_err(run_error)?;
     Ok(job.out)
 }
@@ -665,6 +586,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Damper>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(run_options, m)?)?;
+    m.add_function(wrap_pyfunction!(job_options, m)?)?;
     m.add_function(wrap_pyfunction!(bench_job, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(modes, m)?)?;

@@ -89,3 +89,15 @@ def test_errors_name_the_file_and_the_option(tmp_path):
     with pytest.raises(FileNotFoundError, match="missing.csv"):
         rotorsim.bench(DECK, measured=tmp_path / "missing.csv", out=tmp_path / "e")
     assert not (tmp_path / "b").exists() and not (tmp_path / "c").exists()
+
+
+def test_options_are_the_command_lines(tmp_path):
+    # every option of `rotorsim bench` is a keyword, with the command line's default
+    assert rotorsim.BENCH_OPTIONS["omega"] == 27.02
+    assert rotorsim.BENCH_OPTIONS["scheme"] == "rk4"
+    with pytest.raises(TypeError, match="velocity_units"):
+        rotorsim.bench(DECK, velocity_units="m/s", out=tmp_path / "a")
+    # `deck=`, the earlier name of `damper_deck=`, still works
+    with pytest.warns(DeprecationWarning, match="damper_deck"):
+        r = rotorsim.bench(deck=DECK, damper="linear", peak_velocity=2, cycles=2)
+    assert list(r.summary["model"]) == ["linear"]

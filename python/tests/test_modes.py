@@ -81,3 +81,14 @@ def test_errors_name_the_file_and_the_option(tmp_path):
     with pytest.raises(ValueError, match="27"):
         rotorsim.modes(rotor=UH60A, speeds="0.5,1", out=tmp_path / "h")
     assert not any((tmp_path / x).exists() for x in "abcdefgh")
+
+
+def test_options_are_the_command_lines(tmp_path):
+    # every option of `rotorsim modes` is a keyword, with the command line's default
+    assert rotorsim.MODES_OPTIONS["count"] == 14
+    assert rotorsim.MODES_OPTIONS["speed_fractions"] == "0:1.2:0.1"
+    with pytest.raises(ValueError, match="give one"):
+        rotorsim.modes(rotor=UH60A, speeds="20,27", speed_fractions="0.5,1", out=tmp_path / "a")
+    with pytest.raises(TypeError, match="counts"):
+        rotorsim.modes(rotor=UH60A, counts=3, out=tmp_path / "b")
+    assert not (tmp_path / "a").exists()

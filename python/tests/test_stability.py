@@ -54,3 +54,12 @@ def test_errors_name_the_file_and_the_option(tmp_path):
     with pytest.raises(ValueError, match="rotor.omega_rad_s"):
         rotorsim.stability(HAMMOND, "20", set={"rotor.omega_rad_s": -1.0}, out=tmp_path / "e")
     assert not any((tmp_path / x).exists() for x in "abcde")
+
+
+def test_options_are_the_command_lines(tmp_path):
+    # every option of `rotorsim stability` is a keyword, with the command line's default
+    assert rotorsim.STABILITY_OPTIONS["steps_per_rev"] == 512
+    assert rotorsim.STABILITY_OPTIONS["hover"] is False
+    with pytest.raises(TypeError, match="kick"):
+        rotorsim.stability(HAMMOND, "20", kick=1e-3, out=tmp_path / "a")
+    assert not (tmp_path / "a").exists()

@@ -2,52 +2,19 @@
 //! static equilibrium, optionally in a frame rotating at each of `[modes] speeds_rad_s` (fan).
 //! `rotorsim modes --rotor DECK --speed-fractions 0:1.2:0.1`: fan plot of a rotor deck with
 //! the digitized UH-60A reference over it (src/rotor/fan.rs). The run is the library's
-//! [`ModesJob`] (src/run/modes.rs); this file turns the options into one and prints.
-use crate::run::modes::{ModesAnalysis, ModesJob, SpeedModes};
+//! [`ModesJob`](crate::run::modes::ModesJob) (src/run/modes.rs), read from its
+//! [`ModesSettings`]; this file parses and prints.
+use crate::run::modes::{ModesAnalysis, ModesSettings, SpeedModes};
 use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ModesArgs {
-    /// Model deck (TOML, see docs/model_deck.md); or give --rotor.
-    #[arg(required_unless_present = "rotor", conflicts_with = "rotor")]
-    pub deck: Option<PathBuf>,
-    /// Rotor deck (docs/rotor_deck.md): fan plot over the speeds of --speeds or
-    /// --speed-fractions.
-    #[arg(long)]
-    pub rotor: Option<PathBuf>,
-    /// Rotor speeds [rad/s], START:STOP:STEP (inclusive) or a comma-separated list.
-    #[arg(long, conflicts_with = "speed_fractions")]
-    pub speeds: Option<String>,
-    /// Rotor speeds as fractions of the deck's nominal speed (rotor.omega_rad_s) instead of
-    /// --speeds, START:STOP:STEP (inclusive) or a comma-separated list.
-    #[arg(long, default_value = crate::run::modes::DEFAULT_SPEEDS)]
-    pub speed_fractions: String,
-    /// Digitized reference fan plot drawn over the model's (default: the UH-60A fan plot of
-    /// ../shared/data/uh60a/raw/ next to the source tree, when present).
-    #[arg(long)]
-    pub reference: Option<PathBuf>,
-    /// Modes per speed (rotor decks).
-    #[arg(long, default_value_t = crate::run::modes::DEFAULT_COUNT)]
-    pub count: usize,
+    #[command(flatten)]
+    pub settings: ModesSettings,
     /// Output directory (modes.csv, mode_shapes.csv, fan.csv).
     #[arg(long)]
     pub out: PathBuf,
-}
-
-impl ModesArgs {
-    /// The modes run these options ask for.
-    pub fn job(&self) -> ModesJob {
-        ModesJob {
-            deck: self.deck.clone(),
-            rotor: self.rotor.clone(),
-            speeds: self.speed_fractions.clone(),
-            speeds_rad_s: self.speeds.clone(),
-            reference: self.reference.clone(),
-            count: self.count,
-            out: self.out.clone(),
-        }
-    }
 }
 
 /// A model deck's modes at one speed, as they are found.
@@ -65,8 +32,8 @@ fn print_speed(at: &SpeedModes) {
 }
 
 pub fn run(args: ModesArgs) -> anyhow::Result<()> {
-    let model_deck = args.rotor.is_none();
-    let outcome = args.job().execute(&mut |at| {
+    let model_deck = args.settings.rotor.is_none();
+    let outcome = args.settings.job(&args.out)?.execute(&mut |at| {
         if model_deck {
             print_speed(at)
         }

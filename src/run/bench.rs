@@ -42,6 +42,97 @@ pub struct Config {
 /// Peak velocities of the harmonic sweep by default, in in/s.
 pub const DEFAULT_PEAK_VELOCITIES_IN_S: [f64; 8] = [0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0];
 
+/// Every option of `rotorsim bench` but its result folder, as given: the command's flags (clap)
+/// and the Python package's keyword arguments (serde, through JSON) are this one type;
+/// [`BenchSettings::job`] reads it into a [`BenchJob`]. [`BenchSettings::default`] gives the
+/// command line's defaults (the required `damper_deck` unset).
+#[derive(clap::Args, serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct BenchSettings {
+    /// Damper deck (any TOML file with a [damper] table, e.g. rotors/uh60a.toml).
+    #[arg(long, alias = "deck", value_name = "DECK", required = true)]
+    pub damper_deck: Option<PathBuf>,
+    /// Damper model: physical, linear, nonlinear, or all (default: the deck's `model`).
+    #[arg(long)]
+    pub damper: Option<String>,
+    /// Circular frequency of the harmonic stroking [rad/s].
+    #[arg(long, default_value_t = 27.02)]
+    pub omega: f64,
+    /// Peak velocities, comma separated, in --velocity-unit.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1,2,3,4,6,8,10")]
+    pub peak_velocity: Vec<f64>,
+    /// Unit of --peak-velocity: in/s, m/s or ft/s.
+    #[arg(long, default_value = "in/s")]
+    pub velocity_unit: String,
+    /// Number of stroking cycles per amplitude (peaks are taken over the last one).
+    #[arg(long, default_value_t = 10)]
+    pub cycles: usize,
+    /// Steps per cycle (the structural step of the coupled analysis).
+    #[arg(long, default_value_t = 256)]
+    pub steps_per_cycle: usize,
+    /// Hydraulic sub-steps per step.
+    #[arg(long, default_value_t = 25)]
+    pub substeps: usize,
+    /// Hydraulic sub-step scheme: rk4 or implicit.
+    #[arg(
+        long,
+        alias = "integrator",
+        value_name = "INTEGRATOR",
+        default_value = "rk4"
+    )]
+    pub scheme: String,
+    /// Output samples per second of the harmonic sweep (histories, peaks, loops): a multiple k
+    /// of the step rate omega x --steps-per-cycle / 2 pi (rounded to the nearest; default k = 1,
+    /// a sample at every step end). Each step is fed to the damper in k pieces with
+    /// --substeps / k sub-steps each (rounded up), so the hydraulic sub-step does not grow.
+    #[arg(long, value_name = "HZ")]
+    pub output_rate: Option<f64>,
+    /// Measured bench test(s) to replay instead of the harmonic sweep (bench CSV, docs/formats.md).
+    #[arg(long)]
+    pub measured: Vec<PathBuf>,
+    /// Replay only: leave the first N cycles of each test out of the error metrics (the model
+    /// starts at rest and settles over them). A cycle is the stroke's period: the median
+    /// interval between upward crossings of its mid-range.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub skip_cycles: usize,
+}
+
+impl Default for BenchSettings {
+    fn default() -> Self {
+        super::settings::command_line_defaults("bench")
+    }
+}
+
+impl super::settings::JobSettings for BenchSettings {
+    const COMMAND: &'static str = "bench";
+}
+
+impl BenchSettings {
+    /// The bench these settings ask for into `out` (its options checked when it runs).
+    pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<BenchJob> {
+        let deck = super::settings::required(
+            &self.damper_deck,
+            "--damper-deck",
+            "a damper deck (a TOML file with a [damper] table)",
+        )?;
+        Ok(BenchJob {
+            deck: deck.clone(),
+            damper: self.damper.clone(),
+            omega: self.omega,
+            peak_velocity: self.peak_velocity.clone(),
+            velocity_unit: self.velocity_unit.clone(),
+            cycles: self.cycles,
+            steps_per_cycle: self.steps_per_cycle,
+            substeps: self.substeps,
+            scheme: self.scheme.clone(),
+            output_rate: self.output_rate,
+            measured: self.measured.clone(),
+            skip_cycles: self.skip_cycles,
+            out: out.into(),
+        })
+    }
+}
+
 /// `rotorsim bench` as a library call: the command's options, typed ([`BenchJob::new`] gives
 /// its defaults), checked and run by [`BenchJob::execute`]. The command line and the Python
 /// package both run through it.

@@ -3,13 +3,14 @@
 //! generalized-alpha solver ([`DecaySim`]), and the decay's damped frequency and damping ratio
 //! by a damped-sine fit and by logarithmic decrement (docs/validation_tm4760.md).
 use crate::io::csv_string;
+use crate::io::OutDir;
 use crate::rotor::hinged::{
     blade_node_ids, fit_damped_sine, log_decrement, modes_at, track, DecayOptions, DecaySim,
     HingedSpec,
 };
 use crate::rotor::MAX_SPEED_FRACTION;
 use crate::solver::NewtonMethod;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Options of a decay run (the defaults are the validation run's).
 #[derive(Clone, Debug)]
@@ -279,5 +280,171 @@ fn fmt_num(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+/// Every option of `rotorsim decay` but its result folder, as given: the command's flags
+/// (clap) and JSON (serde) are this one type; [`DecaySettings::job`] reads it into a
+/// [`DecayJob`]. [`DecaySettings::default`] gives the command line's defaults (the required
+/// `rotor` unset).
+#[derive(clap::Args, serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct DecaySettings {
+    /// Hinged-blade rotor deck (docs/rotor_deck.md, "Hinged-blade decks").
+    #[arg(long, required = true)]
+    pub rotor: Option<PathBuf>,
+    /// Shaft speed [rad/s] (default: the deck's `[rotor] omega_rad_s`).
+    #[arg(long, conflicts_with = "rpm")]
+    pub speed_rad_s: Option<f64>,
+    /// Shaft speed in rpm instead of --speed-rad-s.
+    #[arg(long)]
+    pub rpm: Option<f64>,
+    /// Time step [s].
+    #[arg(long, default_value_t = 0.005)]
+    pub step_s: f64,
+    /// Simulated time [s]; the decay is analysed from 1 s on.
+    #[arg(long, default_value_t = 6.0)]
+    pub duration_s: f64,
+    /// Frame of the state: `rotating` (turning with the shaft, hub clamped) or `inertial`
+    /// (hub driven).
+    #[arg(long, default_value = "rotating", value_parser = FRAMES)]
+    pub frame: String,
+    /// Newton method: `modified` (stored factorization) or `full`.
+    #[arg(long, default_value = "modified", value_parser = NEWTON_METHODS)]
+    pub newton: String,
+    /// Spectral radius at infinite frequency of the generalized-alpha integrator, in [0, 1]
+    /// (1: no numerical damping; lower damps the elastic modes the release excites sooner).
+    #[arg(long, default_value_t = 0.9, allow_negative_numbers = true)]
+    pub rho_inf: f64,
+    /// Newton tolerance, relative to the residual of the zero-acceleration predictor, in (0, 1)
+    /// (docs/validation_tm4760.md, "Integrator settings and their cost").
+    #[arg(long, default_value_t = 1e-8)]
+    pub newton_rtol: f64,
+    /// Newton correction tolerance, relative to the model's size, in (0, 1): a step also ends
+    /// once its largest correction is below it and the residual at its round-off floor.
+    #[arg(long, default_value_t = 1e-9)]
+    pub newton_xtol: f64,
+    /// Skip the linearised lag mode (its static solve and eigen analysis, more than half of a
+    /// 2000-step run): decay_summary.csv then has the decay's estimates only.
+    #[arg(long)]
+    pub no_modal: bool,
+}
+
+/// The values of `--frame` and `--newton`.
+const FRAMES: [&str; 2] = ["rotating", "inertial"];
+const NEWTON_METHODS: [&str; 2] = ["modified", "full"];
+
+impl Default for DecaySettings {
+    fn default() -> Self {
+        super::settings::command_line_defaults("decay")
+    }
+}
+
+impl super::settings::JobSettings for DecaySettings {
+    const COMMAND: &'static str = "decay";
+}
+
+impl DecaySettings {
+    /// The decay these settings ask for into `out` (the deck and the values checked when it
+    /// runs).
+    pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<DecayJob> {
+        let rotor = super::settings::required(&self.rotor, "--rotor", "a hinged-blade deck")?;
+        // the command line refuses these; settings read from JSON are checked here
+        for (flag, v, all) in [
+            ("--frame", &self.frame, FRAMES),
+            ("--newton", &self.newton, NEWTON_METHODS),
+        ] {
+            if !all.contains(&v.as_str()) {
+                anyhow::bail!("{flag} {v}: expected {}", all.join(" or "));
+            }
+        }
+        let speed = match (self.speed_rad_s, self.rpm) {
+            (Some(_), Some(_)) => {
+                anyhow::bail!("--speed-rad-s and --rpm: give one (the shaft speed in rad/s or rpm)")
+            }
+            (Some(w), None) => Some(("--speed-rad-s", w)),
+            (None, Some(r)) => Some(("--rpm", r)),
+            (None, None) => None,
+        };
+        Ok(DecayJob {
+            rotor: rotor.clone(),
+            options: DecayRunOptions {
+                omega_rad_s: self
+                    .speed_rad_s
+                    .or(self.rpm.map(|r| r * std::f64::consts::PI / 30.0)),
+                time_step_s: self.step_s,
+                duration_s: self.duration_s,
+                rotating_frame: self.frame == "rotating",
+                newton: if self.newton == "full" {
+                    NewtonMethod::Full
+                } else {
+                    NewtonMethod::Modified
+                },
+                rho_inf: self.rho_inf,
+                newton_rtol: self.newton_rtol,
+                newton_xtol: self.newton_xtol,
+                modal: !self.no_modal,
+                ..Default::default()
+            },
+            speed,
+            out: out.into(),
+        })
+    }
+}
+
+/// `rotorsim decay` as a library call: checked and run by [`DecayJob::execute`] into its
+/// result folder.
+#[derive(Clone, Debug)]
+pub struct DecayJob {
+    /// Hinged-blade rotor deck.
+    pub rotor: PathBuf,
+    pub options: DecayRunOptions,
+    /// The shaft speed as given, by its option (`--speed-rad-s` or `--rpm`), for messages.
+    pub speed: Option<(&'static str, f64)>,
+    pub out: PathBuf,
+}
+
+impl DecayJob {
+    /// Checks the deck and the options (before the result folder exists), then runs the decay
+    /// and writes decay.csv and decay_summary.csv. A failure after the folder exists leaves it
+    /// marked incomplete.
+    pub fn execute(&self) -> anyhow::Result<DecayRun> {
+        let rotor = &self.rotor;
+        let text = std::fs::read_to_string(rotor)
+            .map_err(|e| anyhow::anyhow!("--rotor {}: {e}", rotor.display()))?;
+        if !crate::rotor::hinged::is_hinged(&text) {
+            anyhow::bail!(
+                "--rotor {}: not a hinged-blade deck (expected [[hinge]] tables and a [blade] with \
+                 segments, docs/rotor_deck.md)",
+                rotor.display()
+            );
+        }
+        if let Some((flag, r)) = self.speed.filter(|(_, r)| !(r.is_finite() && *r > 0.0)) {
+            anyhow::bail!("{flag}: expected a positive number, got {r}");
+        }
+        let speed_flag = self.speed.map_or("--speed-rad-s", |(f, _)| f);
+        self.options.validate(|k| {
+            match k {
+                "time_step" => "--step-s",
+                "duration" => "--duration-s",
+                "rho_inf" => "--rho-inf",
+                "newton_rtol" => "--newton-rtol",
+                "newton_xtol" => "--newton-xtol",
+                _ => speed_flag,
+            }
+            .to_string()
+        })?;
+        let out = OutDir::create(&self.out, std::slice::from_ref(rotor))?;
+        let r = match run_decay(rotor, &self.options) {
+            Ok(r) => r,
+            Err(e) => {
+                out.mark_incomplete(&e.to_string())?;
+                return Err(e);
+            }
+        };
+        out.write("decay.csv", r.history_csv().as_bytes())?;
+        out.write("decay_summary.csv", r.summary_csv().as_bytes())?;
+        out.finish()?;
+        Ok(r)
     }
 }

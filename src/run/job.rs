@@ -254,7 +254,7 @@ pub fn parse_set(s: &str) -> Result<Override, String> {
 }
 
 /// Overrides as `KEY=VALUE` texts (serde), each parsed as `--set` parses it.
-mod set_texts {
+pub(crate) mod set_texts {
     use crate::overrides::Override;
     use serde::{Deserialize, Deserializer, Serializer};
 
@@ -271,12 +271,13 @@ mod set_texts {
 }
 
 impl Default for RunSettings {
-    /// The command line's defaults: no option given, parsed (the `#[arg]`s are the only list).
     fn default() -> Self {
-        use clap::{Args, FromArgMatches};
-        let m = Self::augment_args(clap::Command::new("run")).get_matches_from(["run"]);
-        Self::from_arg_matches(&m).unwrap_or_else(|e| unreachable!("run without options: {e}"))
+        super::settings::command_line_defaults("run")
     }
+}
+
+impl super::settings::JobSettings for RunSettings {
+    const COMMAND: &'static str = "run";
 }
 
 impl RunSettings {
@@ -306,26 +307,6 @@ impl RunSettings {
             airloads: &self.airloads,
         })?;
         Ok(job)
-    }
-
-    /// Settings given as a JSON object of fields (the Python package's keyword arguments),
-    /// every other the default; an unknown name or a wrong type is an error naming it.
-    pub fn from_json(text: &str) -> anyhow::Result<Self> {
-        serde_json::from_str(text).map_err(|e| anyhow!("run options: {e}"))
-    }
-
-    /// [`RunSettings::defaults_map`] as JSON text.
-    pub fn defaults_json() -> String {
-        serde_json::Value::Object(Self::defaults_map()).to_string()
-    }
-
-    /// The settings' names with their default values (JSON): what a plan, the Python package
-    /// and the command line each accept.
-    pub fn defaults_map() -> serde_json::Map<String, serde_json::Value> {
-        serde_json::to_value(RunSettings::default())
-            .ok()
-            .and_then(|v| v.as_object().cloned())
-            .unwrap_or_default()
     }
 }
 

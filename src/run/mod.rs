@@ -29,6 +29,7 @@ pub mod report;
 pub mod rigid_blade;
 pub mod rotor;
 pub mod sdof;
+pub mod settings;
 pub mod stability;
 pub mod stop;
 pub mod summary;

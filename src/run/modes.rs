@@ -20,6 +20,65 @@ pub const DEFAULT_SPEEDS: &str = "0:1.2:0.1";
 /// Modes per speed of a rotor deck's fan plot by default (`--count`).
 pub const DEFAULT_COUNT: usize = 14;
 
+/// Every option of `rotorsim modes` but its result folder, as given: the command's arguments
+/// (clap) and the Python package's keyword arguments (serde, through JSON) are this one type;
+/// [`ModesSettings::job`] reads it into a [`ModesJob`]. [`ModesSettings::default`] gives the
+/// command line's defaults (no deck).
+#[derive(clap::Args, serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct ModesSettings {
+    /// Model deck (TOML, see docs/model_deck.md); or give --rotor.
+    #[arg(required_unless_present = "rotor", conflicts_with = "rotor")]
+    pub deck: Option<PathBuf>,
+    /// Rotor deck (docs/rotor_deck.md): fan plot over the speeds of --speeds or
+    /// --speed-fractions.
+    #[arg(long)]
+    pub rotor: Option<PathBuf>,
+    /// Rotor speeds [rad/s], START:STOP:STEP (inclusive) or a comma-separated list.
+    #[arg(long, conflicts_with = "speed_fractions")]
+    pub speeds: Option<String>,
+    /// Rotor speeds as fractions of the deck's nominal speed (rotor.omega_rad_s) instead of
+    /// --speeds, START:STOP:STEP (inclusive) or a comma-separated list.
+    #[arg(long, default_value = DEFAULT_SPEEDS)]
+    pub speed_fractions: String,
+    /// Digitized reference fan plot drawn over the model's (default: the UH-60A fan plot of
+    /// ../shared/data/uh60a/raw/ next to the source tree, when present).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Modes per speed (rotor decks).
+    #[arg(long, default_value_t = DEFAULT_COUNT)]
+    pub count: usize,
+}
+
+impl Default for ModesSettings {
+    fn default() -> Self {
+        super::settings::command_line_defaults("modes")
+    }
+}
+
+impl super::settings::JobSettings for ModesSettings {
+    const COMMAND: &'static str = "modes";
+}
+
+impl ModesSettings {
+    /// The modes run these settings ask for into `out` (its options checked when it runs).
+    pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<ModesJob> {
+        // the command line refuses both; settings read from JSON are checked here
+        if self.speeds.is_some() && self.speed_fractions != DEFAULT_SPEEDS {
+            bail!("--speeds and --speed-fractions: give one (rad/s, or fractions of the nominal speed)");
+        }
+        Ok(ModesJob {
+            deck: self.deck.clone(),
+            rotor: self.rotor.clone(),
+            speeds: self.speed_fractions.clone(),
+            speeds_rad_s: self.speeds.clone(),
+            reference: self.reference.clone(),
+            count: self.count,
+            out: out.into(),
+        })
+    }
+}
+
 /// `rotorsim modes` as a library call: the command's options, typed ([`ModesJob::new`] gives
 /// its defaults), checked and run by [`ModesJob::execute`] into its result folder. The command
 /// line and the Python package both run through it.

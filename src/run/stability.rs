@@ -1113,6 +1113,113 @@ pub fn time_check(
     })
 }
 
+/// Every option of `rotorsim stability` but its result folder, as given: the command's flags
+/// (clap), a sweep plan's stability keys and the Python package's keyword arguments (serde,
+/// through JSON) are this one type; [`StabilitySettings::job`] reads it into a
+/// [`StabilityJob`]. [`StabilitySettings::default`] gives the command line's defaults (the
+/// required `rotor` and `speeds` unset).
+#[derive(clap::Args, serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct StabilitySettings {
+    /// Rotor deck with an `[airframe]` (docs/rotor_deck.md); per-blade differences
+    /// (`[blades.K...]`, `--set blades.K...`) make the rotor anisotropic.
+    #[arg(long, required = true)]
+    pub rotor: Option<std::path::PathBuf>,
+    /// Rotor speeds [rad/s]: START:STOP:STEP (inclusive) or a comma-separated list, increasing.
+    #[arg(long, required = true)]
+    pub speeds: Option<String>,
+    /// Damper model linearised at each speed: linear, nonlinear or physical (default: the
+    /// deck's `damper.model`).
+    #[arg(long)]
+    pub damper: Option<String>,
+    /// Also march the whole multibody rotor on its airframe at these speeds [rad/s] (a list):
+    /// kicked along x, its growth rate fitted (method `time` in stability.csv).
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Velocity of the time-domain kick along x [m/s].
+    #[arg(long, default_value_t = 1e-4)]
+    pub kick_m_s: f64,
+    /// Simulated time of each time-domain run [s] (a growing one stops when the airframe
+    /// moves 10 mm); the fit starts at 7/20 of it.
+    #[arg(long, default_value_t = 20.0)]
+    pub time_duration_s: f64,
+    /// Structural steps per revolution of the time-domain runs (256 is up to 4.5% off in the
+    /// growth rate near a coalescence, 512 within 1%).
+    #[arg(long, default_value_t = 512)]
+    pub steps_per_rev: usize,
+    /// Nonlinear amplitude check: start the reduced rotor on its regressing lag mode at these
+    /// damper stroke amplitudes [m] (an increasing list; `default` for 0.1 to 30 mm), each
+    /// blade's damper a device with its valves live; growth rate against amplitude and the
+    /// limit cycles (amplitude.csv).
+    #[arg(long)]
+    pub amplitudes_m: Option<String>,
+    /// Rotor speed of the amplitude check [rad/s] (default: the deck's rotor.omega_rad_s).
+    #[arg(long)]
+    pub amplitude_at_rad_s: Option<f64>,
+    /// Air resonance in hover instead of ground resonance: rigid blades that lag and flap,
+    /// quasi-steady aerodynamics (the deck's `[aero]`), on the airframe's x, y, roll and pitch.
+    #[arg(long)]
+    pub hover: bool,
+    /// Hover: blade pitch at 0.75 R [deg] (the deck's twist about it).
+    #[arg(long, default_value_t = 8.0)]
+    pub collective_deg: f64,
+    /// Hover: air density [kg/m^3] (sea-level standard by default).
+    #[arg(long, default_value_t = 1.225)]
+    pub density_kg_m3: f64,
+    /// Hover: speed of sound [m/s] (the aerofoil tables' Mach number).
+    #[arg(long, default_value_t = 340.3)]
+    pub speed_of_sound_m_s: f64,
+    /// Hover: strips per blade from the hinge to the tip (mass and aerodynamics).
+    #[arg(long, default_value_t = crate::run::air_resonance::DEFAULT_STRIPS)]
+    pub strips: usize,
+    /// Override a deck value by its dotted path before validation (repeatable), as for run.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = crate::run::job::parse_set)]
+    #[serde(with = "crate::run::job::set_texts")]
+    pub set: Vec<crate::overrides::Override>,
+}
+
+impl Default for StabilitySettings {
+    fn default() -> Self {
+        super::settings::command_line_defaults("stability")
+    }
+}
+
+impl super::settings::JobSettings for StabilitySettings {
+    const COMMAND: &'static str = "stability";
+}
+
+impl StabilitySettings {
+    /// The stability run these settings ask for into `out` (its options checked when it runs).
+    pub fn job(&self, out: impl Into<std::path::PathBuf>) -> anyhow::Result<StabilityJob> {
+        use super::settings::required;
+        let rotor = required(&self.rotor, "--rotor", "a rotor deck with an [airframe]")?;
+        let speeds = required(&self.speeds, "--speeds", "rotor speeds in rad/s")?;
+        Ok(StabilityJob {
+            rotor: rotor.clone(),
+            speeds: speeds.clone(),
+            damper: self.damper.clone(),
+            time_speeds: self.time.clone(),
+            time: TimeOptions {
+                kick_m_s: self.kick_m_s,
+                duration_s: self.time_duration_s,
+                fit_from_s: self.time_duration_s * 7.0 / 20.0,
+                steps_per_rev: self.steps_per_rev,
+            },
+            amplitudes_m: self.amplitudes_m.clone(),
+            amplitude_at_rad_s: self.amplitude_at_rad_s,
+            hover: self.hover,
+            hover_options: super::air_resonance::HoverOptions {
+                collective_deg: self.collective_deg,
+                density_kg_m3: self.density_kg_m3,
+                speed_of_sound_m_s: self.speed_of_sound_m_s,
+                strips: self.strips,
+            },
+            set: self.set.clone(),
+            out: out.into(),
+        })
+    }
+}
+
 /// `rotorsim stability` as a library call: the command's options, typed ([`StabilityJob::new`]
 /// gives its defaults), checked and run by [`StabilityJob::execute`] into its result folder.
 /// The command line and the Python package both run through it.

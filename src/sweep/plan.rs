@@ -4,6 +4,8 @@
 //! by the caller before any case runs.
 use crate::overrides::{check_key, Override};
 use crate::run::job::RunSettings;
+use crate::run::settings::JobSettings;
+use crate::run::stability::StabilitySettings;
 use anyhow::{anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -18,8 +20,22 @@ pub const NOT_PLAN_OPTIONS: &[&str] = &["out", "initial_state", "set"];
 /// stability --speeds`).
 pub const STABILITY_SPEEDS: &str = "stability_speeds";
 
-/// Run options a plan may set (every [`RunSettings`] field but [`NOT_PLAN_OPTIONS`], then
-/// [`STABILITY_SPEEDS`]), with the type each takes, read from the settings' defaults.
+/// The keys of a stability case: [`STABILITY_SPEEDS`], then every [`StabilitySettings`] field
+/// but `speeds` (that key) and `set` (deck values are the plan's dotted keys).
+pub fn stability_options() -> Vec<String> {
+    let mut v = vec![STABILITY_SPEEDS.to_string()];
+    v.extend(
+        StabilitySettings::defaults_map()
+            .into_iter()
+            .map(|(k, _)| k)
+            .filter(|k| k != "speeds" && k != "set"),
+    );
+    v
+}
+
+/// Options a plan may set (every [`RunSettings`] field but [`NOT_PLAN_OPTIONS`], then
+/// [`STABILITY_SPEEDS`] and the other options of a stability case), with the type each takes,
+/// read from the settings' defaults.
 pub fn run_options() -> Vec<(String, OptionType)> {
     let mut v: Vec<(String, OptionType)> = RunSettings::defaults_map()
         .into_iter()
@@ -35,6 +51,11 @@ pub fn run_options() -> Vec<(String, OptionType)> {
         })
         .collect();
     v.push((STABILITY_SPEEDS.to_string(), OptionType::Text));
+    for k in stability_options() {
+        if !v.iter().any(|(n, _)| *n == k) {
+            v.push((k, OptionType::Any));
+        }
+    }
     v
 }
 
@@ -60,6 +81,8 @@ pub enum OptionType {
     Count,
     Number,
     Flag,
+    /// A stability case's option: its type checked when the case is read.
+    Any,
 }
 
 impl OptionType {
@@ -69,6 +92,7 @@ impl OptionType {
             OptionType::Count => "a positive integer",
             OptionType::Number => "a positive number",
             OptionType::Flag => "true or false",
+            OptionType::Any => "a value",
         }
     }
     fn check(self, v: &Value) -> bool {
@@ -78,6 +102,7 @@ impl OptionType {
             (OptionType::Number, Value::Float(x)) => x.is_finite() && *x > 0.0,
             (OptionType::Number, Value::Integer(i)) => *i > 0,
             (OptionType::Flag, Value::Boolean(_)) => true,
+            (OptionType::Any, v) => !matches!(v, Value::Table(_)),
             _ => false,
         }
     }

@@ -1,54 +1,65 @@
 //! A sweep's cases run as [`RunJob`]s in this process, showing nothing.
-use super::{Case, CaseRunner};
+use super::{plan, Case, CaseRunner};
 use crate::flight::FlightRecord;
 use crate::run::job::{self, RunJob, RunSettings};
+use crate::run::settings::JobSettings;
+use crate::run::stability::StabilitySettings;
 use crate::run::stop::StopFlag;
 use crate::run::Silent;
 use anyhow::{anyhow, bail};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use toml::Value;
-
-/// Options a stability case may set besides deck values.
-const STABILITY_OPTIONS: &[&str] = &["stability_speeds", "rotor", "damper"];
 
 /// A case with `stability_speeds`: the ground-resonance map of its rotor deck (its deck values
-/// applied) with its damper model over those speeds, as `rotorsim stability` makes it.
-struct StabilityCase {
-    deck: crate::rotor::RotorDeck,
-    model: crate::hydraulics::DamperModel,
-    speeds: Vec<f64>,
-}
-
-fn stability_case(case: &Case) -> Option<anyhow::Result<StabilityCase>> {
-    let Some(Value::String(speeds)) = case.option("stability_speeds") else {
-        return None;
-    };
+/// applied) over those speeds, run as `rotorsim stability` runs it. Its keys read as
+/// [`StabilitySettings`] (`stability_speeds` is `speeds`, the dotted keys `set`; `rotor`
+/// defaults to a run's); None for a case that is a run.
+pub fn stability_settings(case: &Case) -> Option<anyhow::Result<StabilitySettings>> {
+    case.option(plan::STABILITY_SPEEDS)?;
     Some((|| {
+        let known = plan::stability_options();
+        let mut given = serde_json::Map::new();
         for (k, v) in &case.settings {
-            if !k.contains('.') && !STABILITY_OPTIONS.contains(&k.as_str()) {
+            if k.contains('.') {
+                continue; // a deck value: settings.set below
+            }
+            if !known.contains(k) {
                 bail!(
                     "case {}: `{k} = {v}` is not an option of a stability case (those are {})",
                     case.id,
-                    STABILITY_OPTIONS.join(", ")
+                    known.join(", ")
                 );
             }
+            let name = if k == plan::STABILITY_SPEEDS {
+                "speeds"
+            } else {
+                k
+            };
+            given.insert(name.to_string(), serde_json::to_value(v)?);
         }
-        let speeds = crate::run::stability::parse_speeds(
-            &format!("case {}: stability_speeds", case.id),
-            speeds,
-        )?;
-        let rotor = match case.option("rotor") {
-            Some(Value::String(r)) => PathBuf::from(r),
-            _ => PathBuf::from(job::DEFAULT_ROTOR),
-        };
-        let deck = crate::rotor::RotorDeck::from_file_with(&rotor, &case.overrides())?;
-        crate::run::stability::check_rad_s(
-            &format!("case {}: stability_speeds", case.id),
-            &speeds,
-            &deck,
-        )?;
+        given
+            .entry("rotor")
+            .or_insert_with(|| job::DEFAULT_ROTOR.into());
+        let mut settings: StabilitySettings =
+            serde_json::from_value(serde_json::Value::Object(given))
+                .map_err(|e| anyhow!("case {}: {e}", case.id))?;
+        settings.set = case.overrides();
+        Ok(settings)
+    })())
+}
+
+/// [`stability_settings`], its speeds, damper and deck checked with the case's names before
+/// the job checks the rest.
+fn stability_case(case: &Case) -> Option<anyhow::Result<StabilitySettings>> {
+    let settings = stability_settings(case)?;
+    Some(settings.and_then(|settings| {
+        let speeds = settings.speeds.as_deref().unwrap_or_default();
+        let what = format!("case {}: stability_speeds", case.id);
+        let speeds = crate::run::stability::parse_speeds(&what, speeds)?;
+        let rotor = settings.rotor.clone().unwrap_or_default();
+        let deck = crate::rotor::RotorDeck::from_file_with(&rotor, &settings.set)?;
+        crate::run::stability::check_rad_s(&what, &speeds, &deck)?;
         if deck.spec.airframe.is_none() {
             bail!(
                 "case {}: rotor deck {} has no [airframe]: a stability case needs the airframe under the hub (docs/stability.md)",
@@ -56,19 +67,15 @@ fn stability_case(case: &Case) -> Option<anyhow::Result<StabilityCase>> {
                 rotor.display()
             );
         }
-        let model = match case.option("damper") {
-            Some(Value::String(d)) => d
+        let model = match &settings.damper {
+            Some(d) => d
                 .parse::<crate::hydraulics::DamperModel>()
                 .map_err(|e| anyhow!("case {}: damper `{d}`: {e}", case.id))?,
-            _ => deck.damper()?.model,
+            None => deck.damper()?.model,
         };
         deck.damper()?.require(model)?;
-        Ok(StabilityCase {
-            deck,
-            model,
-            speeds,
-        })
-    })())
+        Ok(settings)
+    }))
 }
 
 /// The run of `case` into `out`, starting from the periodic states of the result folder
@@ -81,7 +88,7 @@ pub fn job_of(case: &Case, out: &Path, initial: Option<&Path>) -> anyhow::Result
         if k.contains('.') {
             continue; // a deck value: job.overrides below
         }
-        if crate::sweep::plan::NOT_PLAN_OPTIONS.contains(&k.as_str()) || !known.contains_key(k) {
+        if plan::NOT_PLAN_OPTIONS.contains(&k.as_str()) || !known.contains_key(k) {
             bail!("case {}: `{k} = {v}` is not a run option", case.id);
         }
         if matches!(k.as_str(), "rotor" | "flight" | "damper_deck")
@@ -134,23 +141,7 @@ impl CaseRunner for JobRunner {
         self.stop
             .check(0.0, &format!("case {} not started", case.id))?;
         if let Some(c) = stability_case(case) {
-            let c = c?;
-            let dir = crate::io::OutDir::create(out, &c.deck.input_files())?;
-            return match crate::run::stability::stability_map(&c.deck, c.model, &c.speeds) {
-                Ok(mut map) => {
-                    map.overrides = case
-                        .overrides()
-                        .iter()
-                        .map(|o| (o.key.clone(), o.value_text()))
-                        .collect();
-                    crate::run::stability::write(&map, &c.deck, &dir)?;
-                    Ok(dir.finish()?)
-                }
-                Err(e) => {
-                    dir.mark_incomplete(&format!("{e:#}"))?;
-                    Err(e)
-                }
-            };
+            return c?.job(out)?.execute(&mut |_| {}).map(|_| ());
         }
         job_of(case, out, initial)?
             .execute_until(&Silent, &self.stop)
