@@ -7,10 +7,10 @@
 //! `cargo bench --bench stability`
 use criterion::{criterion_group, criterion_main, Criterion};
 use rotorsim::hydraulics::DamperModel;
+use rotorsim::resonance::air::{air_resonance_map, HoverOptions};
+use rotorsim::resonance::amplitude::{amplitude_check, AmplitudeOptions};
+use rotorsim::resonance::stability_map;
 use rotorsim::rotor::RotorDeck;
-use rotorsim::run::air_resonance::{air_resonance_map, HoverOptions};
-use rotorsim::run::amplitude::{amplitude_check, AmplitudeOptions};
-use rotorsim::run::stability::stability_map;
 use std::path::Path;
 
 fn deck_named(name: &str) -> RotorDeck {

@@ -4,8 +4,8 @@
 //! frequency and damping ratio (linear-prediction fit and log decrement over t >= 1 s), the
 //! Newton iterations and factorizations per step and the CPU cost per step of this thread, and
 //! writes the lag angle history to `tm4760_decay.csv` in the current folder.
+use rotorsim::checks::decay::{analyse, decay_sim, modal_lag, steps, DecayRun, DecayRunOptions};
 use rotorsim::rotor::hinged::HingedSpec;
-use rotorsim::run::decay::{analyse, decay_sim, modal_lag, steps, DecayRun, DecayRunOptions};
 use rotorsim::solver::NewtonMethod;
 use std::path::Path;
 

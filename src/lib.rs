@@ -4,6 +4,7 @@
 //! Systems" (equation numbers in doc comments, "Eq. N", refer to that paper).
 pub mod aero;
 pub mod analysis;
+pub mod checks;
 pub mod cli;
 pub mod diagnose;
 pub mod flight;
@@ -13,6 +14,7 @@ pub mod loads;
 pub mod overrides;
 pub mod periodic;
 pub mod report;
+pub mod resonance;
 pub mod rotor;
 pub mod run;
 pub mod sensitivity;

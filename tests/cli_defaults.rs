@@ -15,7 +15,7 @@ fn bench_defaults_are_the_jobs() {
     let Command::Bench(a) = parse(&["bench", "--damper-deck", "d.toml", "--out", "o"]) else {
         panic!("not a bench command");
     };
-    let job = rotorsim::run::bench::BenchJob::new("d.toml", "o");
+    let job = rotorsim::checks::bench::BenchJob::new("d.toml", "o");
     assert_eq!(
         format!("{:?}", a.settings.job(&a.out).unwrap()),
         format!("{job:?}")
@@ -35,7 +35,7 @@ fn stability_defaults_are_the_jobs() {
     ]) else {
         panic!("not a stability command");
     };
-    let job = rotorsim::run::stability::StabilityJob::new("r.toml", "1:2:1", "o");
+    let job = rotorsim::resonance::StabilityJob::new("r.toml", "1:2:1", "o");
     assert_eq!(
         format!("{:?}", a.settings.job(&a.out).unwrap()),
         format!("{job:?}")
@@ -47,9 +47,9 @@ fn modes_defaults_are_the_jobs() {
     let Command::Modes(a) = parse(&["modes", "--rotor", "r.toml", "--out", "o"]) else {
         panic!("not a modes command");
     };
-    let job = rotorsim::run::modes::ModesJob {
+    let job = rotorsim::checks::modes::ModesJob {
         rotor: Some("r.toml".into()),
-        ..rotorsim::run::modes::ModesJob::new("o")
+        ..rotorsim::checks::modes::ModesJob::new("o")
     };
     assert_eq!(
         format!("{:?}", a.settings.job(&a.out).unwrap()),

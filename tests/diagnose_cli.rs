@@ -1,8 +1,8 @@
 //! `rotorsim diagnose` end to end: the shipped (SYNTHETIC) flight record, the docs/formats.md JSON
 //! keys, the written deck through `rotorsim bench`, and the clear errors.
+use rotorsim::checks::bench::BenchSettings;
 use rotorsim::cli::bench::{run as bench, BenchArgs};
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
-use rotorsim::run::bench::BenchSettings;
 use std::path::PathBuf;
 mod support;
 use support::{assert_diagnosis_keys, read_json, root, tmp};

@@ -3,12 +3,12 @@
 //! a JSON key giving the same settings (the Python package's keywords, listed in its stub) and,
 //! for stability, a key of a sweep plan's stability case read into the same settings.
 use clap::Parser;
+use rotorsim::checks::bench::BenchSettings;
+use rotorsim::checks::decay::DecaySettings;
+use rotorsim::checks::modes::ModesSettings;
 use rotorsim::cli::{Cli, Command};
-use rotorsim::run::bench::BenchSettings;
-use rotorsim::run::decay::DecaySettings;
-use rotorsim::run::modes::ModesSettings;
+use rotorsim::resonance::StabilitySettings;
 use rotorsim::run::settings::JobSettings;
-use rotorsim::run::stability::StabilitySettings;
 use rotorsim::sweep::Plan;
 use serde_json::{json, Value};
 use std::fmt::Debug;

@@ -92,7 +92,7 @@ fn uh60a_fan_plot_against_digitized_reference() {
 
 #[test]
 fn speeds_argument_parses_ranges_and_lists() {
-    use rotorsim::run::modes::parse_speeds;
+    use rotorsim::checks::modes::parse_speeds;
     let v = parse_speeds("0:1.2:0.1").unwrap();
     assert_eq!(v.len(), 13);
     assert_eq!(v[12], 1.2);

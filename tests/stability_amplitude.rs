@@ -2,9 +2,9 @@
 //! with each blade's damper a device, started on the regressing lag mode at given stroke
 //! amplitudes, against the linear analysis.
 use rotorsim::hydraulics::DamperModel;
+use rotorsim::resonance::amplitude::{amplitude_check, AmplitudeCheck, AmplitudeOptions};
+use rotorsim::resonance::stability_map;
 use rotorsim::rotor::RotorDeck;
-use rotorsim::run::amplitude::{amplitude_check, AmplitudeCheck, AmplitudeOptions};
-use rotorsim::run::stability::stability_map;
 use rotorsim::stability::ModeLabel;
 use std::path::Path;
 
@@ -140,7 +140,7 @@ fn the_amplitude_check_finds_the_limit_cycle_and_the_relief_valves() {
 /// fits 8.
 #[test]
 fn in_hover_the_devices_reproduce_the_air_resonance_map() {
-    use rotorsim::run::air_resonance::{air_resonance_map, HoverOptions};
+    use rotorsim::resonance::air::{air_resonance_map, HoverOptions};
     let deck = RotorDeck::from_file_with(Path::new("rotors/uh60a_hover.toml"), &[]).unwrap();
     let om = 27.0;
     for (model, amps, tol, cycles) in [

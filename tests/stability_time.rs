@@ -7,8 +7,8 @@
 //! motion, about 55 cycles.
 use rotorsim::hydraulics::DamperModel;
 use rotorsim::overrides::Override;
+use rotorsim::resonance::{stability_map, time_check, TimeOptions};
 use rotorsim::rotor::RotorDeck;
-use rotorsim::run::stability::{stability_map, time_check, TimeOptions};
 use std::path::PathBuf;
 
 #[test]

@@ -416,7 +416,7 @@ fn a_stability_sweep_tables_each_cases_least_damping() {
             &[set],
         )
         .unwrap();
-        let map = rotorsim::run::stability::stability_map(
+        let map = rotorsim::resonance::stability_map(
             &deck,
             rotorsim::hydraulics::DamperModel::Linear,
             &speeds,

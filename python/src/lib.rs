@@ -4,16 +4,16 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
+use rotorsim::checks::bench::BenchSettings;
+use rotorsim::checks::modes::ModesSettings;
 use rotorsim::diagnose::pipeline::Config as DiagnoseConfig;
 use rotorsim::hydraulics::bench::{self as damper_bench, BenchTest};
 use rotorsim::hydraulics::{
     DamperDeck, DamperModel, DeckError, Device, HydraulicError, IntegratorOptions, Scheme,
 };
-use rotorsim::run::bench::BenchSettings;
+use rotorsim::resonance::StabilitySettings;
 use rotorsim::run::job::{RunObserver, RunSettings, RunStart};
-use rotorsim::run::modes::ModesSettings;
 use rotorsim::run::settings::JobSettings;
-use rotorsim::run::stability::StabilitySettings;
 use rotorsim::run::stop::{RunStopped, StopFlag, STOPPED_PREFIX};
 use rotorsim::run::Progress;
 use rotorsim::sweep::job::{resolve_shard, SweepJob};

@@ -1,10 +1,10 @@
 //! `rotorsim bench`: harmonic sweeps of a damper deck (paper Figs. 13-14) and replay
 //! of measured bench tests.
-//! The bench is the library's [`BenchJob`](crate::run::bench::BenchJob) (checks and outputs,
-//! src/run/bench.rs), read from its [`BenchSettings`]; this file parses and prints.
+//! The bench is the library's [`BenchJob`](crate::checks::bench::BenchJob) (checks and outputs,
+//! src/checks/bench.rs), read from its [`BenchSettings`]; this file parses and prints.
+use crate::checks::bench::BenchSettings;
 use crate::hydraulics::bench::{HarmonicRun, IN_TO_M, LB_TO_N};
 use crate::hydraulics::{DamperModel, IntegratorOptions};
-use crate::run::bench::BenchSettings;
 use clap::Args;
 use std::f64::consts::PI;
 use std::path::PathBuf;

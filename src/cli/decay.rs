@@ -1,7 +1,7 @@
 //! `rotorsim decay --rotor DECK`: free decay of a hinged blade's lag hinge beside its
-//! linearised mode. The run is the library's [`DecayJob`](crate::run::decay::DecayJob)
-//! (src/run/decay.rs), read from its [`DecaySettings`]; this file parses and prints.
-use crate::run::decay::DecaySettings;
+//! linearised mode. The run is the library's [`DecayJob`](crate::checks::decay::DecayJob)
+//! (src/checks/decay.rs), read from its [`DecaySettings`]; this file parses and prints.
+use crate::checks::decay::DecaySettings;
 use clap::Args;
 use std::path::PathBuf;
 

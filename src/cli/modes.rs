@@ -2,9 +2,9 @@
 //! static equilibrium, optionally in a frame rotating at each of `[modes] speeds_rad_s` (fan).
 //! `rotorsim modes --rotor DECK --speed-fractions 0:1.2:0.1`: fan plot of a rotor deck with
 //! the digitized UH-60A reference over it (src/rotor/fan.rs). The run is the library's
-//! [`ModesJob`](crate::run::modes::ModesJob) (src/run/modes.rs), read from its
+//! [`ModesJob`](crate::checks::modes::ModesJob) (src/checks/modes.rs), read from its
 //! [`ModesSettings`]; this file parses and prints.
-use crate::run::modes::{ModesAnalysis, ModesSettings, SpeedModes};
+use crate::checks::modes::{ModesAnalysis, ModesSettings, SpeedModes};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -1,8 +1,8 @@
 //! `rotorsim stability --rotor DECK --speeds A:B:STEP --out DIR`: ground resonance of a rotor
 //! deck on its airframe over rotor speeds. The run is the library's
-//! [`StabilityJob`](crate::run::stability::StabilityJob) (src/run/stability.rs), read from its
+//! [`StabilityJob`](crate::resonance::StabilityJob) (src/resonance/mod.rs), read from its
 //! [`StabilitySettings`]; this file parses and prints.
-use crate::run::stability::{StabilityOutcome, StabilitySettings};
+use crate::resonance::{StabilityOutcome, StabilitySettings};
 use clap::Args;
 use std::path::PathBuf;
 

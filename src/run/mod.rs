@@ -14,23 +14,16 @@
 //! speeds), [`modes`] (a model deck's modes, a rotor deck's fan plot), [`decay`] (a hinged
 //! blade's lag free decay) and [`outputs`] (the run outputs' writer, shared with the diagnosis'
 //! rotor-level check); [`stop`] stops runs from outside (the Python package's Ctrl-C).
-pub mod air_resonance;
-pub mod amplitude;
-pub mod bench;
-pub mod decay;
 pub mod job;
 pub mod loads;
 pub mod mcap_out;
-pub mod modes;
 pub mod outputs;
 pub mod periodic;
 pub mod ranges;
 pub mod report;
-pub mod rigid_blade;
 pub mod rotor;
 pub mod sdof;
 pub mod settings;
-pub mod stability;
 pub mod stop;
 pub mod summary;
 

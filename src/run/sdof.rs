@@ -83,7 +83,7 @@ impl SdofParams {
     ///
     /// N, C from the replay (revolution average, radial taper to the root cut-out and the tip),
     /// harmonics 0..=16. The blade's `I`, `S`, lag spring and damping and damper arm are its
-    /// [`super::rigid_blade::RigidLagBlade`].
+    /// [`crate::resonance::rigid_blade::RigidLagBlade`].
     pub fn from_rotor(
         spec: &crate::rotor::deck::RotorSpec,
         deck_path: &std::path::Path,
@@ -92,7 +92,7 @@ impl SdofParams {
         use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
         // the record must be of this rotor, as the elastic model requires
         spec.check_record(record, deck_path)?;
-        let blade = super::rigid_blade::RigidLagBlade::of(spec, deck_path)?;
+        let blade = crate::resonance::rigid_blade::RigidLagBlade::of(spec, deck_path)?;
         let e = blade.hinge_offset_m;
         let radius = spec.rotor.radius_m;
         let replay = AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?;

@@ -3,9 +3,9 @@
 //! own structure and the types of run options; deck values and records are checked case by case
 //! by the caller before any case runs.
 use crate::overrides::{check_key, Override};
+use crate::resonance::StabilitySettings;
 use crate::run::job::RunSettings;
 use crate::run::settings::JobSettings;
-use crate::run::stability::StabilitySettings;
 use anyhow::{anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -1,9 +1,9 @@
 //! A sweep's cases run as [`RunJob`]s in this process, showing nothing.
 use super::{plan, Case, CaseRunner};
 use crate::flight::FlightRecord;
+use crate::resonance::StabilitySettings;
 use crate::run::job::{self, RunJob, RunSettings};
 use crate::run::settings::JobSettings;
-use crate::run::stability::StabilitySettings;
 use crate::run::stop::StopFlag;
 use crate::run::Silent;
 use anyhow::{anyhow, bail};
@@ -56,10 +56,10 @@ fn stability_case(case: &Case) -> Option<anyhow::Result<StabilitySettings>> {
     Some(settings.and_then(|settings| {
         let speeds = settings.speeds.as_deref().unwrap_or_default();
         let what = format!("case {}: stability_speeds", case.id);
-        let speeds = crate::run::stability::parse_speeds(&what, speeds)?;
+        let speeds = crate::resonance::parse_speeds(&what, speeds)?;
         let rotor = settings.rotor.clone().unwrap_or_default();
         let deck = crate::rotor::RotorDeck::from_file_with(&rotor, &settings.set)?;
-        crate::run::stability::check_rad_s(&what, &speeds, &deck)?;
+        crate::resonance::check_rad_s(&what, &speeds, &deck)?;
         if deck.spec.airframe.is_none() {
             bail!(
                 "case {}: rotor deck {} has no [airframe]: a stability case needs the airframe under the hub (docs/stability.md)",

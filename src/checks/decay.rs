@@ -336,11 +336,11 @@ const NEWTON_METHODS: [&str; 2] = ["modified", "full"];
 
 impl Default for DecaySettings {
     fn default() -> Self {
-        super::settings::command_line_defaults("decay")
+        crate::run::settings::command_line_defaults("decay")
     }
 }
 
-impl super::settings::JobSettings for DecaySettings {
+impl crate::run::settings::JobSettings for DecaySettings {
     const COMMAND: &'static str = "decay";
 }
 
@@ -348,7 +348,7 @@ impl DecaySettings {
     /// The decay these settings ask for into `out` (the deck and the values checked when it
     /// runs).
     pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<DecayJob> {
-        let rotor = super::settings::required(&self.rotor, "--rotor", "a hinged-blade deck")?;
+        let rotor = crate::run::settings::required(&self.rotor, "--rotor", "a hinged-blade deck")?;
         // the command line refuses these; settings read from JSON are checked here
         for (flag, v, all) in [
             ("--frame", &self.frame, FRAMES),

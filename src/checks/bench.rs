@@ -99,18 +99,18 @@ pub struct BenchSettings {
 
 impl Default for BenchSettings {
     fn default() -> Self {
-        super::settings::command_line_defaults("bench")
+        crate::run::settings::command_line_defaults("bench")
     }
 }
 
-impl super::settings::JobSettings for BenchSettings {
+impl crate::run::settings::JobSettings for BenchSettings {
     const COMMAND: &'static str = "bench";
 }
 
 impl BenchSettings {
     /// The bench these settings ask for into `out` (its options checked when it runs).
     pub fn job(&self, out: impl Into<PathBuf>) -> anyhow::Result<BenchJob> {
-        let deck = super::settings::required(
+        let deck = crate::run::settings::required(
             &self.damper_deck,
             "--damper-deck",
             "a damper deck (a TOML file with a [damper] table)",
@@ -724,7 +724,29 @@ fn sweep_html(
         &fig13_plot(all, cfg, factor, deck).to_svg(1000, 460)?,
     );
 
-    // Dynamic stiffness and energy vs amplitude.
+    stiffness_figures(&mut r, all, cfg, deck)?;
+    loop_figures(&mut r, all, cfg, factor)?;
+    r.heading(2, "Time history (paper Fig. 14)");
+    for (svg, (model, _)) in time_histories.iter().zip(all) {
+        r.svg(
+            &format!(
+                "{} model, amplitude closest to 2 in/s, last two cycles (time_history.svg).",
+                model.name()
+            ),
+            svg,
+        );
+    }
+    r.paragraph("Files: bench_summary.csv (this table, SI), peaks.csv, history_v<v>m_s.csv (every sample; v = peak velocity in m/s), peak_force_vs_velocity.svg, time_history.svg; columns and units in docs/formats.md.");
+    Ok(r.finish())
+}
+
+/// Dynamic stiffness and energy per cycle against amplitude.
+fn stiffness_figures(
+    r: &mut HtmlReport,
+    all: &[(DamperModel, Vec<HarmonicRun>)],
+    cfg: &Config,
+    deck: &DamperDeck,
+) -> anyhow::Result<()> {
     let lin_c = deck.linear_c_n_s_per_m;
     let mut ks = Plot::new(
         "Storage stiffness K' vs stroke amplitude",
@@ -784,7 +806,17 @@ fn sweep_html(
         &from_zero(en).to_svg(1000, 420)?,
     );
 
-    // Loops per amplitude, every model in its colour.
+    Ok(())
+}
+
+/// Hysteresis loops per amplitude, every model in its colour.
+fn loop_figures(
+    r: &mut HtmlReport,
+    all: &[(DamperModel, Vec<HarmonicRun>)],
+    cfg: &Config,
+    factor: f64,
+) -> anyhow::Result<()> {
+    let unit = &cfg.velocity_unit;
     r.heading(2, "Hysteresis loops per amplitude (last cycle)");
     let n_amp = all.first().map_or(0, |(_, runs)| runs.len());
     let mut loops = Vec::new();
@@ -824,18 +856,7 @@ fn sweep_html(
         &grid_svg(&loops, 2, 1100, 330)?,
     );
 
-    r.heading(2, "Time history (paper Fig. 14)");
-    for (svg, (model, _)) in time_histories.iter().zip(all) {
-        r.svg(
-            &format!(
-                "{} model, amplitude closest to 2 in/s, last two cycles (time_history.svg).",
-                model.name()
-            ),
-            svg,
-        );
-    }
-    r.paragraph("Files: bench_summary.csv (this table, SI), peaks.csv, history_v<v>m_s.csv (every sample; v = peak velocity in m/s), peak_force_vs_velocity.svg, time_history.svg; columns and units in docs/formats.md.");
-    Ok(r.finish())
+    Ok(())
 }
 
 /// Where a test's metrics start: the first instant plus `--skip-cycles` stroke periods.
@@ -927,31 +948,7 @@ pub fn replay(
 rms_error_rel,max_abs_error_N,rms_error_all_N\n",
     );
     let mut html = HtmlReport::new("rotorsim bench: replay of bench tests");
-    let synthetic: Vec<&PathBuf> = cfg.measured.iter().filter(|p| is_synthetic(p)).collect();
-    if !synthetic.is_empty() {
-        html.banner(
-            Banner::Synthetic,
-            &format!(
-                "SYNTHETIC bench data: {} (named synthetic), not a measurement of a real damper.",
-                synthetic
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        );
-    }
-    html.banner(
-        Banner::Info,
-        &format!(
-            "Each model (deck {}) is driven by the measured stroke, one step per sample interval, from rest; its force is compared with the measured force.",
-            deck.source
-        ),
-    );
-    html.paragraph(&format!(
-        "--skip-cycles {}: the error metrics leave out the samples before the first instant plus {} cycle(s); a cycle is the stroke's period, the median interval between upward crossings of the stroke's mid-range.",
-        cfg.skip_cycles, cfg.skip_cycles
-    ));
+    replay_intro(&mut html, cfg, deck);
     let mut rows = Vec::new();
     let mut figures = Vec::new();
     for ((test, path), win) in tests.iter().zip(&cfg.measured).zip(&windows) {
@@ -971,49 +968,8 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
         .y_scale(1e-3);
         let first = test.time_s.partition_point(|&t| t < win.from_s);
         for (model, dev) in devices {
-            let r = bench::replay(dev.as_ref(), test).map_err(|e| {
-                let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
-                let mut msg = format!(
-                    "replay of {} ({}) with the {} model: {e}{}",
-                    test.name,
-                    path.display(),
-                    model.name(),
-                    sampling_hint(test)
-                );
-                if *model == DamperModel::Physical {
-                    msg = deck.with_review(msg);
-                }
-                anyhow::Error::msg(msg)
-            })?;
+            let r = replay_model(&out, deck, test, path, *model, dev.as_ref(), syn)?;
             let h = &r.history;
-            let stem = format!("{}_{}", test.name, model.name());
-            let mut header = vec!["time_s", "stroke_m", "velocity_m_s", "force_model_N"];
-            let mut cols: Vec<&[f64]> = vec![&h.time_s, &h.stroke_m, &h.velocity_m_s, &h.force_n];
-            if let Some(m) = &test.force_n {
-                header.push("force_measured_N");
-                cols.push(m);
-            }
-            push_device_channels(h, &mut header, &mut cols);
-            out.write(
-                &format!("replay_{stem}.csv"),
-                csv_from_columns(&header, &cols).as_bytes(),
-            )?;
-            let mut p = Plot::new(
-                &format!(
-                    "{}: force vs stroke, {} model over measurement",
-                    test.name,
-                    model.name()
-                ),
-                "stroke [mm]",
-                "force [kN]",
-            )
-            .x_scale(1e3)
-            .y_scale(1e-3);
-            if let Some(m) = &test.force_n {
-                p = p.points(&format!("{syn}measured"), &test.stroke_m, m);
-            }
-            p = p.line(&format!("{} model", model.name()), &h.stroke_m, &h.force_n);
-            out.write(&format!("loop_{stem}.svg"), p.to_svg(900, 480)?.as_bytes())?;
             tp = tp.line(
                 model.name(),
                 &thin(&h.time_s, 3000),
@@ -1100,6 +1056,105 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
         }
         figures.push((test.name.clone(), tp, lp));
     }
+    replay_figures(&mut html, &rows, figures)?;
+    out.write("replay_summary.csv", summary.as_bytes())?;
+    out.write("bench.html", html.finish().as_bytes())?;
+    out.finish()?;
+    Ok(())
+}
+
+/// The replay report's banners: synthetic data named, what is driven, what the metrics leave
+/// out.
+fn replay_intro(html: &mut HtmlReport, cfg: &Config, deck: &DamperDeck) {
+    let synthetic: Vec<&PathBuf> = cfg.measured.iter().filter(|p| is_synthetic(p)).collect();
+    if !synthetic.is_empty() {
+        html.banner(
+            Banner::Synthetic,
+            &format!(
+                "SYNTHETIC bench data: {} (named synthetic), not a measurement of a real damper.",
+                synthetic
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    }
+    html.banner(
+        Banner::Info,
+        &format!(
+            "Each model (deck {}) is driven by the measured stroke, one step per sample interval, from rest; its force is compared with the measured force.",
+            deck.source
+        ),
+    );
+    html.paragraph(&format!(
+        "--skip-cycles {}: the error metrics leave out the samples before the first instant plus {} cycle(s); a cycle is the stroke's period, the median interval between upward crossings of the stroke's mid-range.",
+        cfg.skip_cycles, cfg.skip_cycles
+    ));
+}
+
+/// One model driven through one test: its time history and loop written, its result returned.
+fn replay_model(
+    out: &OutDir,
+    deck: &DamperDeck,
+    test: &bench::BenchTest,
+    path: &std::path::Path,
+    model: DamperModel,
+    dev: &dyn Device,
+    syn: &str,
+) -> anyhow::Result<bench::Replay> {
+    let r = bench::replay(dev, test).map_err(|e| {
+        let _ = out.mark_incomplete(&format!("replay of {} failed: {e}", test.name));
+        let mut msg = format!(
+            "replay of {} ({}) with the {} model: {e}{}",
+            test.name,
+            path.display(),
+            model.name(),
+            sampling_hint(test)
+        );
+        if model == DamperModel::Physical {
+            msg = deck.with_review(msg);
+        }
+        anyhow::Error::msg(msg)
+    })?;
+    let h = &r.history;
+    let stem = format!("{}_{}", test.name, model.name());
+    let mut header = vec!["time_s", "stroke_m", "velocity_m_s", "force_model_N"];
+    let mut cols: Vec<&[f64]> = vec![&h.time_s, &h.stroke_m, &h.velocity_m_s, &h.force_n];
+    if let Some(m) = &test.force_n {
+        header.push("force_measured_N");
+        cols.push(m);
+    }
+    push_device_channels(h, &mut header, &mut cols);
+    out.write(
+        &format!("replay_{stem}.csv"),
+        csv_from_columns(&header, &cols).as_bytes(),
+    )?;
+    let mut p = Plot::new(
+        &format!(
+            "{}: force vs stroke, {} model over measurement",
+            test.name,
+            model.name()
+        ),
+        "stroke [mm]",
+        "force [kN]",
+    )
+    .x_scale(1e3)
+    .y_scale(1e-3);
+    if let Some(m) = &test.force_n {
+        p = p.points(&format!("{syn}measured"), &test.stroke_m, m);
+    }
+    p = p.line(&format!("{} model", model.name()), &h.stroke_m, &h.force_n);
+    out.write(&format!("loop_{stem}.svg"), p.to_svg(900, 480)?.as_bytes())?;
+    Ok(r)
+}
+
+/// The replay report's metrics table and each test's figures.
+fn replay_figures(
+    html: &mut HtmlReport,
+    rows: &[Vec<String>],
+    figures: Vec<(String, Plot, Plot)>,
+) -> anyhow::Result<()> {
     if !rows.is_empty() {
         html.heading(2, "Error metrics (replay_summary.csv)");
         html.table(
@@ -1114,7 +1169,7 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
                 "max |error| [N]",
                 "RMS error, all samples [N]",
             ],
-            &rows,
+            rows,
         );
     }
     for (name, tp, lp) in figures {
@@ -1128,9 +1183,6 @@ rms_error_rel,max_abs_error_N,rms_error_all_N\n",
             &lp.to_svg(1000, 460)?,
         );
     }
-    out.write("replay_summary.csv", summary.as_bytes())?;
-    out.write("bench.html", html.finish().as_bytes())?;
-    out.finish()?;
     Ok(())
 }
 

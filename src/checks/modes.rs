@@ -52,11 +52,11 @@ pub struct ModesSettings {
 
 impl Default for ModesSettings {
     fn default() -> Self {
-        super::settings::command_line_defaults("modes")
+        crate::run::settings::command_line_defaults("modes")
     }
 }
 
-impl super::settings::JobSettings for ModesSettings {
+impl crate::run::settings::JobSettings for ModesSettings {
     const COMMAND: &'static str = "modes";
 }
 
@@ -710,7 +710,7 @@ pub fn parse_speeds(s: &str) -> anyhow::Result<Vec<f64>> {
 
 /// [`parse_speeds`] of the option `flag`.
 fn parse_speeds_as(flag: &str, s: &str) -> anyhow::Result<Vec<f64>> {
-    let v = super::ranges::parse_range(
+    let v = crate::run::ranges::parse_range(
         flag,
         s,
         "expected START:STOP:STEP, e.g. 0:1.2:0.1, or a list 0.5,1.0",
@@ -718,7 +718,7 @@ fn parse_speeds_as(flag: &str, s: &str) -> anyhow::Result<Vec<f64>> {
         "a fan plot may have (each is a static solve and an eigen-analysis)",
     )?;
     if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-        return Err(super::ranges::range_error(
+        return Err(crate::run::ranges::range_error(
             flag,
             s,
             "speeds must be finite and non-negative",
@@ -740,7 +740,7 @@ impl ModesJob {
         let (flag, fractions) = match &self.speeds_rad_s {
             Some(text) => {
                 let w = parse_speeds_as("--speeds", text)?;
-                super::ranges::check_not_fractions("--speeds", &w, nominal, deck, KEY)?;
+                crate::run::ranges::check_not_fractions("--speeds", &w, nominal, deck, KEY)?;
                 ("--speeds", w.iter().map(|w| w / nominal).collect())
             }
             None => ("--speed-fractions", parse_speeds(&self.speeds)?),

@@ -6,9 +6,9 @@
 //! equivalent stiffness and damping at that amplitude predict (the bench's first harmonic),
 //! and the linearised map's at 0.1 mm. Where the time-domain growth rate changes sign between
 //! two amplitudes there is a limit cycle.
-use super::air_resonance::HoverOptions;
+use super::air::HoverOptions;
 use super::rigid_blade::RigidLagBlade;
-use super::stability::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
+use super::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::rotor::RotorDeck;
 use crate::stability::{
@@ -24,9 +24,9 @@ use std::f64::consts::PI;
 /// deck.
 pub const DEFAULT_AMPLITUDES_M: [f64; 8] = [1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 2e-2, 2.5e-2, 3e-2];
 /// The devices' integrator, in the time domain and on the bench alike (the map's, see
-/// [`super::stability::BENCH_INTEGRATOR`]): at tens of millimetres of stroke at the lag
+/// [`super::BENCH_INTEGRATOR`]): at tens of millimetres of stroke at the lag
 /// frequency the flows make the chambers too stiff for RK4's sub-steps.
-pub const INTEGRATOR: IntegratorOptions = super::stability::BENCH_INTEGRATOR;
+pub const INTEGRATOR: IntegratorOptions = super::BENCH_INTEGRATOR;
 /// Most starts of one amplitude check (each a time-domain run of four live dampers).
 pub const MAX_AMPLITUDES: usize = 200;
 /// Largest lag angle of a start [rad]: the reduced model is linear in the lag angle.
@@ -42,8 +42,8 @@ pub struct AmplitudeOptions {
     pub cycles: usize,
     /// Steps per revolution (RK4 on the blades, the devices sub-stepped inside each).
     pub steps_per_rev: usize,
-    /// In hover (the air-resonance model, [`super::air_resonance`]) rather than on the ground.
-    pub hover: Option<super::air_resonance::HoverOptions>,
+    /// In hover (the air-resonance model, [`super::air`]) rather than on the ground.
+    pub hover: Option<super::air::HoverOptions>,
 }
 
 impl Default for AmplitudeOptions {
@@ -108,7 +108,7 @@ pub struct AmplitudeCheck {
 
 /// Amplitudes: finite, positive, increasing, and a lag angle the reduced model holds.
 pub fn check_amplitudes(a: &[f64], arm_m: f64) -> anyhow::Result<()> {
-    super::ranges::check_increasing("--amplitudes-m", a, "m", "stroke amplitude")?;
+    crate::run::ranges::check_increasing("--amplitudes-m", a, "m", "stroke amplitude")?;
     let top = a[a.len() - 1];
     if top / arm_m > MAX_LAG_RAD {
         bail!(
@@ -139,7 +139,7 @@ impl Reduced {
         }
     }
     fn modes(&self, om: f64) -> anyhow::Result<Vec<Mode>> {
-        let fl = super::stability::FLOQUET_STEPS_PER_REV;
+        let fl = super::FLOQUET_STEPS_PER_REV;
         Ok(match self {
             Reduced::Lag(r) if r.is_isotropic() && r.blades.len() >= 3 => {
                 r.coleman_eigenvalues(om)?
@@ -200,7 +200,7 @@ impl Blades {
         let decks = super::rigid_blade::blade_decks(deck, model)?;
         if let Some(h) = hover {
             h.check()?;
-            let (body, _) = super::air_resonance::body(deck)?;
+            let (body, _) = super::air::body(deck)?;
             return Ok(Blades {
                 decks,
                 x: None,
@@ -227,7 +227,7 @@ impl Blades {
             let mut blades = Vec::with_capacity(self.decks.len());
             let mut airfoils = vec![];
             for ((b, _), &kc) in self.decks.iter().zip(kc) {
-                let (ab, foils) = super::air_resonance::air_blade(&b.spec, &b.path, opts, kc)?;
+                let (ab, foils) = super::air::air_blade(&b.spec, &b.path, opts, kc)?;
                 blades.push(ab);
                 airfoils = foils;
             }
@@ -321,11 +321,11 @@ pub fn amplitude_check(
     if !(omega.is_finite() && omega > 0.0) {
         bail!("the amplitude check's rotor speed {omega} rad/s is not a positive finite speed");
     }
-    if !(16..=super::stability::MAX_TIME_STEPS_PER_REV).contains(&o.steps_per_rev) {
+    if !(16..=super::MAX_TIME_STEPS_PER_REV).contains(&o.steps_per_rev) {
         bail!(
             "--steps-per-rev {}: expected 16 to {}",
             o.steps_per_rev,
-            super::stability::MAX_TIME_STEPS_PER_REV
+            super::MAX_TIME_STEPS_PER_REV
         );
     }
     let blades = Blades::of(deck, model, o.hover)?;

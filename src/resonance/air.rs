@@ -2,7 +2,7 @@
 //! rigid blades on coincident lag and flap hinges with their mass and aerodynamics in spanwise
 //! strips ([`crate::stability::air_rotor`]), each blade's damper linearised at the operating
 //! point, on the airframe's directions under the hub (x, y, roll, pitch), over rotor speeds.
-use super::stability::{
+use super::{
     check_speeds, linearise, unstable_ranges, LinearisedDamper, Method, SpeedModes, StabilityMap,
     FLOQUET_STEPS_PER_REV,
 };

@@ -1,0 +1,490 @@
+//! The stability outputs: stability.csv, summary.json and report.html.
+use super::*;
+use crate::io::OutDir;
+use crate::report::html::{Banner, HtmlReport};
+use crate::report::plot::Plot;
+use crate::rotor::RotorDeck;
+use crate::stability::{AirframeAxis, Mode};
+use std::f64::consts::PI;
+
+/// stability.csv: one row per speed and mode.
+pub fn csv(map: &StabilityMap) -> String {
+    let mut s = String::from(
+        "rotor_speed_rad_s,mode,frequency_Hz,damping_ratio,growth_rate_per_s,method\n",
+    );
+    for sp in &map.speeds {
+        for m in &sp.modes {
+            s.push_str(&format!(
+                "{},{},{},{},{},{}\n",
+                sp.omega_rad_s,
+                m.label,
+                m.frequency_hz,
+                m.damping_ratio,
+                m.growth_rate_per_s,
+                sp.method.name()
+            ));
+        }
+    }
+    s
+}
+
+/// summary.json: the reduced model, the unstable ranges and the least damping.
+pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
+    let blades: Vec<_> = map
+        .blades
+        .iter()
+        .map(|b| {
+            serde_json::json!({
+                "mass_kg": b.mass_kg,
+                "first_moment_kg_m": b.first_moment_kg_m,
+                "inertia_kg_m2": b.inertia_kg_m2,
+                "hinge_offset_m": b.hinge_offset_m,
+                "lag_stiffness_Nm_per_rad": b.stiffness_nm_per_rad,
+                "lag_damping_Nms_per_rad": b.damping_nms_per_rad,
+            })
+        })
+        .collect();
+    let axis = |a: &Option<AirframeAxis>| {
+        a.as_ref().map(|a| {
+            serde_json::json!({
+                "mass_kg": a.mass_kg,
+                "stiffness_N_per_m": a.stiffness_n_per_m,
+                "damping_Ns_per_m": a.damping_ns_per_m,
+            })
+        })
+    };
+    let min = map.min_damping();
+    serde_json::json!({
+        "rotor_deck": deck.path.display().to_string(),
+        "rotor": deck.path.display().to_string(),
+        "options": {
+            "overrides": map.overrides.iter().map(|(k, v)| serde_json::json!({"key": k, "value": v})).collect::<Vec<_>>(),
+        },
+        "damper_model": map.damper.name(),
+        "linearisation_amplitude_m": LINEARISATION_AMPLITUDE_M,
+        "method": map.speeds.first().map(|s| s.method.name()),
+        "speeds_rad_s": map.speeds.iter().map(|s| s.omega_rad_s).collect::<Vec<_>>(),
+        "blades_at_last_speed": blades,
+        "airframe_x": axis(&map.x),
+        "airframe_y": axis(&map.y),
+        "stable": map.unstable.is_empty(),
+        "unstable": map.unstable,
+        "min_damping_ratio": min.as_ref().map(|m| m.0),
+        "min_damping_mode": min.as_ref().map(|m| m.1.clone()),
+        "min_damping_speed_rad_s": min.as_ref().map(|m| m.2),
+        "condition": if map.hover.is_some() { "hover" } else { "ground" },
+        "hover": map.hover,
+        "notes": map.notes,
+    })
+}
+
+/// stability.html: the Coleman diagram, damping versus speed with the unstable ranges shaded,
+/// the reduced model and the ranges.
+pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
+    let mut rep = HtmlReport::new(if map.hover.is_some() {
+        "Air resonance in hover"
+    } else {
+        "Ground resonance"
+    });
+    html_intro(&mut rep, map, deck);
+    html_figures(&mut rep, map)?;
+    html_model(&mut rep, map);
+    rep.list(&map.notes);
+    Ok(rep.finish())
+}
+
+/// The verdict banner and what was solved.
+fn html_intro(rep: &mut HtmlReport, map: &StabilityMap, deck: &RotorDeck) {
+    let method = map
+        .speeds
+        .first()
+        .map_or("", |s| s.method.name())
+        .to_string();
+    if map.unstable.is_empty() {
+        rep.banner(
+            Banner::Ok,
+            &format!(
+                "Stable over {:.3} to {:.3} rad/s ({} damper, {method}).",
+                map.speeds.first().map_or(f64::NAN, |s| s.omega_rad_s),
+                map.speeds.last().map_or(f64::NAN, |s| s.omega_rad_s),
+                map.damper.name()
+            ),
+        );
+    } else {
+        let ranges: Vec<String> = map
+            .unstable
+            .iter()
+            .map(|u| {
+                format!(
+                    "{} from {:.3} to {:.3} rad/s (growth rate up to {:.4} 1/s)",
+                    u.mode, u.from_rad_s, u.to_rad_s, u.max_growth_rate_per_s
+                )
+            })
+            .collect();
+        rep.banner(Banner::Bad, &format!("UNSTABLE: {}.", ranges.join("; ")));
+    }
+    let how = if method == "coleman" {
+        "identical blades: constant-coefficient equations in multi-blade coordinates"
+    } else {
+        "blades differ: Floquet exponents of the periodic equations over one revolution"
+    };
+    let _ = match &map.hover {
+        None => rep.paragraph(&format!(
+            "Rotor deck {}: {} blades reduced to rigid blades on their lag hinges, each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's in-plane directions (docs/stability.md). Method: {method} ({how}).",
+            deck.path.display(),
+            map.blades.len(),
+            map.damper.name(),
+            LINEARISATION_AMPLITUDE_M * 1e3,
+        )),
+        Some(h) => rep.paragraph(&format!(
+            "Rotor deck {}: {} blades reduced to rigid blades on coincident lag and flap hinges ({} strips each), quasi-steady aerodynamics in hover at a collective of {} deg at 0.75 R, air density {} kg/m^3 (Lock number {:.2}), each damper ({}) linearised at the regressing lag's rotating-frame frequency and a stroke amplitude of {} mm, on the airframe's directions under the hub (docs/stability.md). Method: {method} ({how}).",
+            deck.path.display(),
+            map.blades.len(),
+            h.options.strips,
+            h.options.collective_deg,
+            h.options.density_kg_m3,
+            h.lock_number,
+            map.damper.name(),
+            LINEARISATION_AMPLITUDE_M * 1e3,
+        )),
+    };
+}
+
+/// The Coleman diagram, the damping and the unstable ranges.
+fn html_figures(rep: &mut HtmlReport, map: &StabilityMap) -> anyhow::Result<()> {
+    let label_order: Vec<String> = {
+        let mut v: Vec<String> = vec![];
+        for s in &map.speeds {
+            for m in &s.modes {
+                let l = m.label.to_string();
+                if !v.contains(&l) {
+                    v.push(l);
+                }
+            }
+        }
+        v
+    };
+    let series = |f: &dyn Fn(&Mode) -> f64, l: &str| -> (Vec<f64>, Vec<f64>) {
+        let mut xs = vec![];
+        let mut ys = vec![];
+        for s in &map.speeds {
+            for m in s.modes.iter().filter(|m| m.label.to_string() == l) {
+                xs.push(s.omega_rad_s);
+                ys.push(f(m));
+            }
+        }
+        (xs, ys)
+    };
+    let mut coleman = Plot::new(
+        "Frequencies in the fixed frame (Coleman diagram)",
+        "rotor speed [rad/s]",
+        "frequency [Hz]",
+    );
+    let mut damping = Plot::new(
+        "Damping ratio (unstable ranges shaded)",
+        "rotor speed [rad/s]",
+        "damping ratio [-]",
+    );
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for l in &label_order {
+        let (x, f) = series(&|m| m.frequency_hz, l);
+        coleman = coleman.points(l, &x, &f);
+        let (x, z) = series(&|m| m.damping_ratio, l);
+        for v in &z {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        damping = damping.points(l, &x, &z);
+    }
+    for u in &map.unstable {
+        damping = damping.band(
+            &format!("unstable: {}", u.mode),
+            &[u.from_rad_s, u.to_rad_s],
+            &[lo.min(0.0), hi],
+        );
+    }
+    let sp: Vec<f64> = map.speeds.iter().map(|s| s.omega_rad_s).collect();
+    let per_rev: Vec<f64> = sp.iter().map(|w| w / (2.0 * PI)).collect();
+    coleman = coleman.dashed("1/rev", &sp, &per_rev);
+    rep.heading(2, "Coleman diagram");
+    rep.svg(
+        "Frequencies of the coupled modes in the fixed frame against rotor speed.",
+        &coleman.to_svg(900, 500)?,
+    );
+    rep.heading(2, "Damping");
+    rep.svg(
+        "Damping ratio of each mode against rotor speed; negative is unstable.",
+        &damping.to_svg(900, 500)?,
+    );
+    if !map.unstable.is_empty() {
+        let rows: Vec<Vec<String>> = map
+            .unstable
+            .iter()
+            .map(|u| {
+                vec![
+                    u.mode.clone(),
+                    format!("{:.4}", u.from_rad_s),
+                    format!("{:.4}", u.to_rad_s),
+                    format!("{:.5}", u.max_growth_rate_per_s),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "mode",
+                "from [rad/s]",
+                "to [rad/s]",
+                "largest growth rate [1/s]",
+            ],
+            &rows,
+        );
+    }
+    Ok(())
+}
+
+/// The reduced model: blades, airframe, and in hover the equilibrium.
+fn html_model(rep: &mut HtmlReport, map: &StabilityMap) {
+    let sp: Vec<f64> = map.speeds.iter().map(|s| s.omega_rad_s).collect();
+    rep.heading(2, "The reduced model");
+    let rows: Vec<Vec<String>> = map
+        .blades
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            vec![
+                format!("{}", k + 1),
+                format!("{:.2}", b.mass_kg),
+                format!("{:.2}", b.first_moment_kg_m),
+                format!("{:.2}", b.inertia_kg_m2),
+                format!("{:.4}", b.hinge_offset_m),
+                format!("{:.1}", b.stiffness_nm_per_rad),
+                format!("{:.1}", b.damping_nms_per_rad),
+            ]
+        })
+        .collect();
+    rep.paragraph(&format!(
+        "Blades at {:.3} rad/s (the damper's values depend on the frequency it is linearised at):",
+        sp.last().copied().unwrap_or(f64::NAN)
+    ));
+    rep.table(
+        &[
+            "blade",
+            "mass [kg]",
+            "first moment [kg m]",
+            "inertia [kg m^2]",
+            "hinge offset [m]",
+            "lag stiffness [N m/rad]",
+            "lag damping [N m s/rad]",
+        ],
+        &rows,
+    );
+    let axis = |n: &str, a: &Option<AirframeAxis>| {
+        a.as_ref().map(|a| {
+            vec![
+                n.to_string(),
+                format!("{:.1}", a.mass_kg),
+                format!("{:.1}", a.stiffness_n_per_m),
+                format!("{:.1}", a.damping_ns_per_m),
+            ]
+        })
+    };
+    let rows: Vec<Vec<String>> = [axis("x", &map.x), axis("y", &map.y)]
+        .into_iter()
+        .flatten()
+        .collect();
+    if !rows.is_empty() {
+        rep.table(
+            &[
+                "airframe",
+                "mass [kg]",
+                "stiffness [N/m]",
+                "damping [N s/m]",
+            ],
+            &rows,
+        );
+    }
+    if let Some(h) = &map.hover {
+        let rows: Vec<Vec<String>> = h
+            .airframe
+            .iter()
+            .map(|(n, m, k, c, z)| {
+                vec![
+                    n.clone(),
+                    format!("{m:.1}"),
+                    format!("{k:.1}"),
+                    format!("{c:.1}"),
+                    format!("{z:.3}"),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "airframe",
+                "mass [kg] or inertia [kg m^2]",
+                "stiffness [N/m or N m/rad]",
+                "damping [N s/m or N m s/rad]",
+                "centre above the hub [m]",
+            ],
+            &rows,
+        );
+        rep.heading(2, "Hover equilibrium");
+        let rows: Vec<Vec<String>> = h
+            .states
+            .iter()
+            .map(|s| {
+                vec![
+                    format!("{:.3}", s.omega_rad_s),
+                    format!("{:.0}", s.thrust_n),
+                    format!("{:.3}", s.induced_velocity_m_s),
+                    format!("{:.3}", s.coning_deg),
+                    format!("{:.3}", s.lag_deg),
+                ]
+            })
+            .collect();
+        rep.table(
+            &[
+                "rotor speed [rad/s]",
+                "thrust [N]",
+                "induced velocity [m/s]",
+                "coning [deg]",
+                "lag [deg]",
+            ],
+            &rows,
+        );
+    }
+}
+
+/// Writes stability.csv, stability.html and summary.json into `out`.
+pub fn write(map: &StabilityMap, deck: &RotorDeck, out: &OutDir) -> anyhow::Result<()> {
+    write_with_time(map, &[], deck, out)
+}
+
+/// As [`write`], with the time-domain checks: rows of method `time` (mode `whole rotor`), a
+/// table and figure in the report, `time_checks` in summary.json.
+pub fn write_with_time(
+    map: &StabilityMap,
+    time: &[TimeCheck],
+    deck: &RotorDeck,
+    out: &OutDir,
+) -> anyhow::Result<()> {
+    write_all(map, time, None, deck, out)
+}
+
+/// As [`write_with_time`], with the nonlinear amplitude check: amplitude.csv, its section in
+/// the report, `amplitude_check` in summary.json.
+pub fn write_all(
+    map: &StabilityMap,
+    time: &[TimeCheck],
+    amplitude: Option<&amplitude::AmplitudeCheck>,
+    deck: &RotorDeck,
+    out: &OutDir,
+) -> anyhow::Result<()> {
+    let mut text = csv(map);
+    for c in time {
+        let w = 2.0 * PI * c.frequency_hz;
+        let zeta = -c.growth_rate_per_s / c.growth_rate_per_s.hypot(w);
+        text.push_str(&format!(
+            "{},whole rotor,{},{},{},time\n",
+            c.omega_rad_s, c.frequency_hz, zeta, c.growth_rate_per_s
+        ));
+    }
+    out.write("stability.csv", text.as_bytes())?;
+    let mut page = html(map, deck)?;
+    if !time.is_empty() {
+        let mut rep = HtmlReport::new("");
+        rep.heading(2, "Time domain: the whole rotor");
+        rep.paragraph(&format!(
+            "The whole multibody rotor on its airframe (every blade, its damper, the hub on the airframe's chain), in rotating equilibrium without airloads, kicked along x by {} m/s and marched {} s; the growth rate is the slope of ln|x| at the peaks of the airframe's x motion from {} s on, beside the {} analysis's least stable growth rate at the same speed.",
+            time[0].kick_m_s,
+            time[0].time_s.last().copied().unwrap_or(f64::NAN),
+            time[0].fit_from_s,
+            map.speeds.first().map_or("linear", |s| s.method.name())
+        ));
+        let mut rows = vec![];
+        let mut plot = Plot::new("Airframe x after the kick", "time [s]", "airframe x [m]");
+        for c in time {
+            let linear = map
+                .speeds
+                .iter()
+                .find(|s| s.omega_rad_s == c.omega_rad_s)
+                .and_then(|s| {
+                    s.modes
+                        .iter()
+                        .map(|m| m.growth_rate_per_s)
+                        .max_by(f64::total_cmp)
+                });
+            rows.push(vec![
+                format!("{}", c.omega_rad_s),
+                format!("{:+.5}", c.growth_rate_per_s),
+                format!("{:.4}", c.frequency_hz),
+                linear.map_or("-".into(), |g| format!("{g:+.5}")),
+                linear.map_or("-".into(), |g| {
+                    format!("{:.2}%", 100.0 * (c.growth_rate_per_s / g - 1.0).abs())
+                }),
+            ]);
+            plot = plot.line(
+                &format!("{} rad/s", c.omega_rad_s),
+                &c.time_s,
+                &c.airframe_x_m,
+            );
+        }
+        rep.table(
+            &[
+                "rotor speed [rad/s]",
+                "whole rotor growth rate [1/s]",
+                "frequency [Hz]",
+                "linear analysis [1/s]",
+                "difference",
+            ],
+            &rows,
+        );
+        rep.svg(
+            "The airframe's x motion after the kick.",
+            &plot.to_svg(900, 450)?,
+        );
+        // the section goes before the reduced model
+        let body = rep.finish();
+        let section = body
+            .split_once("<body>")
+            .map(|(_, b)| b)
+            .and_then(|b| b.rsplit_once("</body>").map(|(b, _)| b))
+            .unwrap_or("")
+            .to_string();
+        page = match page.find("<h2 id=\"the-reduced-model\"") {
+            Some(i) => format!("{}{}{}", &page[..i], section, &page[i..]),
+            None => page.replace("</body>", &format!("{section}</body>")),
+        };
+    }
+    if let Some(a) = amplitude {
+        out.write("amplitude.csv", amplitude::csv(a).as_bytes())?;
+        let section = amplitude::html_section(a)?;
+        page = match page.find("<h2 id=\"the-reduced-model\"") {
+            Some(i) => format!("{}{}{}", &page[..i], section, &page[i..]),
+            None => page.replace("</body>", &format!("{section}</body>")),
+        };
+    }
+    out.write("stability.html", page.as_bytes())?;
+    let mut summary = summary_json(map, deck);
+    if let Some(a) = amplitude {
+        summary["amplitude_check"] = amplitude::json(a);
+    }
+    summary["time_checks"] = serde_json::Value::Array(
+        time.iter()
+            .map(|c| {
+                serde_json::json!({
+                    "rotor_speed_rad_s": c.omega_rad_s,
+                    "kick_m_s": c.kick_m_s,
+                    "duration_s": c.time_s.last(),
+                    "fit_from_s": c.fit_from_s,
+                    "growth_rate_per_s": c.growth_rate_per_s,
+                    "frequency_Hz": c.frequency_hz,
+                })
+            })
+            .collect(),
+    );
+    out.write(
+        "summary.json",
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
+    Ok(())
+}
