@@ -404,41 +404,7 @@ impl ModesJob {
         // comparison with the reference at the speeds it has
         let comparison = match &reference {
             None => None,
-            Some(rf) => {
-                let mut cmp = vec![];
-                for p in &pts {
-                    if let Some((_, r)) = rf.iter().find(|(x, _)| (x - p.fraction).abs() < 1e-6) {
-                        for (k, (&m, &re)) in p.tracked_hz.iter().zip(r.iter()).enumerate() {
-                            cmp.push((p.fraction, k, m, re, 100.0 * (m - re) / re));
-                        }
-                    }
-                }
-                let ch = [
-                    "speed_fraction",
-                    "mode_index",
-                    "model_Hz",
-                    "reference_Hz",
-                    "error_pct",
-                ];
-                let crow: Vec<Vec<f64>> = cmp
-                    .iter()
-                    .map(|c| vec![c.0, c.1 as f64, c.2, c.3, c.4])
-                    .collect();
-                let mut text = csv_string(&ch, &crow);
-                text.push_str("# mode_index: 0 lag1, 1 flap1, 2 flap2, 3 flap3, 4 torsion1\n");
-                out.write("fan_comparison.csv", text.as_bytes())?;
-                Some(
-                    cmp.iter()
-                        .map(|c| Compared {
-                            speed: c.0,
-                            mode: TRACKED[c.1],
-                            model_hz: c.2,
-                            reference_hz: c.3,
-                            error_pct: c.4,
-                        })
-                        .collect(),
-                )
-            }
+            Some(rf) => Some(fan_comparison(&out, &pts, rf)?),
         };
         // fan.svg
         let x: Vec<f64> = pts.iter().map(|p| p.fraction).collect();
@@ -803,4 +769,45 @@ fn per_rev_lines(mut plot: Plot, xmax: f64, f1: f64) -> Plot {
         plot = plot.dashed(name, &[0.0, xmax], &[0.0, n as f64 * f1]);
     }
     plot
+}
+
+/// fan_comparison.csv: the tracked modes against the reference at the speeds it has.
+fn fan_comparison(
+    out: &OutDir,
+    pts: &[crate::rotor::fan::FanPoint],
+    rf: &[(f64, [f64; 5])],
+) -> anyhow::Result<Vec<Compared>> {
+    use crate::rotor::fan::TRACKED;
+    let mut cmp = vec![];
+    for p in pts {
+        if let Some((_, r)) = rf.iter().find(|(x, _)| (x - p.fraction).abs() < 1e-6) {
+            for (k, (&m, &re)) in p.tracked_hz.iter().zip(r.iter()).enumerate() {
+                cmp.push((p.fraction, k, m, re, 100.0 * (m - re) / re));
+            }
+        }
+    }
+    let ch = [
+        "speed_fraction",
+        "mode_index",
+        "model_Hz",
+        "reference_Hz",
+        "error_pct",
+    ];
+    let crow: Vec<Vec<f64>> = cmp
+        .iter()
+        .map(|c| vec![c.0, c.1 as f64, c.2, c.3, c.4])
+        .collect();
+    let mut text = csv_string(&ch, &crow);
+    text.push_str("# mode_index: 0 lag1, 1 flap1, 2 flap2, 3 flap3, 4 torsion1\n");
+    out.write("fan_comparison.csv", text.as_bytes())?;
+    Ok(cmp
+        .iter()
+        .map(|c| Compared {
+            speed: c.0,
+            mode: TRACKED[c.1],
+            model_hz: c.2,
+            reference_hz: c.3,
+            error_pct: c.4,
+        })
+        .collect())
 }

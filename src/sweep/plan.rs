@@ -189,36 +189,8 @@ impl Plan {
             }
         };
         let options = run_options();
-        let check_setting = |where_: &str, k: &str, v: &Value| -> anyhow::Result<()> {
-            let key = format!("{where_} \"{k}\"");
-            if k.contains('.') {
-                check_key(k).map_err(|e| bad(&key, format!("{e}")))?;
-                if matches!(v, Value::Table(_)) {
-                    return Err(bad(&key, "expected a deck value, found a table".into()));
-                }
-                return Ok(());
-            }
-            match options.iter().find(|(n, _)| n == k) {
-                Some((_, ty)) if ty.check(v) => Ok(()),
-                Some((_, ty)) => Err(bad(&key, format!("expected {}, found {v}", ty.expected()))),
-                None if k == "out" || k == "initial_state" => Err(bad(
-                    &key,
-                    "set by the sweep (each case's folder, the warm start), not by the plan"
-                        .into(),
-                )),
-                None if k == "set" => Err(bad(
-                    &key,
-                    "a plan sets deck values by their dotted keys (e.g. \"damper.physical.A_orf_m2\" = 2.0e-6), not by `set`".into(),
-                )),
-                None => Err(bad(
-                    &key,
-                    format!(
-                        "unknown key: expected a run option ({}) or a dotted deck key with its unit (e.g. damper.physical.A_orf_m2)",
-                        options.iter().map(|o| o.0.as_str()).collect::<Vec<_>>().join(", ")
-                    ),
-                )),
-            }
-        };
+        let check_setting =
+            |where_: &str, k: &str, v: &Value| check_setting(file, &options, where_, k, v);
         let mut base = BTreeMap::new();
         if let Some(t) = table("base")? {
             for (k, v) in t {
@@ -263,32 +235,7 @@ impl Plan {
             Some(Value::Array(list)) => list.len() as u64,
             _ => 0,
         };
-        let product = if axes.is_empty() {
-            0
-        } else {
-            axes.iter()
-                .fold(1u64, |n, a| n.saturating_mul(a.1.len() as u64))
-        };
-        let count = product.saturating_add(n_explicit);
-        if count > MAX_CASES {
-            let shown = if count == u64::MAX {
-                "more than 1.8e19".to_string()
-            } else {
-                count.to_string()
-            };
-            return Err(anyhow!(
-                "sweep plan {file}: {shown} cases ([vary] {} = {product}{}), beyond the {MAX_CASES} a sweep may hold; vary fewer keys or fewer values per key, or split the plan into several plans",
-                axes.iter()
-                    .map(|(k, l)| format!("\"{k}\" {}", l.len()))
-                    .collect::<Vec<_>>()
-                    .join(" x "),
-                if n_explicit > 0 {
-                    format!(", plus {n_explicit} [[case]] tables")
-                } else {
-                    String::new()
-                }
-            ));
-        }
+        let product = case_count(file, &axes, n_explicit)?;
         let mut cases = Vec::new();
         if !axes.is_empty() {
             let total = product as usize;
@@ -302,39 +249,8 @@ impl Plan {
                 cases.push((None, s));
             }
         }
-        match root.get("case") {
-            None => {}
-            Some(Value::Array(list)) => {
-                for (n, c) in list.iter().enumerate() {
-                    let where_ = format!("[[case]] {}", n + 1);
-                    let Value::Table(t) = c else {
-                        return Err(bad(&where_, "expected a table".into()));
-                    };
-                    let mut s = base.clone();
-                    let mut id = None;
-                    for (k, v) in t {
-                        if k == "id" {
-                            match v {
-                                Value::String(x) if valid_id(x) => id = Some(x.clone()),
-                                v => {
-                                    return Err(bad(
-                                        &format!("{where_} \"id\""),
-                                        format!("expected a folder name of letters, digits, '-', '_' and '.', found {v}"),
-                                    ))
-                                }
-                            }
-                            continue;
-                        }
-                        check_setting(&where_, k, v)?;
-                        if !keys.contains(k) {
-                            keys.push(k.clone());
-                        }
-                        s.insert(k.clone(), v.clone());
-                    }
-                    cases.push((id, s));
-                }
-            }
-            Some(v) => return Err(bad("case", format!("expected [[case]] tables, found {v}"))),
+        if let Some(v) = root.get("case") {
+            explicit_cases(v, &base, &mut keys, &mut cases, &check_setting, &bad)?;
         }
         if cases.is_empty() {
             return Err(bad(
@@ -342,33 +258,10 @@ impl Plan {
                 "missing: expected a [vary] table or [[case]] tables (a plan sweeps at least one case)".into(),
             ));
         }
-        let mut sweep = (true, 4usize);
-        if let Some(t) = table("sweep")? {
-            for (k, v) in t {
-                match (k.as_str(), v) {
-                    ("warm_start", Value::Boolean(b)) => sweep.0 = *b,
-                    ("group_size", Value::Integer(n)) if *n >= 1 => sweep.1 = *n as usize,
-                    ("warm_start", v) => {
-                        return Err(bad(
-                            "[sweep] warm_start",
-                            format!("expected true or false, found {v}"),
-                        ))
-                    }
-                    ("group_size", v) => {
-                        return Err(bad(
-                            "[sweep] group_size",
-                            format!("expected a positive integer, found {v}"),
-                        ))
-                    }
-                    (k, _) => {
-                        return Err(bad(
-                            &format!("[sweep] {k}"),
-                            "unknown key, expected warm_start or group_size".into(),
-                        ))
-                    }
-                }
-            }
-        }
+        let sweep = match table("sweep")? {
+            Some(t) => sweep_options(t, file)?,
+            None => (true, 4usize),
+        };
         let width = cases.len().to_string().len().max(3);
         let cases: Vec<Case> = cases
             .into_iter()
@@ -466,6 +359,152 @@ pub fn parse_shard(s: &str) -> anyhow::Result<(usize, usize)> {
         bail!("--shard {s}: expected 0 <= K < N");
     }
     Ok((k, n))
+}
+
+/// A plan's setting `k = v` (in `where_`): a run option of the right type or a dotted deck key.
+fn check_setting(
+    file: &str,
+    options: &[(String, OptionType)],
+    where_: &str,
+    k: &str,
+    v: &Value,
+) -> anyhow::Result<()> {
+    let bad = |key: &str, msg: String| anyhow!("sweep plan {file}, {key}: {msg}");
+    let key = format!("{where_} \"{k}\"");
+    if k.contains('.') {
+        check_key(k).map_err(|e| bad(&key, format!("{e}")))?;
+        if matches!(v, Value::Table(_)) {
+            return Err(bad(&key, "expected a deck value, found a table".into()));
+        }
+        return Ok(());
+    }
+    match options.iter().find(|(n, _)| n == k) {
+        Some((_, ty)) if ty.check(v) => Ok(()),
+        Some((_, ty)) => Err(bad(&key, format!("expected {}, found {v}", ty.expected()))),
+        None if k == "out" || k == "initial_state" => Err(bad(
+            &key,
+            "set by the sweep (each case's folder, the warm start), not by the plan"
+                .into(),
+        )),
+        None if k == "set" => Err(bad(
+            &key,
+            "a plan sets deck values by their dotted keys (e.g. \"damper.physical.A_orf_m2\" = 2.0e-6), not by `set`".into(),
+        )),
+        None => Err(bad(
+            &key,
+            format!(
+                "unknown key: expected a run option ({}) or a dotted deck key with its unit (e.g. damper.physical.A_orf_m2)",
+                options.iter().map(|o| o.0.as_str()).collect::<Vec<_>>().join(", ")
+            ),
+        )),
+    }
+}
+
+/// The `[[case]]` tables, each `base` with its own settings; their keys join `keys`.
+#[allow(clippy::type_complexity)]
+fn explicit_cases(
+    v: &Value,
+    base: &BTreeMap<String, Value>,
+    keys: &mut Vec<String>,
+    cases: &mut Vec<(Option<String>, BTreeMap<String, Value>)>,
+    check_setting: &dyn Fn(&str, &str, &Value) -> anyhow::Result<()>,
+    bad: &dyn Fn(&str, String) -> anyhow::Error,
+) -> anyhow::Result<()> {
+    let Value::Array(list) = v else {
+        return Err(bad("case", format!("expected [[case]] tables, found {v}")));
+    };
+    for (n, c) in list.iter().enumerate() {
+        let where_ = format!("[[case]] {}", n + 1);
+        let Value::Table(t) = c else {
+            return Err(bad(&where_, "expected a table".into()));
+        };
+        let mut s = base.clone();
+        let mut id = None;
+        for (k, v) in t {
+            if k == "id" {
+                match v {
+                    Value::String(x) if valid_id(x) => id = Some(x.clone()),
+                    v => {
+                        return Err(bad(
+                            &format!("{where_} \"id\""),
+                            format!("expected a folder name of letters, digits, '-', '_' and '.', found {v}"),
+                        ))
+                    }
+                }
+                continue;
+            }
+            check_setting(&where_, k, v)?;
+            if !keys.contains(k) {
+                keys.push(k.clone());
+            }
+            s.insert(k.clone(), v.clone());
+        }
+        cases.push((id, s));
+    }
+    Ok(())
+}
+
+/// The number of cases the product of the `[vary]` lists gives, refused beyond [`MAX_CASES`]
+/// with the `[[case]]` tables counted.
+fn case_count(file: &str, axes: &[(String, Vec<Value>)], n_explicit: u64) -> anyhow::Result<u64> {
+    let product = if axes.is_empty() {
+        0
+    } else {
+        axes.iter()
+            .fold(1u64, |n, a| n.saturating_mul(a.1.len() as u64))
+    };
+    let count = product.saturating_add(n_explicit);
+    if count > MAX_CASES {
+        let shown = if count == u64::MAX {
+            "more than 1.8e19".to_string()
+        } else {
+            count.to_string()
+        };
+        return Err(anyhow!(
+            "sweep plan {file}: {shown} cases ([vary] {} = {product}{}), beyond the {MAX_CASES} a sweep may hold; vary fewer keys or fewer values per key, or split the plan into several plans",
+            axes.iter()
+                .map(|(k, l)| format!("\"{k}\" {}", l.len()))
+                .collect::<Vec<_>>()
+                .join(" x "),
+            if n_explicit > 0 {
+                format!(", plus {n_explicit} [[case]] tables")
+            } else {
+                String::new()
+            }
+        ));
+    }
+    Ok(product)
+}
+
+/// The `[sweep]` table: (warm_start, group_size).
+fn sweep_options(t: &Table, file: &str) -> anyhow::Result<(bool, usize)> {
+    let bad = |key: &str, msg: String| anyhow!("sweep plan {file}, {key}: {msg}");
+    let mut sweep = (true, 4usize);
+    for (k, v) in t {
+        match (k.as_str(), v) {
+            ("warm_start", Value::Boolean(b)) => sweep.0 = *b,
+            ("group_size", Value::Integer(n)) if *n >= 1 => sweep.1 = *n as usize,
+            ("warm_start", v) => {
+                return Err(bad(
+                    "[sweep] warm_start",
+                    format!("expected true or false, found {v}"),
+                ))
+            }
+            ("group_size", v) => {
+                return Err(bad(
+                    "[sweep] group_size",
+                    format!("expected a positive integer, found {v}"),
+                ))
+            }
+            (k, _) => {
+                return Err(bad(
+                    &format!("[sweep] {k}"),
+                    "unknown key, expected warm_start or group_size".into(),
+                ))
+            }
+        }
+    }
+    Ok(sweep)
 }
 
 #[cfg(test)]
