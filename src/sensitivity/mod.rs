@@ -12,6 +12,7 @@
 //!
 //! [`scan`] finds the labelled values in the deck text; [`table`] reads the case folders into
 //! the sensitivity table and writes sensitivity.csv, sensitivity.html and summary.json.
+pub mod job;
 pub mod scan;
 pub mod table;
 
