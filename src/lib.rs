@@ -18,5 +18,6 @@ pub mod run;
 pub mod sensitivity;
 pub mod solver;
 pub mod stability;
+pub mod structural;
 pub mod structure;
 pub mod sweep;
