@@ -587,71 +587,7 @@ pub fn html(t: &Sensitivity) -> String {
     }
     h.contents();
     for (k, o) in OUTPUTS.iter().enumerate() {
-        h.heading(2, o.title);
-        match tornado(t, k) {
-            None if o.multibody_only && t.model != "uh60a" => {
-                h.paragraph(&format!(
-                    "Not available: the {} model does not give blade loads (the multibody model does: --model uh60a).",
-                    t.model
-                ));
-                continue;
-            }
-            None => {
-                h.paragraph("Not available from these runs (no nominal value, or no parameter case with a value).");
-                continue;
-            }
-            Some(Ok(svg)) => {
-                h.svg(
-                    &format!(
-                        "tornado: {} at the low and high value of each parameter, in % of the nominal value, largest spread at the top",
-                        o.title
-                    ),
-                    &svg,
-                );
-            }
-            Some(Err(e)) => {
-                h.paragraph(&format!("not plotted: {e}"));
-            }
-        }
-        let unit = if o.unit.is_empty() { "-" } else { o.unit };
-        let rows: Vec<Vec<String>> = t
-            .ranking(k)
-            .iter()
-            .enumerate()
-            .map(|(n, &i)| {
-                let r = &t.rows[i];
-                let nom = t.nominal.values[k];
-                vec![
-                    (n + 1).to_string(),
-                    r.param.name(),
-                    format!("{} .. {}", short(r.param.low), short(r.param.high)),
-                    show(o, r.low.values[k]),
-                    show(o, r.high.values[k]),
-                    pct(change(r.low.values[k], nom)),
-                    pct(change(r.high.values[k], nom)),
-                    match o.unit.is_empty() {
-                        true => r.swing(k).map_or("-".into(), |s| format!("{s:+.4}")),
-                        false => r.swing(k).map_or("-".into(), |s| format!("{s:+.0}")),
-                    },
-                ]
-            })
-            .collect();
-        let h_low = format!("output at low [{unit}]");
-        let h_high = format!("output at high [{unit}]");
-        let h_swing = format!("swing high - low [{unit}]");
-        h.table(
-            &[
-                "rank",
-                "parameter",
-                "low .. high value",
-                &h_low,
-                &h_high,
-                "change at low",
-                "change at high",
-                &h_swing,
-            ],
-            &rows,
-        );
+        output_section(&mut h, t, k, o);
     }
     h.heading(2, "parameters");
     let rows: Vec<Vec<String>> = t
@@ -713,6 +649,75 @@ pub fn html(t: &Sensitivity) -> String {
         "Every case is a complete run folder under cases/ (cases/{NOMINAL}/ the nominal one); sweep.csv has one row per case, sensitivity.csv one per parameter (docs/formats.md)."
     ));
     h.finish()
+}
+
+/// The section of output `k`: its tornado chart and its ranking of the parameters.
+fn output_section(h: &mut HtmlReport, t: &Sensitivity, k: usize, o: &OutputDef) {
+    h.heading(2, o.title);
+    match tornado(t, k) {
+        None if o.multibody_only && t.model != "uh60a" => {
+            h.paragraph(&format!(
+                "Not available: the {} model does not give blade loads (the multibody model does: --model uh60a).",
+                t.model
+            ));
+            return;
+        }
+        None => {
+            h.paragraph("Not available from these runs (no nominal value, or no parameter case with a value).");
+            return;
+        }
+        Some(Ok(svg)) => {
+            h.svg(
+                &format!(
+                    "tornado: {} at the low and high value of each parameter, in % of the nominal value, largest spread at the top",
+                    o.title
+                ),
+                &svg,
+            );
+        }
+        Some(Err(e)) => {
+            h.paragraph(&format!("not plotted: {e}"));
+        }
+    }
+    let unit = if o.unit.is_empty() { "-" } else { o.unit };
+    let rows: Vec<Vec<String>> = t
+        .ranking(k)
+        .iter()
+        .enumerate()
+        .map(|(n, &i)| {
+            let r = &t.rows[i];
+            let nom = t.nominal.values[k];
+            vec![
+                (n + 1).to_string(),
+                r.param.name(),
+                format!("{} .. {}", short(r.param.low), short(r.param.high)),
+                show(o, r.low.values[k]),
+                show(o, r.high.values[k]),
+                pct(change(r.low.values[k], nom)),
+                pct(change(r.high.values[k], nom)),
+                match o.unit.is_empty() {
+                    true => r.swing(k).map_or("-".into(), |s| format!("{s:+.4}")),
+                    false => r.swing(k).map_or("-".into(), |s| format!("{s:+.0}")),
+                },
+            ]
+        })
+        .collect();
+    let h_low = format!("output at low [{unit}]");
+    let h_high = format!("output at high [{unit}]");
+    let h_swing = format!("swing high - low [{unit}]");
+    h.table(
+        &[
+            "rank",
+            "parameter",
+            "low .. high value",
+            &h_low,
+            &h_high,
+            "change at low",
+            "change at high",
+            &h_swing,
+        ],
+        &rows,
+    );
 }
 
 /// A parameter value in short form (6 significant digits; sensitivity.csv has every digit).

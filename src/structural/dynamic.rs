@@ -54,10 +54,8 @@ pub struct DynamicOutcome {
 }
 
 impl DynamicJob {
-    /// Integrates the deck and writes the result folder; `say` gets a progress line every 5 %
-    /// of the steps. A step that fails ends the analysis with an error, its output kept and
-    /// marked incomplete.
-    pub fn execute(&self, say: &dyn Fn(&str)) -> anyhow::Result<DynamicOutcome> {
+    /// The options' own ranges, before the deck is read.
+    pub fn check_options(&self) -> anyhow::Result<()> {
         if let Some(r) = self.rho_inf {
             if !(0.0..=1.0).contains(&r) {
                 anyhow::bail!(
@@ -74,6 +72,14 @@ impl DynamicJob {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// Integrates the deck and writes the result folder; `say` gets a progress line every 5 %
+    /// of the steps. A step that fails ends the analysis with an error, its output kept and
+    /// marked incomplete.
+    pub fn execute(&self, say: &dyn Fn(&str)) -> anyhow::Result<DynamicOutcome> {
+        self.check_options()?;
         // Refused before the model is built when beyond sense: 3 Newton iterations a step is
         // typical (docs/performance.md); kept samples: the time and a channel a node at least.
         let (deck, mut model) = load_deck_within(&self.deck, |d| {
