@@ -11,7 +11,7 @@ pub struct DiagnoseArgs {
     #[command(flatten)]
     pub settings: DiagnoseSettings,
     /// Output directory (diagnosis.json, diagnosis.html).
-    // listed in --help after --flight, as before the other options moved into the settings
+    // --help lists it after --flight (the settings' fourth option)
     #[arg(long, display_order = 3)]
     pub out: PathBuf,
 }

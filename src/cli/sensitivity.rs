@@ -16,7 +16,7 @@ pub struct SensitivityArgs {
     pub settings: SensitivitySettings,
     /// Output folder: sensitivity.csv, sensitivity.html, summary.json, sensitivity_plan.toml,
     /// and the sweep's plan.json, cases/<id>/, sweep.csv, sweep.html.
-    // listed in --help after --flight, as before the other options moved into the settings
+    // --help lists it after --flight (the settings' second option)
     #[arg(long, display_order = 1)]
     pub out: PathBuf,
 }

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 #[serde(default, deny_unknown_fields)]
 pub struct DiagnoseSettings {
     /// Damper deck of the baseline model (any TOML file with a [damper] table).
-    #[arg(long, alias = "deck")]
+    #[arg(long, alias = "deck", value_name = "DECK")]
     pub damper_deck: Option<PathBuf>,
     /// Measured bench test(s) (bench CSV of docs/formats.md, with force).
     #[arg(long)]
@@ -51,7 +51,12 @@ pub struct DiagnoseSettings {
     pub check_revs: usize,
     /// Rotor model of the rotor runs: uh60a (the multibody model of the rotor deck) or rigid
     /// (its rigid-blade reduction, as `rotorsim run --model rigid`; seconds instead of minutes).
-    #[arg(long, alias = "rotor-model", default_value = "uh60a")]
+    #[arg(
+        long,
+        alias = "rotor-model",
+        value_name = "ROTOR_MODEL",
+        default_value = "uh60a"
+    )]
     pub model: String,
 }
 
