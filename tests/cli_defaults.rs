@@ -63,5 +63,5 @@ fn diagnose_defaults_are_the_jobs() {
         panic!("not a diagnose command");
     };
     let cfg = rotorsim::diagnose::pipeline::Config::new("o");
-    assert_eq!(format!("{:?}", a.config()), format!("{cfg:?}"));
+    assert_eq!(format!("{:?}", a.job()), format!("{cfg:?}"));
 }

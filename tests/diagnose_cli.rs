@@ -3,18 +3,22 @@
 use rotorsim::checks::bench::BenchSettings;
 use rotorsim::cli::bench::{run as bench, BenchArgs};
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
+use rotorsim::diagnose::settings::DiagnoseSettings;
 use std::path::PathBuf;
 mod support;
 use support::{assert_diagnosis_keys, read_json, root, tmp};
 
 fn args(out: PathBuf) -> DiagnoseArgs {
     DiagnoseArgs {
-        deck: None,
-        measured: vec![],
-        rotor: Some(root().join("flightdata/damper_nominal.toml")),
-        flight: Some(root().join("flightdata/c8534like")),
-        write_deck: None,
-        ..DiagnoseArgs::new(out)
+        settings: DiagnoseSettings {
+            damper_deck: None,
+            measured: vec![],
+            rotor: Some(root().join("flightdata/damper_nominal.toml")),
+            flight: Some(root().join("flightdata/c8534like")),
+            write_deck: None,
+            ..DiagnoseSettings::default()
+        },
+        out,
     }
 }
 
@@ -23,8 +27,11 @@ fn flight_record_diagnosis_writes_the_formats_json_and_a_usable_deck() {
     let dir = tmp("flight");
     let deck = dir.join("extended.toml");
     diagnose(DiagnoseArgs {
-        write_deck: Some(deck.clone()),
-        ..args(dir.join("out"))
+        settings: DiagnoseSettings {
+            write_deck: Some(deck.clone()),
+            ..args(dir.join("out")).settings
+        },
+        out: dir.join("out"),
     })
     .unwrap();
     let j = read_json(&dir.join("out/diagnosis.json"));
@@ -84,8 +91,11 @@ fn a_deck_written_inside_the_result_folder_is_kept() {
     let deck = out.join("extended.toml");
     for _ in 0..2 {
         diagnose(DiagnoseArgs {
-            write_deck: Some(deck.clone()),
-            ..args(out.clone())
+            settings: DiagnoseSettings {
+                write_deck: Some(deck.clone()),
+                ..args(out.clone()).settings
+            },
+            out: out.clone(),
         })
         .unwrap();
         let text = std::fs::read_to_string(&deck).expect("the written deck");
@@ -115,8 +125,11 @@ fn flight_record_without_stroke_needs_a_rotor_deck_for_the_rotor_run() {
         .collect();
     std::fs::write(dir.join("r.damper.csv"), stripped).unwrap();
     let e = diagnose(DiagnoseArgs {
-        flight: Some(dir.join("r")),
-        ..args(dir.join("out"))
+        settings: DiagnoseSettings {
+            flight: Some(dir.join("r")),
+            ..args(dir.join("out")).settings
+        },
+        out: dir.join("out"),
     })
     .unwrap_err()
     .to_string();
@@ -129,11 +142,14 @@ fn flight_record_without_stroke_needs_a_rotor_deck_for_the_rotor_run() {
 /// `diagnose` of one bench file against the nominal damper deck, the result in `dir/out`.
 fn bench_args(dir: &std::path::Path, file: PathBuf) -> DiagnoseArgs {
     DiagnoseArgs {
-        deck: Some(root().join("flightdata/damper_nominal.toml")),
-        measured: vec![file],
-        rotor: None,
-        flight: None,
-        ..args(dir.join("out"))
+        settings: DiagnoseSettings {
+            damper_deck: Some(root().join("flightdata/damper_nominal.toml")),
+            measured: vec![file],
+            rotor: None,
+            flight: None,
+            ..args(dir.join("out")).settings
+        },
+        out: dir.join("out"),
     }
 }
 
@@ -217,8 +233,11 @@ fn a_calibration_gain_and_a_zero_offset_together_are_both_named() {
         std::fs::write(dir.join(format!("c8534like.{ext}")), text).unwrap();
     }
     diagnose(DiagnoseArgs {
-        flight: Some(dir.join("c8534like")),
-        ..args(dir.join("out"))
+        settings: DiagnoseSettings {
+            flight: Some(dir.join("c8534like")),
+            ..args(dir.join("out")).settings
+        },
+        out: dir.join("out"),
     })
     .unwrap();
     let j = read_json(&dir.join("out/diagnosis.json"));

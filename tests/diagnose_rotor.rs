@@ -3,6 +3,7 @@
 //! deck) and the damper is diagnosed stroke-driven on it. Short run (few revolutions, coarse
 //! steps) so the test stays fast; the periodicity statement then says it is not periodic.
 use rotorsim::cli::diagnose::{run as diagnose, DiagnoseArgs};
+use rotorsim::diagnose::settings::DiagnoseSettings;
 use rotorsim::flight::{DamperSample, FlightRecord};
 use std::path::{Path, PathBuf};
 mod support;
@@ -45,13 +46,16 @@ fn record_without_stroke_is_diagnosed_through_the_rotor_run() {
     let out = dir.join("out");
     let revs = 4;
     diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(stem.clone()),
-        revs,
-        steps_per_rev: 128,
-        // Same hydraulic sub-step as 256 x 25 (64 steps per revolution do not converge) (3.6e-5 s, the explicit RK4 limit of the damper).
-        substeps: 50,
-        ..DiagnoseArgs::new(out.clone())
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(stem.clone()),
+            revs,
+            steps_per_rev: 128,
+            // Same hydraulic sub-step as 256 x 25 (64 steps per revolution do not converge) (3.6e-5 s, the explicit RK4 limit of the damper).
+            substeps: 50,
+            ..DiagnoseSettings::default()
+        },
+        out: out.clone(),
     })
     .unwrap();
     let j = read_json(&out.join("diagnosis.json"));
@@ -105,9 +109,12 @@ fn record_without_stroke_needs_a_rotor_deck_and_enough_revolutions() {
     let (stem, _) = record_without_stroke(&dir);
     // No --rotor: the baseline deck alone cannot simulate the stroke.
     let e = diagnose(DiagnoseArgs {
-        deck: Some(root().join("flightdata/damper_nominal.toml")),
-        flight: Some(stem.clone()),
-        ..DiagnoseArgs::new(dir.join("out"))
+        settings: DiagnoseSettings {
+            damper_deck: Some(root().join("flightdata/damper_nominal.toml")),
+            flight: Some(stem.clone()),
+            ..DiagnoseSettings::default()
+        },
+        out: dir.join("out"),
     })
     .unwrap_err()
     .to_string();
@@ -116,20 +123,26 @@ fn record_without_stroke_needs_a_rotor_deck_and_enough_revolutions() {
         "{e}"
     );
     let e = diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(stem),
-        revs: 1,
-        ..DiagnoseArgs::new(dir.join("out"))
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(stem),
+            revs: 1,
+            ..DiagnoseSettings::default()
+        },
+        out: dir.join("out"),
     })
     .unwrap_err()
     .to_string();
     assert!(e.contains("--revs must be at least 2"), "{e}");
     // --rotor-check without a flight record.
     let e = diagnose(DiagnoseArgs {
-        deck: Some(root().join("flightdata/damper_nominal.toml")),
-        measured: vec![root().join("nonexistent.csv")],
-        rotor_check: true,
-        ..DiagnoseArgs::new(dir.join("out"))
+        settings: DiagnoseSettings {
+            damper_deck: Some(root().join("flightdata/damper_nominal.toml")),
+            measured: vec![root().join("nonexistent.csv")],
+            rotor_check: true,
+            ..DiagnoseSettings::default()
+        },
+        out: dir.join("out"),
     })
     .unwrap_err()
     .to_string();
@@ -142,14 +155,17 @@ fn rotor_check_runs_baseline_and_extended_decks_and_reports_both() {
     let out = dir.join("out");
     let deck = dir.join("extended.toml");
     diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(root().join("flightdata/c8534like")),
-        write_deck: Some(deck.clone()),
-        rotor_check: true,
-        check_revs: 2,
-        steps_per_rev: 128,
-        substeps: 50,
-        ..DiagnoseArgs::new(out.clone())
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(root().join("flightdata/c8534like")),
+            write_deck: Some(deck.clone()),
+            rotor_check: true,
+            check_revs: 2,
+            steps_per_rev: 128,
+            substeps: 50,
+            ..DiagnoseSettings::default()
+        },
+        out: out.clone(),
     })
     .unwrap();
     let j = read_json(&out.join("diagnosis.json"));
@@ -209,12 +225,15 @@ fn extended_deck_improves_the_rigid_rotor_comparison_of_the_shipped_record() {
     let dir = tmp("rigidgain");
     let out = dir.join("out");
     diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(root().join("flightdata/c8534like")),
-        write_deck: Some(dir.join("extended.toml")),
-        rotor_check: true,
-        rotor_model: "rigid".into(),
-        ..DiagnoseArgs::new(out.clone())
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(root().join("flightdata/c8534like")),
+            write_deck: Some(dir.join("extended.toml")),
+            rotor_check: true,
+            model: "rigid".into(),
+            ..DiagnoseSettings::default()
+        },
+        out: out.clone(),
     })
     .unwrap();
     let j = read_json(&out.join("diagnosis.json"));
@@ -244,10 +263,13 @@ fn extended_deck_improves_the_rigid_rotor_comparison_of_the_shipped_record() {
 fn unknown_rotor_model_is_refused_by_name() {
     let dir = tmp("badmodel");
     let err = diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(root().join("flightdata/c8534like")),
-        rotor_model: "elastic".into(),
-        ..DiagnoseArgs::new(dir.join("out"))
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(root().join("flightdata/c8534like")),
+            model: "elastic".into(),
+            ..DiagnoseSettings::default()
+        },
+        out: dir.join("out"),
     })
     .unwrap_err();
     let msg = format!("{err:#}");
@@ -266,11 +288,14 @@ fn record_without_stroke_through_the_rigid_reduction_finds_the_mount() {
     let (fl, _) = record_without_stroke(&dir);
     let out = dir.join("out");
     diagnose(DiagnoseArgs {
-        rotor: Some(root().join("rotors/uh60a.toml")),
-        flight: Some(fl),
-        rotor_model: "rigid".into(),
-        revs: 75,
-        ..DiagnoseArgs::new(out.clone())
+        settings: DiagnoseSettings {
+            rotor: Some(root().join("rotors/uh60a.toml")),
+            flight: Some(fl),
+            model: "rigid".into(),
+            revs: 75,
+            ..DiagnoseSettings::default()
+        },
+        out: out.clone(),
     })
     .unwrap();
     let j = read_json(&out.join("diagnosis.json"));

@@ -157,11 +157,9 @@ fn cli_marks_output_incomplete_on_divergence() {
     let text = format!("{BASE}\n[[load]]\nname = \"f\"\nnode = \"b.n6\"\nforce_N = [0.0, 0.0, 1e5]\nfollower = true\n\n[static]\nload_steps = 1\nmax_iterations = 3\n");
     std::fs::write(&deck, text).unwrap();
     let out = dir.join("out");
-    let r = rotorsim::cli::static_cmd::run(rotorsim::cli::static_cmd::StaticArgs {
-        deck,
-        out: out.clone(),
-        check_tangent: false,
-    });
+    let r = rotorsim::checks::static_job::StaticSettings::default()
+        .job(deck, out.clone())
+        .execute(&|_| {});
     let e = r.unwrap_err();
     println!("{e:#}");
     assert!(out.join("INCOMPLETE").exists());

@@ -543,56 +543,54 @@ class ModesResult:
         return f"ModesResult({str(self.folder)!r}, fan={self.fan is not None})"
 
 
-def diagnose(
-    deck=None,
-    measured=None,
-    rotor=None,
-    flight=None,
-    write_deck=None,
-    fit_cycles=None,
-    max_substep=None,
-    revs=None,
-    steps_per_rev=None,
-    substeps=None,
-    rotor_check=False,
-    check_revs=None,
-    model=None,
-    out=None,
-    progress=None,
-):
+# The options of ``rotorsim diagnose`` with their defaults, from the library's one definition.
+DIAGNOSE_OPTIONS = _json.loads(_native.diagnose_options())
+
+
+def diagnose(damper_deck=None, measured=None, *, out=None, progress=None, deck=None, **options):
     """What the damper model gets wrong in measured data, as ``rotorsim diagnose`` finds it:
     the cause named, the model extended, the gain measured on held-out data.
 
-    The data: ``deck`` (the baseline damper deck) with ``measured`` bench CSV file(s), or
-    ``rotor`` (rotor deck; its ``[damper]`` is the baseline unless ``deck``) with ``flight`` (a
-    flight record). Every option left out takes the command line's default: ``fit_cycles`` (3),
-    ``max_substep`` (3e-5 s), ``revs`` (40), ``steps_per_rev`` (256), ``substeps`` (25),
-    ``rotor_check`` (False; the rotor-level before/after of a flight record) with ``check_revs``
-    (75), ``model`` (uh60a or rigid, the rotor runs' model). ``write_deck``: also write the
-    extended model as a damper deck there. ``out``: the result folder to write (a temporary one,
-    removed with the result, when not given). ``progress``: a callable given each progress line.
+    ``options`` are the options of ``rotorsim diagnose`` by their names (``--fit-cycles`` is
+    ``fit_cycles``); every one left out (or None) takes the command line's default. The data:
+    ``damper_deck`` (the baseline damper deck) with ``measured`` bench CSV file(s), or
+    ``rotor`` (rotor deck; its ``[damper]`` is the baseline unless ``damper_deck``) with
+    ``flight`` (a flight record). The others: ``fit_cycles`` (3), ``max_substep`` (3e-5 s),
+    ``revs`` (40), ``steps_per_rev`` (256), ``substeps`` (25), ``rotor_check`` (False; the
+    rotor-level before/after of a flight record) with ``check_revs`` (75), ``model`` (uh60a or
+    rigid, the rotor runs' model). ``write_deck``: also write the extended model as a damper
+    deck there. ``deck`` is the deprecated name of ``damper_deck``. An unknown name raises
+    TypeError. ``out``: the result folder to write (a temporary one, removed with the result,
+    when not given). ``progress``: a callable given each progress line.
 
     Bad input raises FileNotFoundError or ValueError naming the file and key, as the command
     line does. Returns a :class:`DiagnoseResult`.
     """
+    if deck is not None:
+        _deprecated("deck", "damper_deck")
+        if damper_deck is None:
+            damper_deck = deck
+    unknown = sorted(k for k in options if k not in DIAGNOSE_OPTIONS)
+    if unknown:
+        raise TypeError(
+            f"diagnose() got unexpected keyword argument(s) {', '.join(unknown)} "
+            f"(the options of rotorsim diagnose are {', '.join(DIAGNOSE_OPTIONS)})"
+        )
+    settings = {k: v for k, v in options.items() if v is not None}
+    if damper_deck is not None:
+        settings["damper_deck"] = damper_deck
+    if measured is not None:
+        settings["measured"] = _paths(measured)
+    if "max_substep" in settings:
+        settings["max_substep"] = float(settings["max_substep"])
+    if "rotor_check" in settings:
+        settings["rotor_check"] = bool(settings["rotor_check"])
+    for k, v in settings.items():
+        if isinstance(v, _os.PathLike):
+            settings[k] = _os.fspath(v)
     out, keep = _out_folder(out, "rotorsim-diagnose-")
-    folder = _native.diagnose(
-        str(out),
-        deck=_opt(deck),
-        measured=_paths(measured),
-        rotor=_opt(rotor),
-        flight=_opt(flight),
-        write_deck=_opt(write_deck),
-        fit_cycles=fit_cycles,
-        max_substep=None if max_substep is None else float(max_substep),
-        revs=revs,
-        steps_per_rev=steps_per_rev,
-        substeps=substeps,
-        rotor_check=bool(rotor_check),
-        check_revs=check_revs,
-        model=_opt(model),
-        progress=progress,
-    )
+    folder = _native.diagnose(str(out), settings=_json.dumps(settings), progress=progress)
+    write_deck = settings.get("write_deck")
     return DiagnoseResult(folder, None if write_deck is None else _Path(write_deck), keep)
 
 

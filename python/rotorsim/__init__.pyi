@@ -15,6 +15,7 @@ RUN_OPTIONS: Dict[str, Any]
 BENCH_OPTIONS: Dict[str, Any]
 STABILITY_OPTIONS: Dict[str, Any]
 MODES_OPTIONS: Dict[str, Any]
+DIAGNOSE_OPTIONS: Dict[str, Any]
 
 class Damper:
     def __init__(
@@ -173,8 +174,14 @@ class DiagnoseResult:
     def candidates(self) -> List[Dict[str, Any]]: ...
 
 def diagnose(
-    deck: Optional[_Path] = ...,
+    damper_deck: Optional[_Path] = ...,
     measured: Union[None, _Path, Iterable[_Path]] = ...,
+    *,
+    out: Optional[_Path] = ...,
+    progress: Optional[Callable[[str], None]] = ...,
+    deck: Optional[_Path] = ...,
+    # the options of `rotorsim diagnose` (rotorsim.DIAGNOSE_OPTIONS; checked against the library
+    # by tests/job_options.rs)
     rotor: Optional[_Path] = ...,
     flight: Optional[_Path] = ...,
     write_deck: Optional[_Path] = ...,
@@ -183,11 +190,9 @@ def diagnose(
     revs: Optional[int] = ...,
     steps_per_rev: Optional[int] = ...,
     substeps: Optional[int] = ...,
-    rotor_check: bool = ...,
+    rotor_check: Optional[bool] = ...,
     check_revs: Optional[int] = ...,
     model: Optional[str] = ...,
-    out: Optional[_Path] = ...,
-    progress: Optional[Callable[[str], None]] = ...,
 ) -> DiagnoseResult: ...
 
 class SweepResult:

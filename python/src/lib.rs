@@ -7,6 +7,7 @@ use pyo3::prelude::*;
 use rotorsim::checks::bench::BenchSettings;
 use rotorsim::checks::modes::ModesSettings;
 use rotorsim::diagnose::pipeline::Config as DiagnoseConfig;
+use rotorsim::diagnose::settings::DiagnoseSettings;
 use rotorsim::hydraulics::bench::{self as damper_bench, BenchTest};
 use rotorsim::hydraulics::{
     DamperDeck, DamperModel, DeckError, Device, HydraulicError, IntegratorOptions, Scheme,
@@ -415,48 +416,20 @@ fn modes(py: Python<'_>, out: PathBuf, settings: &str) -> PyResult<PathBuf> {
     Ok(job.out)
 }
 
-/// `rotorsim diagnose` as a library call: the command's defaults for every option not given,
-/// the same checks and messages; `progress` gets its progress lines. Returns the result folder.
+/// `rotorsim diagnose` as a library call: `settings` is a JSON object of its options (the
+/// fields of `DiagnoseSettings`, the command line's names), every other the command's default;
+/// the same checks and messages. `progress` gets its progress lines. Returns the result folder.
 #[pyfunction]
-#[pyo3(signature = (out, deck = None, measured = Vec::new(), rotor = None, flight = None,
-    write_deck = None, fit_cycles = None, max_substep = None, revs = None, steps_per_rev = None,
-    substeps = None, rotor_check = false, check_revs = None, model = None, progress = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (out, settings, progress = None))]
 fn diagnose(
     py: Python<'_>,
     out: PathBuf,
-    deck: Option<PathBuf>,
-    measured: Vec<PathBuf>,
-    rotor: Option<PathBuf>,
-    flight: Option<PathBuf>,
-    write_deck: Option<PathBuf>,
-    fit_cycles: Option<usize>,
-    max_substep: Option<f64>,
-    revs: Option<usize>,
-    steps_per_rev: Option<usize>,
-    substeps: Option<usize>,
-    rotor_check: bool,
-    check_revs: Option<usize>,
-    model: Option<String>,
+    settings: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PathBuf> {
-    let d = DiagnoseConfig::new(out);
-    let cfg = DiagnoseConfig {
-        deck,
-        measured,
-        rotor,
-        flight,
-        write_deck,
-        fit_cycles: fit_cycles.unwrap_or(d.fit_cycles),
-        max_substep: max_substep.unwrap_or(d.max_substep),
-        revs: revs.unwrap_or(d.revs),
-        steps_per_rev: steps_per_rev.unwrap_or(d.steps_per_rev),
-        substeps: substeps.unwrap_or(d.substeps),
-        rotor_check,
-        check_revs: check_revs.unwrap_or(d.check_revs),
-        rotor_model: model.unwrap_or_else(|| d.rotor_model.clone()),
-        ..d
-    };
+    let cfg = DiagnoseSettings::from_json(settings)
+        .map_err(run_error)?
+        .job(out);
     let say = |line: &str| {
         if let Some(cb) = &progress {
             Python::attach(|py| {
@@ -469,6 +442,13 @@ fn diagnose(
     py.detach(|| rotorsim::diagnose::pipeline::run(&cfg, &say))
         .map_err(run_error)?;
     Ok(cfg.out)
+}
+
+/// The options of `rotorsim diagnose` by name with their defaults, as JSON (what `diagnose`
+/// takes).
+#[pyfunction]
+fn diagnose_options() -> String {
+    DiagnoseSettings::defaults_json()
 }
 
 /// Progress of a sweep handed to a Python callable `progress(event: dict)` (called with the GIL
@@ -591,6 +571,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_options, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -50,5 +50,15 @@ def test_errors_name_the_file_and_the_option(tmp_path):
     with pytest.raises(ValueError, match="--model: unknown rotor model 'coaxial'"):
         rotorsim.diagnose(rotor=DECK, flight=RECORD, model="coaxial", out=tmp_path / "d")
     with pytest.raises(FileNotFoundError, match="nope.csv"):
-        rotorsim.diagnose(deck=DECK, measured=[tmp_path / "nope.csv"], out=tmp_path / "e")
+        rotorsim.diagnose(damper_deck=DECK, measured=[tmp_path / "nope.csv"], out=tmp_path / "e")
     assert not any((tmp_path / x).exists() for x in "abcd")
+
+
+def test_options_are_the_commands_and_deck_is_deprecated(tmp_path):
+    assert rotorsim.DIAGNOSE_OPTIONS["fit_cycles"] == 3
+    assert rotorsim.DIAGNOSE_OPTIONS["model"] == "uh60a"
+    with pytest.warns(DeprecationWarning, match="deck= is deprecated: use damper_deck="):
+        with pytest.raises(FileNotFoundError, match="nope.csv"):
+            rotorsim.diagnose(deck=DECK, measured=[tmp_path / "nope.csv"], out=tmp_path / "e")
+    with pytest.raises(TypeError, match="no_such_option"):
+        rotorsim.diagnose(no_such_option=1, out=tmp_path / "f")

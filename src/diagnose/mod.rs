@@ -11,6 +11,7 @@ pub mod identify;
 pub mod pipeline;
 pub mod report;
 pub mod rotor;
+pub mod settings;
 pub mod support;
 
 pub use candidates::Cause;

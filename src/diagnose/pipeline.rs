@@ -23,8 +23,9 @@ use std::path::{Path, PathBuf};
 /// A progress line for the user (the command prints it on stderr).
 pub type Say<'a> = &'a (dyn Fn(&str) + Sync);
 
-/// What to diagnose and how: `rotorsim diagnose`'s options ([`Config::new`] gives its
-/// defaults), checked by [`run`]. The command line and the Python package both run through it.
+/// What to diagnose and how, typed: `rotorsim diagnose`'s options
+/// ([`super::settings::DiagnoseSettings::job`]; [`Config::new`] gives its defaults), checked by
+/// [`run`]. The command line and the Python package both run through it.
 #[derive(Debug, Clone)]
 pub struct Config {
     /// Damper deck of the baseline model.
@@ -58,22 +59,7 @@ pub struct Config {
 impl Config {
     /// A diagnosis into `out` with the defaults of `rotorsim diagnose` (no data given).
     pub fn new(out: impl Into<PathBuf>) -> Self {
-        Config {
-            deck: None,
-            measured: vec![],
-            rotor: None,
-            flight: None,
-            out: out.into(),
-            write_deck: None,
-            fit_cycles: 3,
-            max_substep: 3.0e-5,
-            revs: 40,
-            steps_per_rev: 256,
-            substeps: 25,
-            rotor_check: false,
-            check_revs: 75,
-            rotor_model: "uh60a".into(),
-        }
+        super::settings::DiagnoseSettings::default().job(out)
     }
 
     /// The options' own checks, before anything is read ([`run`] starts with them).

@@ -12,6 +12,7 @@
 //!
 //! [`scan`] finds the labelled values in the deck text; [`table`] reads the case folders into
 //! the sensitivity table and writes sensitivity.csv, sensitivity.html and summary.json.
+pub mod job;
 pub mod scan;
 pub mod table;
 
@@ -239,63 +240,7 @@ pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<
         if o.vary.iter().any(|v| v.key == t.name()) {
             continue; // --vary gives its range
         }
-        let mut notes = Vec::new();
-        let mut side = |factors: &[f64]| -> (Option<f64>, Vec<f64>) {
-            let mut refused = Vec::new();
-            let mut why = String::new();
-            for f in factors {
-                let x = t.nominal * f;
-                match check(&t, x) {
-                    Ok(()) => break,
-                    Err(e) => {
-                        refused.push(format!("x{f}"));
-                        if why.is_empty() {
-                            // the deck's reason, without the override and file it names
-                            let line = first_line(&e);
-                            let at = format!("{}: ", t.key);
-                            why = match line.find(&at) {
-                                Some(i) => line[i + at.len()..].to_string(),
-                                None => line,
-                            };
-                        }
-                    }
-                }
-            }
-            if !refused.is_empty() {
-                notes.push(format!("{} refused: {why}", refused.join(", ")));
-            }
-            let k = refused.len();
-            (
-                factors.get(k).copied(),
-                factors.get(k + 1..).unwrap_or_default().to_vec(),
-            )
-        };
-        let ((down, down_next), (up, up_next)) = (side(&LOW_FACTORS), side(&HIGH_FACTORS));
-        // numeric order: a negative nominal value is lowest at the larger factor
-        let (fl, fh, low_next, high_next) = if t.nominal > 0.0 {
-            (down, up, down_next, up_next)
-        } else {
-            (up, down, up_next, down_next)
-        };
-        let (low_runs, high_runs) = (fl.is_some(), fh.is_some());
-        let fs = |f: Option<f64>| f.map_or("x1 (none accepted)".to_string(), |f| format!("x{f}"));
-        let mut range = format!("{} .. {}", fs(fl), fs(fh));
-        if !notes.is_empty() {
-            range.push_str(&format!(" ({})", notes.join("; ")));
-        }
-        params.push(Param {
-            low: t.nominal * fl.unwrap_or(1.0),
-            high: t.nominal * fh.unwrap_or(1.0),
-            low_runs,
-            high_runs,
-            low_next,
-            high_next,
-            low_round: 0,
-            high_round: 0,
-            range,
-            source: format!("ASSUMED (line {})", t.line.unwrap_or(0)),
-            target: t,
-        });
+        params.push(default_param(t, &check));
     }
     for v in &o.vary {
         let t = scan::target_of(&root, &v.key)
@@ -337,6 +282,68 @@ pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<
         damper,
         plan_text,
     })
+}
+
+/// A labelled value's parameter with its default range: each side at the first of its factors
+/// the deck accepts (`check`), the refused ones noted.
+fn default_param(t: Target, check: &dyn Fn(&Target, f64) -> anyhow::Result<()>) -> Param {
+    let mut notes = Vec::new();
+    let mut side = |factors: &[f64]| -> (Option<f64>, Vec<f64>) {
+        let mut refused = Vec::new();
+        let mut why = String::new();
+        for f in factors {
+            let x = t.nominal * f;
+            match check(&t, x) {
+                Ok(()) => break,
+                Err(e) => {
+                    refused.push(format!("x{f}"));
+                    if why.is_empty() {
+                        // the deck's reason, without the override and file it names
+                        let line = first_line(&e);
+                        let at = format!("{}: ", t.key);
+                        why = match line.find(&at) {
+                            Some(i) => line[i + at.len()..].to_string(),
+                            None => line,
+                        };
+                    }
+                }
+            }
+        }
+        if !refused.is_empty() {
+            notes.push(format!("{} refused: {why}", refused.join(", ")));
+        }
+        let k = refused.len();
+        (
+            factors.get(k).copied(),
+            factors.get(k + 1..).unwrap_or_default().to_vec(),
+        )
+    };
+    let ((down, down_next), (up, up_next)) = (side(&LOW_FACTORS), side(&HIGH_FACTORS));
+    // numeric order: a negative nominal value is lowest at the larger factor
+    let (fl, fh, low_next, high_next) = if t.nominal > 0.0 {
+        (down, up, down_next, up_next)
+    } else {
+        (up, down, up_next, down_next)
+    };
+    let (low_runs, high_runs) = (fl.is_some(), fh.is_some());
+    let fs = |f: Option<f64>| f.map_or("x1 (none accepted)".to_string(), |f| format!("x{f}"));
+    let mut range = format!("{} .. {}", fs(fl), fs(fh));
+    if !notes.is_empty() {
+        range.push_str(&format!(" ({})", notes.join("; ")));
+    }
+    Param {
+        low: t.nominal * fl.unwrap_or(1.0),
+        high: t.nominal * fh.unwrap_or(1.0),
+        low_runs,
+        high_runs,
+        low_next,
+        high_next,
+        low_round: 0,
+        high_round: 0,
+        range,
+        source: format!("ASSUMED (line {})", t.line.unwrap_or(0)),
+        target: t,
+    }
 }
 
 /// The deck's own words of a refusal: the first line, without the `--set KEY=VALUE: ` prefix.

@@ -15,6 +15,7 @@
 //! Shards. Shard K of N runs the groups `g` with `g % N == K` and writes only their case folders
 //! (and plan.json, the same bytes for every shard), so shards never collide; [`table`] builds
 //! sweep.csv from the case folders whoever ran them.
+pub mod batch;
 pub mod job;
 pub mod plan;
 pub mod runner;
