@@ -1,7 +1,7 @@
 //! The forced-response simulation of the rotor: expanded model + damper element + airload
 //! replay + swashplate law, marched by the generalized-alpha solver (see docs/rotor_model.md).
 use super::deck::{AirloadFrame, RotorSpec};
-use super::expand::{expand, names, ramp, Controls, ExpandOptions};
+use super::expand::{expand_deck, names, ramp, Controls, ExpandOptions};
 use super::{ForcedResponse, RunOptions, Timing, BASE_CHANNELS};
 use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
 use crate::flight::FlightRecord;
@@ -9,7 +9,7 @@ use crate::hydraulics::{DamperDeck, DamperModel};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonError, State};
 use crate::structure::beam::{SectionLoad, NPTS_M};
-use crate::structure::deck::parse_deck;
+use crate::structure::deck::{build_deck, Deck};
 use crate::structure::hydraulic::{HydraulicForceElement, HydraulicProbe};
 use crate::structure::kin::TimeTable;
 use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
@@ -165,24 +165,24 @@ impl BladeAirloads {
     }
 }
 
-/// Parse the expanded deck of `spec` into a model (relative paths against `base`).
+/// The model of `spec`'s expanded deck (relative paths against `file`'s folder).
 pub fn expanded_model(
     spec: &RotorSpec,
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    parse_expanded(&expand(spec, opts), file)
+    model_of_expanded(&expand_deck(spec, opts), file)
 }
 
-/// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub,
-/// parsed (relative paths against `file`'s folder). The hub and the airframe's chain are its
-/// border nodes: the blades meet only there, so the solver factors each blade on its own.
+/// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub
+/// (relative paths against `file`'s folder). The hub and the airframe's chain are its border
+/// nodes: the blades meet only there, so the solver factors each blade on its own.
 pub fn whole_rotor_model(
     specs: &[RotorSpec],
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    let mut model = parse_expanded(&super::expand::expand_rotor(specs, opts), file)?;
+    let mut model = model_of_expanded(&super::expand::expand_rotor_deck(specs, opts), file)?;
     let airframe = format!("{}.", names::AIRFRAME);
     model.border_nodes = (0..model.nodes.len())
         .filter(|&i| {
@@ -193,12 +193,12 @@ pub fn whole_rotor_model(
     Ok(model)
 }
 
-/// A model deck expanded from the rotor deck `file`, parsed into a model (relative paths against
-/// the deck's folder, errors naming the deck as expanded).
-pub(crate) fn parse_expanded(text: &str, file: &Path) -> anyhow::Result<Model> {
+/// The model of a deck expanded from the rotor deck `file`, checked as a read deck is (relative
+/// paths against the deck's folder, errors naming the deck as expanded).
+pub(crate) fn model_of_expanded(deck: &Deck, file: &Path) -> anyhow::Result<Model> {
     let base = file.parent().map(Path::to_path_buf).unwrap_or_default();
     let name = format!("{} (expanded)", file.display());
-    let (_, model) = parse_deck(text, &name, &base)?;
+    let (model, _) = build_deck(deck, &name, &base)?;
     Ok(model)
 }
 
