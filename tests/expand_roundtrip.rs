@@ -3,12 +3,13 @@
 //! one the run builds from, and both build the same model, number for number.
 use rotorsim::flight::FlightRecord;
 use rotorsim::rotor::expand::{
-    expand_deck, expand_rotor_deck, Controls, ExpandOptions, HydraulicRef,
+    expand_deck, expand_items, expand_rotor_deck, expand_rotor_items, Controls, ExpandOptions,
+    HydraulicRef,
 };
 use rotorsim::rotor::hinged::{self, HingedExpand, HingedSpec};
 use rotorsim::rotor::RotorDeck;
 use rotorsim::solver::State;
-use rotorsim::structure::deck::{build_deck, parse_deck, Deck};
+use rotorsim::structure::deck::{build_deck, build_deck_ids, parse_deck, Deck};
 use rotorsim::structure::deck_text::to_toml;
 use rotorsim::structure::model::Model;
 use std::path::{Path, PathBuf};
@@ -148,4 +149,49 @@ fn every_shipped_rotor_deck_prints_the_model_it_runs() {
         checked += 1;
     }
     assert!(checked >= 5, "only {checked} rotor decks found");
+}
+
+/// The ids the build returns for the parts a run drives and reads are the parts the names say.
+#[test]
+fn the_expansion_and_the_build_give_the_run_its_parts_by_id() {
+    let path = root().join("rotors/uh60a_airframe.toml");
+    let deck = RotorDeck::from_file(&path).unwrap();
+    let specs: Vec<_> = (1..=deck.spec.rotor.blades)
+        .map(|k| deck.blade(k).unwrap().spec)
+        .collect();
+    let opts = ExpandOptions {
+        table_revs: 1,
+        ..Default::default()
+    };
+    for (whole, (d, items)) in [
+        (true, expand_rotor_items(&specs, &opts)),
+        (false, expand_items(&deck.spec, &opts)),
+    ] {
+        let built = build_deck_ids(&d, "ids", path.parent().unwrap()).unwrap();
+        let (m, ids) = (&built.model, &built.ids);
+        let node = |i: usize| m.nodes[ids.nodes[i]].name.clone();
+        assert_eq!(node(items.hub), "hub");
+        assert_eq!(items.airframe.is_empty(), !whole);
+        for &i in &items.airframe {
+            assert!(node(i).starts_with("airframe."), "{}", node(i));
+        }
+        for (k, b) in items.blades.iter().enumerate() {
+            let p = if whole {
+                format!("b{}.", k + 1)
+            } else {
+                String::new()
+            };
+            assert_eq!(
+                m.element_id(&format!("{p}swashplate_drive")),
+                Some(ids.joints[b.swash])
+            );
+            assert_eq!(node(b.damper_ends[0]), format!("{p}damper_hub_end"));
+            assert_eq!(node(b.damper_ends[1]), format!("{p}damper_blade_end"));
+            let blade = &ids.beam_nodes[b.blade];
+            let n = 3 * specs[k].blade.elements;
+            assert_eq!(blade.len(), n + 1);
+            assert_eq!(m.node_id(&format!("{p}blade.n0")).unwrap(), blade[0]);
+            assert_eq!(m.node_id(&format!("{p}blade.n{n}")).unwrap(), blade[n]);
+        }
+    }
 }

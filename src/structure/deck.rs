@@ -945,11 +945,71 @@ pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), 
     Ok((deck, model))
 }
 
+/// A model built from a typed deck, with the probes of its `[[hydraulic]]` elements and the
+/// model ids of its items.
+pub struct Built {
+    pub model: Model,
+    pub probes: Probes,
+    pub ids: BuiltIds,
+}
+
+/// The model ids of a built deck's items, by their index in the deck.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BuiltIds {
+    /// The node of each `[[node]]`.
+    pub nodes: Vec<usize>,
+    /// The nodes of each `[[beam]]`, first to last.
+    pub beam_nodes: Vec<Vec<usize>>,
+    /// The element of each `[[joint]]`.
+    pub joints: Vec<usize>,
+}
+
 /// Checks a typed deck as reading one checks it, then builds its model and the probes of its
 /// `[[hydraulic]]` elements (`file` names it in errors; relative paths resolve against `base`).
 pub fn build_deck(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError> {
     validate(d).map_err(|(key, msg)| DeckError::invalid(file, key, msg))?;
     build(d, file, base)
+}
+
+/// [`build_deck`], with the model ids of the deck's items.
+pub fn build_deck_ids(d: &Deck, file: &str, base: &Path) -> Result<Built, DeckError> {
+    let (model, probes) = build_deck(d, file, base)?;
+    let ids = built_ids(d, &model)
+        .map_err(|key| DeckError::invalid(file, key, "not found in the built model"))?;
+    Ok(Built { model, probes, ids })
+}
+
+/// The ids of the deck's items in its built model (Err: the key of an item not found).
+fn built_ids(d: &Deck, m: &Model) -> Result<BuiltIds, String> {
+    let nodes = d
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| m.node_id(&n.name).map_err(|_| format!("node[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let joints = d
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| m.element_id(&j.name).ok_or(format!("joint[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let mut beam_nodes = vec![];
+    for (i, b) in d.beams.iter().enumerate() {
+        let elements = m.beams.get(&b.name).ok_or(format!("beam[{i}]"))?;
+        let mut v = vec![];
+        // consecutive elements share their end node
+        for (k, &e) in elements.iter().enumerate() {
+            if let Some(Element::Beam(be)) = m.elements.get(e) {
+                v.extend_from_slice(&be.nodes[usize::from(k > 0)..]);
+            }
+        }
+        beam_nodes.push(v);
+    }
+    Ok(BuiltIds {
+        nodes,
+        beam_nodes,
+        joints,
+    })
 }
 
 /// The probes of the `[[hydraulic]]` elements (name, probe).
