@@ -628,14 +628,15 @@ fn initial_model(
     base_controls: Controls,
 ) -> anyhow::Result<(Model, RotorIds)> {
     let spec = blades[0].0;
-    let ((deck, items), whole) = if whole {
+    let (built, items) = if whole {
         let specs: Vec<RotorSpec> = blades.iter().map(|b| b.0.clone()).collect();
         let xo = ExpandOptions {
             controls: base_controls,
             table_revs: 1,
             ..Default::default()
         };
-        (expand_rotor_items(&specs, &xo), true)
+        let (deck, items) = expand_rotor_items(&specs, &xo);
+        (whole_rotor_built(&deck, file)?, items)
     } else {
         // a blade ahead of the reference blade sees the shared swashplate's cyclic turned
         let xo = ExpandOptions {
@@ -643,12 +644,8 @@ fn initial_model(
             table_revs: 1,
             ..Default::default()
         };
-        (expand_items(spec, &xo), false)
-    };
-    let built = if whole {
-        whole_rotor_built(&deck, file)?
-    } else {
-        built_expanded(&deck, file)?
+        let (deck, items) = expand_items(spec, &xo);
+        (built_expanded(&deck, file)?, items)
     };
     let ids = RotorIds::new(&items, &built.ids)?;
     Ok((built.model, ids))
