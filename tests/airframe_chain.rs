@@ -3,10 +3,11 @@
 //! and damper: with a rigid hub mass on the chain, every mode is one direction alone at
 //! `sqrt(k / (m + m_hub))` with damping ratio `c / (2 sqrt(k (m + m_hub)))` (analytic).
 use rotorsim::rotor::deck::{AirframeRotation, AirframeTable, AirframeTranslation};
-use rotorsim::rotor::expand::write_airframe;
+use rotorsim::rotor::expand::add_airframe;
 use rotorsim::solver::modal::{modes, ModalOptions};
 use rotorsim::solver::State;
 use rotorsim::structure::deck::parse_deck;
+use rotorsim::structure::deck_text::{to_toml, DeckBuilder};
 use std::path::Path;
 
 const HUB_KG: f64 = 400.0;
@@ -29,6 +30,15 @@ fn r(i: f64, k: f64, c: f64) -> Option<AirframeRotation> {
     })
 }
 
+/// The chain's items as text, followed by the hub's (the analysis tables last).
+fn chain_text(b: DeckBuilder) -> String {
+    let text = to_toml(&b.finish());
+    text.split("[static]")
+        .next()
+        .unwrap_or_default()
+        .to_string()
+}
+
 #[test]
 fn each_airframe_direction_has_its_own_mass_spring_and_damper() {
     // masses out of order (y is the heaviest, z the lightest), every direction
@@ -40,8 +50,9 @@ fn each_airframe_direction_has_its_own_mass_spring_and_damper() {
         pitch: r(30000.0, 5.0e6, 0.0),
         mode: Vec::new(),
     };
-    let mut deck = String::from("title = \"airframe chain\"\n");
-    let mount = write_airframe(&mut deck, &a).expect("a chain");
+    let mut b = DeckBuilder::new(vec![], "airframe chain");
+    let mount = add_airframe(&mut b, &a).expect("a chain");
+    let mut deck = chain_text(b);
     // a hub: a point mass with inertia, clamped on the chain's last node
     deck.push_str(&format!(
         "[[node]]\nname = \"hub\"\nposition_m = [0.0, 0.0, 0.0]\n\n[[rigid_body]]\nname = \"hub_body\"\nnode = \"hub\"\nmass_kg = {HUB_KG}\ninertia_kgm2 = [[{HUB_KG_M2}, 0.0, 0.0], [0.0, {HUB_KG_M2}, 0.0], [0.0, 0.0, {HUB_KG_M2}]]\n\n[[joint]]\nname = \"shaft\"\ntype = \"clamp\"\nnode_a = \"{mount}\"\nnode_b = \"hub\"\n"
@@ -136,8 +147,9 @@ fn airframe_modes_keep_their_frequency_damping_and_hub_participation() {
         ],
         ..Default::default()
     };
-    let mut deck = String::from("title = \"airframe modes\"\n");
-    let mount = write_airframe(&mut deck, &a).expect("a chain");
+    let mut b = DeckBuilder::new(vec![], "airframe modes");
+    let mount = add_airframe(&mut b, &a).expect("a chain");
+    let mut deck = chain_text(b);
     deck.push_str(&format!(
         "[[node]]\nname = \"hub\"\nposition_m = [0.0, 0.0, 0.0]\n\n[[rigid_body]]\nname = \"hub_body\"\nnode = \"hub\"\nmass_kg = {HUB_KG}\ninertia_kgm2 = [[{HUB_KG_M2}, 0.0, 0.0], [0.0, {HUB_KG_M2}, 0.0], [0.0, 0.0, {HUB_KG_M2}]]\n\n[[joint]]\nname = \"shaft\"\ntype = \"clamp\"\nnode_a = \"{mount}\"\nnode_b = \"hub\"\n"
     ));

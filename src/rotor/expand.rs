@@ -1,6 +1,7 @@
-//! Rotor deck -> multibody model deck (docs/model_deck.md), printed by `rotorsim expand` and
-//! parsed back by [`crate::rotor::build`] and `rotorsim modes --rotor`, so that the printed deck
-//! is exactly the model that runs.
+//! Rotor deck -> typed multibody model deck (docs/model_deck.md). A run builds its model from
+//! the typed deck; `rotorsim expand` prints the same deck through the one deck writer
+//! ([`crate::structure::deck_text::to_toml`]), so that the printed deck is exactly the model that
+//! runs.
 //!
 //! Layout (hub frame, blade along +x, rotation about +z, y toward the leading edge), paper
 //! Fig. 15: hub node driven at Omega (prescribed revolute `shaft`); segment 1 (`seg1`) from the
@@ -13,8 +14,12 @@
 //! `damper_hub_end` (rigid to the hub) and `damper_blade_end` (rigid to `bearing_lag`, so the
 //! stroke is `arm x lag angle`).
 use super::deck::{AxisElastomer, BearingAxis, RotorSpec, Segment};
+use crate::structure::deck::{
+    BeamDeck, Deck, DynamicDeck, ElastomerDeck, HydraulicDeck, JointDeck, ModesDeck, NodeDeck,
+    RigidDeck, SensorDeck, StaticDeck,
+};
+use crate::structure::deck_text::{to_toml, DeckBuilder};
 use crate::structure::section::SectionProps;
-use std::fmt::Write as _;
 
 /// Blade-pitch controls [deg]: `theta = th0 + th1c cos psi + th1s sin psi` (bearing pitch; the
 /// blade twist is zero where the record quotes the collective).
@@ -110,46 +115,16 @@ impl RotorSpec {
     }
 }
 
-/// A value as TOML writes it back exactly (shortest round-trip form).
-pub(crate) fn f(v: f64) -> String {
-    format!("{v:?}")
+/// A section as the model deck takes it: the text the deck was printed as never carried the
+/// station `s_m`, so it is zero here too.
+fn section(p: &SectionProps) -> SectionProps {
+    SectionProps { s_m: 0.0, ..*p }
 }
 
-pub(crate) fn v3(v: [f64; 3]) -> String {
-    format!("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2]))
-}
-
-/// A model-deck section table (inline TOML), offsets only where non-zero.
-pub(crate) fn section(p: &SectionProps) -> String {
-    let mut s = format!(
-        "{{ EA_N = {}, GA2_N = {}, GA3_N = {}, GJ_Nm2 = {}, EI2_Nm2 = {}, EI3_Nm2 = {}, m_kg_per_m = {}, I1_kgm = {}, I2_kgm = {}, I3_kgm = {}",
-        f(p.ea), f(p.ga2), f(p.ga3), f(p.gj), f(p.ei2), f(p.ei3), f(p.m), f(p.i1), f(p.i2), f(p.i3)
-    );
-    for (k, v) in [
-        ("cm2_m", p.cm2),
-        ("cm3_m", p.cm3),
-        ("sc2_m", p.sc2),
-        ("sc3_m", p.sc3),
-        ("ca2_m", p.ca2),
-        ("ca3_m", p.ca3),
-    ] {
-        if v != 0.0 {
-            let _ = write!(s, ", {k} = {}", f(v));
-        }
-    }
-    s.push_str(" }");
-    s
-}
-
-fn point_inertia(m: f64, r: f64) -> String {
-    // small sphere of radius r: 2/5 m r^2
+/// Inertia of a small sphere of radius `r`: 2/5 m r^2 about each axis.
+fn point_inertia(m: f64, r: f64) -> [[f64; 3]; 3] {
     let i = 0.4 * m * r * r;
-    format!(
-        "[[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]",
-        f(i),
-        f(i),
-        f(i)
-    )
+    [[i, 0.0, 0.0], [0.0, i, 0.0], [0.0, 0.0, i]]
 }
 
 /// Options of the expansion.
@@ -230,138 +205,124 @@ impl Place {
     }
 }
 
-/// Writes one blade's copy of the model (everything but the hub node, the shaft and the
-/// analysis tables), section by section, so that several copies interleave by section.
-struct BladeWriter<'a> {
+/// The pitch link's keys as printed (its e2 direction after its ends).
+const PITCH_LINK_KEYS: &[&str] = &["name", "elements", "start_m", "end_m", "e2_direction"];
+
+/// One blade's copy of the model (everything but the hub node, the shaft and the analysis
+/// tables), added section by section, so that several copies interleave by section.
+struct BladeParts<'a> {
     spec: &'a RotorSpec,
     opts: &'a ExpandOptions,
     place: Place,
     controls: Controls,
 }
 
-impl BladeWriter<'_> {
-    fn nodes(&self, s: &mut String) {
+/// Where the parts a run drives and reads sit in an expanded deck: indices of its items.
+#[derive(Clone, Debug, Default)]
+pub struct ExpandedItems {
+    /// The hub's `[[node]]`.
+    pub hub: usize,
+    /// The airframe chain's `[[node]]`s, in the order of [`airframe_chain`].
+    pub airframe: Vec<usize>,
+    pub blades: Vec<BladeItems>,
+}
+
+/// One blade's parts in an expanded deck.
+#[derive(Clone, Debug, Default)]
+pub struct BladeItems {
+    /// The swashplate drive's `[[joint]]`.
+    pub swash: usize,
+    /// The damper's end `[[node]]`s (hub end, blade end).
+    pub damper_ends: [usize; 2],
+    /// The blade's `[[beam]]`.
+    pub blade: usize,
+}
+
+/// Index of the item an entry prints.
+fn index(e: &crate::structure::deck_text::Entry) -> usize {
+    e.item.map_or(0, |(_, i)| i)
+}
+
+impl BladeParts<'_> {
+    /// Adds the blade's nodes; returns its damper ends.
+    fn nodes(&self, d: &mut DeckBuilder) -> [usize; 2] {
         let (spec, pl) = (self.spec, &self.place);
         let e = spec.retention.hinge_r_m;
-        let node = |s: &mut String, name: &str, p: [f64; 3]| {
-            let _ = writeln!(
-                s,
-                "[[node]]\nname = \"{}\"\nposition_m = {}\n",
-                pl.n(name),
-                v3(pl.p(p))
-            );
-        };
-        node(s, "bearing_lag", [e, 0.0, 0.0]);
-        node(s, "bearing_flap", [e, 0.0, 0.0]);
-        node(s, "swashplate", spec.swash_point());
-        node(s, names::DAMPER_HUB_END, spec.hub_end());
-        node(s, names::DAMPER_BLADE_END, spec.blade_end());
+        let mut node = |name: &str, p: [f64; 3]| index(d.node(NodeDeck::at(&pl.n(name), pl.p(p))));
+        node("bearing_lag", [e, 0.0, 0.0]);
+        node("bearing_flap", [e, 0.0, 0.0]);
+        node("swashplate", spec.swash_point());
+        [
+            node(names::DAMPER_HUB_END, spec.hub_end()),
+            node(names::DAMPER_BLADE_END, spec.blade_end()),
+        ]
     }
 
-    fn beams(&self, s: &mut String) {
+    /// A straight beam of this blade from `a` to `z` (points of the reference blade); the
+    /// beams' default e2 is the global y: a turned blade names its own.
+    fn beam(&self, name: &str, elements: usize, a: [f64; 3], z: [f64; 3]) -> BeamDeck {
+        let pl = &self.place;
+        BeamDeck {
+            e2_direction: pl.turned().then(|| pl.p([0.0, 1.0, 0.0])),
+            start_m: Some(pl.p(a)),
+            end_m: Some(pl.p(z)),
+            ..BeamDeck::new(&pl.n(name), elements)
+        }
+    }
+
+    /// Adds the blade's beams; returns the blade's.
+    fn beams(&self, d: &mut DeckBuilder) -> usize {
         let (spec, pl) = (self.spec, &self.place);
         let r = &spec.retention;
         let e = r.hinge_r_m;
         let b = &spec.blade;
         let pc = &spec.pitch_control;
         let n2 = last(r.segment2.elements);
-        // the beams' default e2 is the global y: a turned blade names its own
-        let e2 = |s: &mut String| {
-            if pl.turned() {
-                let _ = writeln!(s, "e2_direction = {}", v3(pl.p([0.0, 1.0, 0.0])));
-            }
-        };
-        let seg = |s: &mut String,
-                   name: &str,
-                   g: &Segment,
-                   a: [f64; 3],
-                   z: [f64; 3],
-                   start: Option<&str>| {
-            let _ = writeln!(
-                s,
-                "[[beam]]\nname = \"{}\"\nelements = {}",
-                pl.n(name),
-                g.elements
-            );
-            if let Some(n) = start {
-                let _ = writeln!(s, "start_node = \"{}\"", pl.n(n));
-            }
-            e2(s);
-            let _ = writeln!(
-                s,
-                "start_m = {}\nend_m = {}\nsection = {}\ndamping_mu_s = {}\n",
-                v3(pl.p(a)),
-                v3(pl.p(z)),
-                section(&g.section),
-                f(g.damping_mu_s)
-            );
-        };
+        let seg =
+            |name: &str, g: &Segment, a: [f64; 3], z: [f64; 3], start: Option<&str>| BeamDeck {
+                start_node: start.map(|n| pl.n(n)),
+                section: Some(section(&g.section)),
+                damping_mu_s: Some(g.damping_mu_s),
+                ..self.beam(name, g.elements, a, z)
+            };
         // A beam's first node carries its section frame: the single blade's, along x, is the
         // hub's; a copy of the whole rotor starts its own and is clamped to the hub (joints).
         let whole = !pl.prefix.is_empty();
-        seg(
-            s,
-            "seg1",
-            &r.segment1,
-            [0.0; 3],
-            [e, 0.0, 0.0],
-            (!whole).then_some(names::HUB),
-        );
-        seg(
-            s,
-            "seg2",
-            &r.segment2,
-            [e, 0.0, 0.0],
-            [r.horn_r_m, 0.0, 0.0],
-            None,
-        );
+        let hub = (!whole).then_some(names::HUB);
+        d.beam(seg("seg1", &r.segment1, [0.0; 3], [e, 0.0, 0.0], hub));
+        let horn = [r.horn_r_m, 0.0, 0.0];
+        d.beam(seg("seg2", &r.segment2, [e, 0.0, 0.0], horn, None));
         let seg2_end = format!("seg2.n{n2}");
-        seg(
-            s,
-            "seg3",
-            &r.segment3,
-            [r.horn_r_m, 0.0, 0.0],
-            [b.root_r_m, 0.0, 0.0],
-            Some(&seg2_end),
-        );
-        let _ = writeln!(
-            s,
-            "[[beam]]\nname = \"{}\"\nelements = {}",
-            pl.n(names::BLADE),
-            b.elements
-        );
-        e2(s);
-        let _ = writeln!(
-            s,
-            "start_m = {}\nend_m = {}\nsections_csv = \"{}\"\ndamping_mu_s = {}",
-            v3(pl.p([b.root_r_m, 0.0, 0.0])),
-            v3(pl.p([spec.rotor.radius_m, 0.0, 0.0])),
-            b.sections_csv,
-            f(b.damping_mu_s)
-        );
-        if !b.twist_deg.is_empty() {
-            let pts: Vec<String> = b
-                .twist_deg
+        let root = [b.root_r_m, 0.0, 0.0];
+        d.beam(seg("seg3", &r.segment3, horn, root, Some(&seg2_end)));
+        let tip = [spec.rotor.radius_m, 0.0, 0.0];
+        let twist = (!b.twist_deg.is_empty()).then(|| {
+            b.twist_deg
                 .iter()
-                .map(|p| format!("[{}, {}]", f(p[0] - b.root_r_m), f(p[1])))
-                .collect();
-            let _ = writeln!(s, "twist_deg = [{}]", pts.join(", "));
-        }
-        s.push('\n');
-        let sp = spec.swash_point();
-        let _ = writeln!(
-            s,
-            "[[beam]]\nname = \"{}\"\nelements = {}\nstart_m = {}\nend_m = {}\ne2_direction = {}\nsection = {}\n",
-            pl.n("pitch_link"),
-            pc.link_elements,
-            v3(pl.p(sp)),
-            v3(pl.p(pc.horn_tip_m)),
-            v3(pl.p([0.0, 1.0, 0.0])),
-            section(&pc.link_section)
-        );
+                .map(|p| [p[0] - b.root_r_m, p[1]])
+                .collect()
+        });
+        let blade = index(d.beam(BeamDeck {
+            sections_csv: Some(b.sections_csv.clone()),
+            damping_mu_s: Some(b.damping_mu_s),
+            twist_deg: twist,
+            ..self.beam(names::BLADE, b.elements, root, tip)
+        }));
+        let link = BeamDeck {
+            e2_direction: Some(pl.p([0.0, 1.0, 0.0])),
+            section: Some(section(&pc.link_section)),
+            ..self.beam(
+                "pitch_link",
+                pc.link_elements,
+                spec.swash_point(),
+                pc.horn_tip_m,
+            )
+        };
+        d.beam(link).keys = Some(PITCH_LINK_KEYS);
+        blade
     }
 
-    fn bodies(&self, s: &mut String) {
+    fn bodies(&self, d: &mut DeckBuilder) {
         let (spec, pl) = (self.spec, &self.place);
         let r = &spec.retention;
         let pc = &spec.pitch_control;
@@ -369,302 +330,280 @@ impl BladeWriter<'_> {
         // offsets and inertias are in the node's frame, which turns with the blade
         let horn_node = [r.horn_r_m, 0.0, 0.0];
         let h = pc.horn_tip_m;
-        let _ = writeln!(
-            s,
-            "[[rigid_body]]\nname = \"{}\"\nnode = \"{seg2_end}\"\nmass_kg = {}\ncm_offset_m = {}\ninertia_kgm2 = {}\n",
-            pl.n("pitch_horn"),
-            f(pc.horn_mass_kg),
-            v3([0.5 * (h[0] - horn_node[0]), 0.5 * h[1], 0.5 * h[2]]),
-            point_inertia(pc.horn_mass_kg, 0.05)
-        );
+        d.rigid_body(RigidDeck {
+            name: pl.n("pitch_horn"),
+            node: seg2_end,
+            mass_kg: pc.horn_mass_kg,
+            cm_offset_m: Some([0.5 * (h[0] - horn_node[0]), 0.5 * h[1], 0.5 * h[2]]),
+            inertia_kgm2: point_inertia(pc.horn_mass_kg, 0.05),
+        });
         let da = &spec.damper_attachment;
-        let _ = writeln!(
-            s,
-            "[[rigid_body]]\nname = \"{}\"\nnode = \"{}\"\nmass_kg = {}\ninertia_kgm2 = {}\n",
-            pl.n("damper_arm"),
-            pl.n(names::DAMPER_BLADE_END),
-            f(da.arm_mass_kg),
-            point_inertia(da.arm_mass_kg, 0.05)
-        );
-        let _ = writeln!(
-            s,
-            "[[rigid_body]]\nname = \"{}\"\nnode = \"{}\"\nmass_kg = {}\ninertia_kgm2 = {}\n",
-            pl.n("damper_horn"),
-            pl.n(names::DAMPER_HUB_END),
-            f(da.horn_mass_kg),
-            point_inertia(da.horn_mass_kg, 0.05)
-        );
+        for (name, node, m) in [
+            ("damper_arm", names::DAMPER_BLADE_END, da.arm_mass_kg),
+            ("damper_horn", names::DAMPER_HUB_END, da.horn_mass_kg),
+        ] {
+            d.rigid_body(RigidDeck {
+                name: pl.n(name),
+                node: pl.n(node),
+                mass_kg: m,
+                cm_offset_m: None,
+                inertia_kgm2: point_inertia(m, 0.05),
+            });
+        }
     }
 
-    fn joints(&self, s: &mut String) {
-        let (spec, opts, pl) = (self.spec, self.opts, &self.place);
+    /// Per bearing axis: stiffness, damping, elastomer.
+    fn bearing_axis(&self, a: BearingAxis) -> (f64, f64, Option<AxisElastomer>) {
+        let bg = &self.spec.bearing;
+        let om = self.spec.rotor.omega_rad_s;
+        if self.opts.bearing_equivalent {
+            let (k, c) = bg.equivalent(a, om);
+            (k, c, None)
+        } else {
+            let (k, c) = match a {
+                BearingAxis::Lag => (bg.lag_k, bg.lag_c),
+                BearingAxis::Flap => (bg.flap_k, bg.flap_c),
+                BearingAxis::Pitch => (bg.pitch_k, bg.pitch_c),
+            };
+            (k, c, bg.elastomer(a, om))
+        }
+    }
+
+    /// The bearing's revolute joints `lag`, `flap`, `pitch`.
+    fn bearing(&self, d: &mut DeckBuilder) {
+        let (opts, pl) = (self.opts, &self.place);
+        let n1 = last(self.spec.retention.segment1.elements);
+        let lag = self.bearing_axis(BearingAxis::Lag);
+        let lag = (lag.0 + opts.lag_extra_k, lag.1 + opts.lag_extra_c, lag.2);
+        let seg1_end = format!("seg1.n{n1}");
+        let (x, y) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        for (name, a, b, axis, xd, (k, c, el)) in [
+            (
+                names::LAG,
+                seg1_end.as_str(),
+                "bearing_lag",
+                [0.0, 0.0, -1.0],
+                x,
+                lag,
+            ),
+            (
+                names::FLAP,
+                "bearing_lag",
+                "bearing_flap",
+                [0.0, -1.0, 0.0],
+                x,
+                self.bearing_axis(BearingAxis::Flap),
+            ),
+            (
+                names::PITCH,
+                "bearing_flap",
+                "seg2.n0",
+                x,
+                y,
+                self.bearing_axis(BearingAxis::Pitch),
+            ),
+        ] {
+            d.joint(JointDeck {
+                axis: Some(pl.p(axis)),
+                x_direction: Some(pl.p(xd)),
+                stiffness: Some(k),
+                damping: Some(c),
+                elastomer: el.map(|e| ElastomerDeck {
+                    loss_factor: e.loss_factor,
+                    band_rad_s: e.band_rad_s,
+                    reference_rad_s: e.reference_rad_s,
+                }),
+                ..JointDeck::new(&pl.n(name), "revolute", Some(&pl.n(a)), &pl.n(b))
+            });
+        }
+    }
+
+    /// The swashplate's vertical displacement in the hub frame, tabulated over `table_revs`.
+    fn swash_table(&self) -> Vec<[f64; 2]> {
+        let (spec, opts, c) = (self.spec, self.opts, &self.controls);
+        if c.th1c_deg == 0.0 && c.th1s_deg == 0.0 {
+            return vec![[0.0, spec.swash_z(c.th0_deg.to_radians())]];
+        }
+        let period = 2.0 * std::f64::consts::PI / spec.rotor.omega_rad_s;
+        let npts = 64 * opts.table_revs.max(1);
+        (0..=npts)
+            .map(|k| {
+                let t = period * opts.table_revs.max(1) as f64 * k as f64 / npts as f64;
+                [t, spec.swash_z(spec.pitch_rad(c, t))]
+            })
+            .collect()
+    }
+
+    /// Adds the blade's joints; returns its swashplate drive.
+    fn joints(&self, d: &mut DeckBuilder) -> usize {
+        let (spec, pl) = (self.spec, &self.place);
         let r = &spec.retention;
         let pc = &spec.pitch_control;
-        let period = 2.0 * std::f64::consts::PI / spec.rotor.omega_rad_s;
-        let n1 = last(r.segment1.elements);
-        let n3 = last(r.segment3.elements);
-        let npl = last(pc.link_elements);
-        let seg2_end = format!("seg2.n{}", last(r.segment2.elements));
-        let c = &self.controls;
-        let bg = &spec.bearing;
-        let rev = |s: &mut String,
-                   name: &str,
-                   a: &str,
-                   bn: &str,
-                   axis: [f64; 3],
-                   xd: [f64; 3],
-                   k: f64,
-                   c: f64,
-                   el: Option<AxisElastomer>| {
-            let _ = writeln!(
-                s,
-                "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_a = \"{}\"\nnode_b = \"{}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}",
-                pl.n(name),
-                pl.n(a),
-                pl.n(bn),
-                v3(pl.p(axis)),
-                v3(pl.p(xd)),
-                f(k),
-                f(c)
-            );
-            if let Some(e) = el {
-                let _ = writeln!(
-                    s,
-                    "elastomer = {{ loss_factor = {}, band_rad_s = [{}, {}], reference_rad_s = {} }}",
-                    f(e.loss_factor),
-                    f(e.band_rad_s[0]),
-                    f(e.band_rad_s[1]),
-                    f(e.reference_rad_s)
-                );
-            }
-            s.push('\n');
-        };
-        let om = spec.rotor.omega_rad_s;
-        // per axis: stiffness, damping, elastomer
-        let axis = |a: BearingAxis| {
-            if opts.bearing_equivalent {
-                let (k, c) = bg.equivalent(a, om);
-                (k, c, None)
-            } else {
-                let (k, c) = match a {
-                    BearingAxis::Lag => (bg.lag_k, bg.lag_c),
-                    BearingAxis::Flap => (bg.flap_k, bg.flap_c),
-                    BearingAxis::Pitch => (bg.pitch_k, bg.pitch_c),
-                };
-                (k, c, bg.elastomer(a, om))
-            }
-        };
-        let (lag, flap, pitch) = (
-            axis(BearingAxis::Lag),
-            axis(BearingAxis::Flap),
-            axis(BearingAxis::Pitch),
-        );
-        rev(
-            s,
-            names::LAG,
-            &format!("seg1.n{n1}"),
-            "bearing_lag",
-            [0.0, 0.0, -1.0],
-            [1.0, 0.0, 0.0],
-            lag.0 + opts.lag_extra_k,
-            lag.1 + opts.lag_extra_c,
-            lag.2,
-        );
-        rev(
-            s,
-            names::FLAP,
-            "bearing_lag",
-            "bearing_flap",
-            [0.0, -1.0, 0.0],
-            [1.0, 0.0, 0.0],
-            flap.0,
-            flap.1,
-            flap.2,
-        );
-        rev(
-            s,
-            names::PITCH,
-            "bearing_flap",
-            "seg2.n0",
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            pitch.0,
-            pitch.1,
-            pitch.2,
-        );
-        let clamp = |s: &mut String, name: &str, a: &str, bn: &str| {
-            let _ = writeln!(
-                s,
-                "[[joint]]\nname = \"{}\"\ntype = \"clamp\"\nnode_a = \"{}\"\nnode_b = \"{}\"\n",
-                pl.n(name),
-                pl.n(a),
-                pl.n(bn)
-            );
+        self.bearing(d);
+        let mut clamp = |name: &str, a: &str, b: &str| {
+            d.joint(JointDeck::new(
+                &pl.n(name),
+                "clamp",
+                Some(&pl.n(a)),
+                &pl.n(b),
+            ));
         };
         if !pl.prefix.is_empty() {
-            clamp(s, "hub_mount", names::HUB, "seg1.n0");
+            clamp("hub_mount", names::HUB, "seg1.n0");
         }
-        clamp(
-            s,
-            "blade_root",
-            &format!("seg3.n{n3}"),
-            &format!("{}.n0", names::BLADE),
-        );
-        clamp(s, "damper_hub_mount", names::HUB, names::DAMPER_HUB_END);
-        clamp(
-            s,
-            "damper_arm_mount",
-            "bearing_lag",
-            names::DAMPER_BLADE_END,
-        );
-        // swashplate: vertical displacement in the hub frame, table over `table_revs`
-        let npts = 64 * opts.table_revs.max(1);
-        let mut table = vec![];
-        if c.th1c_deg == 0.0 && c.th1s_deg == 0.0 {
-            table.push(format!(
-                "[0.0, {}]",
-                f(spec.swash_z(c.th0_deg.to_radians()))
-            ));
-        } else {
-            for k in 0..=npts {
-                let t = period * opts.table_revs.max(1) as f64 * k as f64 / npts as f64;
-                table.push(format!(
-                    "[{}, {}]",
-                    f(t),
-                    f(spec.swash_z(spec.pitch_rad(c, t)))
-                ));
-            }
-        }
-        let _ = writeln!(
-            s,
-            "# Swashplate: z(t) = horn_y sin(theta) + horn_z (cos(theta) - 1), theta = th0 + ramp (th1c cos psi + th1s sin psi)\n\
-             [[joint]]\nname = \"{}\"\ntype = \"prescribed\"\nnode_a = \"{}\"\nnode_b = \"{}\"\ndisplacement_m = [0.0, 0.0, 1.0]\ndisplacement_table = [{}]\n",
-            pl.n(names::SWASH_DRIVE),
-            names::HUB,
-            pl.n("swashplate"),
-            table.join(", ")
-        );
-        let _ = writeln!(
-            s,
-            "[[joint]]\nname = \"{}\"\ntype = \"universal\"\nnode_a = \"{}\"\nnode_b = \"{}\"\naxis = [0.0, 0.0, 1.0]\n",
-            pl.n("pitch_link_lower"),
-            pl.n("swashplate"),
-            pl.n("pitch_link.n0")
-        );
-        let _ = writeln!(
-            s,
-            "[[joint]]\nname = \"{}\"\ntype = \"spherical\"\nnode_a = \"{}\"\nnode_b = \"{}\"\nposition_m = {}\n",
-            pl.n("pitch_link_upper"),
-            pl.n(&seg2_end),
-            pl.n(&format!("pitch_link.n{npl}")),
-            v3(pl.p(pc.horn_tip_m))
-        );
+        let n3 = last(r.segment3.elements);
+        let blade_start = format!("{}.n0", names::BLADE);
+        clamp("blade_root", &format!("seg3.n{n3}"), &blade_start);
+        clamp("damper_hub_mount", names::HUB, names::DAMPER_HUB_END);
+        clamp("damper_arm_mount", "bearing_lag", names::DAMPER_BLADE_END);
+        let swash = pl.n("swashplate");
+        let e = d.joint(JointDeck {
+            displacement_m: Some([0.0, 0.0, 1.0]),
+            displacement_table: Some(self.swash_table()),
+            ..JointDeck::new(
+                &pl.n(names::SWASH_DRIVE),
+                "prescribed",
+                Some(names::HUB),
+                &swash,
+            )
+        });
+        e.comment = vec![
+            "Swashplate: z(t) = horn_y sin(theta) + horn_z (cos(theta) - 1), theta = th0 + ramp (th1c cos psi + th1s sin psi)".into(),
+        ];
+        let drive = index(e);
+        let link = pl.n("pitch_link.n0");
+        d.joint(JointDeck {
+            axis: Some([0.0, 0.0, 1.0]),
+            ..JointDeck::new(&pl.n("pitch_link_lower"), "universal", Some(&swash), &link)
+        });
+        let seg2_end = pl.n(&format!("seg2.n{}", last(r.segment2.elements)));
+        let link_end = pl.n(&format!("pitch_link.n{}", last(pc.link_elements)));
+        d.joint(JointDeck {
+            position_m: Some(pl.p(pc.horn_tip_m)),
+            ..JointDeck::new(
+                &pl.n("pitch_link_upper"),
+                "spherical",
+                Some(&seg2_end),
+                &link_end,
+            )
+        });
+        drive
     }
 
-    fn hydraulic(&self, s: &mut String) {
+    fn hydraulic(&self, d: &mut DeckBuilder) {
         let pl = &self.place;
-        match &self.opts.hydraulic {
-            Some(h) => {
-                let _ = writeln!(
-                    s,
-                    "# Damper (paper Eqs. 9-16): stroke = arm x lag angle, positive when lag aft lengthens it
-                 [[hydraulic]]
-name = \"{}\"
-node_a = \"{}\"
-node_b = \"{}\"
-deck = \"{}\"
-model = \"{}\"
-scheme = \"{}\"
-substeps = {}
-reference_length_m = {}
-",
-                    pl.n("damper"),
-                    pl.n(names::DAMPER_HUB_END),
-                    pl.n(names::DAMPER_BLADE_END),
-                    h.deck,
-                    h.model,
-                    h.scheme,
-                    h.substeps,
-                    f(self.spec.damper_attachment.reference_length_m)
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    s,
-                    "# Damper: not included here (added by the caller between `{}` and `{}`)
-",
-                    pl.n(names::DAMPER_HUB_END),
-                    pl.n(names::DAMPER_BLADE_END)
-                );
-            }
-        }
+        let (a, b) = (pl.n(names::DAMPER_HUB_END), pl.n(names::DAMPER_BLADE_END));
+        let Some(h) = &self.opts.hydraulic else {
+            d.note(vec![format!(
+                "Damper: not included here (added by the caller between `{a}` and `{b}`)"
+            )]);
+            return;
+        };
+        let e = d.hydraulic(HydraulicDeck {
+            name: pl.n("damper"),
+            node_a: a,
+            position_m: None,
+            node_b: b,
+            deck: h.deck.clone(),
+            model: Some(h.model.clone()),
+            scheme: Some(h.scheme.clone()),
+            substeps: Some(h.substeps),
+            orifice_area_table: None,
+            reference_length_m: Some(self.spec.damper_attachment.reference_length_m),
+            applied_force: None,
+        });
+        e.comment = vec![
+            "Damper (paper Eqs. 9-16): stroke = arm x lag angle, positive when lag aft lengthens it"
+                .into(),
+        ];
+        // the printed deck has always indented this table: kept so that its text is unchanged
+        e.indent = 17;
     }
 
-    fn sensors(&self, s: &mut String) {
+    fn sensors(&self, d: &mut DeckBuilder) {
         let pl = &self.place;
         let nb = last(self.spec.blade.elements);
-        let _ = writeln!(
-            s,
-            "[[sensor]]\nname = \"{}\"\nnode = \"{}\"\n\n[[sensor]]\nname = \"{}\"\njoint = \"{}\"\n\n[[sensor]]\nname = \"{}\"\njoint = \"{}\"\n\n[[sensor]]\nname = \"{}\"\njoint = \"{}\"\n",
-            pl.n("tip"),
-            pl.n(&format!("{}.n{nb}", names::BLADE)),
-            pl.n("lag"),
-            pl.n(names::LAG),
-            pl.n("flap"),
-            pl.n(names::FLAP),
-            pl.n("pitch"),
-            pl.n(names::PITCH),
-        );
+        let tip = pl.n(&format!("{}.n{nb}", names::BLADE));
+        d.sensor(SensorDeck::at_node(&pl.n("tip"), &tip));
+        for (name, joint) in [
+            ("lag", names::LAG),
+            ("flap", names::FLAP),
+            ("pitch", names::PITCH),
+        ] {
+            d.sensor(SensorDeck::at_joint(&pl.n(name), &pl.n(joint)));
+        }
     }
 }
 
-/// The model deck text. Relative paths (section CSV) resolve against the rotor deck's folder.
-pub fn expand(spec: &RotorSpec, opts: &ExpandOptions) -> String {
+/// The model deck of the single blade. Relative paths (section CSV) resolve against the rotor
+/// deck's folder.
+pub fn expand_deck(spec: &RotorSpec, opts: &ExpandOptions) -> Deck {
+    expand_items(spec, opts).0
+}
+
+/// [`expand_deck`], with where the run's parts sit in it.
+pub fn expand_items(spec: &RotorSpec, opts: &ExpandOptions) -> (Deck, ExpandedItems) {
     let c = &opts.controls;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Multibody model deck generated by `rotorsim expand` from a rotor deck (docs/rotor_deck.md).\n\
-         # Paths are relative to the rotor deck's folder: save this deck next to it.\n\
-         # Controls: th0 = {} deg, th1c = {} deg, th1s = {} deg (cyclic ramped in over {} revolutions).\n\
-         title = \"rotor: single blade, root retention, elastomeric bearing, pitch link, damper\"\n",
-        c.th0_deg, c.th1c_deg, c.th1s_deg, spec.pitch_control.cyclic_ramp_revs
+    let header = vec![
+        "Multibody model deck generated by `rotorsim expand` from a rotor deck (docs/rotor_deck.md).".into(),
+        "Paths are relative to the rotor deck's folder: save this deck next to it.".into(),
+        format!(
+            "Controls: th0 = {} deg, th1c = {} deg, th1s = {} deg (cyclic ramped in over {} revolutions).",
+            c.th0_deg, c.th1c_deg, c.th1s_deg, spec.pitch_control.cyclic_ramp_revs
+        ),
+    ];
+    let mut d = DeckBuilder::new(
+        header,
+        "rotor: single blade, root retention, elastomeric bearing, pitch link, damper",
     );
-    let w = BladeWriter {
+    let b = BladeParts {
         spec,
         opts,
         place: Place::reference(),
         controls: *c,
     };
-    write_model(&mut s, spec, opts, &[w]);
-    s
+    let items = add_model(&mut d, spec, opts, &[b]);
+    (d.finish(), items)
+}
+
+/// The model deck text of the single blade ([`expand_deck`] as TOML).
+pub fn expand(spec: &RotorSpec, opts: &ExpandOptions) -> String {
+    to_toml(&expand_deck(spec, opts))
 }
 
 /// The whole rotor's model deck: blade k (1 to N, its own deck `specs[k-1]`) named `b<k>.`
 /// and turned (k-1) 360/N deg ahead of blade 1 about the shaft, seeing the cyclic at its own
 /// azimuth; all on one hub driven by the shaft. Relative paths resolve against the rotor deck's
-/// folder.
-pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
+/// folder. No blades: an empty deck.
+pub fn expand_rotor_deck(specs: &[RotorSpec], opts: &ExpandOptions) -> Deck {
+    expand_rotor_items(specs, opts).0
+}
+
+/// [`expand_rotor_deck`], with where the run's parts sit in it.
+pub fn expand_rotor_items(specs: &[RotorSpec], opts: &ExpandOptions) -> (Deck, ExpandedItems) {
     let n = specs.len();
     let c = &opts.controls;
-    let mut s = String::new();
     let Some(first) = specs.first() else {
-        return s;
+        return Default::default();
     };
-    let _ = writeln!(
-        s,
-        "# Multibody model deck of the whole rotor generated by `rotorsim expand --all-blades` from a rotor deck (docs/rotor_deck.md).\n\
-         # Paths are relative to the rotor deck's folder: save this deck next to it.\n\
-         # Controls: th0 = {} deg, th1c = {} deg, th1s = {} deg at blade 1 (cyclic ramped in over {} revolutions).\n\
-         title = \"rotor: {n} blades on a driven hub, each with root retention, elastomeric bearing, pitch link, damper\"\n",
-        c.th0_deg, c.th1c_deg, c.th1s_deg, first.pitch_control.cyclic_ramp_revs
+    let header = vec![
+        "Multibody model deck of the whole rotor generated by `rotorsim expand --all-blades` from a rotor deck (docs/rotor_deck.md).".into(),
+        "Paths are relative to the rotor deck's folder: save this deck next to it.".into(),
+        format!(
+            "Controls: th0 = {} deg, th1c = {} deg, th1s = {} deg at blade 1 (cyclic ramped in over {} revolutions).",
+            c.th0_deg, c.th1c_deg, c.th1s_deg, first.pitch_control.cyclic_ramp_revs
+        ),
+    ];
+    let mut d = DeckBuilder::new(
+        header,
+        &format!("rotor: {n} blades on a driven hub, each with root retention, elastomeric bearing, pitch link, damper"),
     );
-    let writers: Vec<BladeWriter> = specs
+    let blades: Vec<BladeParts> = specs
         .iter()
         .enumerate()
         .map(|(i, spec)| {
             let az = i as f64 * 360.0 / n as f64;
-            BladeWriter {
+            BladeParts {
                 spec,
                 opts,
                 place: Place::blade(&format!("b{}.", i + 1), az),
@@ -672,8 +611,16 @@ pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
             }
         })
         .collect();
-    write_model(&mut s, first, opts, &writers);
-    s
+    let items = add_model(&mut d, first, opts, &blades);
+    (d.finish(), items)
+}
+
+/// The whole rotor's model deck text ([`expand_rotor_deck`] as TOML; empty without blades).
+pub fn expand_rotor(specs: &[RotorSpec], opts: &ExpandOptions) -> String {
+    if specs.is_empty() {
+        return String::new();
+    }
+    to_toml(&expand_rotor_deck(specs, opts))
 }
 
 /// The airframe's directions in the order of its chain from the ground: the translations by
@@ -707,127 +654,128 @@ pub fn airframe_node_masses(dofs: &[super::deck::AirframeDof]) -> Vec<f64> {
 /// counts in all their directions: the translations are ordered by decreasing mass and each
 /// node carries the difference to the next (the last the smallest); the rotations' nodes
 /// carry inertia about their own axis only and no mass. Returns the last node's name.
-pub fn write_airframe(s: &mut String, airframe: &super::deck::AirframeTable) -> Option<String> {
+pub fn add_airframe(d: &mut DeckBuilder, airframe: &super::deck::AirframeTable) -> Option<String> {
+    add_airframe_chain(d, airframe).0
+}
+
+/// [`add_airframe`], with the chain's `[[node]]` indices.
+fn add_airframe_chain(
+    d: &mut DeckBuilder,
+    airframe: &super::deck::AirframeTable,
+) -> (Option<String>, Vec<usize>) {
     let dofs = airframe_chain(airframe);
     let masses = airframe_node_masses(&dofs);
     let mut prev: Option<String> = None;
+    let mut chain = vec![];
     const AXES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
-    for (i, d) in dofs.iter().enumerate() {
-        let node = format!("{}.{}", names::AIRFRAME, d.name);
-        let _ = writeln!(
-            s,
-            "[[node]]\nname = \"{node}\"\nposition_m = {}\n",
-            v3([0.0; 3])
-        );
-        let (mass, inertia) = if d.rotation {
+    for (i, f) in dofs.iter().enumerate() {
+        let node = format!("{}.{}", names::AIRFRAME, f.name);
+        chain.push(index(d.node(NodeDeck::at(&node, [0.0; 3]))));
+        let (mass, inertia) = if f.rotation {
             let mut j = [0.0; 3];
-            j[d.axis] = d.mass;
+            j[f.axis] = f.mass;
             (0.0, j)
         } else {
             (masses[i], [0.0; 3])
         };
-        let _ = writeln!(
-            s,
-            "[[rigid_body]]\nname = \"{node}.body\"\nnode = \"{node}\"\nmass_kg = {}\ninertia_kgm2 = [[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]\n",
-            f(mass),
-            f(inertia[0]),
-            f(inertia[1]),
-            f(inertia[2])
-        );
-        let free = d.axis + if d.rotation { 3 } else { 0 };
-        let locked: Vec<String> = (0..6)
+        let [i1, i2, i3] = inertia;
+        d.rigid_body(RigidDeck {
+            name: format!("{node}.body"),
+            node: node.clone(),
+            mass_kg: mass,
+            cm_offset_m: None,
+            inertia_kgm2: [[i1, 0.0, 0.0], [0.0, i2, 0.0], [0.0, 0.0, i3]],
+        });
+        let free = f.axis + if f.rotation { 3 } else { 0 };
+        let locked = (0..6)
             .filter(|&k| k != free)
-            .map(|k| format!("\"{}\"", AXES[k]))
+            .map(|k| AXES[k].to_string())
             .collect();
-        let mut k = [0.0; 3];
-        let mut c = [0.0; 3];
-        k[d.axis] = d.stiffness;
-        c[d.axis] = d.damping;
-        let (kk, ck) = if d.rotation {
-            ("rot_stiffness_Nm_per_rad", "rot_damping_Nms_per_rad")
-        } else {
-            ("stiffness_N_per_m", "damping_Ns_per_m")
+        let mut k = vec![0.0; 3];
+        let mut c = vec![0.0; 3];
+        k[f.axis] = f.stiffness;
+        c[f.axis] = f.damping;
+        let mut j = JointDeck {
+            position_m: Some([0.0, 0.0, f.center_z_m]),
+            locked: Some(locked),
+            ..JointDeck::new(&format!("{node}.link"), "bushing", prev.as_deref(), &node)
         };
-        let _ = write!(s, "[[joint]]\nname = \"{node}.link\"\ntype = \"bushing\"\n");
-        if let Some(p) = &prev {
-            let _ = writeln!(s, "node_a = \"{p}\"");
+        if f.rotation {
+            (j.stiffness_r, j.damping_r) = (Some(k), Some(c));
+        } else {
+            (j.stiffness_t, j.damping_t) = (Some(k), Some(c));
         }
-        let _ = writeln!(
-            s,
-            "node_b = \"{node}\"\nposition_m = {}\nlocked = [{}]\n{kk} = {}\n{ck} = {}\n",
-            v3([0.0, 0.0, d.center_z_m]),
-            locked.join(", "),
-            v3(k),
-            v3(c)
-        );
+        d.joint(j);
         prev = Some(node);
     }
-    prev
+    (prev, chain)
 }
 
-/// Hub, blades (section by section), shaft, analysis tables.
-fn write_model(s: &mut String, spec: &RotorSpec, opts: &ExpandOptions, blades: &[BladeWriter]) {
+/// Hub, blades (section by section), shaft, analysis tables; returns where the run's parts sit.
+fn add_model(
+    d: &mut DeckBuilder,
+    spec: &RotorSpec,
+    opts: &ExpandOptions,
+    blades: &[BladeParts],
+) -> ExpandedItems {
     let om = spec.rotor.omega_rad_s;
     let period = 2.0 * std::f64::consts::PI / om;
-    let _ = writeln!(
-        s,
-        "[[node]]\nname = \"{}\"\nposition_m = {}\n",
-        names::HUB,
-        v3([0.0; 3])
-    );
-    for b in blades {
-        b.nodes(s);
+    let mut items = ExpandedItems {
+        hub: index(d.node(NodeDeck::at(names::HUB, [0.0; 3]))),
+        airframe: vec![],
+        blades: vec![BladeItems::default(); blades.len()],
+    };
+    for (b, it) in blades.iter().zip(&mut items.blades) {
+        it.damper_ends = b.nodes(d);
+    }
+    for (b, it) in blades.iter().zip(&mut items.blades) {
+        it.blade = b.beams(d);
     }
     for b in blades {
-        b.beams(s);
-    }
-    // rigid bodies
-    for b in blades {
-        b.bodies(s);
+        b.bodies(d);
     }
     // joints: the shaft turns the hub on the airframe (the whole rotor's model, its blades
     // named b<K>.), or on the ground
     let whole = blades.iter().any(|b| !b.place.prefix.is_empty());
     let mount = match &spec.airframe {
-        Some(a) if whole => write_airframe(s, a),
+        Some(a) if whole => {
+            let (mount, chain) = add_airframe_chain(d, a);
+            items.airframe = chain;
+            mount
+        }
         _ => None,
     };
-    let _ = write!(
-        s,
-        "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\n",
-        names::SHAFT
-    );
-    if let Some(m) = &mount {
-        let _ = writeln!(s, "node_a = \"{m}\"");
-    }
-    let _ = writeln!(
-        s,
-        "node_b = \"{}\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
-        names::HUB,
-        f(om)
-    );
-    for b in blades {
-        b.joints(s);
+    d.joint(JointDeck {
+        axis: Some([0.0, 0.0, 1.0]),
+        omega_rad_s: Some(om),
+        ..JointDeck::new(names::SHAFT, "revolute", mount.as_deref(), names::HUB)
+    });
+    for (b, it) in blades.iter().zip(&mut items.blades) {
+        it.swash = b.joints(d);
     }
     for b in blades {
-        b.hydraulic(s);
+        b.hydraulic(d);
     }
     for b in blades {
-        b.sensors(s);
+        b.sensors(d);
     }
-    let _ = writeln!(
-        s,
-        "[static]\nload_steps = 4\nomega_rad_s = [0.0, 0.0, {}]\n\n[dynamic]\ntime_step_s = {}\nend_time_s = {}\ninitial_omega_rad_s = [0.0, 0.0, {}]\nstart_from_static = true\n",
-        f(om),
-        f(period / 256.0),
-        f(period),
-        f(om)
-    );
-    let sp: Vec<String> = opts.speeds_rad_s.iter().map(|v| f(*v)).collect();
-    let _ = writeln!(
-        s,
-        "[modes]\ncount = {}\naxis = [0.0, 0.0, 1.0]\nspeeds_rad_s = [{}]",
-        14 * blades.len(),
-        sp.join(", ")
-    );
+    let deck = d.deck_mut();
+    deck.statics = StaticDeck {
+        load_steps: 4,
+        omega_rad_s: Some([0.0, 0.0, om]),
+        ..Default::default()
+    };
+    deck.dynamic = DynamicDeck {
+        time_step_s: Some(period / 256.0),
+        end_time_s: Some(period),
+        initial_omega_rad_s: Some([0.0, 0.0, om]),
+        start_from_static: true,
+        ..Default::default()
+    };
+    deck.modes = ModesDeck {
+        count: 14 * blades.len(),
+        axis: [0.0, 0.0, 1.0],
+        speeds_rad_s: opts.speeds_rad_s.clone(),
+    };
+    items
 }

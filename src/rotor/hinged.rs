@@ -13,10 +13,14 @@ use super::deck::RotorTable;
 use crate::solver::modal::{modes, ModalOptions, Mode, ModeKind};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonMethod, State};
+use crate::structure::deck::{
+    BeamDeck, Deck, DynamicDeck, JointDeck, LoadDeck, ModesDeck, NodeDeck, RigidDeck, SensorDeck,
+    StaticDeck,
+};
+use crate::structure::deck_text::{to_toml, DeckBuilder};
 use crate::structure::model::{Element, Model};
 use crate::structure::section::SectionProps;
 use serde::Deserialize;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Whether a rotor deck text is of the hinged-blade form (it has `[[hinge]]` tables).
@@ -369,81 +373,95 @@ pub struct HingedExpand {
     pub hub_clamped: bool,
 }
 
-use super::expand::{f, section, v3};
-
-/// The model deck text (docs/model_deck.md): hub node driven at Omega (`shaft`), the hinges as
+/// The model deck (docs/model_deck.md): hub node driven at Omega (`shaft`), the hinges as
 /// revolute joints `lag`/`flap`/`pitch` through the nodes `hinge0`, `hinge1`, ... (a hinge
 /// outboard of the previous one hangs on a rigid offset, `*_base` clamped to its parent), the
 /// blade segments `blade_s0`, `blade_s1`, ... sharing their end nodes, the masses as rigid
 /// bodies on the nearest blade node.
-pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
-    let mut s = String::new();
+pub fn expand_deck(spec: &HingedSpec, opts: &HingedExpand) -> Deck {
     let om = opts.omega_rad_s.unwrap_or(spec.rotor.omega_rad_s);
-    let _ = writeln!(
-        s,
-        "# Multibody model deck generated from a hinged-blade rotor deck (docs/rotor_deck.md).\n\
-         title = \"rotor: single hinged blade\"\n"
+    let mut d = DeckBuilder::new(
+        vec![
+            "Multibody model deck generated from a hinged-blade rotor deck (docs/rotor_deck.md)."
+                .into(),
+        ],
+        "rotor: single hinged blade",
     );
-    let node = |s: &mut String, name: &str, p: [f64; 3]| {
-        let _ = writeln!(s, "[[node]]\nname = \"{name}\"\nposition_m = {}\n", v3(p));
-    };
-    let clamp = |s: &mut String, name: &str, a: &str, b: &str| {
-        let _ = writeln!(
-            s,
-            "[[joint]]\nname = \"{name}\"\ntype = \"clamp\"\nnode_a = \"{a}\"\nnode_b = \"{b}\"\n"
-        );
-    };
-    node(&mut s, "hub", [0.0; 3]);
+    d.node(NodeDeck::at("hub", [0.0; 3]));
     if opts.hub_clamped {
-        let _ = writeln!(
-            s,
-            "# hub fixed: the state is relative to the frame turning with the shaft\n[[joint]]\nname = \"shaft\"\ntype = \"clamp\"\nnode_b = \"hub\"\n"
-        );
+        d.joint(JointDeck::new("shaft", "clamp", None, "hub"))
+            .comment =
+            vec!["hub fixed: the state is relative to the frame turning with the shaft".into()];
     } else {
-        let _ = writeln!(
-            s,
-            "[[joint]]\nname = \"shaft\"\ntype = \"revolute\"\nnode_b = \"hub\"\naxis = [0.0, 0.0, 1.0]\nomega_rad_s = {}\n",
-            f(om)
-        );
+        d.joint(JointDeck {
+            axis: Some([0.0, 0.0, 1.0]),
+            omega_rad_s: Some(om),
+            ..JointDeck::new("shaft", "revolute", None, "hub")
+        });
     }
+    let parent = add_hinges(&mut d, spec);
+    add_blade(&mut d, spec, &parent);
+    add_lag_release(&mut d, spec, opts);
+    d.sensor(SensorDeck::at_node("tip", &spec.tip_node()));
+    for h in &spec.hinges {
+        d.sensor(SensorDeck::at_joint(h.axis.name(), h.axis.name()));
+    }
+    let period = 2.0 * std::f64::consts::PI / om;
+    let deck = d.deck_mut();
+    deck.statics = StaticDeck {
+        load_steps: 1,
+        omega_rad_s: Some([0.0, 0.0, om]),
+        ..Default::default()
+    };
+    deck.dynamic = DynamicDeck {
+        time_step_s: Some(opts.time_step_s.unwrap_or(period / 256.0)),
+        end_time_s: Some(opts.end_time_s.unwrap_or(period)),
+        initial_omega_rad_s: Some([0.0, 0.0, om]),
+        start_from_static: true,
+        ..Default::default()
+    };
+    deck.modes = ModesDeck {
+        count: 14,
+        ..Default::default()
+    };
+    d.finish()
+}
+
+/// The hinges from the hub out; returns the last hinge's node and radius.
+fn add_hinges(d: &mut DeckBuilder, spec: &HingedSpec) -> (String, f64) {
     let mut parent = ("hub".to_string(), 0.0);
     for (i, h) in spec.hinges.iter().enumerate() {
         let p = [h.r_m, 0.0, 0.0];
         let a = if h.r_m != parent.1 {
             let base = format!("hinge{i}_base");
-            node(&mut s, &base, p);
-            clamp(&mut s, &format!("{base}_mount"), &parent.0, &base);
+            d.node(NodeDeck::at(&base, p));
+            let mount = format!("{base}_mount");
+            d.joint(JointDeck::new(&mount, "clamp", Some(&parent.0), &base));
             base
         } else {
             parent.0.clone()
         };
         let b = format!("hinge{i}");
-        node(&mut s, &b, p);
+        d.node(NodeDeck::at(&b, p));
         let (axis, xd) = h.axis.axes();
-        let _ = writeln!(
-            s,
-            "[[joint]]\nname = \"{}\"\ntype = \"revolute\"\nnode_a = \"{a}\"\nnode_b = \"{b}\"\naxis = {}\nx_direction = {}\nstiffness_Nm_per_rad = {}\ndamping_Nms_per_rad = {}\n",
-            h.axis.name(),
-            v3(axis),
-            v3(xd),
-            f(h.k),
-            f(h.c)
-        );
+        d.joint(JointDeck {
+            axis: Some(axis),
+            x_direction: Some(xd),
+            stiffness: Some(h.k),
+            damping: Some(h.c),
+            ..JointDeck::new(h.axis.name(), "revolute", Some(&a), &b)
+        });
         parent = (b, h.r_m);
     }
+    parent
+}
+
+/// The blade segments (on the last hinge's node, or clamped to it) and the masses.
+fn add_blade(d: &mut DeckBuilder, spec: &HingedSpec, parent: &(String, f64)) {
     let b = &spec.blade;
-    let root_start = if b.root_r_m == parent.1 {
-        Some(parent.0.clone())
-    } else {
-        None
-    };
+    let root_start = (b.root_r_m == parent.1).then(|| parent.0.clone());
     let mut r0 = b.root_r_m;
     for (k, seg) in b.segments.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "[[beam]]\nname = \"blade_s{k}\"\nelements = {}",
-            seg.elements
-        );
         let start = if k == 0 {
             root_start.clone()
         } else {
@@ -453,21 +471,27 @@ pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
                 3 * b.segments[k - 1].elements
             ))
         };
-        if let Some(n) = start {
-            let _ = writeln!(s, "start_node = \"{n}\"");
-        }
-        let _ = writeln!(
-            s,
-            "start_m = {}\nend_m = {}\nsection = {}\ndamping_mu_s = {}\n",
-            v3([r0, 0.0, 0.0]),
-            v3([seg.r_end_m, 0.0, 0.0]),
-            section(&seg.section),
-            f(b.damping_mu_s)
-        );
+        d.beam(BeamDeck {
+            start_node: start,
+            start_m: Some([r0, 0.0, 0.0]),
+            end_m: Some([seg.r_end_m, 0.0, 0.0]),
+            // the station is not the model's: zero, as the printed deck has always had it
+            section: Some(SectionProps {
+                s_m: 0.0,
+                ..seg.section
+            }),
+            damping_mu_s: Some(b.damping_mu_s),
+            ..BeamDeck::new(&format!("blade_s{k}"), seg.elements)
+        });
         r0 = seg.r_end_m;
     }
     if root_start.is_none() {
-        clamp(&mut s, "blade_root", &parent.0, "blade_s0.n0");
+        d.joint(JointDeck::new(
+            "blade_root",
+            "clamp",
+            Some(&parent.0),
+            "blade_s0.n0",
+        ));
     }
     let nodes = spec.blade_nodes();
     for m in &spec.masses {
@@ -477,62 +501,47 @@ pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
             .cloned()
             .unwrap_or_else(|| (spec.root_node(), b.root_r_m));
         let i = m.inertia_kgm2;
-        let _ = writeln!(
-            s,
-            "[[rigid_body]]\nname = \"{}\"\nnode = \"{name}\"\nmass_kg = {}\ncm_offset_m = {}\ninertia_kgm2 = [[{}, 0.0, 0.0], [0.0, {}, 0.0], [0.0, 0.0, {}]]\n",
-            m.name,
-            f(m.mass_kg),
-            v3([m.r_m - rn, m.offset_m[0], m.offset_m[1]]),
-            f(i[0]),
-            f(i[1]),
-            f(i[2])
-        );
+        d.rigid_body(RigidDeck {
+            name: m.name.clone(),
+            node: name,
+            mass_kg: m.mass_kg,
+            cm_offset_m: Some([m.r_m - rn, m.offset_m[0], m.offset_m[1]]),
+            inertia_kgm2: [[i[0], 0.0, 0.0], [0.0, i[1], 0.0], [0.0, 0.0, i[2]]],
+        });
     }
-    if opts.lag_release_moment_nm != 0.0 {
-        let lag = spec.hinges.iter().any(|h| h.axis == HingeAxis::Lag);
-        if lag {
-            let (axis, _) = HingeAxis::Lag.axes();
-            let mz = opts.lag_release_moment_nm;
-            let _ = writeln!(
-                s,
-                "# Free decay: static lag moment at t = 0, ramped to zero\n[[load]]\nname = \"lag_release\"\nnode = \"{}\"\nforce_N = [0.0, 0.0, 0.0]\nmoment_Nm = {}\ntime_table = [[0.0, 1.0], [{}, 0.0]]\n",
-                spec.root_node(),
-                v3([mz * axis[0], mz * axis[1], mz * axis[2]]),
-                f(opts.lag_release_time_s.max(1e-9))
-            );
-        }
-    }
-    let _ = writeln!(
-        s,
-        "[[sensor]]\nname = \"tip\"\nnode = \"{}\"\n",
-        spec.tip_node()
-    );
-    for h in &spec.hinges {
-        let _ = writeln!(
-            s,
-            "[[sensor]]\nname = \"{0}\"\njoint = \"{0}\"\n",
-            h.axis.name()
-        );
-    }
-    let period = 2.0 * std::f64::consts::PI / om;
-    let _ = writeln!(
-        s,
-        "[static]\nload_steps = 1\nomega_rad_s = [0.0, 0.0, {}]\n\n[dynamic]\ntime_step_s = {}\nend_time_s = {}\ninitial_omega_rad_s = [0.0, 0.0, {}]\nstart_from_static = true\n\n[modes]\ncount = 14\naxis = [0.0, 0.0, 1.0]\n",
-        f(om),
-        f(opts.time_step_s.unwrap_or(period / 256.0)),
-        f(opts.end_time_s.unwrap_or(period)),
-        f(om)
-    );
-    s
 }
 
-/// Parse the expanded deck into a model (relative paths against the deck's folder).
+/// The free-decay release: a static lag moment at t = 0, ramped to zero.
+fn add_lag_release(d: &mut DeckBuilder, spec: &HingedSpec, opts: &HingedExpand) {
+    let lag = spec.hinges.iter().any(|h| h.axis == HingeAxis::Lag);
+    if opts.lag_release_moment_nm == 0.0 || !lag {
+        return;
+    }
+    let (axis, _) = HingeAxis::Lag.axes();
+    let mz = opts.lag_release_moment_nm;
+    d.load(LoadDeck {
+        name: "lag_release".into(),
+        node: spec.root_node(),
+        force: [0.0; 3],
+        moment: [mz * axis[0], mz * axis[1], mz * axis[2]],
+        follower: false,
+        time_table: Some(vec![[0.0, 1.0], [opts.lag_release_time_s.max(1e-9), 0.0]]),
+    })
+    .comment = vec!["Free decay: static lag moment at t = 0, ramped to zero".into()];
+}
+
+/// The model deck text ([`expand_deck`] as TOML).
+pub fn expand(spec: &HingedSpec, opts: &HingedExpand) -> String {
+    to_toml(&expand_deck(spec, opts))
+}
+
+/// The model of the expanded deck (relative paths against the deck's folder).
 pub fn expanded_model(
     spec: &HingedSpec,
     opts: &HingedExpand,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    super::sim::parse_expanded(&expand(spec, opts), file)
+    super::sim::model_of_expanded(&expand_deck(spec, opts), file)
 }
 
 /// Modes at one rotor speed.

@@ -1,7 +1,10 @@
 //! The forced-response simulation of the rotor: expanded model + damper element + airload
 //! replay + swashplate law, marched by the generalized-alpha solver (see docs/rotor_model.md).
 use super::deck::{AirloadFrame, RotorSpec};
-use super::expand::{expand, names, ramp, Controls, ExpandOptions};
+use super::expand::{
+    expand_deck, expand_items, expand_rotor_items, names, ramp, Controls, ExpandOptions,
+    ExpandedItems,
+};
 use super::{ForcedResponse, RunOptions, Timing, BASE_CHANNELS};
 use crate::flight::replay::{AirloadReplay, ReplayMode, ReplayOptions};
 use crate::flight::FlightRecord;
@@ -9,7 +12,7 @@ use crate::hydraulics::{DamperDeck, DamperModel};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonError, State};
 use crate::structure::beam::{SectionLoad, NPTS_M};
-use crate::structure::deck::parse_deck;
+use crate::structure::deck::{build_deck_ids, Built, BuiltIds, Deck};
 use crate::structure::hydraulic::{HydraulicForceElement, HydraulicProbe};
 use crate::structure::kin::TimeTable;
 use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
@@ -165,24 +168,31 @@ impl BladeAirloads {
     }
 }
 
-/// Parse the expanded deck of `spec` into a model (relative paths against `base`).
+/// The model of `spec`'s expanded deck (relative paths against `file`'s folder).
 pub fn expanded_model(
     spec: &RotorSpec,
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    parse_expanded(&expand(spec, opts), file)
+    model_of_expanded(&expand_deck(spec, opts), file)
 }
 
-/// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub,
-/// parsed (relative paths against `file`'s folder). The hub and the airframe's chain are its
-/// border nodes: the blades meet only there, so the solver factors each blade on its own.
+/// The whole rotor's model (every blade's deck in `specs`, blade 1 first) on one driven hub
+/// (relative paths against `file`'s folder). The hub and the airframe's chain are its border
+/// nodes: the blades meet only there, so the solver factors each blade on its own.
 pub fn whole_rotor_model(
     specs: &[RotorSpec],
     opts: &ExpandOptions,
     file: &Path,
 ) -> anyhow::Result<Model> {
-    let mut model = parse_expanded(&super::expand::expand_rotor(specs, opts), file)?;
+    let deck = super::expand::expand_rotor_deck(specs, opts);
+    Ok(whole_rotor_built(&deck, file)?.model)
+}
+
+/// The whole rotor's deck built, with the hub and the airframe's chain as its border nodes.
+fn whole_rotor_built(deck: &Deck, file: &Path) -> anyhow::Result<Built> {
+    let mut built = built_expanded(deck, file)?;
+    let model = &mut built.model;
     let airframe = format!("{}.", names::AIRFRAME);
     model.border_nodes = (0..model.nodes.len())
         .filter(|&i| {
@@ -190,21 +200,77 @@ pub fn whole_rotor_model(
             name == names::HUB || name.starts_with(&airframe)
         })
         .collect();
-    Ok(model)
+    Ok(built)
 }
 
-/// A model deck expanded from the rotor deck `file`, parsed into a model (relative paths against
-/// the deck's folder, errors naming the deck as expanded).
-pub(crate) fn parse_expanded(text: &str, file: &Path) -> anyhow::Result<Model> {
+/// The model of a deck expanded from the rotor deck `file`, checked as a read deck is (relative
+/// paths against the deck's folder, errors naming the deck as expanded).
+pub(crate) fn model_of_expanded(deck: &Deck, file: &Path) -> anyhow::Result<Model> {
+    Ok(built_expanded(deck, file)?.model)
+}
+
+fn built_expanded(deck: &Deck, file: &Path) -> anyhow::Result<Built> {
     let base = file.parent().map(Path::to_path_buf).unwrap_or_default();
     let name = format!("{} (expanded)", file.display());
-    let (_, model) = parse_deck(text, &name, &base)?;
-    Ok(model)
+    Ok(build_deck_ids(deck, &name, &base)?)
 }
 
-fn joint_id(m: &Model, name: &str) -> anyhow::Result<usize> {
-    m.element_id(name)
-        .ok_or_else(|| anyhow::anyhow!("expanded rotor model has no joint `{name}`"))
+/// The model ids of the parts a run drives and reads.
+struct RotorIds {
+    hub: usize,
+    /// The airframe chain's nodes, in the order of [`super::expand::airframe_chain`].
+    airframe: Vec<usize>,
+    blades: Vec<BladeIds>,
+}
+
+/// One blade's parts in the model.
+struct BladeIds {
+    swash: usize,
+    damper_ends: [usize; 2],
+    root: usize,
+    tip: usize,
+}
+
+impl RotorIds {
+    /// The ids of the expansion's `items` in the model built with `ids`.
+    fn new(items: &ExpandedItems, ids: &BuiltIds) -> anyhow::Result<Self> {
+        let missing =
+            |what: &str, i: usize| anyhow::anyhow!("expanded rotor model: {what}[{i}] not built");
+        let node = |i: usize| ids.nodes.get(i).copied().ok_or_else(|| missing("node", i));
+        let blades = items
+            .blades
+            .iter()
+            .map(|b| {
+                let beam = ids
+                    .beam_nodes
+                    .get(b.blade)
+                    .ok_or_else(|| missing("beam", b.blade))?;
+                let ends = (beam.first().copied(), beam.last().copied());
+                let (Some(root), Some(tip)) = ends else {
+                    return Err(missing("beam", b.blade));
+                };
+                Ok(BladeIds {
+                    swash: ids
+                        .joints
+                        .get(b.swash)
+                        .copied()
+                        .ok_or_else(|| missing("joint", b.swash))?,
+                    damper_ends: [node(b.damper_ends[0])?, node(b.damper_ends[1])?],
+                    root,
+                    tip,
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+        Ok(RotorIds {
+            hub: node(items.hub)?,
+            airframe: items
+                .airframe
+                .iter()
+                .map(|&i| node(i))
+                .collect::<anyhow::Result<_>>()?,
+            blades,
+        })
+    }
 }
 
 /// Newton tolerance of the rotor simulation (relative to the predictor residual).
@@ -481,7 +547,7 @@ fn build_parts(
     let period = 2.0 * std::f64::consts::PI / om;
     let h = period / opts.steps_per_rev as f64;
     let base_controls = Controls::from_record(&record.meta.controls_deg);
-    let mut model = initial_model(blades, whole, file, base_controls)?;
+    let (mut model, ids) = initial_model(blades, whole, file, base_controls)?;
     let t_ramp = spec.pitch_control.cyclic_ramp_revs * period;
     let scale = Arc::new(AtomicU64::new(0f64.to_bits()));
     // the lifting lines' shared state (computed and hybrid airloads); off in the statics
@@ -508,20 +574,24 @@ fn build_parts(
     };
     let mut pending = Vec::with_capacity(blades.len());
     for (k, &(bspec, damper, ahead_deg)) in blades.iter().enumerate() {
+        let part = ids
+            .blades
+            .get(k)
+            .ok_or_else(|| anyhow::anyhow!("expanded rotor model: no blade {}", k + 1))?;
         pending.push(add_blade(
             &ctx,
             &mut model,
-            k,
+            (k, part),
             (bspec, damper, ahead_deg),
             &aero_common,
         )?);
     }
     let mut st = initial_state(&mut model, &ctx.scale, om)?;
     ctx.aero_active.store(true, Ordering::Relaxed);
-    let hub = model.node_id(names::HUB)?;
-    let airframe = airframe_part(spec, whole, &model, &mut st)?;
+    let hub = ids.hub;
+    let airframe = airframe_part(spec, whole, &ids.airframe, &mut st)?;
     let r0 = (0..model.nodes.len()).map(|i| model.node_r0(i)).collect();
-    let parts = blade_parts(pending, blades, whole, &model)?;
+    let parts = blade_parts(pending, blades, whole, &model, &ids.blades)?;
     let solver = dynamic_solver(model, st, h, opts, source)?;
     let aero = aero_run(&ctx, blades, spec, aero_common)?;
     Ok(RotorSim {
@@ -549,22 +619,24 @@ fn build_parts(
     })
 }
 
-/// Expands the deck(s) into the structural model: the whole rotor or one blade.
+/// Expands the deck(s) into the structural model: the whole rotor or one blade; with the ids
+/// of the parts the run drives and reads.
 fn initial_model(
     blades: &[(&RotorSpec, &DamperDeck, f64)],
     whole: bool,
     file: &Path,
     base_controls: Controls,
-) -> anyhow::Result<Model> {
+) -> anyhow::Result<(Model, RotorIds)> {
     let spec = blades[0].0;
-    Ok(if whole {
+    let (built, items) = if whole {
         let specs: Vec<RotorSpec> = blades.iter().map(|b| b.0.clone()).collect();
         let xo = ExpandOptions {
             controls: base_controls,
             table_revs: 1,
             ..Default::default()
         };
-        whole_rotor_model(&specs, &xo, file)?
+        let (deck, items) = expand_rotor_items(&specs, &xo);
+        (whole_rotor_built(&deck, file)?, items)
     } else {
         // a blade ahead of the reference blade sees the shared swashplate's cyclic turned
         let xo = ExpandOptions {
@@ -572,8 +644,11 @@ fn initial_model(
             table_revs: 1,
             ..Default::default()
         };
-        expanded_model(spec, &xo, file)?
-    })
+        let (deck, items) = expand_items(spec, &xo);
+        (built_expanded(&deck, file)?, items)
+    };
+    let ids = RotorIds::new(&items, &built.ids)?;
+    Ok((built.model, ids))
 }
 
 /// Sets up the lifting lines' shared air and inflow (computed and hybrid airloads only).
@@ -610,7 +685,7 @@ fn aero_common(
 fn add_blade(
     ctx: &BuildCtx,
     model: &mut Model,
-    k: usize,
+    (k, ids): (usize, &BladeIds),
     (bspec, damper, ahead_deg): (&RotorSpec, &DamperDeck, f64),
     aero_common: &Option<AeroCommon>,
 ) -> anyhow::Result<Pending> {
@@ -623,7 +698,7 @@ fn add_blade(
     };
     let nm = |s: &str| format!("{prefix}{s}");
     let controls = ctx.base_controls.ahead_by(ahead_deg);
-    let swash = joint_id(model, &nm(names::SWASH_DRIVE))?;
+    let swash = ids.swash;
     set_swash(
         model,
         swash,
@@ -635,8 +710,7 @@ fn add_blade(
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let n_hub_end = model.node_id(&nm(names::DAMPER_HUB_END))?;
-    let n_blade_end = model.node_id(&nm(names::DAMPER_BLADE_END))?;
+    let [n_hub_end, n_blade_end] = ids.damper_ends;
     // Coupling element (paper Eqs. 9-16), applying the end-of-step force (docs/coupling.md:
     // the step mean F_m is unstable with generalized-alpha for stiff devices).
     let elem = HydraulicForceElement::new(nm("damper"), n_hub_end, n_blade_end, device)
@@ -806,16 +880,13 @@ fn initial_state(model: &mut Model, scale: &AtomicU64, om: f64) -> anyhow::Resul
 fn airframe_part(
     spec: &RotorSpec,
     whole: bool,
-    model: &Model,
+    chain: &[usize],
     st: &mut State,
 ) -> anyhow::Result<Option<AirframePart>> {
     Ok(match (&spec.airframe, whole) {
         (Some(a), true) => {
             let dofs = super::expand::airframe_chain(a);
-            let chain = dofs
-                .iter()
-                .map(|d| model.node_id(&format!("{}.{}", names::AIRFRAME, d.name)))
-                .collect::<Result<Vec<usize>, _>>()?;
+            let chain = chain.to_vec();
             // the airframe does not turn with the rotor: it starts at rest in its deflection
             for &i in &chain {
                 st.v[i] = [0.0; 3];
@@ -823,11 +894,8 @@ fn airframe_part(
                 st.a[i] = [0.0; 3];
                 st.al[i] = [0.0; 3];
             }
-            let mount = match &model.elements[joint_id(model, names::SHAFT)?] {
-                Element::Joint(j) => j.node_a,
-                _ => None,
-            }
-            .ok_or_else(|| {
+            // the shaft turns the hub on the chain's last node
+            let mount = chain.last().copied().ok_or_else(|| {
                 anyhow::anyhow!("expanded rotor model: the shaft is not on the airframe")
             })?;
             Some(AirframePart {
@@ -847,19 +915,14 @@ fn blade_parts(
     blades: &[(&RotorSpec, &DamperDeck, f64)],
     whole: bool,
     model: &Model,
+    ids: &[BladeIds],
 ) -> anyhow::Result<Vec<BladePart>> {
     let mut parts = Vec::with_capacity(pending.len());
-    for (p, &(bspec, _, ahead_deg)) in pending.into_iter().zip(blades) {
-        let nm = |s: &str| format!("{}{s}", p.prefix);
+    for ((p, &(bspec, _, ahead_deg)), b) in pending.into_iter().zip(blades).zip(ids) {
         // where the blade sits in the model: turned in the whole rotor's; a single blade
         // (even one ahead of blade 1 in time) lies along the hub's x axis
         let ahead_deg = if whole { ahead_deg } else { 0.0 };
-        let tip = model.node_id(&nm(&format!(
-            "{}.n{}",
-            names::BLADE,
-            3 * bspec.blade.elements
-        )))?;
-        let root = model.node_id(&nm(&format!("{}.n0", names::BLADE)))?;
+        let (tip, root) = (b.tip, b.root);
         let (sn, cs) = ahead_deg.to_radians().sin_cos();
         let frame = [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]];
         let tip_ref = mtv(&frame, model.nodes[tip].x0);

@@ -20,7 +20,7 @@ use std::sync::Arc;
 /// The deck error of every deck reader (file, key and what was expected).
 pub use crate::hydraulics::DeckError;
 
-#[derive(Debug, Deserialize, Default)]
+#[derive(Clone, Debug, Deserialize, Default, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Deck {
     #[serde(default)]
@@ -51,12 +51,33 @@ pub struct Deck {
     pub modes: ModesDeck,
     /// Probes of the `[[hydraulic]]` elements (name, probe), filled when the model is built.
     #[serde(skip)]
-    pub hydraulic_probes: Vec<(String, Arc<HydraulicProbe>)>,
+    pub hydraulic_probes: BuiltProbes,
+    /// How the deck is printed (comments, order of its items): not what it builds.
+    #[serde(skip)]
+    pub layout: super::deck_text::Layout,
+}
+
+/// The probes of a built deck's `[[hydraulic]]` elements. They are results of the build, not
+/// part of what the deck says: decks compare equal whatever their probes.
+#[derive(Clone, Debug, Default)]
+pub struct BuiltProbes(pub Vec<(String, Arc<HydraulicProbe>)>);
+
+impl PartialEq for BuiltProbes {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::ops::Deref for BuiltProbes {
+    type Target = Vec<(String, Arc<HydraulicProbe>)>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
 }
 
 /// `[[hydraulic]]`: a hydraulic device (actuator, damper or dashpot) between two nodes
 /// (paper Eqs. 9-16, [`HydraulicForceElement`]).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct HydraulicDeck {
     pub name: String,
@@ -88,7 +109,7 @@ pub struct HydraulicDeck {
     pub applied_force: Option<String>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct NodeDeck {
     pub name: String,
@@ -97,7 +118,7 @@ pub struct NodeDeck {
     pub rotation_vector_rad: [f64; 3],
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ArcDeck {
     pub center_m: [f64; 3],
@@ -121,7 +142,7 @@ fn y_axis() -> [f64; 3] {
     [0.0, 1.0, 0.0]
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BeamDeck {
     pub name: String,
@@ -135,8 +156,9 @@ pub struct BeamDeck {
     /// Existing node used as the first beam node (its position must match the start).
     #[serde(default)]
     pub start_node: Option<String>,
-    #[serde(default = "y_axis")]
-    pub e2_direction: [f64; 3],
+    /// Section e2 direction (absent: global y).
+    #[serde(default)]
+    pub e2_direction: Option<[f64; 3]>,
     #[serde(default)]
     pub sections_csv: Option<String>,
     #[serde(default)]
@@ -144,25 +166,36 @@ pub struct BeamDeck {
     #[serde(default)]
     pub sections: Option<Vec<SectionProps>>,
     #[serde(default)]
-    pub damping_mu_s: f64,
+    pub damping_mu_s: Option<f64>,
     /// Built-in twist of a straight beam about its axis, `[[s_m, deg], ...]` (piecewise linear
     /// in the arc length from the first node, constant beyond the ends; positive about +e1).
     #[serde(default)]
     pub twist_deg: Option<Vec<[f64; 2]>>,
 }
 
-#[derive(Debug, Deserialize)]
+impl BeamDeck {
+    /// The section e2 direction (default global y).
+    pub fn e2(&self) -> [f64; 3] {
+        self.e2_direction.unwrap_or_else(y_axis)
+    }
+    /// The stiffness-proportional damping [s] (default 0).
+    pub fn damping(&self) -> f64 {
+        self.damping_mu_s.unwrap_or(0.0)
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RigidDeck {
     pub name: String,
     pub node: String,
     pub mass_kg: f64,
     #[serde(default)]
-    pub cm_offset_m: [f64; 3],
+    pub cm_offset_m: Option<[f64; 3]>,
     pub inertia_kgm2: [[f64; 3]; 3],
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct JointDeck {
     pub name: String,
@@ -173,15 +206,16 @@ pub struct JointDeck {
     pub node_b: String,
     #[serde(default)]
     pub position_m: Option<[f64; 3]>,
-    /// Joint z axis (revolute axis), global.
-    #[serde(default = "z_axis")]
-    pub axis: [f64; 3],
-    #[serde(default = "x_axis")]
-    pub x_direction: [f64; 3],
+    /// Joint z axis (revolute axis), global (absent: z).
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    /// Joint x direction (absent: x).
+    #[serde(default)]
+    pub x_direction: Option<[f64; 3]>,
     #[serde(default, rename = "stiffness_Nm_per_rad")]
-    pub stiffness: f64,
+    pub stiffness: Option<f64>,
     #[serde(default, rename = "damping_Nms_per_rad")]
-    pub damping: f64,
+    pub damping: Option<f64>,
     #[serde(default)]
     pub omega_rad_s: Option<f64>,
     /// (t_s, angle_rad) pairs added to omega t.
@@ -213,7 +247,7 @@ pub struct JointDeck {
 
 /// An elastomer about a joint axis: a Maxwell chain fitted to a constant loss factor over a
 /// band of frequencies (src/structure/elastomer.rs).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ElastomerDeck {
     pub loss_factor: f64,
@@ -232,6 +266,22 @@ fn locked_axes(names: &Option<Vec<String>>) -> [bool; 6] {
 }
 
 impl JointDeck {
+    /// The joint axis (default z).
+    pub fn axis(&self) -> [f64; 3] {
+        self.axis.unwrap_or_else(z_axis)
+    }
+    /// The joint x direction (default x).
+    pub fn x_direction(&self) -> [f64; 3] {
+        self.x_direction.unwrap_or_else(x_axis)
+    }
+    /// The revolute spring [N m/rad] (default 0).
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness.unwrap_or(0.0)
+    }
+    /// The revolute damper [N m s/rad] (default 0).
+    pub fn damping(&self) -> f64 {
+        self.damping.unwrap_or(0.0)
+    }
     /// The bushing keys with their values (deck spelling).
     fn bushing_keys(&self) -> [(&'static str, &Option<Vec<f64>>); 4] {
         [
@@ -251,7 +301,7 @@ fn axes3(v: &Option<Vec<f64>>) -> [f64; 3] {
     }
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LoadDeck {
     pub name: String,
@@ -266,7 +316,7 @@ pub struct LoadDeck {
     pub time_table: Option<Vec<[f64; 2]>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DistDeck {
     pub beam: String,
@@ -280,7 +330,7 @@ pub struct DistDeck {
     pub time_table: Option<Vec<[f64; 2]>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SensorDeck {
     pub name: String,
@@ -294,7 +344,7 @@ pub struct SensorDeck {
     pub s_m: Option<f64>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct StaticDeck {
     #[serde(default = "ten")]
@@ -329,7 +379,7 @@ fn rho_default() -> f64 {
     0.9
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicDeck {
     #[serde(default)]
@@ -365,7 +415,7 @@ impl Default for DynamicDeck {
     }
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ModesDeck {
     #[serde(default = "ten")]
@@ -483,7 +533,7 @@ pub fn load_deck_within(
         message,
     })?;
     let (model, probes) = build(&deck, &file, &base)?;
-    deck.hydraulic_probes = probes;
+    deck.hydraulic_probes = BuiltProbes(probes);
     Ok((deck, model))
 }
 
@@ -638,8 +688,8 @@ fn bushing_values(key: &str, j: &JointDeck) -> Check {
         return Ok(());
     }
     let other = [
-        ("stiffness_Nm_per_rad", j.stiffness != 0.0),
-        ("damping_Nms_per_rad", j.damping != 0.0),
+        ("stiffness_Nm_per_rad", j.stiffness() != 0.0),
+        ("damping_Nms_per_rad", j.damping() != 0.0),
         ("omega_rad_s", j.omega_rad_s.is_some()),
         ("angle_table", j.angle_table.is_some()),
         ("displacement_m", j.displacement_m.is_some()),
@@ -724,8 +774,8 @@ fn validate(d: &Deck) -> Check {
         let key = format!("beam[{i}] `{}`", b.name);
         named(&key, &b.name)?;
         counted(&format!("{key}.elements"), b.elements)?;
-        non_negative(&format!("{key}.damping_mu_s"), b.damping_mu_s)?;
-        direction(&format!("{key}.e2_direction"), b.e2_direction)?;
+        non_negative(&format!("{key}.damping_mu_s"), b.damping())?;
+        direction(&format!("{key}.e2_direction"), b.e2())?;
         if let Some(a) = b.start_m {
             finite3(&format!("{key}.start_m"), a)?;
         }
@@ -741,7 +791,7 @@ fn validate(d: &Deck) -> Check {
                     format!("{e:?} equals start_m: expected a beam of positive length"),
                 ));
             }
-            let e2 = b.e2_direction;
+            let e2 = b.e2();
             let c = cross(t, e2);
             if dot(c, c).sqrt() <= 1e-9 * len * dot(e2, e2).sqrt() {
                 return Err((
@@ -779,7 +829,10 @@ fn validate(d: &Deck) -> Check {
         let key = format!("rigid_body[{i}] `{}`", r.name);
         named(&key, &r.name)?;
         non_negative(&format!("{key}.mass_kg"), r.mass_kg)?;
-        finite3(&format!("{key}.cm_offset_m"), r.cm_offset_m)?;
+        finite3(
+            &format!("{key}.cm_offset_m"),
+            r.cm_offset_m.unwrap_or_default(),
+        )?;
         if r.inertia_kgm2.iter().flatten().any(|x| !x.is_finite()) {
             return Err((
                 format!("{key}.inertia_kgm2"),
@@ -802,10 +855,10 @@ fn validate(d: &Deck) -> Check {
         if let Some(p) = j.position_m {
             finite3(&format!("{key}.position_m"), p)?;
         }
-        direction(&format!("{key}.axis"), j.axis)?;
-        direction(&format!("{key}.x_direction"), j.x_direction)?;
-        non_negative(&format!("{key}.stiffness_Nm_per_rad"), j.stiffness)?;
-        non_negative(&format!("{key}.damping_Nms_per_rad"), j.damping)?;
+        direction(&format!("{key}.axis"), j.axis())?;
+        direction(&format!("{key}.x_direction"), j.x_direction())?;
+        non_negative(&format!("{key}.stiffness_Nm_per_rad"), j.stiffness())?;
+        non_negative(&format!("{key}.damping_Nms_per_rad"), j.damping())?;
         if let Some(w) = j.omega_rad_s {
             finite(&format!("{key}.omega_rad_s"), w)?;
         }
@@ -888,11 +941,79 @@ fn validate(d: &Deck) -> Check {
 pub fn parse_deck(text: &str, file: &str, base: &Path) -> Result<(Deck, Model), DeckError> {
     let mut deck = deserialize(text, file)?;
     let (model, probes) = build(&deck, file, base)?;
-    deck.hydraulic_probes = probes;
+    deck.hydraulic_probes = BuiltProbes(probes);
     Ok((deck, model))
 }
 
-type Probes = Vec<(String, Arc<HydraulicProbe>)>;
+/// A model built from a typed deck, with the probes of its `[[hydraulic]]` elements and the
+/// model ids of its items.
+pub struct Built {
+    pub model: Model,
+    pub probes: Probes,
+    pub ids: BuiltIds,
+}
+
+/// The model ids of a built deck's items, by their index in the deck.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BuiltIds {
+    /// The node of each `[[node]]`.
+    pub nodes: Vec<usize>,
+    /// The nodes of each `[[beam]]`, first to last.
+    pub beam_nodes: Vec<Vec<usize>>,
+    /// The element of each `[[joint]]`.
+    pub joints: Vec<usize>,
+}
+
+/// Checks a typed deck as reading one checks it, then builds its model and the probes of its
+/// `[[hydraulic]]` elements (`file` names it in errors; relative paths resolve against `base`).
+pub fn build_deck(d: &Deck, file: &str, base: &Path) -> Result<(Model, Probes), DeckError> {
+    validate(d).map_err(|(key, msg)| DeckError::invalid(file, key, msg))?;
+    build(d, file, base)
+}
+
+/// [`build_deck`], with the model ids of the deck's items.
+pub fn build_deck_ids(d: &Deck, file: &str, base: &Path) -> Result<Built, DeckError> {
+    let (model, probes) = build_deck(d, file, base)?;
+    let ids = built_ids(d, &model)
+        .map_err(|key| DeckError::invalid(file, key, "not found in the built model"))?;
+    Ok(Built { model, probes, ids })
+}
+
+/// The ids of the deck's items in its built model (Err: the key of an item not found).
+fn built_ids(d: &Deck, m: &Model) -> Result<BuiltIds, String> {
+    let nodes = d
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| m.node_id(&n.name).map_err(|_| format!("node[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let joints = d
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| m.element_id(&j.name).ok_or(format!("joint[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let mut beam_nodes = vec![];
+    for (i, b) in d.beams.iter().enumerate() {
+        let elements = m.beams.get(&b.name).ok_or(format!("beam[{i}]"))?;
+        let mut v = vec![];
+        // consecutive elements share their end node
+        for (k, &e) in elements.iter().enumerate() {
+            if let Some(Element::Beam(be)) = m.elements.get(e) {
+                v.extend_from_slice(&be.nodes[usize::from(k > 0)..]);
+            }
+        }
+        beam_nodes.push(v);
+    }
+    Ok(BuiltIds {
+        nodes,
+        beam_nodes,
+        joints,
+    })
+}
+
+/// The probes of the `[[hydraulic]]` elements (name, probe).
+pub type Probes = Vec<(String, Arc<HydraulicProbe>)>;
 
 /// What every build stage needs: the deck file (named in errors) and the base directory.
 struct Ctx<'a> {
@@ -984,38 +1105,15 @@ fn add_beam(ctx: &Ctx, m: &mut Model, i: usize, b: &BeamDeck) -> Result<(), Deck
         (None, Some(a), Some(e)) if b.twist_deg.is_some() => {
             let tw = twist_table(b.twist_deg.as_deref().unwrap_or_default())
                 .map_err(|msg| inv(format!("{key}.twist_deg"), msg))?;
-            let (len, curve) = twisted_curve(a, e, b.e2_direction, tw);
-            m.add_beam(
-                &b.name,
-                b.elements,
-                len,
-                &curve,
-                &sec,
-                b.damping_mu_s,
-                first,
-            )
+            let (len, curve) = twisted_curve(a, e, b.e2(), tw);
+            m.add_beam(&b.name, b.elements, len, &curve, &sec, b.damping(), first)
         }
-        (None, Some(a), Some(e)) => m.add_straight_beam(
-            &b.name,
-            b.elements,
-            a,
-            e,
-            b.e2_direction,
-            &sec,
-            b.damping_mu_s,
-            first,
-        ),
+        (None, Some(a), Some(e)) => {
+            m.add_straight_beam(&b.name, b.elements, a, e, b.e2(), &sec, b.damping(), first)
+        }
         (Some(arc), None, None) => {
             let (len, curve) = arc_curve(arc);
-            m.add_beam(
-                &b.name,
-                b.elements,
-                len,
-                &curve,
-                &sec,
-                b.damping_mu_s,
-                first,
-            )
+            m.add_beam(&b.name, b.elements, len, &curve, &sec, b.damping(), first)
         }
         _ => {
             return Err(inv(
@@ -1101,7 +1199,7 @@ fn add_rigid_bodies(ctx: &Ctx, m: &mut Model, d: &Deck) -> Result<(), DeckError>
             name: r.name.clone(),
             node: n,
             mass_kg: r.mass_kg,
-            cm_offset_m: r.cm_offset_m,
+            cm_offset_m: r.cm_offset_m.unwrap_or_default(),
             inertia_kgm2: r.inertia_kgm2,
         }))
         .map_err(|e| inv(key, e.to_string()))?;
@@ -1127,7 +1225,7 @@ fn add_joint(ctx: &Ctx, m: &mut Model, i: usize, j: &JointDeck) -> Result<(), De
     };
     let b = ctx.node(m, &format!("{key}.node_b"), &j.node_b)?;
     let p = j.position_m.unwrap_or(m.nodes[b].x0);
-    let q = frame_from_axis(j.axis, j.x_direction);
+    let q = frame_from_axis(j.axis(), j.x_direction());
     // frame_from_axis gives columns (axis, ~x, .): reorder to (x, y, z = axis)
     let q = [
         [q[0][1], q[0][2], q[0][0]],
@@ -1151,8 +1249,8 @@ fn joint_properties(
 ) -> Result<(), DeckError> {
     let inv = |k: String, msg: String| ctx.inv(k, msg);
     if let Element::Joint(jj) = &mut m.elements[id] {
-        jj.spring_nm_per_rad = j.stiffness;
-        jj.damper_nms_per_rad = j.damping;
+        jj.spring_nm_per_rad = j.stiffness();
+        jj.damper_nms_per_rad = j.damping();
         jj.bushing = BushingCoeffs {
             k_n_per_m: axes3(&j.stiffness_t),
             c_ns_per_m: axes3(&j.damping_t),
@@ -1183,15 +1281,16 @@ fn joint_properties(
                     "an elastomer acts about a free revolute axis (type = \"revolute\" without omega_rad_s or angle_table)".into(),
                 ));
             }
-            if j.stiffness.is_nan() || j.stiffness <= 0.0 {
+            if j.stiffness().is_nan() || j.stiffness() <= 0.0 {
                 return Err(inv(
                     format!("{key}.stiffness_Nm_per_rad"),
                     "an elastomer needs its storage stiffness here: expected > 0".into(),
                 ));
             }
             let [lo, hi] = el.band_rad_s;
-            let chain = MaxwellChain::fit(j.stiffness, el.loss_factor, lo, hi, el.reference_rad_s)
-                .map_err(|e| inv(ek, e))?;
+            let chain =
+                MaxwellChain::fit(j.stiffness(), el.loss_factor, lo, hi, el.reference_rad_s)
+                    .map_err(|e| inv(ek, e))?;
             jj.spring_nm_per_rad = 0.0;
             jj.elastomer = Some(Elastomer::new(chain));
         }

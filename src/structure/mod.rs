@@ -4,6 +4,7 @@
 pub mod beam;
 mod beam_tangent;
 pub mod deck;
+pub mod deck_text;
 pub mod elastomer;
 pub mod hydraulic;
 pub mod joint;
