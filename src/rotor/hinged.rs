@@ -275,6 +275,14 @@ impl HingedSpec {
                 format!("expected the outer end of the last blade segment ({tip} m), found {rr}"),
             ));
         }
+        self.validate_masses(file, tip)
+    }
+
+    /// The point masses: unique names, on the blade (root to `tip`), positive, finite.
+    fn validate_masses(&self, file: &str, tip: f64) -> anyhow::Result<()> {
+        let bad = |key: &str, msg: String| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
+        let fin = |v: f64| v.is_finite();
+        let b = &self.blade;
         let mut names: Vec<&str> = vec![];
         for (i, m) in self.masses.iter().enumerate() {
             let key = |k: &str| format!("mass[{i}].{k}");

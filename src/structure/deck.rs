@@ -771,59 +771,7 @@ fn validate(d: &Deck) -> Check {
         finite3(&format!("{key}.rotation_vector_rad"), n.rotation_vector_rad)?;
     }
     for (i, b) in d.beams.iter().enumerate() {
-        let key = format!("beam[{i}] `{}`", b.name);
-        named(&key, &b.name)?;
-        counted(&format!("{key}.elements"), b.elements)?;
-        non_negative(&format!("{key}.damping_mu_s"), b.damping())?;
-        direction(&format!("{key}.e2_direction"), b.e2())?;
-        if let Some(a) = b.start_m {
-            finite3(&format!("{key}.start_m"), a)?;
-        }
-        if let Some(e) = b.end_m {
-            finite3(&format!("{key}.end_m"), e)?;
-        }
-        if let (Some(a), Some(e)) = (b.start_m, b.end_m) {
-            let t = sub(e, a);
-            let len = dot(t, t).sqrt();
-            if len <= 0.0 {
-                return Err((
-                    format!("{key}.end_m"),
-                    format!("{e:?} equals start_m: expected a beam of positive length"),
-                ));
-            }
-            let e2 = b.e2();
-            let c = cross(t, e2);
-            if dot(c, c).sqrt() <= 1e-9 * len * dot(e2, e2).sqrt() {
-                return Err((
-                    format!("{key}.e2_direction"),
-                    format!("{e2:?} is along the beam axis: expected a direction across it"),
-                ));
-            }
-        }
-        if let Some(arc) = &b.arc {
-            let k = format!("{key}.arc");
-            finite3(&format!("{k}.center_m"), arc.center_m)?;
-            positive(&format!("{k}.radius_m"), arc.radius_m)?;
-            finite(&format!("{k}.start_deg"), arc.start_deg)?;
-            finite(&format!("{k}.end_deg"), arc.end_deg)?;
-            if arc.start_deg == arc.end_deg {
-                return Err((
-                    format!("{k}.end_deg"),
-                    "equals start_deg: expected an arc of positive length".into(),
-                ));
-            }
-            direction(&format!("{k}.normal"), arc.normal)?;
-            let n = arc.normal;
-            let z = arc.zero_direction;
-            direction(&format!("{k}.zero_direction"), z)?;
-            let c = cross(n, z);
-            if dot(c, c).sqrt() <= 1e-9 * dot(n, n).sqrt() * dot(z, z).sqrt() {
-                return Err((
-                    format!("{k}.zero_direction"),
-                    format!("{z:?} is along the normal: expected a direction in the arc plane"),
-                ));
-            }
-        }
+        validate_beam(i, b)?;
     }
     for (i, r) in d.rigid_bodies.iter().enumerate() {
         let key = format!("rigid_body[{i}] `{}`", r.name);
@@ -904,6 +852,69 @@ fn validate(d: &Deck) -> Check {
             positive(&format!("{key}.reference_length_m"), l)?;
         }
     }
+    validate_tables(d)
+}
+
+/// A `[[beam]]`: its counts, directions and length, its arc.
+fn validate_beam(i: usize, b: &BeamDeck) -> Check {
+    let key = format!("beam[{i}] `{}`", b.name);
+    named(&key, &b.name)?;
+    counted(&format!("{key}.elements"), b.elements)?;
+    non_negative(&format!("{key}.damping_mu_s"), b.damping())?;
+    direction(&format!("{key}.e2_direction"), b.e2())?;
+    if let Some(a) = b.start_m {
+        finite3(&format!("{key}.start_m"), a)?;
+    }
+    if let Some(e) = b.end_m {
+        finite3(&format!("{key}.end_m"), e)?;
+    }
+    if let (Some(a), Some(e)) = (b.start_m, b.end_m) {
+        let t = sub(e, a);
+        let len = dot(t, t).sqrt();
+        if len <= 0.0 {
+            return Err((
+                format!("{key}.end_m"),
+                format!("{e:?} equals start_m: expected a beam of positive length"),
+            ));
+        }
+        let e2 = b.e2();
+        let c = cross(t, e2);
+        if dot(c, c).sqrt() <= 1e-9 * len * dot(e2, e2).sqrt() {
+            return Err((
+                format!("{key}.e2_direction"),
+                format!("{e2:?} is along the beam axis: expected a direction across it"),
+            ));
+        }
+    }
+    if let Some(arc) = &b.arc {
+        let k = format!("{key}.arc");
+        finite3(&format!("{k}.center_m"), arc.center_m)?;
+        positive(&format!("{k}.radius_m"), arc.radius_m)?;
+        finite(&format!("{k}.start_deg"), arc.start_deg)?;
+        finite(&format!("{k}.end_deg"), arc.end_deg)?;
+        if arc.start_deg == arc.end_deg {
+            return Err((
+                format!("{k}.end_deg"),
+                "equals start_deg: expected an arc of positive length".into(),
+            ));
+        }
+        direction(&format!("{k}.normal"), arc.normal)?;
+        let n = arc.normal;
+        let z = arc.zero_direction;
+        direction(&format!("{k}.zero_direction"), z)?;
+        let c = cross(n, z);
+        if dot(c, c).sqrt() <= 1e-9 * dot(n, n).sqrt() * dot(z, z).sqrt() {
+            return Err((
+                format!("{k}.zero_direction"),
+                format!("{z:?} is along the normal: expected a direction in the arc plane"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The `[static]`, `[dynamic]` and `[modes]` tables.
+fn validate_tables(d: &Deck) -> Check {
     let st = &d.statics;
     counted("static.load_steps", st.load_steps)?;
     counted("static.max_iterations", st.max_iterations)?;
@@ -1433,45 +1444,10 @@ fn hydraulic_element(
     base: &Path,
 ) -> Result<(HydraulicForceElement, Arc<HydraulicProbe>), DeckError> {
     let inv = |k: &str, msg: String| DeckError::invalid(file, format!("{key}.{k}"), msg);
-    let node = |m: &Model, k: &str, name: &str| {
-        m.node_id(name).map_err(|_| {
-            inv(
-                k,
-                format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)"),
-            )
-        })
-    };
     if h.name.is_empty() {
         return Err(inv("name", "must not be empty".into()));
     }
-    let b = node(m, "node_b", &h.node_b)?;
-    let a = match (h.node_a.as_str(), h.position_m) {
-        ("ground", Some(p)) => {
-            if !p.iter().all(|x| x.is_finite()) {
-                return Err(inv("position_m", format!("{p:?} is not a finite point")));
-            }
-            let id = m
-                .add_node(&format!("{}.ground", h.name), p, ident())
-                .map_err(|e| inv("name", e.to_string()))?;
-            m.clamp(&format!("{}.ground_clamp", h.name), id)
-                .map_err(|e| inv("name", e.to_string()))?;
-            id
-        }
-        ("ground", None) => {
-            return Err(inv(
-                "position_m",
-                "required with node_a = \"ground\": the ground attachment point [x, y, z] in m"
-                    .into(),
-            ))
-        }
-        (n, None) => node(m, "node_a", n)?,
-        (_, Some(_)) => {
-            return Err(inv(
-                "position_m",
-                "only allowed with node_a = \"ground\" (a node's position is its own)".into(),
-            ))
-        }
-    };
+    let (a, b) = attachments(m, h, &inv)?;
     if a == b {
         return Err(inv("node_b", "the device connects a node to itself".into()));
     }
@@ -1498,73 +1474,7 @@ fn hydraulic_element(
             ),
         )
     })?;
-    let device: Box<dyn Device> = match (root.contains_key("actuator"), root.contains_key("damper"))
-    {
-        (true, true) => {
-            return Err(inv(
-                "deck",
-                format!(
-                "device deck {dfile} has both [actuator] and [damper]: give one device per deck"
-            ),
-            ))
-        }
-        (false, false) => {
-            return Err(inv(
-                "deck",
-                format!("device deck {dfile} has neither an [actuator] nor a [damper] table"),
-            ))
-        }
-        (true, false) => {
-            if let Some(md) = h.model.as_deref().filter(|md| *md != "physical") {
-                return Err(inv(
-                    "model",
-                    format!("`{md}`: an actuator deck ({dfile}) has only the physical model"),
-                ));
-            }
-            let params =
-                actuator_from_toml_str(&text, &dfile).map_err(|e| inv("deck", e.to_string()))?;
-            let mut dev = CircuitDevice::new(params.to_circuit(), opts);
-            if let Some(tab) = &h.orifice_area_table {
-                let sch = PiecewiseLinear::new(
-                    tab.iter().map(|p| p[0]).collect(),
-                    tab.iter().map(|p| p[1]).collect(),
-                )
-                .map_err(|e| {
-                    inv(
-                        "orifice_area_table",
-                        format!("expected [[t_s, factor], ...] with increasing times: {e}"),
-                    )
-                })?;
-                if let Some(p) = tab.iter().find(|p| p[1] < 0.0) {
-                    return Err(inv(
-                        "orifice_area_table",
-                        format!(
-                            "factor {} at t = {} s is negative (areas scale by factors >= 0)",
-                            p[1], p[0]
-                        ),
-                    ));
-                }
-                dev.set_orifice_area_schedule(sch);
-            }
-            Box::new(dev)
-        }
-        (false, true) => {
-            if h.orifice_area_table.is_some() {
-                return Err(inv(
-                    "orifice_area_table",
-                    format!("only for actuator decks ([actuator]); {dfile} is a damper deck"),
-                ));
-            }
-            let dd =
-                DamperDeck::from_toml_str(&text, &dfile).map_err(|e| inv("deck", e.to_string()))?;
-            let model = match h.model.as_deref() {
-                None => dd.model,
-                Some(s) => s.parse::<DamperModel>().map_err(|e| inv("model", e))?,
-            };
-            dd.build(model, opts)
-                .map_err(|e| inv("model", e.to_string()))?
-        }
-    };
+    let device = device_of(h, &root, &text, &dfile, opts, &inv)?;
     let applied = match h.applied_force.as_deref() {
         None | Some("end") => AppliedForce::End,
         Some("mean") => AppliedForce::Mean,
@@ -1600,4 +1510,129 @@ fn hydraulic_element(
     elem = elem.with_reference_length(l_ref);
     let probe = elem.probe();
     Ok((elem, probe))
+}
+
+/// The device of a `[[hydraulic]]` element: its deck's `[actuator]` or `[damper]`, with the
+/// element's model, sub-stepping and orifice schedule.
+fn device_of(
+    h: &HydraulicDeck,
+    root: &toml::Table,
+    text: &str,
+    dfile: &str,
+    opts: IntegratorOptions,
+    inv: &dyn Fn(&str, String) -> DeckError,
+) -> Result<Box<dyn Device>, DeckError> {
+    let device: Box<dyn Device> = match (root.contains_key("actuator"), root.contains_key("damper"))
+    {
+        (true, true) => {
+            return Err(inv(
+                "deck",
+                format!(
+                "device deck {dfile} has both [actuator] and [damper]: give one device per deck"
+            ),
+            ))
+        }
+        (false, false) => {
+            return Err(inv(
+                "deck",
+                format!("device deck {dfile} has neither an [actuator] nor a [damper] table"),
+            ))
+        }
+        (true, false) => {
+            if let Some(md) = h.model.as_deref().filter(|md| *md != "physical") {
+                return Err(inv(
+                    "model",
+                    format!("`{md}`: an actuator deck ({dfile}) has only the physical model"),
+                ));
+            }
+            let params =
+                actuator_from_toml_str(text, dfile).map_err(|e| inv("deck", e.to_string()))?;
+            let mut dev = CircuitDevice::new(params.to_circuit(), opts);
+            if let Some(tab) = &h.orifice_area_table {
+                let sch = PiecewiseLinear::new(
+                    tab.iter().map(|p| p[0]).collect(),
+                    tab.iter().map(|p| p[1]).collect(),
+                )
+                .map_err(|e| {
+                    inv(
+                        "orifice_area_table",
+                        format!("expected [[t_s, factor], ...] with increasing times: {e}"),
+                    )
+                })?;
+                if let Some(p) = tab.iter().find(|p| p[1] < 0.0) {
+                    return Err(inv(
+                        "orifice_area_table",
+                        format!(
+                            "factor {} at t = {} s is negative (areas scale by factors >= 0)",
+                            p[1], p[0]
+                        ),
+                    ));
+                }
+                dev.set_orifice_area_schedule(sch);
+            }
+            Box::new(dev)
+        }
+        (false, true) => {
+            if h.orifice_area_table.is_some() {
+                return Err(inv(
+                    "orifice_area_table",
+                    format!("only for actuator decks ([actuator]); {dfile} is a damper deck"),
+                ));
+            }
+            let dd =
+                DamperDeck::from_toml_str(text, dfile).map_err(|e| inv("deck", e.to_string()))?;
+            let model = match h.model.as_deref() {
+                None => dd.model,
+                Some(s) => s.parse::<DamperModel>().map_err(|e| inv("model", e))?,
+            };
+            dd.build(model, opts)
+                .map_err(|e| inv("model", e.to_string()))?
+        }
+    };
+    Ok(device)
+}
+
+/// The nodes a `[[hydraulic]]` element joins: `node_a` (or a clamped ground point) and `node_b`.
+fn attachments(
+    m: &mut Model,
+    h: &HydraulicDeck,
+    inv: &dyn Fn(&str, String) -> DeckError,
+) -> Result<(usize, usize), DeckError> {
+    let node = |m: &Model, k: &str, name: &str| {
+        m.node_id(name).map_err(|_| {
+            inv(
+                k,
+                format!("node `{name}` does not exist (declare it in [[node]] or use a beam node `beam.nK`)"),
+            )
+        })
+    };
+    let b = node(m, "node_b", &h.node_b)?;
+    let a = match (h.node_a.as_str(), h.position_m) {
+        ("ground", Some(p)) => {
+            if !p.iter().all(|x| x.is_finite()) {
+                return Err(inv("position_m", format!("{p:?} is not a finite point")));
+            }
+            let id = m
+                .add_node(&format!("{}.ground", h.name), p, ident())
+                .map_err(|e| inv("name", e.to_string()))?;
+            m.clamp(&format!("{}.ground_clamp", h.name), id)
+                .map_err(|e| inv("name", e.to_string()))?;
+            id
+        }
+        ("ground", None) => {
+            return Err(inv(
+                "position_m",
+                "required with node_a = \"ground\": the ground attachment point [x, y, z] in m"
+                    .into(),
+            ))
+        }
+        (n, None) => node(m, "node_a", n)?,
+        (_, Some(_)) => {
+            return Err(inv(
+                "position_m",
+                "only allowed with node_a = \"ground\" (a node's position is its own)".into(),
+            ))
+        }
+    };
+    Ok((a, b))
 }
