@@ -107,7 +107,7 @@ fn every_shipped_rotor_deck_prints_the_model_it_runs() {
     let mut checked = 0;
     for path in shipped() {
         let text = std::fs::read_to_string(&path).unwrap();
-        if hinged::is_hinged(&text) {
+        if rotorsim::rotor::RotorKind::of_text(&text) == rotorsim::rotor::RotorKind::Hinged {
             let spec = HingedSpec::from_file(&path).unwrap();
             let name = path.display().to_string();
             check(

@@ -412,7 +412,7 @@ impl DecayJob {
         let rotor = &self.rotor;
         let text = std::fs::read_to_string(rotor)
             .map_err(|e| anyhow::anyhow!("--rotor {}: {e}", rotor.display()))?;
-        if !crate::rotor::hinged::is_hinged(&text) {
+        if crate::rotor::RotorKind::of_text(&text) != crate::rotor::RotorKind::Hinged {
             anyhow::bail!(
                 "--rotor {}: not a hinged-blade deck (expected [[hinge]] tables and a [blade] with \
                  segments, docs/rotor_deck.md)",

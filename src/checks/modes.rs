@@ -326,10 +326,12 @@ impl ModesJob {
         if self.count == 0 {
             bail!("--count 0: expected at least 1 mode per speed");
         }
-        if std::fs::read_to_string(path).is_ok_and(|t| crate::rotor::hinged::is_hinged(&t)) {
-            return self.hinged_fan(path, on_speed);
-        }
-        let deck = crate::rotor::RotorDeck::from_file(path)?;
+        let deck = match crate::rotor::AnyRotorDeck::from_file(path)? {
+            crate::rotor::AnyRotorDeck::Hinged(spec) => {
+                return self.hinged_fan(spec, path, on_speed)
+            }
+            crate::rotor::AnyRotorDeck::Elastomeric(deck) => deck,
+        };
         let fractions = self.fractions(deck.spec.rotor.omega_rad_s, path)?;
         let (ndof, _) = deck.spec.size_estimate();
         let one = crate::solver::budget::dense_modal_of(ndof);
@@ -440,11 +442,11 @@ impl ModesJob {
     /// speeds are added to `speeds` so that every reference row is compared.
     fn hinged_fan(
         &self,
+        spec: crate::rotor::hinged::HingedSpec,
         path: &Path,
         on_speed: &mut dyn FnMut(&SpeedModes),
     ) -> anyhow::Result<ModesOutcome> {
-        use crate::rotor::hinged::{fan, read_reference, HingedSpec, TRACKED};
-        let spec = HingedSpec::from_file(path)?;
+        use crate::rotor::hinged::{fan, read_reference, TRACKED};
         let mut fractions = self.fractions(spec.rotor.omega_rad_s, path)?;
         let rpm_n = spec.rpm();
         let mut inputs = vec![path.to_path_buf()];

@@ -1024,7 +1024,7 @@ impl RotorSpec {
 
     /// Parse deck text; `file` names it in errors (toml reports line and column).
     pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
-        if super::hinged::is_hinged(text) {
+        if super::RotorKind::of_text(text) == super::RotorKind::Hinged {
             anyhow::bail!(
                 "rotor deck {file}: a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it"
             );

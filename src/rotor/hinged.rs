@@ -23,13 +23,6 @@ use crate::structure::section::SectionProps;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-/// Whether a rotor deck text is of the hinged-blade form (it has `[[hinge]]` tables).
-pub fn is_hinged(text: &str) -> bool {
-    toml::from_str::<toml::Table>(text)
-        .map(|t| t.contains_key("hinge"))
-        .unwrap_or(false)
-}
-
 /// Rotation a hinge frees (hub frame; angle signs as the bearing of docs/rotor_deck.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -286,6 +286,61 @@ pub struct RotorDeck {
     assumed: assumed::Scan,
 }
 
+/// A rotor deck of either kind, both with the `[rotor]` table (docs/rotor_deck.md): the
+/// elastomeric rotor (retention, bearing, pitch link, damper) or a hinged blade (`[[hinge]]`
+/// tables, "Hinged-blade decks"). The one place that tells the kinds apart.
+#[derive(Clone, Debug)]
+pub enum AnyRotorDeck {
+    Elastomeric(Box<RotorDeck>),
+    Hinged(hinged::HingedSpec),
+}
+
+/// The kind of rotor deck a file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotorKind {
+    Elastomeric,
+    Hinged,
+}
+
+impl RotorKind {
+    /// The kind of deck `text` is: hinged when it has `[[hinge]]` tables (text that is not TOML
+    /// reads as elastomeric, whose reader names the error).
+    pub fn of_text(text: &str) -> Self {
+        let hinged = toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("hinge"));
+        if hinged {
+            RotorKind::Hinged
+        } else {
+            RotorKind::Elastomeric
+        }
+    }
+
+    /// The kind of the deck file at `path` (a file that cannot be read: elastomeric, whose
+    /// reader names the error).
+    pub fn of_file(path: &Path) -> Self {
+        std::fs::read_to_string(path).map_or(RotorKind::Elastomeric, |t| Self::of_text(&t))
+    }
+}
+
+impl AnyRotorDeck {
+    /// Reads the deck at `path` as the kind it is.
+    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+        Ok(match RotorKind::of_file(path) {
+            RotorKind::Elastomeric => {
+                AnyRotorDeck::Elastomeric(Box::new(RotorDeck::from_file(path)?))
+            }
+            RotorKind::Hinged => AnyRotorDeck::Hinged(hinged::HingedSpec::from_file(path)?),
+        })
+    }
+
+    /// The shared `[rotor]` table.
+    pub fn rotor(&self) -> &deck::RotorTable {
+        match self {
+            AnyRotorDeck::Elastomeric(d) => &d.spec.rotor,
+            AnyRotorDeck::Hinged(h) => &h.rotor,
+        }
+    }
+}
+
 impl RotorDeck {
     pub fn from_file(path: &Path) -> anyhow::Result<Self> {
         Self::from_file_with(path, &[])
