@@ -178,7 +178,9 @@ fn assemble_joint(
     if let Some((values, pos)) = mat {
         let mut seeds = [[Seed::default(); 6]; 2];
         for (l, sl) in seeds.iter_mut().enumerate().take(k.len()) {
-            *sl = std::array::from_fn(|c| seed(dofs[6 * l] / 6, c));
+            for (c, s) in sl.iter_mut().enumerate() {
+                *s = seed(dofs[6 * l] / 6, c);
+            }
         }
         let mut t = [0.0; 18 * 18];
         j.tangent(&a, &b, lam, ctx, &seeds[..k.len()], &mut t[..n * n]);
@@ -423,8 +425,13 @@ impl Assembler {
             if let (Element::Beam(bm), true, false) = (e, self.multilane, self.beam_tangent_dual) {
                 // all 24 columns in closed form
                 let kk = [kf[0], kf[1], kf[2], kf[3]];
-                let seeds: [[Seed; 6]; 4] =
-                    std::array::from_fn(|l| std::array::from_fn(|c| seed(dofs[6 * l] / 6, c)));
+                // filled in place: built through nested `from_fn` the 3 kB array is copied
+                let mut seeds = [[Seed::default(); 6]; 4];
+                for (l, sl) in seeds.iter_mut().enumerate() {
+                    for (c, s) in sl.iter_mut().enumerate() {
+                        *s = seed(dofs[6 * l] / 6, c);
+                    }
+                }
                 let mut t = [0.0; 576];
                 bm.tangent(&kk, ctx, &seeds, &mut t);
                 for (p, v) in pos.iter().zip(t.iter()) {

@@ -613,7 +613,9 @@ impl Beam {
         rr: &M3<f64>,
         psi: &[V3<f64>; 4],
     ) -> [([f64; 3], M3<f64>, [f64; 3], [f64; 3]); NPTS_M] {
-        std::array::from_fn(|q| {
+        // filled in place (a `from_fn` closure here was called out of line and its result copied)
+        let mut out = [([0.0; 3], [[0.0; 3]; 3], [0.0; 3], [0.0; 3]); NPTS_M];
+        for (q, o) in out.iter_mut().enumerate() {
             let g = &self.gm[q];
             let r = Self::rot_at(g, rr, psi);
             let mut x = [0.0; 3];
@@ -624,8 +626,9 @@ impl Beam {
                 v = add(v, fmul(g.n[i], k[i].v));
                 w = add(w, fmul(g.n[i], k[i].w));
             }
-            (x, r, v, w)
-        })
+            *o = (x, r, v, w);
+        }
+        out
     }
 
     /// Kinetic energy of the element (4-point quadrature).
