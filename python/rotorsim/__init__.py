@@ -137,14 +137,19 @@ STABILITY_OPTIONS = _json.loads(_native.job_options("stability"))
 MODES_OPTIONS = _json.loads(_native.job_options("modes"))
 
 
-def _settings(job, known, options):
-    """Keyword arguments of ``job`` as the JSON its settings type reads (None left out)."""
+def _check_known(job, known, options):
+    """A TypeError naming the keywords of ``options`` that are not options of ``job``."""
     unknown = sorted(k for k in options if k not in known)
     if unknown:
         raise TypeError(
             f"{job}() got unexpected keyword argument(s) {', '.join(unknown)} "
             f"(the options of rotorsim {job} are {', '.join(known)})"
         )
+
+
+def _settings(job, known, options):
+    """Keyword arguments of ``job`` as the JSON its settings type reads (None left out)."""
+    _check_known(job, known, options)
     settings = {}
     for k, v in options.items():
         if v is None:
@@ -188,12 +193,7 @@ def run(out=None, progress=True, models=None, rotor_model=None, **options):
     if rotor_model is not None:
         _deprecated("rotor_model", "model")
         options.setdefault("model", rotor_model)
-    unknown = sorted(k for k in options if k not in RUN_OPTIONS)
-    if unknown:
-        raise TypeError(
-            f"run() got unexpected keyword argument(s) {', '.join(unknown)} "
-            f"(the options of rotorsim run are {', '.join(RUN_OPTIONS)})"
-        )
+    _check_known("run", RUN_OPTIONS, options)
     settings = {k: v for k, v in options.items() if v is not None}
     if "damper" in settings:
         settings["damper"] = _damper_choice(settings["damper"])
@@ -570,12 +570,7 @@ def diagnose(damper_deck=None, measured=None, *, out=None, progress=None, deck=N
         _deprecated("deck", "damper_deck")
         if damper_deck is None:
             damper_deck = deck
-    unknown = sorted(k for k in options if k not in DIAGNOSE_OPTIONS)
-    if unknown:
-        raise TypeError(
-            f"diagnose() got unexpected keyword argument(s) {', '.join(unknown)} "
-            f"(the options of rotorsim diagnose are {', '.join(DIAGNOSE_OPTIONS)})"
-        )
+    _check_known("diagnose", DIAGNOSE_OPTIONS, options)
     settings = {k: v for k, v in options.items() if v is not None}
     if damper_deck is not None:
         settings["damper_deck"] = damper_deck
