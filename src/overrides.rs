@@ -130,24 +130,19 @@ pub fn apply(root: &mut Table, ov: &Override) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Applies `overrides` to the deck text one after the other, validating the deck with
+/// Applies `overrides` to the parsed deck `root` one after the other, validating the deck with
 /// `validate` after each (after the last of consecutive keys of one table), and returns the
-/// final text. An error names the override (`--set
-/// KEY=VALUE: ...`) followed by the deck's own message, which names the file and the key.
+/// edited tables. An error names the override (`--set KEY=VALUE: ...`) followed by the deck's
+/// own message, which names the file and the key.
 pub fn apply_all(
-    text: &str,
+    mut root: Table,
     file: &str,
     overrides: &[Override],
-    validate: impl Fn(&str, &Override) -> anyhow::Result<()>,
-) -> anyhow::Result<String> {
-    let mut root: Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| anyhow!("deck {file}: {}", e.to_string().trim_end()))?;
-    let mut out = text.to_string();
+    validate: impl Fn(&Table, &Override) -> anyhow::Result<()>,
+) -> anyhow::Result<Table> {
     let table = |k: &str| k.rsplit_once('.').map(|(t, _)| t.to_string());
     for (i, ov) in overrides.iter().enumerate() {
         apply(&mut root, ov).map_err(|e| anyhow!("--set {ov}: deck {file}, {}: {e}", ov.key))?;
-        out = toml::to_string(&root).map_err(|e| anyhow!("--set {ov}: deck {file}: {e}"))?;
         // a table built key by key (`--set airframe.x.mass_kg=... --set
         // airframe.x.stiffness_N_per_m=...`) is checked once its next key is set
         let completed_later = table(&ov.key).is_some_and(|t| {
@@ -155,13 +150,19 @@ pub fn apply_all(
                 .iter()
                 .any(|o| table(&o.key).as_deref() == Some(t.as_str()))
         });
-        if let Err(e) = validate(&out, ov) {
+        if let Err(e) = validate(&root, ov) {
             if !completed_later {
                 return Err(anyhow!("--set {ov}: {e:#}"));
             }
         }
     }
-    Ok(out)
+    Ok(root)
+}
+
+/// The deck text `text` parsed, an error naming `file`.
+pub fn parse_deck(text: &str, file: &str) -> anyhow::Result<Table> {
+    text.parse()
+        .map_err(|e: toml::de::Error| anyhow!("deck {file}: {}", e.to_string().trim_end()))
 }
 
 #[cfg(test)]

@@ -211,13 +211,13 @@ fn set_entry(file: &str, ov: &Override, n: usize) -> anyhow::Result<Entry> {
     })
 }
 
-/// The rotor reader's verdict on `text`; a schema error without the position in the generated
-/// text (the user wrote the value elsewhere: the caller names where).
-fn check_rotor(text: &str, file: &str) -> anyhow::Result<()> {
-    if let Err(e) = toml::from_str::<RotorSpec>(text) {
+/// The rotor reader's verdict on the tables `root`; a schema error without the table's path
+/// (the user wrote the value elsewhere: the caller names where).
+fn check_rotor(root: &Table, file: &str) -> anyhow::Result<()> {
+    if let Err(e) = RotorSpec::schema(root) {
         bail!("{}", e.message().trim_end());
     }
-    RotorSpec::parse(text, file).map(|_| ())
+    RotorSpec::from_table(root, file).map(|_| ())
 }
 
 impl RotorDeck {
@@ -278,9 +278,7 @@ impl RotorDeck {
 
     /// The base deck's tables (the `[blades]` table removed).
     fn base_table(&self) -> anyhow::Result<Table> {
-        let mut root: Table = self.text.parse().map_err(|e: toml::de::Error| {
-            anyhow!("rotor deck {}: {}", self.file(), e.to_string().trim_end())
-        })?;
+        let mut root = self.table.clone();
         root.remove(KEY);
         Ok(root)
     }
@@ -303,24 +301,18 @@ impl RotorDeck {
             .into_iter()
             .filter(|e| e.blade == k && (has_damper || !e.ov.is_damper()))
             .collect();
-        let mut text = if self.blades.table.is_some() {
-            toml::to_string(&root).map_err(|e| anyhow!("rotor deck {file}: {e}"))?
-        } else {
-            self.text.clone()
-        };
         for e in &entries {
             overrides::apply(&mut root, &e.ov).map_err(|err| e.error(&file, &err))?;
-            text = toml::to_string(&root).map_err(|err| e.error(&file, &err.into()))?;
-            check_rotor(&text, &file).map_err(|err| e.error(&file, &err))?;
+            check_rotor(&root, &file).map_err(|err| e.error(&file, &err))?;
             if e.ov.is_damper() {
-                DamperDeck::from_toml_str(&text, &file)
+                DamperDeck::from_toml_table(root.clone(), &file)
                     .map_err(|err| e.error(&file, &err.into()))?;
             }
         }
         Ok(RotorDeck {
             path: self.path.clone(),
-            spec: RotorSpec::parse(&text, &file)?,
-            text,
+            spec: RotorSpec::from_table(&root, &file)?,
+            table: root,
             blades: PerBlade::default(),
             damper: Default::default(),
             assumed: self.assumed.clone(),
@@ -354,12 +346,10 @@ impl RotorDeck {
         let text = std::fs::read_to_string(damper_file)
             .map_err(|e| anyhow!("damper deck {dfile}: cannot read: {e}"))?;
         DamperDeck::from_toml_str(&text, &dfile)?;
-        let mut text = overrides::apply_all(&text, &dfile, damper_sets, |t, _| {
-            DamperDeck::from_toml_str(t, &dfile)?;
+        let root = overrides::parse_deck(&text, &dfile)?;
+        let mut root = overrides::apply_all(root, &dfile, damper_sets, |t, _| {
+            DamperDeck::from_toml_table(t.clone(), &dfile)?;
             Ok(())
-        })?;
-        let mut root: Table = text.parse().map_err(|e: toml::de::Error| {
-            anyhow!("damper deck {dfile}: {}", e.to_string().trim_end())
         })?;
         let file = self.file();
         for e in self
@@ -376,10 +366,9 @@ impl RotorDeck {
                 )
             };
             overrides::apply(&mut root, &e.ov).map_err(|err| ctx(&err))?;
-            text = toml::to_string(&root).map_err(|err| ctx(&err.into()))?;
-            DamperDeck::from_toml_str(&text, &dfile).map_err(|err| ctx(&err.into()))?;
+            DamperDeck::from_toml_table(root.clone(), &dfile).map_err(|err| ctx(&err.into()))?;
         }
-        Ok(DamperDeck::from_toml_str(&text, &dfile)?)
+        Ok(DamperDeck::from_toml_table(root, &dfile)?)
     }
 
     /// Refuses bad per-blade input before anything runs, naming the file and the key as

@@ -822,6 +822,13 @@ pub struct LagMoments {
     pub inertia_kg_m2: f64,
 }
 
+/// The error for a hinged-blade deck given where an elastomeric rotor is read.
+fn hinged_deck(file: &str) -> anyhow::Error {
+    anyhow::anyhow!(
+        "rotor deck {file}: a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it"
+    )
+}
+
 impl RotorSpec {
     /// The bearing's lag spring and dashpot for the linear models (an elastomer's equivalent
     /// at its reference frequency, [`BearingTable::equivalent`]).
@@ -1025,9 +1032,7 @@ impl RotorSpec {
     /// Parse deck text; `file` names it in errors (toml reports line and column).
     pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
         if super::RotorKind::of_text(text) == super::RotorKind::Hinged {
-            anyhow::bail!(
-                "rotor deck {file}: a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it"
-            );
+            return Err(hinged_deck(file));
         }
         let spec: RotorSpec = toml::from_str(text)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.to_string().trim_end()))?;
@@ -1040,6 +1045,22 @@ impl RotorSpec {
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
         Self::parse(&text, &file)
+    }
+
+    /// The deck of parsed (and possibly overridden) tables, validated like [`RotorSpec::parse`].
+    pub fn from_table(root: &toml::Table, file: &str) -> anyhow::Result<Self> {
+        if root.contains_key("hinge") {
+            return Err(hinged_deck(file));
+        }
+        let spec = Self::schema(root)
+            .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.message().trim_end()))?;
+        spec.validate(file)?;
+        Ok(spec)
+    }
+
+    /// The tables read by the schema alone (no value checked).
+    pub fn schema(root: &toml::Table) -> Result<Self, toml::de::Error> {
+        toml::Value::Table(root.clone()).try_into()
     }
 
     fn validate(&self, file: &str) -> anyhow::Result<()> {

@@ -275,8 +275,8 @@ pub struct RotorDeck {
     pub path: std::path::PathBuf,
     /// The parsed tables of the base deck (`blades` None).
     pub spec: deck::RotorSpec,
-    /// The deck text, overrides applied (the `[damper]` table is read from it).
-    text: String,
+    /// The deck's tables as read, overrides applied (what a blade's deck starts from).
+    table: toml::Table,
     /// The per-blade differences, applied only to the blades' decks.
     blades: blades::PerBlade,
     /// The typed `[damper]` table, read on first use (a command that runs no damper does not
@@ -354,39 +354,40 @@ impl RotorDeck {
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
         let spec = deck::RotorSpec::parse(&text, &file)?;
-        let assumed = match text.parse::<toml::Table>() {
-            Ok(root) => assumed::scan(&text, &root),
-            Err(_) => assumed::Scan::default(), // RotorSpec::parse has read it: unreachable
-        };
+        let root = crate::overrides::parse_deck(&text, &file)?;
+        let assumed = assumed::scan(&text, &root);
         let (sets, overrides): (Vec<Override>, Vec<Override>) = overrides
             .iter()
             .cloned()
             .partition(blades::is_blade_override);
-        let (text, mut spec) = if overrides.is_empty() {
-            (text, spec)
+        let (root, mut spec) = if overrides.is_empty() {
+            (root, spec)
         } else {
-            let text = crate::overrides::apply_all(&text, &file, &overrides, |t, ov| {
-                // the schema's message without its position in the generated text: the user
-                // wrote the value on the command line, which the caller names
-                if let Err(e) = toml::from_str::<deck::RotorSpec>(t) {
+            let root = crate::overrides::apply_all(root, &file, &overrides, |t, ov| {
+                // the schema's message without its position: the user wrote the value on the
+                // command line, which the caller names
+                if let Err(e) = deck::RotorSpec::schema(t) {
                     let table = ov.key.rsplit_once('.').map_or("", |(t, _)| t);
                     anyhow::bail!("rotor deck {file}, {table}: {}", e.message().trim_end());
                 }
-                deck::RotorSpec::parse(t, &file)?;
+                deck::RotorSpec::from_table(t, &file)?;
                 if ov.is_damper() {
-                    DamperDeck::from_toml_str(t, &file)?;
+                    DamperDeck::from_toml_table(t.clone(), &file)?;
                 }
                 Ok(())
             })?;
-            let spec = deck::RotorSpec::parse(&text, &file)?;
-            (text, spec)
+            let spec = deck::RotorSpec::from_table(&root, &file)?;
+            (root, spec)
         };
-        let table = spec.blades.take();
+        let per_blade = spec.blades.take();
         let deck = RotorDeck {
             path: path.to_path_buf(),
             spec,
-            text,
-            blades: blades::PerBlade { table, sets },
+            table: root,
+            blades: blades::PerBlade {
+                table: per_blade,
+                sets,
+            },
             damper: Default::default(),
             assumed,
         };
@@ -405,6 +406,10 @@ impl RotorDeck {
     /// values and lines; overrides do not change what is labelled).
     pub fn assumed(&self) -> &assumed::Scan {
         &self.assumed
+    }
+    /// The deck's values as read, overrides applied (keys as `--set` takes them).
+    pub fn table(&self) -> &toml::Table {
+        &self.table
     }
     /// The deck's `[damper]` table (overrides applied).
     pub fn damper(&self) -> anyhow::Result<DamperDeck> {

@@ -449,11 +449,12 @@ pub fn damper_deck_with(path: &Path, overrides: &[Override]) -> anyhow::Result<D
     let text = std::fs::read_to_string(path)
         .map_err(|e| anyhow!("damper deck {file}: cannot read: {e}"))?;
     DamperDeck::from_toml_str(&text, &file)?;
-    let text = crate::overrides::apply_all(&text, &file, overrides, |t, _| {
-        DamperDeck::from_toml_str(t, &file)?;
+    let root = crate::overrides::parse_deck(&text, &file)?;
+    let root = crate::overrides::apply_all(root, &file, overrides, |t, _| {
+        DamperDeck::from_toml_table(t.clone(), &file)?;
         Ok(())
     })?;
-    Ok(DamperDeck::from_toml_str(&text, &file)?)
+    Ok(DamperDeck::from_toml_table(root, &file)?)
 }
 
 /// The units that run side by side: one per damper model, or per model and blade (separate

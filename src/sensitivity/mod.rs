@@ -183,22 +183,20 @@ fn case_with(base: &Table, id: &str, setting: Option<(&str, Value)>) -> sweep::C
 /// the plan text. Errors name the option or the key.
 pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<Setup> {
     let file = o.rotor.display().to_string();
-    let text = std::fs::read_to_string(&o.rotor)
-        .with_context(|| format!("--rotor {file}: cannot read the rotor deck"))?;
-    let root: Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| anyhow!("--rotor {file}: {}", e.to_string().trim_end()))?;
+    let deck = crate::rotor::RotorDeck::from_file(&o.rotor)
+        .with_context(|| format!("--rotor {file}: reading the rotor deck"))?;
+    let root = deck.table();
     let damper = match &o.damper {
         Some(d) if d == "all" => bail!(
             "--damper all: a sensitivity follows one damper model (linear, nonlinear or physical)"
         ),
         Some(d) => d.clone(),
-        None => scan::lookup(&root, "damper.model")
+        None => scan::lookup(root, "damper.model")
             .and_then(|v| v.as_str())
             .unwrap_or("physical")
             .to_string(),
     };
-    let found = scan::scan(&text, &root);
+    let found = deck.assumed();
     let mut skipped = found.skipped.clone();
     let mut targets: Vec<Target> = Vec::new();
     if !o.only_vary {
@@ -243,7 +241,7 @@ pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<
         params.push(default_param(t, &check));
     }
     for v in &o.vary {
-        let t = scan::target_of(&root, &v.key)
+        let t = scan::target_of(root, &v.key)
             .map_err(|e| anyhow!("--vary {}: deck {file}: {e}", v.text))?;
         if t.integer && (v.low.fract() != 0.0 || v.high.fract() != 0.0) {
             bail!(
