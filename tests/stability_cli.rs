@@ -143,7 +143,16 @@ fn hammond_deck_with_one_damper_out_is_unstable_and_a_result() {
     );
     println!("{text}");
     assert!(ok, "an unstable rotor is a result: {text}");
-    assert!(text.contains("UNSTABLE: regressing lag from"), "{text}");
+    assert!(
+        text.contains("linear map: regressing lag grows from"),
+        "{text}"
+    );
+    // every UNSTABLE or marginal verdict names its band and the values that decide it
+    for l in text.lines() {
+        if l.starts_with("UNSTABLE") || l.starts_with("marginal") {
+            assert!(l.contains(" band ") && l.contains("decided by"), "{l}");
+        }
+    }
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(s["stable"], false);
@@ -188,7 +197,7 @@ fn hammond_deck_with_one_damper_out_is_unstable_and_a_result() {
     );
     assert!(worst < 1e-6, "{worst}");
     let html = std::fs::read_to_string(out.join("stability.html")).unwrap();
-    assert!(html.contains("UNSTABLE") && html.contains("unstable: regressing lag"));
+    assert!(html.contains("growing regressing lag") && html.contains("unstable: regressing lag"));
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -54,13 +54,14 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
     } else {
         for u in &map.unstable {
             outln!(
-                "UNSTABLE: {} from {:.3} to {:.3} rad/s, growth rate up to {:.4} 1/s",
+                "linear map: {} grows {}",
                 u.mode,
-                u.from_rad_s,
-                u.to_rad_s,
-                u.max_growth_rate_per_s
+                crate::resonance::range_text(&map, u)
             );
         }
+    }
+    for v in &map.verdicts {
+        outln!("{}", v.line());
     }
     for n in &map.notes {
         outln!("note: {n}");

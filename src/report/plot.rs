@@ -60,6 +60,28 @@ pub fn model_colour(name: &str) -> Option<RGBColor> {
         })
 }
 
+/// The stability modes' colours, one per mode family in every report: lag modes in blues and
+/// greens, flap modes in oranges, the airframe's directions in reds, purples and greys.
+pub const MODE_COLOURS: [(&str, RGBColor); 12] = [
+    ("regressing lag", RGBColor(31, 119, 180)),
+    ("progressive lag", RGBColor(23, 190, 207)),
+    ("collective lag", RGBColor(44, 160, 44)),
+    ("differential lag", RGBColor(188, 189, 34)),
+    ("regressing flap", RGBColor(255, 127, 14)),
+    ("progressive flap", RGBColor(227, 119, 194)),
+    ("collective flap", RGBColor(140, 86, 75)),
+    ("differential flap", RGBColor(255, 187, 120)),
+    ("airframe x", RGBColor(214, 39, 40)),
+    ("airframe y", RGBColor(148, 103, 189)),
+    ("airframe roll", RGBColor(127, 127, 127)),
+    ("airframe pitch", RGBColor(0, 0, 128)),
+];
+
+/// The fixed colour of a stability mode label, or None.
+pub fn mode_colour(label: &str) -> Option<RGBColor> {
+    MODE_COLOURS.iter().find(|m| m.0 == label).map(|m| m.1)
+}
+
 /// The colour as a CSS hex string (for HTML next to the plots).
 pub fn css(c: RGBColor) -> String {
     format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2)
@@ -540,6 +562,15 @@ impl Plot {
                 s.x.iter()
                     .zip(&s.y)
                     .filter(|(x, y)| x.is_finite() && y.is_finite())
+                    // a marker outside a y range that was asked for is left out, not drawn
+                    // over the axes (lines and bands keep their points)
+                    .filter(|(_, &y)| {
+                        !matches!(
+                            s.kind,
+                            SeriesKind::Points | SeriesKind::Dots | SeriesKind::Rings
+                        ) || self.y_categories.is_some()
+                            || self.y_range.is_none_or(|(lo, hi)| (lo..=hi).contains(&y))
+                    })
                     .map(|(&x, &y)| (x * sx, fy(y)))
                     .collect();
             match s.kind {

@@ -389,6 +389,7 @@ pub fn air_resonance_map(
         unstable,
         notes,
         overrides: Vec::new(),
+        verdicts: Vec::new(),
         hover: Some(report),
     })
 }

@@ -95,6 +95,8 @@ pub struct StabilityMap {
     pub overrides: Vec<(String, String)>,
     /// Air resonance in hover ([`air`]); `None` on the ground.
     pub hover: Option<air::HoverReport>,
+    /// The verdicts with their bands ([`super::band`]; empty until the job computes them).
+    pub verdicts: Vec<super::band::Verdict>,
 }
 
 impl StabilityMap {
@@ -311,6 +313,7 @@ pub fn stability_map(
         unstable,
         notes,
         overrides: Vec::new(),
+        verdicts: Vec::new(),
         hover: None,
     })
 }

@@ -256,6 +256,20 @@ impl StabilityJob {
                 return Err(e);
             }
         };
+        let mut map = map;
+        say("verdict bands: the map moved over the deck's assumed values...");
+        let cond = if self.hover {
+            band::Condition::Hover(&hover)
+        } else {
+            band::Condition::Ground
+        };
+        match band::verdicts(&deck, &self.set, model, &map, cond) {
+            Ok(v) => map.verdicts = v,
+            Err(e) => {
+                out.mark_incomplete(&format!("{e:#}"))?;
+                return Err(e.context("verdict bands"));
+            }
+        }
         let mut time = vec![];
         for &w in &time_speeds {
             say(&format!(

@@ -6,6 +6,7 @@
 //! periodic equations over one revolution.
 pub mod air;
 pub mod amplitude;
+pub mod band;
 pub mod rigid_blade;
 
 mod ground;

@@ -69,6 +69,7 @@ pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
         "airframe_y": axis(&map.y),
         "stable": map.unstable.is_empty(),
         "unstable": map.unstable,
+        "verdicts": map.verdicts,
         "min_damping_ratio": min.as_ref().map(|m| m.0),
         "min_damping_mode": min.as_ref().map(|m| m.1.clone()),
         "min_damping_speed_rad_s": min.as_ref().map(|m| m.2),
@@ -76,6 +77,32 @@ pub fn summary_json(map: &StabilityMap, deck: &RotorDeck) -> serde_json::Value {
         "hover": map.hover,
         "notes": map.notes,
     })
+}
+
+/// Largest damping ratio the damping plot's axis is sized for (the modes a resonance is about).
+pub const DAMPING_AXIS_MAX: f64 = 0.3;
+
+/// "from A to B rad/s (growth rate up to G 1/s)", an end at the first or last speed of the map
+/// said to be the scan's end (the range may go on beyond it).
+pub fn range_text(map: &StabilityMap, u: &UnstableRange) -> String {
+    let first = map.speeds.first().map_or(f64::NAN, |s| s.omega_rad_s);
+    let last = map.speeds.last().map_or(f64::NAN, |s| s.omega_rad_s);
+    let mut ends = vec![];
+    if u.from_rad_s <= first {
+        ends.push("from the scan's first speed: it may begin below");
+    }
+    if u.to_rad_s >= last {
+        ends.push("to the scan's last speed: it may go on above");
+    }
+    let ends = if ends.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", ends.join("; "))
+    };
+    format!(
+        "from {:.3} to {:.3} rad/s{ends}, growth rate up to {:.4} 1/s",
+        u.from_rad_s, u.to_rad_s, u.max_growth_rate_per_s
+    )
 }
 
 /// stability.html: the Coleman diagram, damping versus speed with the unstable ranges shaded,
@@ -114,14 +141,26 @@ fn html_intro(rep: &mut HtmlReport, map: &StabilityMap, deck: &RotorDeck) {
         let ranges: Vec<String> = map
             .unstable
             .iter()
-            .map(|u| {
-                format!(
-                    "{} from {:.3} to {:.3} rad/s (growth rate up to {:.4} 1/s)",
-                    u.mode, u.from_rad_s, u.to_rad_s, u.max_growth_rate_per_s
-                )
-            })
+            .map(|u| format!("{} {}", u.mode, range_text(map, u)))
             .collect();
-        rep.banner(Banner::Bad, &format!("UNSTABLE: {}.", ranges.join("; ")));
+        rep.banner(
+            Banner::Bad,
+            &format!("Linear map: growing {}.", ranges.join("; ")),
+        );
+    }
+    for v in &map.verdicts {
+        let kind = match v.call {
+            band::Call::Stable => Banner::Ok,
+            _ => Banner::Bad,
+        };
+        rep.banner(kind, &format!("{}.", v.line()));
+    }
+    if !map.verdicts.is_empty() {
+        rep.paragraph(&format!(
+            "A verdict's band: the map recomputed at the verdict's speed with each of the deck's ASSUMED values at x1/{a} and x{a} (and, for the physical damper, the flow laws' numerical floor dp_laminar_Pa at x1/{f} and x{f}), the changes of the growth rate combined in quadrature on each side. UNSTABLE only where the whole band grows, marginal where it crosses zero (docs/stability.md, \"Verdicts and their band\").",
+            a = band::ASSUMED_FACTOR,
+            f = band::FLOOR_FACTOR
+        ));
     }
     let how = if method == "coleman" {
         "identical blades: constant-coefficient equations in multi-blade coordinates"
@@ -180,27 +219,50 @@ fn html_figures(rep: &mut HtmlReport, map: &StabilityMap) -> anyhow::Result<()> 
         "rotor speed [rad/s]",
         "frequency [Hz]",
     );
+    // the axis holds the lightly damped modes: overdamped ones (ratio above DAMPING_AXIS_MAX,
+    // real roots at +-1) would squeeze an unstable -0.01 onto the zero line
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    for s in &map.speeds {
+        for m in &s.modes {
+            let z = m.damping_ratio;
+            if z.abs() < 0.999 && z < DAMPING_AXIS_MAX {
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
+        }
+    }
+    let pad = 0.08 * (hi - lo).max(1e-3);
+    let (lo, hi) = (lo - pad, hi + pad);
+    let clipped = map
+        .speeds
+        .iter()
+        .flat_map(|s| &s.modes)
+        .any(|m| m.damping_ratio < lo || m.damping_ratio > hi);
     let mut damping = Plot::new(
-        "Damping ratio (unstable ranges shaded)",
+        if clipped {
+            "Damping ratio (unstable ranges shaded; axis clipped to the lightly damped modes)"
+        } else {
+            "Damping ratio (unstable ranges shaded)"
+        },
         "rotor speed [rad/s]",
         "damping ratio [-]",
-    );
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    )
+    .y_range(lo, hi);
     for l in &label_order {
         let (x, f) = series(&|m| m.frequency_hz, l);
         coleman = coleman.points(l, &x, &f);
         let (x, z) = series(&|m| m.damping_ratio, l);
-        for v in &z {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
         damping = damping.points(l, &x, &z);
+        if let Some(c) = crate::report::plot::mode_colour(l) {
+            coleman = coleman.colour(c);
+            damping = damping.colour(c);
+        }
     }
     for u in &map.unstable {
         damping = damping.band(
             &format!("unstable: {}", u.mode),
             &[u.from_rad_s, u.to_rad_s],
-            &[lo.min(0.0), hi],
+            &[lo, hi],
         );
     }
     let sp: Vec<f64> = map.speeds.iter().map(|s| s.omega_rad_s).collect();

@@ -207,6 +207,126 @@ pub fn scan(text: &str, root: &Table) -> Scan {
     out
 }
 
+/// One number of the deck moved by a sensitivity study or a verdict's band: a scalar at `key`, or component `index`
+/// of the number array at `key`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Target {
+    pub key: String,
+    pub index: Option<usize>,
+    /// The deck's value there.
+    pub nominal: f64,
+    /// The whole array (for a component), to be written back with one component changed.
+    pub array: Option<Vec<f64>>,
+    /// Whether the deck holds an integer (a `--vary` value must then be whole).
+    pub integer: bool,
+    pub line: Option<usize>,
+}
+
+impl Target {
+    /// The name shown in tables: `key`, or `key[i]` for a component.
+    pub fn name(&self) -> String {
+        match self.index {
+            Some(i) => format!("{}[{i}]", self.key),
+            None => self.key.clone(),
+        }
+    }
+
+    /// The deck value (for an override of `key`) with this number set to `x`.
+    pub fn value_at(&self, x: f64) -> Value {
+        match (&self.array, self.index) {
+            (Some(a), Some(i)) => Value::Array(
+                a.iter()
+                    .enumerate()
+                    .map(|(k, v)| Value::Float(if k == i { x } else { *v }))
+                    .collect(),
+            ),
+            _ if self.integer => Value::Integer(x.round() as i64),
+            _ => Value::Float(x),
+        }
+    }
+}
+
+/// The numbers of a labelled value that the sensitivity moves by default, and the skipped
+/// ones with the reason: a nonzero number; each nonzero component of an array of numbers.
+pub fn targets(l: &Labelled) -> (Vec<Target>, Vec<Skipped>) {
+    let skip = |key: String, reason: String| Skipped {
+        line: l.line,
+        key: Some(key),
+        text: format!("{} = {}  # {}", l.key, l.value, l.comment),
+        reason,
+    };
+    let zero = "zero: x0.5 and x2 of 0 are 0, so there is no relative range; give one with --vary KEY=LOW:HIGH";
+    match &l.value {
+        Value::Float(x) if *x != 0.0 && x.is_finite() => (
+            vec![Target {
+                key: l.key.clone(),
+                index: None,
+                nominal: *x,
+                array: None,
+                integer: false,
+                line: Some(l.line),
+            }],
+            vec![],
+        ),
+        Value::Float(_) => (vec![], vec![skip(l.key.clone(), zero.into())]),
+        Value::Integer(_) => (
+            vec![],
+            vec![skip(
+                l.key.clone(),
+                "an integer count: halving or doubling a count is not a stated range; give one with --vary KEY=LOW:HIGH".into(),
+            )],
+        ),
+        Value::Array(a) => {
+            let nums: Option<Vec<f64>> = a
+                .iter()
+                .map(|v| match v {
+                    Value::Float(x) => Some(*x),
+                    Value::Integer(i) => Some(*i as f64),
+                    _ => None,
+                })
+                .collect();
+            let Some(nums) = nums else {
+                return (
+                    vec![],
+                    vec![skip(
+                        l.key.clone(),
+                        "an array of other than numbers (a table of rows): not varied".into(),
+                    )],
+                );
+            };
+            let mut t = Vec::new();
+            let mut s = Vec::new();
+            for (i, x) in nums.iter().enumerate() {
+                let name = format!("{}[{i}]", l.key);
+                if *x == 0.0 || !x.is_finite() {
+                    s.push(skip(name, zero.into()));
+                } else {
+                    t.push(Target {
+                        key: l.key.clone(),
+                        index: Some(i),
+                        nominal: *x,
+                        array: Some(nums.clone()),
+                        integer: false,
+                        line: Some(l.line),
+                    });
+                }
+            }
+            (t, s)
+        }
+        Value::Table(_) => (
+            vec![],
+            vec![skip(
+                l.key.clone(),
+                "an inline table of several values: name one with --vary KEY.MEMBER=LOW:HIGH".into(),
+            )],
+        ),
+        Value::String(_) | Value::Boolean(_) | Value::Datetime(_) => (
+            vec![],
+            vec![skip(l.key.clone(), "not a number: not varied".into())],
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
