@@ -31,8 +31,22 @@ fn check(
     unit: &str,
     output_rate: Option<f64>,
 ) -> Vec<f64> {
+    check_cycles(name, deck, omega, peak, unit, output_rate, 10)
+}
+
+/// [`check`] with `cycles` stroking cycles.
+fn check_cycles(
+    name: &str,
+    deck: &str,
+    omega: f64,
+    peak: &[f64],
+    unit: &str,
+    output_rate: Option<f64>,
+    cycles: usize,
+) -> Vec<f64> {
     let out = tmp(name);
     let mut job = BenchJob::new(root().join(deck), out.join("bench"));
+    job.cycles = cycles;
     job.damper = Some("physical".into());
     job.omega = omega;
     job.peak_velocity = peak.to_vec();
@@ -123,6 +137,18 @@ fn design_deck_bench_is_converged() {
         "in/s",
         None,
     );
+}
+
+/// tests/shipped_examples.rs's bench of every shipped damper deck (goldens
+/// tests/golden/examples/*-bench.txt): 1 and 6 in/s, 2 cycles.
+#[test]
+fn shipped_example_benches_are_converged() {
+    for (name, deck) in [
+        ("conv_ex_nominal", "flightdata/damper_nominal.toml"),
+        ("conv_ex_design", "rotors/uh60a_damper_design.toml"),
+    ] {
+        check_cycles(name, deck, 27.02, &[1.0, 6.0], "in/s", None, 2);
+    }
 }
 
 /// 0.1 mm at 7.8 rad/s on the nominal damper: RK4 at 256 steps per cycle and 25 sub-steps gave
