@@ -252,12 +252,23 @@ fn sweep_writes_summary_histories_by_amplitude_and_bench_html() {
         header,
         "model,peak_velocity_m_s,peak_velocity_in_s,amplitude_m,omega_rad_s,output_rate_Hz,\
 peak_force_pos_N,peak_force_neg_N,K_storage_N_per_m,K_loss_N_per_m,energy_per_cycle_J,\
-equivalent_damping_N_s_per_m,history_file"
+equivalent_damping_N_s_per_m,history_file,steps_per_cycle,substeps,scheme,convergence,\
+relative_error,peak_force_pos_error_N,peak_force_neg_error_N,K_storage_error_N_per_m,\
+K_loss_error_N_per_m,energy_per_cycle_error_J,equivalent_damping_error_N_s_per_m"
     );
-    // every numeric column carries its unit
+    // every numeric column carries its unit (counts, names and the relative error have none)
     for col in header.split(',') {
         assert!(
-            ["model", "history_file"].contains(&col)
+            [
+                "model",
+                "history_file",
+                "steps_per_cycle",
+                "substeps",
+                "scheme",
+                "convergence",
+                "relative_error",
+            ]
+            .contains(&col)
                 || ["_m", "_s", "_Hz", "_N", "_J", "_per_m"]
                     .iter()
                     .any(|u| col.ends_with(u)),
@@ -284,10 +295,13 @@ equivalent_damping_N_s_per_m,history_file"
     let models = csv_column(&s, "model");
     let kl = csv_column(&s, "K_loss_N_per_m");
     let ks = csv_column(&s, "K_storage_N_per_m");
+    // the default refines: each row at its own steps per cycle
+    let steps = csv_column(&s, "steps_per_cycle");
     for i in (0..models.len()).filter(|&i| models[i] == "linear") {
         let k2: f64 = kl[i].parse().unwrap();
+        let n: usize = steps[i].parse().unwrap();
         assert!(
-            (k2 / (c * 27.02 * attenuation(256)) - 1.0).abs() < 1e-10,
+            (k2 / (c * 27.02 * attenuation(n)) - 1.0).abs() < 1e-10,
             "{k2}"
         );
         assert!(ks[i].parse::<f64>().unwrap().abs() < 1e-9 * k2);
@@ -334,12 +348,14 @@ equivalent_damping_N_s_per_m,history_file"
     let s = std::fs::read_to_string(one.join("bench_summary.csv")).unwrap();
     assert_eq!(csv_column(&s, "history_file"), ["history_v0.050800m_s.csv"]);
     let rate: f64 = csv_column(&s, "output_rate_Hz")[0].parse().unwrap();
+    // k = 5 samples per step of the first 256 steps per cycle, kept when the default refines
+    let n: usize = csv_column(&s, "steps_per_cycle")[0].parse().unwrap();
     assert!(
-        (rate - 5.0 * 27.02 * 256.0 / (2.0 * PI)).abs() < 1e-6,
+        (rate - 5.0 * 27.02 * n as f64 / (2.0 * PI)).abs() < 1e-6,
         "{rate}"
     );
     let h = std::fs::read_to_string(one.join("history_v0.050800m_s.csv")).unwrap();
-    assert_eq!(h.lines().count(), 1 + 256 * 5 + 1);
+    assert_eq!(h.lines().count(), 1 + n * 5 + 1);
     assert!(one.join("bench.html").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }

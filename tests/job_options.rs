@@ -272,7 +272,7 @@ fn bench_options_are_cli_json_and_python() {
         },
     );
     assert_eq!(by_alias.damper_deck, Some(PathBuf::from("d.toml")));
-    assert_eq!(by_alias.scheme, "implicit");
+    assert_eq!(by_alias.scheme.as_deref(), Some("implicit"));
 }
 
 #[test]

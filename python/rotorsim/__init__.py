@@ -343,7 +343,9 @@ def bench(damper_deck=None, *, out=None, deck=None, **options):
     every one left out takes the command line's default: ``damper`` (physical, linear,
     nonlinear or all; default the deck's ``model``), ``omega`` (27.02 rad/s), ``peak_velocity``
     (0.5, 1, 2, 3, 4, 6, 8, 10), ``velocity_unit`` (in/s, m/s or ft/s), ``cycles`` (10),
-    ``steps_per_cycle`` (256), ``substeps`` (25), ``scheme`` (rk4 or implicit),
+    ``steps_per_cycle``, ``substeps``, ``scheme`` (implicit or rk4): all three left out, each
+    run is refined from 256 steps per cycle until converged (implicit, 4 sub-steps; the error
+    estimate of each output is in the summary); any given, the bench runs as asked,
     ``output_rate`` (samples per second of the sweep; one per step by default). ``measured``:
     bench CSV file(s) to replay instead of the harmonic sweep, ``skip_cycles`` cycles of each
     left out of the error metrics. An unknown name raises TypeError.

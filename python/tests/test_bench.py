@@ -94,7 +94,8 @@ def test_errors_name_the_file_and_the_option(tmp_path):
 def test_options_are_the_command_lines(tmp_path):
     # every option of `rotorsim bench` is a keyword, with the command line's default
     assert rotorsim.BENCH_OPTIONS["omega"] == 27.02
-    assert rotorsim.BENCH_OPTIONS["scheme"] == "rk4"
+    # left out (None): implicit, steps per cycle refined until converged
+    assert rotorsim.BENCH_OPTIONS["scheme"] is None
     with pytest.raises(TypeError, match="velocity_units"):
         rotorsim.bench(DECK, velocity_units="m/s", out=tmp_path / "a")
     # `deck=`, the earlier name of `damper_deck=`, still works

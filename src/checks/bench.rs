@@ -5,7 +5,8 @@
 //! the deck by [`BenchJob`], which checks the command's options; nothing here prints (the
 //! command reports through the callbacks).
 use crate::hydraulics::bench::{
-    self, BenchTest, HarmonicRun, History, ReplayMetrics, SweepOptions, IN_TO_M, LB_TO_N,
+    self, BenchTest, Convergence, HarmonicRun, History, ReplayMetrics, RunEstimate, SweepOptions,
+    IN_TO_M, LB_TO_N, REFINE_MAX_DOUBLINGS, REFINE_TOLERANCE,
 };
 use crate::hydraulics::{DamperDeck, DamperModel, Device, IntegratorOptions, Scheme};
 use crate::io::{csv_from_columns, OutDir};
@@ -29,11 +30,15 @@ pub struct Config {
     pub velocity_unit: String,
     pub factor: f64,
     pub cycles: usize,
+    /// Steps per cycle (the first of the refinement when `refine`).
     pub steps_per_cycle: usize,
     /// Output samples per step of the harmonic sweep.
     pub per_step: usize,
     /// Hydraulic sub-stepping of each output sample.
     pub opts: IntegratorOptions,
+    /// Refine each run until it converges (the default); false: run as asked, the error
+    /// estimated from one extra run at twice the steps per cycle.
+    pub refine: bool,
     /// Measured tests to replay, and the cycles their metrics leave out.
     pub measured: Vec<PathBuf>,
     pub skip_cycles: usize,
@@ -67,20 +72,19 @@ pub struct BenchSettings {
     /// Number of stroking cycles per amplitude (peaks are taken over the last one).
     #[arg(long, default_value_t = 10)]
     pub cycles: usize,
-    /// Steps per cycle (the structural step of the coupled analysis).
-    #[arg(long, default_value_t = 256)]
-    pub steps_per_cycle: usize,
-    /// Hydraulic sub-steps per step.
-    #[arg(long, default_value_t = 25)]
-    pub substeps: usize,
-    /// Hydraulic sub-step scheme: rk4 or implicit.
-    #[arg(
-        long,
-        alias = "integrator",
-        value_name = "INTEGRATOR",
-        default_value = "rk4"
-    )]
-    pub scheme: String,
+    /// Steps per cycle (the structural step of the coupled analysis). Left out (with --substeps
+    /// and --scheme), each run starts at 256 and doubles them until its outputs converge to
+    /// 0.2 % (at most 16x); given, the bench runs at it as asked.
+    #[arg(long)]
+    pub steps_per_cycle: Option<usize>,
+    /// Hydraulic sub-steps per step (default: 4 with the implicit scheme, 25 with rk4). Given,
+    /// the bench runs as asked (no refinement).
+    #[arg(long)]
+    pub substeps: Option<usize>,
+    /// Hydraulic sub-step scheme: implicit (the default) or rk4. Given, the bench runs as asked
+    /// (no refinement).
+    #[arg(long, alias = "integrator", value_name = "INTEGRATOR")]
+    pub scheme: Option<String>,
     /// Output samples per second of the harmonic sweep (histories, peaks, loops): a multiple k
     /// of the step rate omega x --steps-per-cycle / 2 pi (rounded to the nearest; default k = 1,
     /// a sample at every step end). Each step is fed to the damper in k pieces with
@@ -148,10 +152,12 @@ pub struct BenchJob {
     pub peak_velocity: Vec<f64>,
     pub velocity_unit: String,
     pub cycles: usize,
-    pub steps_per_cycle: usize,
-    pub substeps: usize,
-    /// Hydraulic sub-step scheme: rk4 or implicit.
-    pub scheme: String,
+    /// Steps per cycle, sub-steps per step and scheme (None: the defaults, 256 steps per cycle
+    /// refined until converged, 4 implicit sub-steps; any of them given: run as asked).
+    pub steps_per_cycle: Option<usize>,
+    pub substeps: Option<usize>,
+    /// Hydraulic sub-step scheme: implicit or rk4.
+    pub scheme: Option<String>,
     /// Output samples per second of the harmonic sweep (None: one per step).
     pub output_rate: Option<f64>,
     /// Measured bench tests to replay instead of the harmonic sweep.
@@ -161,11 +167,28 @@ pub struct BenchJob {
     pub out: PathBuf,
 }
 
+/// Steps per cycle of the bench when not given: the first of the refinement.
+pub const DEFAULT_STEPS_PER_CYCLE: usize = 256;
+/// Hydraulic sub-steps per step when not given, by scheme.
+pub const DEFAULT_SUBSTEPS_IMPLICIT: usize = 4;
+pub const DEFAULT_SUBSTEPS_RK4: usize = 25;
+
+/// One model's harmonic sweep as the bench ran it: the sub-stepping, whether it was refined,
+/// and each run's error estimate (in `--peak-velocity` order).
+#[derive(Debug, Clone)]
+pub struct ModelSweep {
+    pub opts: IntegratorOptions,
+    pub refined: bool,
+    pub estimates: Vec<RunEstimate>,
+}
+
 /// What a bench run did, its folder published.
 #[derive(Debug)]
 pub struct BenchOutcome {
     /// Harmonic sweep: each model's runs (empty for a replay).
     pub sweep: Vec<(DamperModel, Vec<HarmonicRun>)>,
+    /// Each model's error estimates, as `sweep`.
+    pub estimates: Vec<(DamperModel, ModelSweep)>,
     /// Output samples per step and hydraulic sub-steps per sample of the harmonic sweep.
     pub per_step: usize,
     pub substeps: usize,
@@ -192,9 +215,9 @@ impl BenchJob {
             peak_velocity: DEFAULT_PEAK_VELOCITIES_IN_S.to_vec(),
             velocity_unit: "in/s".into(),
             cycles: 10,
-            steps_per_cycle: 256,
-            substeps: 25,
-            scheme: "rk4".into(),
+            steps_per_cycle: None,
+            substeps: None,
+            scheme: None,
             output_rate: None,
             measured: vec![],
             skip_cycles: 0,
@@ -204,20 +227,33 @@ impl BenchJob {
 
     /// Checks the options and the deck, builds the devices, and runs the harmonic sweep (or
     /// the replay of `measured`) into `out`. `on_model` gets each model's sweep (and the
-    /// hydraulic sub-stepping of its samples) once its files are written; `note` the replay's
-    /// lines (each test's error metrics).
+    /// hydraulic sub-stepping of its samples and each run's error estimate) once its files are
+    /// written; `note` the replay's lines (each test's error metrics) and the sweep's warnings
+    /// (a run that did not converge or whose error is not estimated).
     pub fn execute(
         &self,
-        on_model: &mut dyn FnMut(DamperModel, &[HarmonicRun], IntegratorOptions),
+        on_model: &mut dyn FnMut(DamperModel, &[HarmonicRun], &ModelSweep),
         note: &mut dyn FnMut(&str),
     ) -> anyhow::Result<BenchOutcome> {
         let deck = DamperDeck::from_file(&self.deck)?;
-        let scheme: Scheme = self
-            .scheme
-            .parse()
-            .map_err(|e| anyhow::anyhow!("--integrator {}: {e}", self.scheme))?;
-        if self.substeps == 0 || self.steps_per_cycle < 4 || self.cycles == 0 {
-            bail!("--substeps and --cycles must be >= 1 and --steps-per-cycle >= 4");
+        let scheme: Scheme = match &self.scheme {
+            None => Scheme::Implicit,
+            Some(s) => s
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--integrator {s}: {e}"))?,
+        };
+        let refine =
+            self.scheme.is_none() && self.steps_per_cycle.is_none() && self.substeps.is_none();
+        let steps_per_cycle = self.steps_per_cycle.unwrap_or(DEFAULT_STEPS_PER_CYCLE);
+        let substeps_asked = self.substeps.unwrap_or(match scheme {
+            Scheme::Implicit => DEFAULT_SUBSTEPS_IMPLICIT,
+            Scheme::Rk4 => DEFAULT_SUBSTEPS_RK4,
+        });
+        if substeps_asked == 0 || steps_per_cycle < 4 || self.cycles == 0 {
+            bail!(
+                "--substeps ({substeps_asked}) and --cycles ({}) must be >= 1 and --steps-per-cycle ({steps_per_cycle}) >= 4",
+                self.cycles
+            );
         }
         let replaying = !self.measured.is_empty();
         if replaying && self.output_rate.is_some() {
@@ -233,7 +269,7 @@ impl BenchJob {
             );
         }
         // Output samples per step (the harmonic sweep only).
-        let step_rate = self.omega * self.steps_per_cycle as f64 / (2.0 * PI);
+        let step_rate = self.omega * steps_per_cycle as f64 / (2.0 * PI);
         let per_step = match self.output_rate {
             None => 1,
             Some(r) if !(r > 0.0 && r.is_finite()) => bail!(
@@ -244,15 +280,18 @@ impl BenchJob {
             ),
             Some(r) => ((r / step_rate).round() as usize).max(1),
         };
-        let substeps = self.substeps.div_ceil(per_step);
-        // per amplitude and model: cycles x steps x pieces x sub-steps, every piece kept (5 columns)
-        let samples = self.cycles as f64 * self.steps_per_cycle as f64 * per_step as f64;
+        let substeps = substeps_asked.div_ceil(per_step);
+        // per amplitude and model: cycles x steps x pieces x sub-steps, every piece kept (5
+        // columns), at the most steps per cycle the bench may run (the refinement's cap, or
+        // the error estimate's run at twice the steps)
+        let most_steps = steps_per_cycle * if refine { 1 << REFINE_MAX_DOUBLINGS } else { 2 };
+        let samples = self.cycles as f64 * most_steps as f64 * per_step as f64;
         crate::solver::budget::substeps(samples * substeps as f64)
             .plus(crate::solver::budget::samples(samples, 5.0))
             .check(
                 &format!(
                     "{} cycles x {} steps x {} samples per step x {} sub-steps per amplitude",
-                    self.cycles, self.steps_per_cycle, per_step, substeps
+                    self.cycles, most_steps, per_step, substeps
                 ),
                 "check --cycles, --steps-per-cycle, --output-rate and --substeps",
             )?;
@@ -283,14 +322,16 @@ impl BenchJob {
             velocity_unit: self.velocity_unit.clone(),
             factor: factor.as_ref().map_or(1.0, |f| *f),
             cycles: self.cycles,
-            steps_per_cycle: self.steps_per_cycle,
+            steps_per_cycle,
             per_step,
             opts,
+            refine,
             measured: self.measured.clone(),
             skip_cycles: self.skip_cycles,
         };
         let mut outcome = BenchOutcome {
             sweep: vec![],
+            estimates: vec![],
             per_step,
             substeps,
             output_rate_hz: step_rate * per_step as f64,
@@ -326,24 +367,40 @@ impl BenchJob {
                 );
             }
         }
-        sweep(&cfg, &deck, &devices, &mut |model, runs| {
-            on_model(model, runs, opts);
-            outcome.sweep.push((model, runs.to_vec()));
-        })?;
+        sweep(
+            &cfg,
+            &deck,
+            &devices,
+            &mut |model, runs, est| {
+                let ms = ModelSweep {
+                    opts,
+                    refined: refine,
+                    estimates: est.to_vec(),
+                };
+                on_model(model, runs, &ms);
+                outcome.sweep.push((model, runs.to_vec()));
+                outcome.estimates.push((model, ms));
+            },
+            note,
+        )?;
         Ok(outcome)
     }
 }
 
+/// What [`sweep`] calls with each model's runs and their error estimates.
+pub type SweepCallback<'a> = dyn FnMut(DamperModel, &[HarmonicRun], &[RunEstimate]) + 'a;
+
 /// Runs the harmonic sweep of every device and writes its outputs into `cfg.out`;
-/// `on_model` gets each model's runs once its files are written.
+/// `on_model` gets each model's runs and their error estimates once its files are written,
+/// `note` a warning per run that did not converge or whose error is not estimated.
 pub fn sweep(
     cfg: &Config,
     deck: &DamperDeck,
     devices: &[(DamperModel, Box<dyn Device>)],
-    on_model: &mut dyn FnMut(DamperModel, &[HarmonicRun]),
+    on_model: &mut SweepCallback,
+    note: &mut dyn FnMut(&str),
 ) -> anyhow::Result<()> {
     let (factor, per_step, opts) = (cfg.factor, cfg.per_step, cfg.opts);
-    let step_rate = cfg.omega * cfg.steps_per_cycle as f64 / (2.0 * PI);
     let sweep = SweepOptions {
         omega_rad_s: cfg.omega,
         peak_velocities_m_s: cfg.peak_velocity.iter().map(|v| v * factor).collect(),
@@ -368,20 +425,36 @@ pub fn sweep(
     }
     let out = OutDir::create(&cfg.out, std::slice::from_ref(&cfg.deck))?;
     let mut all = Vec::new();
+    let mut all_est = Vec::new();
     let mut time_histories = Vec::new();
     for (model, dev) in devices {
         let mut runs = Vec::with_capacity(sweep.peak_velocities_m_s.len());
+        let mut estimates = Vec::with_capacity(sweep.peak_velocities_m_s.len());
         for &v in &sweep.peak_velocities_m_s {
-            let r = bench::harmonic_run_sampled(
-                dev.as_ref(),
-                sweep.omega_rad_s,
-                v,
-                sweep.cycles,
-                sweep.steps_per_cycle,
-                per_step,
-                true,
-            );
-            runs.push(r.map_err(|e| {
+            let r = if cfg.refine {
+                bench::harmonic_run_converged(
+                    dev.as_ref(),
+                    sweep.omega_rad_s,
+                    v,
+                    sweep.cycles,
+                    sweep.steps_per_cycle,
+                    per_step,
+                    true,
+                    REFINE_TOLERANCE,
+                    REFINE_MAX_DOUBLINGS,
+                )
+            } else {
+                bench::harmonic_run_estimated(
+                    dev.as_ref(),
+                    sweep.omega_rad_s,
+                    v,
+                    sweep.cycles,
+                    sweep.steps_per_cycle,
+                    per_step,
+                    true,
+                )
+            };
+            let r = r.map_err(|e| {
                 let mut msg = format!(
                     "{} model at peak velocity {} {} ({v} m/s): {e}",
                     model.name(),
@@ -393,7 +466,12 @@ pub fn sweep(
                 }
                 let _ = out.mark_incomplete(&msg);
                 anyhow::anyhow!(msg)
-            })?);
+            })?;
+            if let Some(w) = estimate_warning(&r.estimate, *model, v / factor, cfg) {
+                note(&w);
+            }
+            runs.push(r.run);
+            estimates.push(r.estimate);
         }
         let sub = if devices.len() > 1 {
             format!("{}/", model.name())
@@ -402,13 +480,13 @@ pub fn sweep(
         };
         let th = write_sweep(&out, &sub, deck, *model, &runs, cfg, factor)?;
         time_histories.push(th);
-        on_model(*model, &runs);
+        on_model(*model, &runs, &estimates);
         all.push((*model, runs));
+        all_est.push(estimates);
     }
-    let rate = step_rate * per_step as f64;
     out.write(
         "bench_summary.csv",
-        summary_csv(&all, cfg, rate, devices.len() > 1).as_bytes(),
+        summary_csv(&all, &all_est, cfg, devices.len() > 1).as_bytes(),
     )?;
     let fig13 = fig13_plot(&all, cfg, factor, deck);
     out.write(
@@ -417,10 +495,10 @@ pub fn sweep(
     )?;
     let html = sweep_html(
         &all,
+        &all_est,
         cfg,
         factor,
         deck,
-        rate,
         per_step,
         opts,
         &time_histories,
@@ -462,11 +540,46 @@ fn channel<'a>(h: &'a History, name: &str) -> Option<&'a [f64]> {
 }
 
 /// Index of the first sample of the last cycle.
-fn last_cycle_start(r: &HarmonicRun, steps_per_cycle: usize) -> usize {
+fn last_cycle_start(r: &HarmonicRun) -> usize {
     r.history
         .time_s
         .len()
-        .saturating_sub(steps_per_cycle * r.samples_per_step + 1)
+        .saturating_sub(r.steps_per_cycle * r.samples_per_step + 1)
+}
+
+/// Output samples per second of a run.
+fn run_rate(r: &HarmonicRun, omega: f64) -> f64 {
+    omega * (r.steps_per_cycle * r.samples_per_step) as f64 / (2.0 * PI)
+}
+
+/// The warning a run's estimate calls for: not converged within the cap, or not estimated.
+fn estimate_warning(e: &RunEstimate, model: DamperModel, v: f64, cfg: &Config) -> Option<String> {
+    let at = format!(
+        "{} model at peak velocity {v} {}, {} rad/s",
+        model.name(),
+        cfg.velocity_unit,
+        cfg.omega
+    );
+    match e.status {
+        Convergence::NotConverged => Some(format!(
+            "WARNING: {at}: not converged: estimated error {:.3} % of scale after refining to {} steps per cycle (tolerance {} %, cap {}x the first {}); its values are the finest run's (bench_summary.csv convergence = not_converged)",
+            100.0 * e.relative_error,
+            e.steps_per_cycle,
+            100.0 * REFINE_TOLERANCE,
+            1usize << REFINE_MAX_DOUBLINGS,
+            cfg.steps_per_cycle
+        )),
+        Convergence::NotEstimated => Some(format!(
+            "WARNING: {at}: discretisation error not estimated ({})",
+            e.note
+        )),
+        Convergence::Estimated if e.relative_error > REFINE_TOLERANCE => Some(format!(
+            "note: {at}: estimated discretisation error {:.3} % of scale at the {} steps per cycle asked (leave --steps-per-cycle, --substeps and --scheme out to refine until converged)",
+            100.0 * e.relative_error,
+            e.steps_per_cycle
+        )),
+        _ => None,
+    }
 }
 
 /// Writes one model's peaks.csv, histories and time_history.svg; returns the time-history SVG.
@@ -511,7 +624,7 @@ fn write_sweep(
     let from = h
         .time_s
         .len()
-        .saturating_sub(2 * cfg.steps_per_cycle * r.samples_per_step + 1);
+        .saturating_sub(2 * r.steps_per_cycle * r.samples_per_step + 1);
     let t = &h.time_s[from..];
     let title = format!(
         "{} model, peak velocity {} {} (cf. paper Fig. 14; {}), {}",
@@ -565,17 +678,24 @@ fn write_sweep(
 /// bench_summary.csv: one row per model and amplitude.
 fn summary_csv(
     all: &[(DamperModel, Vec<HarmonicRun>)],
+    est: &[Vec<RunEstimate>],
     cfg: &Config,
-    rate: f64,
     sub_dirs: bool,
 ) -> String {
     let mut s = String::from(
         "model,peak_velocity_m_s,peak_velocity_in_s,amplitude_m,omega_rad_s,output_rate_Hz,\
 peak_force_pos_N,peak_force_neg_N,K_storage_N_per_m,K_loss_N_per_m,energy_per_cycle_J,\
-equivalent_damping_N_s_per_m,history_file\n",
+equivalent_damping_N_s_per_m,history_file,steps_per_cycle,substeps,scheme,convergence,\
+relative_error,peak_force_pos_error_N,peak_force_neg_error_N,K_storage_error_N_per_m,\
+K_loss_error_N_per_m,energy_per_cycle_error_J,equivalent_damping_error_N_s_per_m\n",
     );
-    for (model, runs) in all {
-        for r in runs {
+    let scheme = match cfg.opts.scheme {
+        Scheme::Implicit => "implicit",
+        Scheme::Rk4 => "rk4",
+    };
+    for ((model, runs), est) in all.iter().zip(est) {
+        for (r, e) in runs.iter().zip(est) {
+            let rate = run_rate(r, cfg.omega);
             let a = r.amplitude_m;
             let c_eq = r.dissipated_last_cycle_j / (PI * cfg.omega * a * a);
             let dir = if sub_dirs {
@@ -583,8 +703,27 @@ equivalent_damping_N_s_per_m,history_file\n",
             } else {
                 String::new()
             };
+            let errs = e.error.map_or_else(
+                || ",,,,,".to_string(),
+                |x| {
+                    format!(
+                        "{},{},{},{},{},{}",
+                        x.peak_force_pos_n,
+                        x.peak_force_neg_n,
+                        x.storage_stiffness_n_per_m,
+                        x.loss_stiffness_n_per_m,
+                        x.dissipated_last_cycle_j,
+                        x.equivalent_damping_n_s_per_m
+                    )
+                },
+            );
+            let rel = if e.relative_error.is_nan() {
+                String::new()
+            } else {
+                e.relative_error.to_string()
+            };
             s.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{},{},{},{},{}{}\n",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{}{},{},{},{},{},{},{}\n",
                 model.name(),
                 r.peak_velocity_m_s,
                 // to 1e-9 in/s, so 6 in/s reads 6 and not 5.999999999999999
@@ -599,7 +738,13 @@ equivalent_damping_N_s_per_m,history_file\n",
                 r.dissipated_last_cycle_j,
                 c_eq,
                 dir,
-                history_name(r.peak_velocity_m_s)
+                history_name(r.peak_velocity_m_s),
+                r.steps_per_cycle,
+                cfg.opts.substeps * r.samples_per_step,
+                scheme,
+                e.status.name(),
+                rel,
+                errs
             ));
         }
     }
@@ -661,10 +806,10 @@ fn fmt_num(v: f64, d: usize) -> String {
 #[allow(clippy::too_many_arguments)]
 fn sweep_html(
     all: &[(DamperModel, Vec<HarmonicRun>)],
+    est: &[Vec<RunEstimate>],
     cfg: &Config,
     factor: f64,
     deck: &DamperDeck,
-    rate: f64,
     per_step: usize,
     opts: IntegratorOptions,
     time_histories: &[String],
@@ -678,9 +823,37 @@ fn sweep_html(
             deck.source
         ),
     );
+    let bad = est
+        .iter()
+        .flatten()
+        .filter(|e| e.status == Convergence::NotConverged)
+        .count();
+    if bad > 0 {
+        r.banner(
+            Banner::Bad,
+            &format!(
+                "{bad} run(s) did NOT converge: their estimated discretisation error exceeds {} % after refining to {}x the first steps per cycle (bench_summary.csv: convergence = not_converged, relative_error).",
+                100.0 * REFINE_TOLERANCE,
+                1usize << REFINE_MAX_DOUBLINGS
+            ),
+        );
+    }
+    let steps = if cfg.refine {
+        format!(
+            "from {} steps per cycle, doubled until every output's estimated discretisation error is within {} % of its scale (at most {}x; the steps per cycle of each run in the table)",
+            cfg.steps_per_cycle,
+            100.0 * REFINE_TOLERANCE,
+            1usize << REFINE_MAX_DOUBLINGS
+        )
+    } else {
+        format!(
+            "{} steps per cycle as asked (error estimated from one run at twice the steps)",
+            cfg.steps_per_cycle
+        )
+    };
     r.paragraph(&format!(
-        "Stroke d(t) = A sin(omega t), A = v/omega, omega = {} rad/s; {} cycles per amplitude from a fresh damper, {} steps per cycle, {} sample(s) per step ({:.1} samples/s), {:?} with {} sub-step(s) per sample. Peaks, loops, K', K'' and the energy are over the last cycle.",
-        cfg.omega, cfg.cycles, cfg.steps_per_cycle, per_step, rate, opts.scheme, opts.substeps
+        "Stroke d(t) = A sin(omega t), A = v/omega, omega = {} rad/s; {} cycles per amplitude from a fresh damper, {steps}, {} sample(s) per step, {:?} with {} sub-step(s) per sample. Peaks, loops, K', K'' and the energy are over the last cycle.",
+        cfg.omega, cfg.cycles, per_step, opts.scheme, opts.substeps
     ));
     let header = [
         "model",
@@ -692,15 +865,18 @@ fn sweep_html(
         "K'' [N/m]",
         "energy/cycle [J]",
         "history",
+        "steps/cycle",
+        "est. error",
+        "convergence",
     ];
     let mut rows = Vec::new();
-    for (model, runs) in all {
+    for ((model, runs), est) in all.iter().zip(est) {
         let dir = if all.len() > 1 {
             format!("{}/", model.name())
         } else {
             String::new()
         };
-        for x in runs {
+        for (x, e) in runs.iter().zip(est) {
             rows.push(vec![
                 model.name().to_string(),
                 fmt_num(x.peak_velocity_m_s / factor, 3),
@@ -711,6 +887,13 @@ fn sweep_html(
                 format!("{:.4e}", x.loss_stiffness_n_per_m),
                 fmt_num(x.dissipated_last_cycle_j, 2),
                 format!("{dir}{}", history_name(x.peak_velocity_m_s)),
+                x.steps_per_cycle.to_string(),
+                if e.relative_error.is_nan() {
+                    "-".into()
+                } else {
+                    format!("{:.3} %", 100.0 * e.relative_error)
+                },
+                e.status.name().to_string(),
             ]);
         }
     }
@@ -844,7 +1027,7 @@ fn loop_figures(
         for (model, runs) in all {
             let x = &runs[k];
             let h = &x.history;
-            let from = last_cycle_start(x, cfg.steps_per_cycle);
+            let from = last_cycle_start(x);
             fs = fs.line(model.name(), &h.stroke_m[from..], &h.force_n[from..]);
             fv = fv.line(model.name(), &h.velocity_m_s[from..], &h.force_n[from..]);
         }

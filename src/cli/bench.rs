@@ -2,9 +2,9 @@
 //! of measured bench tests.
 //! The bench is the library's [`BenchJob`](crate::checks::bench::BenchJob) (checks and outputs,
 //! src/checks/bench.rs), read from its [`BenchSettings`]; this file parses and prints.
-use crate::checks::bench::BenchSettings;
-use crate::hydraulics::bench::{HarmonicRun, IN_TO_M, LB_TO_N};
-use crate::hydraulics::{DamperModel, IntegratorOptions};
+use crate::checks::bench::{BenchSettings, ModelSweep, DEFAULT_STEPS_PER_CYCLE};
+use crate::hydraulics::bench::{HarmonicRun, IN_TO_M, LB_TO_N, REFINE_TOLERANCE};
+use crate::hydraulics::DamperModel;
 use clap::Args;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -23,8 +23,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let s = &args.settings;
     let factor = velocity_factor(&s.velocity_unit);
     let outcome = job.execute(
-        &mut |model, runs, opts| print_table(model, runs, s, factor, opts),
-        &mut |line| outln!("{line}"),
+        &mut |model, runs, ms| print_table(model, runs, s, factor, ms),
+        &mut |line| {
+            if line.starts_with("WARNING") {
+                errln!("{line}");
+            } else {
+                outln!("{line}");
+            }
+        },
     )?;
     if !s.measured.is_empty() {
         outln!("wrote {} (open bench.html)", args.out.display());
@@ -35,7 +41,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             "output rate {:.1} Hz: {} samples per step of {:.3e} s, {} sub-steps each",
             outcome.output_rate_hz,
             outcome.per_step,
-            2.0 * PI / s.omega / s.steps_per_cycle as f64,
+            2.0 * PI / s.omega / s.steps_per_cycle.unwrap_or(DEFAULT_STEPS_PER_CYCLE) as f64,
             outcome.substeps
         );
     }
@@ -57,19 +63,29 @@ fn print_table(
     runs: &[HarmonicRun],
     args: &BenchSettings,
     factor: f64,
-    opts: IntegratorOptions,
+    ms: &ModelSweep,
 ) {
+    let steps = if ms.refined {
+        format!(
+            "steps per cycle from {DEFAULT_STEPS_PER_CYCLE} doubled until converged to {} %",
+            100.0 * REFINE_TOLERANCE
+        )
+    } else {
+        format!(
+            "{} steps per cycle as asked",
+            args.steps_per_cycle.unwrap_or(DEFAULT_STEPS_PER_CYCLE)
+        )
+    };
     outln!(
-        "{} model, omega {} rad/s, {} cycles x {} steps, {:?} x {} substeps; over the last cycle",
+        "{} model, omega {} rad/s, {} cycles, {steps}, {:?} x {} substeps; over the last cycle; err: estimated discretisation error (largest over the outputs, of scale)",
         model.name(),
         args.omega,
         args.cycles,
-        args.steps_per_cycle,
-        opts.scheme,
-        opts.substeps
+        ms.opts.scheme,
+        ms.opts.substeps
     );
     outln!(
-        "{:>10} {:>9} {:>8} {:>10} {:>10} {:>9} {:>9} {:>11} {:>11} {:>9}",
+        "{:>10} {:>9} {:>8} {:>10} {:>10} {:>9} {:>9} {:>11} {:>11} {:>9} {:>6} {:>8} {}",
         format!("v [{}]", args.velocity_unit),
         "v [m/s]",
         "A [mm]",
@@ -79,11 +95,14 @@ fn print_table(
         "F- [lb]",
         "K' [N/m]",
         "K'' [N/m]",
-        "E [J]"
+        "E [J]",
+        "steps",
+        "err [%]",
+        "status"
     );
-    for r in runs {
+    for (r, e) in runs.iter().zip(&ms.estimates) {
         outln!(
-            "{:>10.3} {:>9.5} {:>8.3} {:>10.1} {:>10.1} {:>9.1} {:>9.1} {:>11.4e} {:>11.4e} {:>9.3}",
+            "{:>10.3} {:>9.5} {:>8.3} {:>10.1} {:>10.1} {:>9.1} {:>9.1} {:>11.4e} {:>11.4e} {:>9.3} {:>6} {:>8} {}",
             r.peak_velocity_m_s / factor,
             r.peak_velocity_m_s,
             r.amplitude_m * 1e3,
@@ -93,7 +112,14 @@ fn print_table(
             r.peak_force_neg_n / LB_TO_N,
             r.storage_stiffness_n_per_m,
             r.loss_stiffness_n_per_m,
-            r.dissipated_last_cycle_j
+            r.dissipated_last_cycle_j,
+            e.steps_per_cycle,
+            if e.relative_error.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{:.3}", 100.0 * e.relative_error)
+            },
+            e.status.name()
         );
     }
 }

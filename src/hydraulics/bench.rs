@@ -91,6 +91,8 @@ pub struct HarmonicRun {
     pub loss_stiffness_n_per_m: f64,
     /// Output samples per step (1: one sample at every step end).
     pub samples_per_step: usize,
+    /// Steps per cycle of the run.
+    pub steps_per_cycle: usize,
     pub history: History,
 }
 
@@ -224,6 +226,7 @@ pub fn harmonic_run_sampled(
         storage_stiffness_n_per_m: in_phase * scale,
         loss_stiffness_n_per_m: quadrature * scale,
         samples_per_step: m,
+        steps_per_cycle,
         history: hist,
     })
 }
@@ -728,4 +731,241 @@ pub fn differentiate(t: &[f64], x: &[f64]) -> Vec<f64> {
             (x[b] - x[a]) / (t[b] - t[a])
         })
         .collect()
+}
+
+/// Relative tolerance of the converged bench: the estimated error of every output (peaks, K',
+/// K'', energy per cycle, equivalent damping) over its scale ([`RunError::relative`]).
+pub const REFINE_TOLERANCE: f64 = 2e-3;
+/// Doublings of the steps per cycle the converged bench may take (16x the first).
+pub const REFINE_MAX_DOUBLINGS: u32 = 4;
+
+/// Estimated discretisation error of a harmonic run's outputs, in their units (absolute
+/// values).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunError {
+    pub peak_force_pos_n: f64,
+    pub peak_force_neg_n: f64,
+    pub storage_stiffness_n_per_m: f64,
+    pub loss_stiffness_n_per_m: f64,
+    pub dissipated_last_cycle_j: f64,
+    /// Of `energy / (pi omega A^2)` [N s/m].
+    pub equivalent_damping_n_s_per_m: f64,
+}
+
+impl RunError {
+    /// `factor |a - b|` for every output of two runs at the same frequency and amplitude.
+    pub fn between(a: &HarmonicRun, b: &HarmonicRun, omega: f64, factor: f64) -> Self {
+        let d = |x: f64, y: f64| factor * (x - y).abs();
+        let e = d(a.dissipated_last_cycle_j, b.dissipated_last_cycle_j);
+        let amp = b.amplitude_m;
+        Self {
+            peak_force_pos_n: d(a.peak_force_pos_n, b.peak_force_pos_n),
+            peak_force_neg_n: d(a.peak_force_neg_n, b.peak_force_neg_n),
+            storage_stiffness_n_per_m: d(a.storage_stiffness_n_per_m, b.storage_stiffness_n_per_m),
+            loss_stiffness_n_per_m: d(a.loss_stiffness_n_per_m, b.loss_stiffness_n_per_m),
+            dissipated_last_cycle_j: e,
+            equivalent_damping_n_s_per_m: e / (std::f64::consts::PI * omega * amp * amp),
+        }
+    }
+
+    /// The largest error over its output's scale: the peaks over the larger peak magnitude,
+    /// K' and K'' over the dynamic stiffness `|K*| = sqrt(K'^2 + K''^2)`, the energy per
+    /// cycle over `pi A^2 |K*|` (the equivalent damping's error over `|K*|/omega` is the same
+    /// ratio). A scale of zero makes any non-zero error infinite.
+    pub fn relative(&self, run: &HarmonicRun) -> f64 {
+        let ratio = |e: f64, scale: f64| {
+            if e == 0.0 {
+                0.0
+            } else if scale > 0.0 {
+                e / scale
+            } else {
+                f64::INFINITY
+            }
+        };
+        let peak = run.peak_force_pos_n.abs().max(run.peak_force_neg_n.abs());
+        let k = run
+            .storage_stiffness_n_per_m
+            .hypot(run.loss_stiffness_n_per_m);
+        let e = std::f64::consts::PI * run.amplitude_m * run.amplitude_m * k;
+        [
+            ratio(self.peak_force_pos_n, peak),
+            ratio(self.peak_force_neg_n, peak),
+            ratio(self.storage_stiffness_n_per_m, k),
+            ratio(self.loss_stiffness_n_per_m, k),
+            ratio(self.dissipated_last_cycle_j, e),
+        ]
+        .into_iter()
+        .fold(
+            0.0,
+            |a, x| if x.is_nan() { f64::INFINITY } else { a.max(x) },
+        )
+    }
+}
+
+/// How a bench run's discretisation error is known.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Convergence {
+    /// Refined by doubling the steps per cycle until the estimated error is within the
+    /// tolerance.
+    Converged,
+    /// Refined up to the cap without reaching the tolerance: the error is the last estimate.
+    NotConverged,
+    /// Run as asked; the error from one extra run at twice the steps per cycle.
+    Estimated,
+    /// Run as asked; the extra run failed (its reason in [`RunEstimate::note`]).
+    NotEstimated,
+}
+
+impl Convergence {
+    /// The name written in bench_summary.csv's `convergence` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            Convergence::Converged => "converged",
+            Convergence::NotConverged => "not_converged",
+            Convergence::Estimated => "estimated",
+            Convergence::NotEstimated => "not_estimated",
+        }
+    }
+}
+
+/// A harmonic run with its estimated discretisation error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RefinedRun {
+    pub run: HarmonicRun,
+    pub estimate: RunEstimate,
+}
+
+/// The estimated discretisation error of a harmonic run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunEstimate {
+    /// Steps per cycle of the run.
+    pub steps_per_cycle: usize,
+    /// Estimated error of `run`'s outputs (None: not estimated).
+    pub error: Option<RunError>,
+    /// `error` relative to the outputs' scales ([`RunError::relative`]; NaN when not estimated).
+    pub relative_error: f64,
+    pub status: Convergence,
+    /// Why the error is not estimated (empty otherwise).
+    pub note: String,
+}
+
+/// The converged harmonic run: runs at `steps_per_cycle` and at twice as many (the device's
+/// sub-steps per step unchanged, so the hydraulic sub-step halves with the step), doubling
+/// until the estimated error of every output is within `tolerance` of its scale or
+/// `max_doublings` is reached. The estimate assumes first-order convergence (seat contact,
+/// check-valve opening and peaks read at the samples converge at first order at worst): the
+/// error of the finer run is the difference between the two, whatever the order above one.
+#[allow(clippy::too_many_arguments)]
+pub fn harmonic_run_converged(
+    device: &dyn Device,
+    omega: f64,
+    peak_velocity: f64,
+    cycles: usize,
+    steps_per_cycle: usize,
+    samples_per_step: usize,
+    keep_history: bool,
+    tolerance: f64,
+    max_doublings: u32,
+) -> Result<RefinedRun, HydraulicError> {
+    let run = |n: usize| {
+        harmonic_run_sampled(
+            device,
+            omega,
+            peak_velocity,
+            cycles,
+            n,
+            samples_per_step,
+            keep_history,
+        )
+    };
+    let mut n = steps_per_cycle;
+    let mut prev = run(n)?;
+    let mut doublings = 0;
+    loop {
+        n *= 2;
+        doublings += 1;
+        let cur = run(n)?;
+        let err = RunError::between(&prev, &cur, omega, 1.0);
+        let rel = err.relative(&cur);
+        let status = if rel <= tolerance {
+            Convergence::Converged
+        } else if doublings >= max_doublings.max(1) {
+            Convergence::NotConverged
+        } else {
+            prev = cur;
+            continue;
+        };
+        return Ok(RefinedRun {
+            run: cur,
+            estimate: RunEstimate {
+                steps_per_cycle: n,
+                error: Some(err),
+                relative_error: rel,
+                status,
+                note: String::new(),
+            },
+        });
+    }
+}
+
+/// The run as asked, at `steps_per_cycle`, with its error estimated from one extra run at
+/// twice the steps per cycle: twice their difference (first order: the run as asked is twice
+/// as far from the limit as the finer one). A failing extra run leaves the error unestimated.
+pub fn harmonic_run_estimated(
+    device: &dyn Device,
+    omega: f64,
+    peak_velocity: f64,
+    cycles: usize,
+    steps_per_cycle: usize,
+    samples_per_step: usize,
+    keep_history: bool,
+) -> Result<RefinedRun, HydraulicError> {
+    let run = harmonic_run_sampled(
+        device,
+        omega,
+        peak_velocity,
+        cycles,
+        steps_per_cycle,
+        samples_per_step,
+        keep_history,
+    )?;
+    let fine = harmonic_run_sampled(
+        device,
+        omega,
+        peak_velocity,
+        cycles,
+        2 * steps_per_cycle,
+        samples_per_step,
+        false,
+    );
+    let (error, relative_error, status, note) = match fine {
+        Ok(f) => {
+            let e = RunError::between(&run, &f, omega, 2.0);
+            (
+                Some(e),
+                e.relative(&run),
+                Convergence::Estimated,
+                String::new(),
+            )
+        }
+        Err(e) => (
+            None,
+            f64::NAN,
+            Convergence::NotEstimated,
+            format!(
+                "the run at {} steps per cycle failed: {e}",
+                2 * steps_per_cycle
+            ),
+        ),
+    };
+    Ok(RefinedRun {
+        run,
+        estimate: RunEstimate {
+            steps_per_cycle,
+            error,
+            relative_error,
+            status,
+            note,
+        },
+    })
 }
