@@ -422,6 +422,21 @@ fn deck_keys_are_checked_and_written_back() {
     let mut back = DamperDeck::from_toml_str(&text, "deck.toml").unwrap();
     back.source = d.source.clone();
     assert_eq!(back, d);
+    // what the deck says of its small-amplitude damping
+    let say = d.small_amplitude_damping().unwrap();
+    assert!(
+        say.contains("mu_Pa_s") && say.contains("seal friction 150"),
+        "{say}"
+    );
+    let say = deck("").small_amplitude_damping().unwrap();
+    assert!(say.contains("dp_laminar_Pa = 1000"), "{say}");
+    // the regularised law's zero-amplitude damping, A^2 dp_l/(1.25 Cd A_orf sqrt(2 dp_l/rho))
+    let u_l = (2.0e3f64 / 850.0).sqrt();
+    let c_reg = 1.6e-3f64.powi(2) * 1.0e3 / (1.25 * 0.611 * 1.8e-6 * u_l);
+    assert!(
+        say.contains(&format!("{c_reg:.1} N s/m")),
+        "{say} vs {c_reg}"
+    );
     // without the keys: the old law
     let old = deck("");
     assert!(old.physical.unwrap().ext.orifice_viscosity.is_none());

@@ -195,6 +195,11 @@ pub struct Flows {
 }
 
 impl CircuitParams {
+    /// The regularised Eq. (4) law of the valves (and of an orifice without viscosity).
+    pub fn flow_law(&self) -> FlowLaw {
+        self.law()
+    }
+
     fn law(&self) -> FlowLaw {
         FlowLaw {
             rho: self.fluid.rho,

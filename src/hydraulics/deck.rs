@@ -1121,6 +1121,38 @@ impl DamperDeck {
         v
     }
 
+    /// Where the physical damper's small-amplitude damping comes from, in words (None without
+    /// a physical table or orifice): the oil's viscosity through the orifice, or, on a deck
+    /// without `mu_Pa_s`, the numerical `dp_laminar_Pa` of Eq. (4)'s regularisation, with the
+    /// zero-amplitude damping `A0^2 dQ/d(dp)^-1` it gives.
+    pub fn small_amplitude_damping(&self) -> Option<String> {
+        let c = self.physical.as_ref()?;
+        let a = c.chambers[0].area;
+        let slope = match c.viscous_orifice() {
+            Some(v) => 1.0 / v.r,
+            None => c.orifice?.flow(&c.flow_law(), 0.0).1,
+        };
+        let c0 = a * a / slope;
+        let friction = match self.extensions.friction {
+            Some(f) if f.has_presliding() => format!(
+                "; seal friction {} N with presliding {:.3e} m",
+                f.f_c, f.presliding_m
+            ),
+            Some(f) => format!("; seal friction {} N", f.f_c),
+            None => String::new(),
+        };
+        Some(match c.ext.orifice_viscosity {
+            Some(v) => format!(
+                "orifice laminar at small amplitude (mu_Pa_s = {}, orifice_length_m = {}): {c0:.1} N s/m at zero amplitude{friction}",
+                v.mu, v.length
+            ),
+            None => format!(
+                "orifice regularised below dp_laminar_Pa = {} (a numerical value, no mu_Pa_s): {c0:.1} N s/m at zero amplitude{friction}",
+                c.dp_laminar
+            ),
+        })
+    }
+
     /// Refuses a stroke history reaching `max_stroke_m` (either way; `what` names it) that
     /// empties a chamber of the physical table: `A |d| >= V` (Eq. 2).
     pub fn check_stroke(&self, max_stroke_m: f64, what: &str) -> Result<(), String> {
