@@ -3,7 +3,7 @@
 //! assembly on the state `[p0, p1, x0, x0_dot, x1, x1_dot, impulse]`. Absent elements contribute
 //! nothing; the impulse `int F dt` is integrated alongside so that `F_m` of Eq. (13) has the
 //! order of the scheme.
-use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve};
+use super::elements::{Chamber, CheckValve, FlowLaw, Orifice, ReliefValve, ViscousOrificeLaw};
 use super::extensions::HydraulicExtensions;
 use super::fluid::Fluid;
 use super::integrators::{integrate, IntegratorOptions, OdeSystem, Scheme};
@@ -195,10 +195,25 @@ pub struct Flows {
 }
 
 impl CircuitParams {
+    /// The regularised Eq. (4) law of the valves (and of an orifice without viscosity).
+    pub fn flow_law(&self) -> FlowLaw {
+        self.law()
+    }
+
     fn law(&self) -> FlowLaw {
         FlowLaw {
             rho: self.fluid.rho,
             dp_laminar: self.dp_laminar,
+        }
+    }
+
+    /// The inter-chamber orifice's laminar-to-turbulent law, where the deck gives the oil's
+    /// viscosity and the bore (None: Eq. 4 regularised below `dp_laminar`).
+    #[inline(always)]
+    pub fn viscous_orifice(&self) -> Option<ViscousOrificeLaw> {
+        match (&self.orifice, &self.ext.orifice_viscosity) {
+            (Some(o), Some(v)) => Some(v.law(o, self.fluid.rho)),
+            _ => None,
         }
     }
 
@@ -374,7 +389,10 @@ impl CircuitParams {
         let mut dq = [[0.0; NS]; 2];
 
         if let Some(o) = &self.orifice {
-            let (q, dqd) = o.flow(&law, p0 - p1);
+            let (q, dqd) = match self.viscous_orifice() {
+                Some(v) => v.flow(p0 - p1),
+                None => o.flow(&law, p0 - p1),
+            };
             fl.orifice = q;
             dq[0][IP0] -= dqd;
             dq[0][IP1] += dqd;
@@ -535,6 +553,8 @@ struct DamperRhs {
     cda_check: f64,
     /// `A lambda` of each chamber.
     a_lambda: [f64; 2],
+    /// The orifice's laminar-to-turbulent law (None: Eq. 4 regularised).
+    viscous: Option<ViscousOrificeLaw>,
 }
 
 impl DamperRhs {
@@ -556,6 +576,7 @@ impl DamperRhs {
             cda_orifice: p.orifice.map_or(0.0, |o| o.cd * o.area),
             cda_check,
             a_lambda: [0, 1].map(|k| p.chambers[k].area * p.chambers[k].lambda),
+            viscous: p.viscous_orifice(),
         })
     }
 
@@ -613,7 +634,9 @@ impl DamperRhs {
                 self.laminar(dp)
             }
         };
-        let o = if params.orifice.is_some() {
+        let o = if let Some(v) = &self.viscous {
+            v.flow(dp).0
+        } else if params.orifice.is_some() {
             self.cda_orifice * unit(dp)
         } else {
             0.0
@@ -1154,6 +1177,12 @@ mod damper_rhs_tests {
         let mut cavitating = full.clone();
         cavitating.fluid.p_cav = 1e5;
         assert_bitwise(&cavitating, "cavitation on");
+        let mut viscous = full.clone();
+        viscous.ext.orifice_viscosity = Some(crate::hydraulics::elements::OrificeViscosity {
+            mu: 0.011,
+            length: 3e-3,
+        });
+        assert_bitwise(&viscous, "viscous orifice");
     }
 
     #[test]

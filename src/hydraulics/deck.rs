@@ -2,7 +2,7 @@
 //! are ignored; unknown keys inside `[damper...]` tables are errors).
 use super::circuit::{ActuatorParams, CircuitDevice, CircuitParams};
 use super::dashpot::{LinearDashpot, MonotoneTable, NonlinearDashpot};
-use super::elements::{Chamber, CheckValve, Orifice, ReliefValve};
+use super::elements::{Chamber, CheckValve, Orifice, OrificeViscosity, ReliefValve};
 use super::extensions::{
     AnnularLeakage, CompliantFreePlay, EntrainedAir, ExtendedDamper, FreePlay, HydraulicExtensions,
     Leakage, SealFriction, SeriesMount,
@@ -211,6 +211,9 @@ pub struct DeviceExtensions {
     /// damping (None: a massless, quasi-static link; without a link the mass moves with the end
     /// and its inertia force is left out).
     pub link_mass: Option<LinkMass>,
+    /// The seal's presliding stiffness sigma0 [N/m] as `[damper.physical]` gives it with
+    /// `seal_friction_N` (the Dahl friction of [`SealFriction::dahl`] in `friction`).
+    pub seal_presliding_stiffness_n_per_m: Option<f64>,
 }
 
 /// The damper deck file as written: `[damper]` and its tables, keys with their units (other
@@ -273,6 +276,14 @@ pub struct PhysicalTable {
     pub check_valve_area_m2: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub p_cav_Pa: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mu_Pa_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orifice_length_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seal_friction_N: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seal_presliding_stiffness_N_per_m: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relief_valve_0: Option<ReliefValveTable>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -575,10 +586,11 @@ impl DamperDeck {
             None => (None, DeviceExtensions::default(), None),
             Some(t) => {
                 let mut c = physical_params(file, t)?;
-                let e = match &t.extensions {
+                let mut e = match &t.extensions {
                     None => DeviceExtensions::default(),
                     Some(et) => extensions(file, et, &mut c)?,
                 };
+                seal_dahl(file, t, &mut e)?;
                 // After the extensions: the leakage and bleed move with the temperature too.
                 let oil = match &t.oil {
                     None => None,
@@ -665,6 +677,7 @@ fn physical_params(file: &str, t: &PhysicalTable) -> Result<CircuitParams, DeckE
         "a non-negative area in m^2 (0 disables)",
         non_negative,
     )?;
+    let viscosity = orifice_viscosity(&cx, t)?;
     let mut relief = [None, None];
     for (k, (r, vt)) in relief
         .iter_mut()
@@ -722,8 +735,92 @@ fn physical_params(file: &str, t: &PhysicalTable) -> Result<CircuitParams, DeckE
         entrance: None,
         p_s,
         p_init: [p_s; 2],
-        ext: HydraulicExtensions::default(),
+        ext: HydraulicExtensions {
+            orifice_viscosity: viscosity,
+            ..Default::default()
+        },
     })
+}
+
+/// Largest oil viscosity that makes sense [Pa s] (MIL-PRF-5606 at -54 C is ~2.5e3 mm^2/s,
+/// about 2.2 Pa s).
+pub const MU_MAX_PA_S: f64 = 10.0;
+/// Largest orifice bore length that makes sense [m].
+pub const ORIFICE_LENGTH_MAX_M: f64 = 1.0;
+
+/// `mu_Pa_s` and `orifice_length_m` of `[damper.physical]`: both (the orifice's
+/// laminar-to-turbulent law) or neither (Eq. 4 regularised below `dp_laminar_Pa`).
+fn orifice_viscosity(cx: &Check, t: &PhysicalTable) -> Result<Option<OrificeViscosity>, DeckError> {
+    let mu = cx.opt(
+        "mu_Pa_s",
+        t.mu_Pa_s,
+        "a dynamic viscosity in Pa s, above 0 and below 10",
+        |x| x > 0.0 && x < MU_MAX_PA_S,
+    )?;
+    let length = cx.opt(
+        "orifice_length_m",
+        t.orifice_length_m,
+        "an orifice bore length in m, at least 0 and below 1",
+        |x| (0.0..ORIFICE_LENGTH_MAX_M).contains(&x),
+    )?;
+    match (mu, length) {
+        (Some(mu), Some(length)) => Ok(Some(OrificeViscosity { mu, length })),
+        (None, None) => Ok(None),
+        (Some(mu), None) => Err(cx.bad(
+            "mu_Pa_s",
+            mu,
+            "the orifice's viscous law needs its bore too: give orifice_length_m (0 for a sharp edge) with mu_Pa_s",
+        )),
+        (None, Some(l)) => Err(cx.bad(
+            "orifice_length_m",
+            l,
+            "the orifice's viscous law needs the oil's viscosity too: give mu_Pa_s with orifice_length_m",
+        )),
+    }
+}
+
+/// `seal_friction_N` and `seal_presliding_stiffness_N_per_m` of `[damper.physical]`: the
+/// seal's Dahl friction (0 or absent: none), set on `e` unless `[damper.physical.extensions]`
+/// gives a seal friction of its own, which takes its place.
+fn seal_dahl(file: &str, t: &PhysicalTable, e: &mut DeviceExtensions) -> Result<(), DeckError> {
+    let cx = Check {
+        file,
+        table: "damper.physical",
+    };
+    let f_c = cx.opt(
+        "seal_friction_N",
+        t.seal_friction_N,
+        "a non-negative force in N (0: no seal friction)",
+        non_negative,
+    )?;
+    let sigma0 = cx.opt(
+        "seal_presliding_stiffness_N_per_m",
+        t.seal_presliding_stiffness_N_per_m,
+        "a positive stiffness in N/m",
+        positive,
+    )?;
+    match (f_c.filter(|f| *f > 0.0), sigma0) {
+        (Some(f), Some(k)) => {
+            // a friction law of the extensions (e.g. one a diagnosis fitted) takes the place of
+            // the data sheet's
+            if e.friction.is_none() {
+                e.friction = Some(SealFriction::dahl(f, k));
+                e.seal_presliding_stiffness_n_per_m = Some(k);
+            }
+            Ok(())
+        }
+        (Some(f), None) => Err(cx.bad(
+            "seal_friction_N",
+            f,
+            "a seal friction needs its presliding stiffness: give seal_presliding_stiffness_N_per_m (N/m) too",
+        )),
+        (None, Some(k)) if f_c.is_none() => Err(cx.bad(
+            "seal_presliding_stiffness_N_per_m",
+            k,
+            "the presliding stiffness belongs to the seal friction: give seal_friction_N too",
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// `[damper.physical.oil]`: the properties above hold at `reference_temperature_K`; they are
@@ -1024,6 +1121,38 @@ impl DamperDeck {
         v
     }
 
+    /// Where the physical damper's small-amplitude damping comes from, in words (None without
+    /// a physical table or orifice): the oil's viscosity through the orifice, or, on a deck
+    /// without `mu_Pa_s`, the numerical `dp_laminar_Pa` of Eq. (4)'s regularisation, with the
+    /// zero-amplitude damping `A0^2 dQ/d(dp)^-1` it gives.
+    pub fn small_amplitude_damping(&self) -> Option<String> {
+        let c = self.physical.as_ref()?;
+        let a = c.chambers[0].area;
+        let slope = match c.viscous_orifice() {
+            Some(v) => 1.0 / v.r,
+            None => c.orifice?.flow(&c.flow_law(), 0.0).1,
+        };
+        let c0 = a * a / slope;
+        let friction = match self.extensions.friction {
+            Some(f) if f.has_presliding() => format!(
+                "; seal friction {} N with presliding {:.3e} m",
+                f.f_c, f.presliding_m
+            ),
+            Some(f) => format!("; seal friction {} N", f.f_c),
+            None => String::new(),
+        };
+        Some(match c.ext.orifice_viscosity {
+            Some(v) => format!(
+                "orifice laminar at small amplitude (mu_Pa_s = {}, orifice_length_m = {}): {c0:.1} N s/m at zero amplitude{friction}",
+                v.mu, v.length
+            ),
+            None => format!(
+                "orifice regularised below dp_laminar_Pa = {} (a numerical value, no mu_Pa_s): {c0:.1} N s/m at zero amplitude{friction}",
+                c.dp_laminar
+            ),
+        })
+    }
+
     /// Refuses a stroke history reaching `max_stroke_m` (either way; `what` names it) that
     /// empties a chamber of the physical table: `A |d| >= V` (Eq. 2).
     pub fn check_stroke(&self, max_stroke_m: f64, what: &str) -> Result<(), String> {
@@ -1188,7 +1317,14 @@ impl DamperDeck {
                 })
             };
             let e = &self.extensions;
-            let friction = e.friction;
+            // the Dahl friction is written where it is read, in [damper.physical]
+            let dahl = e.friction.filter(|f| f.is_dahl());
+            let friction = e.friction.filter(|f| !f.is_dahl());
+            let sigma0 = dahl.map(|f| {
+                e.seal_presliding_stiffness_n_per_m
+                    .filter(|k| f.f_c / k == f.presliding_m)
+                    .unwrap_or(f.f_c / f.presliding_m)
+            });
             let leakage = c.ext.leakage;
             let ext = ExtensionsTable {
                 seal_friction_N: friction.map(|f| f.f_c),
@@ -1226,6 +1362,10 @@ impl DamperDeck {
                 dp_laminar_Pa: Some(c.dp_laminar),
                 check_valve_area_m2: Some(c.check.map_or(0.0, |v| v.area)),
                 p_cav_Pa: Some(c.fluid.p_cav),
+                mu_Pa_s: c.ext.orifice_viscosity.map(|v| v.mu),
+                orifice_length_m: c.ext.orifice_viscosity.map(|v| v.length),
+                seal_friction_N: dahl.map(|f| f.f_c),
+                seal_presliding_stiffness_N_per_m: sigma0,
                 relief_valve_0: valve(0),
                 relief_valve_1: valve(1),
                 extensions: (ext != ExtensionsTable::default()).then_some(ext),

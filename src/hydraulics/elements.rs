@@ -173,6 +173,65 @@ impl Orifice {
     }
 }
 
+/// Discharge constant delta of a sharp-edged circular orifice at low Reynolds number, where
+/// `C_d = delta sqrt(Re)` (Merritt, Hydraulic Control Systems, 1967, Sec. 3.2, after Wuest).
+pub const ORIFICE_LAMINAR_DELTA: f64 = 0.2;
+
+/// What the viscous orifice law needs beyond Eq. (4): the oil's dynamic viscosity and the length
+/// of the orifice's bore (deck keys `mu_Pa_s`, `orifice_length_m`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrificeViscosity {
+    /// Dynamic viscosity mu [Pa s] (follows the oil temperature, `temperature.rs`).
+    pub mu: f64,
+    /// Bore length L [m] (>= 0; 0: a sharp edge only).
+    pub length: f64,
+}
+
+impl OrificeViscosity {
+    /// Laminar resistance `R_lam = mu/(2 delta^2 d A) + 128 mu L/(pi d^4)` [Pa s/m^3] of an
+    /// orifice of area `area`, `d = sqrt(4 A/pi)`: the sharp edge's low-Reynolds discharge law
+    /// (`C_d = delta sqrt(Re)`, `Re = d Q/(A nu)`, in Eq. 4 gives `Q = 2 delta^2 d A dp/mu`) in
+    /// series with Hagen-Poiseuille flow through the bore.
+    pub fn laminar_resistance(&self, area: f64) -> f64 {
+        use std::f64::consts::PI;
+        let d = (4.0 * area / PI).sqrt();
+        let edge = self.mu / (2.0 * ORIFICE_LAMINAR_DELTA * ORIFICE_LAMINAR_DELTA * d * area);
+        let bore = 128.0 * self.mu * self.length / (PI * d.powi(4));
+        edge + bore
+    }
+
+    /// The law `dp = R Q + k Q|Q|` of `orifice` in oil of density `rho`.
+    pub fn law(&self, orifice: &Orifice, rho: f64) -> ViscousOrificeLaw {
+        let cda = orifice.cd * orifice.area;
+        ViscousOrificeLaw {
+            r: self.laminar_resistance(orifice.area),
+            k: rho / (2.0 * cda * cda),
+        }
+    }
+}
+
+/// Laminar-to-turbulent orifice: `dp = R Q + k Q|Q|`, with `k = rho/(2 C_d^2 A^2)` (Eq. 4's
+/// turbulent limit) and R the laminar resistance ([`OrificeViscosity::laminar_resistance`]).
+/// Smooth (C-infinity but at dp = 0, where it is C1) with the finite slope `1/R` at zero: no
+/// regularisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViscousOrificeLaw {
+    /// Laminar resistance R [Pa s/m^3].
+    pub r: f64,
+    /// Turbulent coefficient k [Pa s^2/m^6].
+    pub k: f64,
+}
+
+impl ViscousOrificeLaw {
+    /// Q and dQ/d(dp): the root `Q = sign(dp) (-R + S)/(2k)`, `S = sqrt(R^2 + 4 k |dp|)`,
+    /// written `2 dp/(R + S)` (no cancellation at small dp); `dQ/d(dp) = 1/S` (1/R at 0).
+    #[inline(always)]
+    pub fn flow(&self, dp: f64) -> (f64, f64) {
+        let s = (self.r * self.r + 4.0 * self.k * dp.abs()).sqrt();
+        (2.0 * dp / (self.r + s), 1.0 / s)
+    }
+}
+
 /// Pressure relief valve, Eqs. (5)-(7). The poppet state is (x, x_dot); `x >= 0` (the seat).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReliefValve {
@@ -307,6 +366,80 @@ impl CheckValve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The shipped orifice (1.8e-6 m^2, Cd 0.611) in oil of mu = 0.011 Pa s with a 3 mm bore.
+    fn shipped_law() -> ViscousOrificeLaw {
+        let o = Orifice {
+            area: 1.8e-6,
+            cd: 0.611,
+        };
+        OrificeViscosity {
+            mu: 0.011,
+            length: 3.0e-3,
+        }
+        .law(&o, 850.0)
+    }
+
+    #[test]
+    fn viscous_orifice_inverts_its_pressure_law() {
+        let law = shipped_law();
+        for dp in [0.0f64, 1e-3, 1.0, 1e3, 1e5, 3e6, 2e7] {
+            for dp in [dp, -dp] {
+                let (q, _) = law.flow(dp);
+                // dp = R Q + k Q|Q| written out
+                let back = law.r * q + law.k * q * q.abs();
+                assert!(
+                    (back - dp).abs() <= 1e-12 * dp.abs().max(1.0),
+                    "{dp} -> {q} -> {back}"
+                );
+                assert_eq!(law.flow(-dp).0, -q);
+            }
+        }
+        // laminar and turbulent limits
+        let (q, dq) = law.flow(1e-6);
+        // Q = (dp/R)(1 - k dp/R^2 + ...), dQ/d(dp) = (1/R)(1 - 2 k dp/R^2 + ...)
+        let e = law.k * 1e-6 / (law.r * law.r);
+        assert!((q / (1e-6 / law.r) - 1.0).abs() < 1.01 * e);
+        assert!((dq * law.r - 1.0).abs() < 2.01 * e);
+        let dp = 2e7;
+        let q_t = (dp / law.k).sqrt();
+        let (q, _) = law.flow(dp);
+        // Q = Q_t (1 - R/(2 sqrt(k dp)) + ...)
+        let expect = q_t - law.r / (2.0 * law.k);
+        assert!((q - expect).abs() < 1e-3 * (q_t - expect), "{q} {expect}");
+    }
+
+    #[test]
+    fn viscous_orifice_slope_is_the_finite_difference() {
+        let law = shipped_law();
+        for dp in [0.0f64, 0.5, 30.0, 1e3, 4e4, 1e6, 1e7] {
+            for dp in [dp, -dp] {
+                let h = 1e-6 * dp.abs().max(1.0);
+                let fd = (law.flow(dp + h).0 - law.flow(dp - h).0) / (2.0 * h);
+                let (_, dq) = law.flow(dp);
+                assert!((fd - dq).abs() < 1e-6 * dq, "dp {dp}: {dq} vs {fd}");
+            }
+        }
+        assert_eq!(law.flow(0.0).1, 1.0 / law.r);
+    }
+
+    #[test]
+    fn laminar_resistance_is_merritt_plus_poiseuille() {
+        // written out for A = 1.8e-6 m^2: d = 1.51388 mm
+        let a: f64 = 1.8e-6;
+        let d = (4.0 * a / std::f64::consts::PI).sqrt();
+        let (mu, l) = (0.011, 3.0e-3);
+        let edge = mu / (2.0 * 0.04 * d * a);
+        let bore = 128.0 * mu * l / (std::f64::consts::PI * d * d * d * d);
+        let r = OrificeViscosity { mu, length: l }.laminar_resistance(a);
+        assert!((r - (edge + bore)).abs() < 1e-12 * r);
+        // the edge term from Cd = delta sqrt(Re) in Eq. (4) at a small flow
+        let q = 1e-8;
+        let re = d * q / (a * mu / 850.0);
+        let cd = 0.2 * re.sqrt();
+        let dp_edge = 850.0 / 2.0 * (q / (cd * a)).powi(2);
+        assert!((dp_edge - edge * q).abs() < 1e-9 * dp_edge);
+    }
 
     #[test]
     fn unit_flow_is_odd_and_c1_at_transition() {

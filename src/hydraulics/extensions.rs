@@ -50,11 +50,44 @@ impl SealFriction {
         }
     }
 
+    /// Dahl's friction (Dahl 1968, exponent 1): `dF/dt = sigma0 (v - |v| F/F_c)` for the
+    /// friction F resisting the stroke rate v, i.e. along the stroke s travelled the force
+    /// relaxes to `-F_c sign(v)` (on the damper) over `x_p = F_c/sigma0`: the presliding law
+    /// below with the exact Coulomb sign (`v_eps = 0`) and no Stribeck bump.
+    pub fn dahl(f_c: f64, sigma0: f64) -> Self {
+        Self {
+            f_c,
+            f_s: f_c,
+            v_s: 0.01,
+            v_eps: 0.0,
+            presliding_m: f_c / sigma0,
+        }
+    }
+
+    /// Whether this is [`SealFriction::dahl`]'s friction (exact sign, presliding).
+    pub fn is_dahl(&self) -> bool {
+        self.v_eps == 0.0 && self.f_s == self.f_c && self.has_presliding()
+    }
+
+    /// `tanh(v/v_eps)`, the exact sign (0 at rest) when `v_eps = 0`.
+    #[inline]
+    fn sign_of(&self, v: f64) -> f64 {
+        if self.v_eps == 0.0 {
+            if v == 0.0 {
+                0.0
+            } else {
+                v.signum()
+            }
+        } else {
+            (v / self.v_eps).tanh()
+        }
+    }
+
     /// Friction force on the damper (opposes the piston velocity `v`) [N].
     #[inline]
     pub fn force(&self, v: f64) -> f64 {
         let s = (-(v / self.v_s).powi(2)).exp();
-        -(self.f_c + (self.f_s - self.f_c) * s) * (v / self.v_eps).tanh()
+        -(self.f_c + (self.f_s - self.f_c) * s) * self.sign_of(v)
     }
 
     /// With presliding: the force at the end of a step and its mean over the step, from `f0` at
@@ -84,6 +117,10 @@ impl SealFriction {
         let s = (-(v / self.v_s).powi(2)).exp();
         let g = self.f_c + (self.f_s - self.f_c) * s;
         let dg = (self.f_s - self.f_c) * s * (-2.0 * v / (self.v_s * self.v_s));
+        if self.v_eps == 0.0 {
+            // the exact sign: flat but at 0, where the presliding law takes over
+            return -dg * self.sign_of(v);
+        }
         let th = (v / self.v_eps).tanh();
         -dg * th - g * (1.0 - th * th) / self.v_eps
     }
@@ -251,6 +288,10 @@ pub struct HydraulicExtensions {
     /// Bleed of each chamber to the accumulator at p_s, `Q_k = k (p_k - p_s)` out of chamber k
     /// (the accumulator's link that the paper's conclusions say is not modelled).
     pub bleed: Option<Leakage>,
+    /// Viscosity and bore length of the inter-chamber orifice: with them the orifice follows the
+    /// laminar-to-turbulent law ([`super::elements::ViscousOrificeLaw`]); without, Eq. (4) with
+    /// the `dp_laminar` regularisation.
+    pub orifice_viscosity: Option<super::elements::OrificeViscosity>,
 }
 
 impl HydraulicExtensions {

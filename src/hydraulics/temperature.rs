@@ -7,10 +7,11 @@
 //! - bulk modulus: alpha and beta of Eq. (3) scaled by g and g^2, `g = exp(c_B (T - T_ref))`,
 //!   so that `B_T(p) = B_ref(g p) / g`: the zero-pressure modulus falls by the factor g;
 //! - viscosity `mu(T) = mu_ref exp(-c_mu (T - T_ref))`: the laminar conductances (piston
-//!   leakage, accumulator bleed) scale by 1/mu, the leakage's `mu L` by mu (its clearance stays).
+//!   leakage, accumulator bleed) scale by 1/mu, the leakage's `mu L` by mu (its clearance stays),
+//!   and the viscous orifice's `mu` (its laminar resistance) by mu.
 //!
 //! Exponentials compose: moving from T1 to T2 and on to T3 is moving from T1 to T3 (up to
-//! rounding). The laminar transition of the flow laws (`dp_laminar_Pa`) is left as given.
+//! rounding). The valves' numerical laminar transition (`dp_laminar_Pa`) is left as given.
 use super::circuit::CircuitParams;
 
 /// Oil temperatures that make sense [K]: from below any cold day to above any oil's flash point.
@@ -65,6 +66,10 @@ impl OilTemperature {
         }
         if let Some(b) = c.ext.bleed.as_mut() {
             b.conductance /= mu;
+        }
+        // the orifice's laminar resistance is proportional to mu
+        if let Some(v) = c.ext.orifice_viscosity.as_mut() {
+            v.mu *= mu;
         }
         OilTemperature {
             temperature_k: t_k,
