@@ -1,8 +1,9 @@
 //! A stability verdict carries the band that could flip it (docs/stability.md, "Verdicts and
-//! their band"): on the shipped hover deck the regressing lag at the operating speed grows by the
-//! linear map, but the bearing's ASSUMED lag damping at twice its value damps it, so the verdict
-//! is "marginal" and names that value; the band is checked against maps of the deck with the
-//! value overridden, run as a user would.
+//! their band"): on the shipped hover deck without its seal friction (the oil alone) the
+//! regressing lag at the operating speed grows by the linear map, but the bearing's ASSUMED lag
+//! damping at twice its value damps it, so the verdict is "marginal" and names that value; the
+//! band is checked against maps of the deck with the value overridden, run as a user would.
+//! With the shipped seal friction the seal's values decide the verdict.
 use std::path::Path;
 use std::process::Command;
 
@@ -42,7 +43,15 @@ fn hover_operating_speed_is_marginal_and_names_the_bearing_damping() {
     let deck = root().join("rotors/uh60a_hover.toml");
     let deck = deck.to_str().unwrap();
     let base = [
-        "--rotor", deck, "--hover", "--speeds", "27", "--damper", "physical",
+        "--rotor",
+        deck,
+        "--hover",
+        "--speeds",
+        "27",
+        "--damper",
+        "physical",
+        "--set",
+        "damper.physical.seal_friction_N=0",
     ];
     let out = tmp("verdict_hover");
     let text = stability(&base, &out);
@@ -125,5 +134,54 @@ fn the_free_airframes_flight_modes_are_named_for_what_they_are() {
         line.contains("flight dynamics of the free airframe"),
         "{line}"
     );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn with_the_shipped_seal_friction_the_seal_decides() {
+    let deck = root().join("rotors/uh60a_hover.toml");
+    let out = tmp("verdict_seal");
+    stability(
+        &[
+            "--rotor",
+            deck.to_str().unwrap(),
+            "--hover",
+            "--speeds",
+            "27",
+            "--damper",
+            "physical",
+        ],
+        &out,
+    );
+    let s = read_json(&out.join("summary.json"));
+    let v = s["verdicts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["at"] == "operating speed")
+        .unwrap();
+    let keys: Vec<&str> = v["deciding"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["key"].as_str().unwrap())
+        .collect();
+    assert!(
+        keys.iter().any(|k| k.starts_with("damper.physical.seal_")),
+        "{keys:?}"
+    );
+    // the call follows the band
+    let band = [
+        v["band_per_s"][0].as_f64().unwrap(),
+        v["band_per_s"][1].as_f64().unwrap(),
+    ];
+    let call = if band[0] > 0.0 {
+        "unstable"
+    } else if band[1] < 0.0 {
+        "stable"
+    } else {
+        "marginal"
+    };
+    assert_eq!(v["call"], call, "{v}");
     let _ = std::fs::remove_dir_all(&out);
 }
