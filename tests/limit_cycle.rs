@@ -159,7 +159,10 @@ fn ground_resonance_limit_cycle_agrees_with_the_describing_function() {
         df * 1e3,
         100.0 * e
     );
-    assert!(lc.start_bracket_m[1] / lc.start_bracket_m[0] <= 1.0101, "{lc:?}");
+    assert!(
+        lc.start_bracket_m[1] / lc.start_bracket_m[0] <= 1.0101,
+        "{lc:?}"
+    );
     assert!(
         lc.bracket_growth_rates_per_s[0] > 0.0 && lc.bracket_growth_rates_per_s[1] < 0.0,
         "{lc:?}"

@@ -125,9 +125,15 @@ fn the_amplitude_check_finds_the_limit_cycle_and_the_relief_valves() {
         lc.stable && lc.stroke_amplitude_m > 3e-4 && lc.stroke_amplitude_m < 1e-3,
         "{lc:?}"
     );
-    // past the relief valves' opening the motion is damped less at larger amplitude
+    // past the relief valves' opening the motion is damped less at larger amplitude (the
+    // regressing lag followed by MAC at every start)
     let g: Vec<f64> = c.points.iter().map(|p| p.growth_rate_per_s).collect();
-    assert!(g[6] > g[5] && g[5] > g[4] - 0.05, "{g:?}");
+    assert!(g[6] > g[5], "{g:?}");
+    assert!(
+        c.points.iter().all(|p| p.mac >= 0.8),
+        "{:?}",
+        c.points.iter().map(|p| p.mac).collect::<Vec<_>>()
+    );
 }
 
 /// In hover (air resonance, rotors/uh60a_hover.toml): a linear dashpot as a device decays at
