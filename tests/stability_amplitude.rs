@@ -72,12 +72,19 @@ fn a_linear_dashpot_as_a_device_decays_at_the_coleman_eigenvalue() {
 }
 
 /// Must hold: at small amplitude the physical damper, valves live, gives the growth rate of
-/// the damper linearised on the bench at 0.1 mm, within 1%: at the shipped speed (stable) and
+/// the damper linearised on the bench at 0.1 mm, within 1% (the window at 0.1 mm): at the shipped speed (stable) and
 /// at a speed where the linear analysis finds the regressing lag unstable.
 #[test]
 fn the_physical_damper_at_small_amplitude_grows_as_the_linearised_one() {
     for om in [27.0, 70.0] {
-        let c = check(DamperModel::Physical, om, &[1e-4]);
+        // the fitted window (four damper cycles after one) is at another amplitude than the
+        // start's (0.12 mm from a 0.1 mm start at 70 rad/s, where the growth rate is 3% lower):
+        // started again so that the window's amplitude is the linearisation's 0.1 mm
+        let first = check(DamperModel::Physical, om, &[1e-4]);
+        let start = 1e-4 * 1e-4 / first.points[0].stroke_amplitude_m;
+        let c = check(DamperModel::Physical, om, &[start]);
+        let w = c.points[0].stroke_amplitude_m;
+        assert!((w / 1e-4 - 1.0).abs() < 0.02, "window at {w} m");
         let lin = map_growth(DamperModel::Physical, om);
         let g = c.points[0].growth_rate_per_s;
         let e = (g / lin - 1.0).abs();
