@@ -72,12 +72,19 @@ fn a_linear_dashpot_as_a_device_decays_at_the_coleman_eigenvalue() {
 }
 
 /// Must hold: at small amplitude the physical damper, valves live, gives the growth rate of
-/// the damper linearised on the bench at 0.1 mm, within 1%: at the shipped speed (stable) and
+/// the damper linearised on the bench at 0.1 mm, within 1% (the window at 0.1 mm): at the shipped speed (stable) and
 /// at a speed where the linear analysis finds the regressing lag unstable.
 #[test]
 fn the_physical_damper_at_small_amplitude_grows_as_the_linearised_one() {
     for om in [27.0, 70.0] {
-        let c = check(DamperModel::Physical, om, &[1e-4]);
+        // the fitted window (four damper cycles after one) is at another amplitude than the
+        // start's (0.12 mm from a 0.1 mm start at 70 rad/s, where the growth rate is 3% lower):
+        // started again so that the window's amplitude is the linearisation's 0.1 mm
+        let first = check(DamperModel::Physical, om, &[1e-4]);
+        let start = 1e-4 * 1e-4 / first.points[0].stroke_amplitude_m;
+        let c = check(DamperModel::Physical, om, &[start]);
+        let w = c.points[0].stroke_amplitude_m;
+        assert!((w / 1e-4 - 1.0).abs() < 0.02, "window at {w} m");
         let lin = map_growth(DamperModel::Physical, om);
         let g = c.points[0].growth_rate_per_s;
         let e = (g / lin - 1.0).abs();
@@ -125,19 +132,23 @@ fn the_amplitude_check_finds_the_limit_cycle_and_the_relief_valves() {
         lc.stable && lc.stroke_amplitude_m > 3e-4 && lc.stroke_amplitude_m < 1e-3,
         "{lc:?}"
     );
-    // past the relief valves' opening the motion is damped less at larger amplitude
+    // past the relief valves' opening the motion is damped less at larger amplitude (the
+    // regressing lag followed by MAC at every start)
     let g: Vec<f64> = c.points.iter().map(|p| p.growth_rate_per_s).collect();
-    assert!(g[6] > g[5] && g[5] > g[4] - 0.05, "{g:?}");
+    assert!(g[6] > g[5], "{g:?}");
+    assert!(
+        c.points.iter().all(|p| p.mac >= 0.8),
+        "{:?}",
+        c.points.iter().map(|p| p.mac).collect::<Vec<_>>()
+    );
 }
 
 /// In hover (air resonance, rotors/uh60a_hover.toml): a linear dashpot as a device decays at
 /// the hover map's Coleman eigenvalue, and the physical damper at 0.1 mm grows at the
 /// linearised damper's rate within 1%, where the hover map finds the regressing lag unstable
-/// (27 rad/s, docs/stability.md). The dashpot's tolerance: the devices start at rest while
-/// the blades move, and that transient excites the free airframe's slow modes (decay rates
-/// 0.1 to 1.1 /s) which the cyclic lag amplitude still carries after a few cycles: 1.1e-4
-/// after the default 4 cycles, 2.5e-5 after 8 (the step's `(w h)^2/12` is 6e-6); the test
-/// fits 8.
+/// (27 rad/s, docs/stability.md). The dashpot's tolerance: the response is projected onto
+/// the tracked mode, so the free airframe's slow modes the start excites do not enter the fit;
+/// 6.0e-6 measured with 8 fitted damper cycles (the step's `(w h)^2/12` is 6e-6).
 #[test]
 fn in_hover_the_devices_reproduce_the_air_resonance_map() {
     use rotorsim::resonance::air::{air_resonance_map, HoverOptions};

@@ -8,6 +8,7 @@
 //! two amplitudes there is a limit cycle.
 use super::air::HoverOptions;
 use super::rigid_blade::RigidLagBlade;
+use super::tracking::{fit_log, settle, track, Follow, Settled, TrackedMode, Whirl};
 use super::{in_plane, linearise_at, LINEARISATION_AMPLITUDE_M};
 use crate::hydraulics::{DamperDeck, DamperModel, IntegratorOptions};
 use crate::rotor::RotorDeck;
@@ -16,6 +17,7 @@ use crate::stability::{
     Hover, LagRotor, Mode, ModeLabel,
 };
 use anyhow::{anyhow, bail};
+use faer::c64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -37,8 +39,8 @@ pub const MAX_LAG_RAD: f64 = 0.35;
 pub struct AmplitudeOptions {
     /// Stroke amplitudes of the starts [m], increasing.
     pub amplitudes_m: Vec<f64>,
-    /// Fixed-frame cycles of the regressing lag mode integrated from each start; the first is
-    /// left out of the fit (the devices start at rest while the blades move).
+    /// Damper cycles (the tracked mode's rotating-frame period) fitted from each start, after
+    /// [`SKIP_CYCLES`] left out; the devices are pressurised on the mode's stroke before it.
     pub cycles: usize,
     /// Steps per revolution (RK4 on the blades, the devices sub-stepped inside each).
     pub steps_per_rev: usize,
@@ -78,13 +80,38 @@ pub struct AmplitudePoint {
     pub max_iterations: usize,
     /// Stroke amplitude envelope over the run: (time [s], amplitude [m]), thinned.
     pub envelope: Vec<(f64, f64)>,
+    /// MAC of the start's mode with the mode at the amplitude before it (the linearisation's
+    /// for the first start, the bracket's lower end for a refinement).
+    pub mac: f64,
+    /// The next best MAC among the other modes.
+    pub runner_up_mac: f64,
+    /// The tracked mode's label at this amplitude (for the record: it is followed by MAC).
+    pub label: ModeLabel,
+    /// The fitted window of the free response [s] (first and last revolution sampled).
+    pub fit_from_s: f64,
+    pub fit_to_s: f64,
+    /// Revolutions sampled in the window.
+    pub fitted_revolutions: usize,
+    /// How the devices were pressurised before the start.
+    pub settled: Settled,
+    /// A start of the neutral amplitude's refinement (not one of the given amplitudes).
+    pub bisection: bool,
 }
 
 /// A limit cycle between two starts.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct LimitCycle {
-    /// Stroke amplitude where the growth rate crosses zero (log-linear interpolation) [m].
+    /// Stroke amplitude where the growth rate crosses zero [m]: log-linear interpolation
+    /// inside the refined bracket.
     pub stroke_amplitude_m: f64,
+    /// The refined bracket: the window amplitudes of its two starts [m].
+    pub bracket_m: [f64; 2],
+    /// Its start amplitudes [m] (within [`BRACKET_RATIO`]).
+    pub start_bracket_m: [f64; 2],
+    /// Their growth rates [1/s].
+    pub bracket_growth_rates_per_s: [f64; 2],
+    /// The interpolation between the two given starts, before the refinement [m].
+    pub coarse_m: f64,
     /// Stable (smaller motions grow to it, larger decay to it) or a threshold (larger motions
     /// grow without bound, smaller decay).
     pub stable: bool,
@@ -98,10 +125,14 @@ pub struct AmplitudeCheck {
     /// The linearised map's regressing lag at 0.1 mm.
     pub linearised: Mode,
     pub points: Vec<AmplitudePoint>,
+    /// The starts of the neutral amplitudes' refinement, by amplitude.
+    pub refinements: Vec<AmplitudePoint>,
     pub limit_cycles: Vec<LimitCycle>,
     /// The relief valves' force limits of blade 1's damper, where it has them [N].
     pub relief_limits_n: Option<(f64, f64)>,
     pub steps_per_rev: usize,
+    /// Damper cycles fitted per start.
+    pub fit_cycles: usize,
     /// The outcome in a sentence.
     pub statement: String,
 }
@@ -123,6 +154,9 @@ pub fn check_amplitudes(a: &[f64], arm_m: f64) -> anyhow::Result<()> {
 /// A rotor with its dampers' equivalent values, its regressing lag mode, and each blade's
 /// (stiffness, damping) at the hinge.
 type Equivalent = (Reduced, Mode, Vec<(f64, f64)>);
+/// A rotor with its dampers' equivalent values, the mode tracked on it, and each blade's
+/// (stiffness, damping) at the hinge.
+type Tracked = (Reduced, TrackedMode, Vec<(f64, f64)>);
 
 /// The reduced rotor of the check: on the ground (lag only) or in hover (lag, flap, air).
 #[derive(Clone, Debug)]
@@ -149,18 +183,16 @@ impl Reduced {
             Reduced::Air(r, _) => r.floquet(om, fl)?.1,
         })
     }
-    /// The regressing lag mode's state of this rotor (the mean rotor's when blades differ).
-    fn mode_state(&self, om: f64) -> anyhow::Result<Vec<f64>> {
-        let l = ModeLabel::RegressingLag;
-        Ok(match self {
-            Reduced::Lag(r) if r.is_isotropic() => r.mode_state(om, l)?,
-            Reduced::Lag(r) => r.mean_rotor().mode_state(om, l)?,
-            Reduced::Air(r, h) if r.is_isotropic() => r.mode_state(h, l)?,
-            Reduced::Air(r, _) => {
-                let m = r.blend_to_mean(0.0);
-                m.mode_state(&m.hover(om)?, l)?
-            }
-        })
+    /// The mode of this rotor that `follow` picks (its Floquet basis at zero time).
+    fn tracked(&self, om: f64, follow: Follow) -> anyhow::Result<TrackedMode> {
+        let fl = super::FLOQUET_STEPS_PER_REV;
+        let modes = self.modes(om)?;
+        let phi = match self {
+            Reduced::Lag(r) => r.monodromy(om, fl)?,
+            Reduced::Air(r, h) => r.monodromy(h, fl)?,
+        };
+        let m = (phi.len() as f64).sqrt().round() as usize;
+        track(&phi, m, &modes, om, self.blades(), follow)
     }
     fn respond(
         &self,
@@ -257,6 +289,41 @@ impl Blades {
     }
 
     /// The rotor with its dampers' equivalent values at stroke amplitude `a`, linearised at
+    /// the rotating-frame frequency `w` [rad/s], and its mode of largest MAC with `previous`
+    /// (a right eigenvector of [`TrackedMode`]).
+    fn tracked(
+        &self,
+        model: DamperModel,
+        om: f64,
+        a: f64,
+        w: f64,
+        previous: &[c64],
+    ) -> anyhow::Result<Tracked> {
+        let w_lin = w.max(0.05 * om).max(0.1);
+        let mut kc: Vec<(f64, f64)> = Vec::with_capacity(self.decks.len());
+        for (k, (b, d)) in self.decks.iter().enumerate() {
+            let same = (0..k).find(|&j| super::rigid_blade::same_damper(&self.decks, j, k));
+            kc.push(match same {
+                Some(j) => kc[j],
+                None => linearise_at(
+                    d,
+                    model,
+                    b.spec.damper_attachment.arm_m,
+                    w_lin,
+                    a,
+                    INTEGRATOR,
+                )
+                .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?,
+            });
+        }
+        let rotor = self.rotor(&kc, om)?;
+        let t = rotor
+            .tracked(om, Follow::Vector(previous))
+            .map_err(|e| anyhow!("the reduced model at {om} rad/s: {e:#}"))?;
+        Ok((rotor, t, kc))
+    }
+
+    /// The rotor with its dampers' equivalent values at stroke amplitude `a`, linearised at
     /// the regressing lag's rotating-frame frequency (found in two passes, as the map does,
     /// or taken from `w_guess`: it moves little with the amplitude), and that mode.
     fn equivalent(
@@ -310,6 +377,16 @@ impl Blades {
     }
 }
 
+/// Damper cycles of the free response left out of the fit: the coupled system's adjustment
+/// from the prescribed start (the other modes the start excites, the devices' change from a
+/// prescribed to a free stroke).
+pub const SKIP_CYCLES: usize = 1;
+/// The neutral amplitude's bracket is refined until its ends are within this ratio.
+pub const BRACKET_RATIO: f64 = 1.01;
+/// Most refinement rounds of one bracket (each splits it in three; 1.2 of log amplitude
+/// needs five).
+pub const MAX_REFINEMENTS: usize = 12;
+
 /// The amplitude check of `deck` (per-blade differences applied) with damper model `model`
 /// at rotor speed `omega` [rad/s].
 pub fn amplitude_check(
@@ -328,102 +405,296 @@ pub fn amplitude_check(
             super::MAX_TIME_STEPS_PER_REV
         );
     }
+    if !(1..=MAX_FIT_CYCLES).contains(&o.cycles) {
+        bail!(
+            "the amplitude check's fitted damper cycles {}: expected 1 to {MAX_FIT_CYCLES}",
+            o.cycles
+        );
+    }
     let blades = Blades::of(deck, model, o.hover)?;
     let arm = blades.decks[0].0.spec.damper_attachment.arm_m;
     check_amplitudes(&o.amplitudes_m, arm)?;
-    let (_, linearised, _) = blades.equivalent(model, omega, LINEARISATION_AMPLITUDE_M, None)?;
-    let w_rot = |m: &Mode| (omega - 2.0 * PI * m.frequency_hz).abs();
-    let w_lin = w_rot(&linearised);
+    let (lin_rotor, linearised, _) =
+        blades.equivalent(model, omega, LINEARISATION_AMPLITUDE_M, None)?;
+    let first = lin_rotor
+        .tracked(omega, Follow::Eigenvalue(linearised.eigenvalue))
+        .map_err(|e| anyhow!("the regressing lag mode at {omega} rad/s: {e:#}"))?;
     let bare = blades.rotor(&vec![(0.0, 0.0); blades.decks.len()], omega)?;
-    let nb = bare.blades();
-    let dt = 2.0 * PI / omega / o.steps_per_rev as f64;
-    // the starts are independent: side by side on the cores
-    let start = |a: f64| -> anyhow::Result<AmplitudePoint> {
-        let (eq, mode, _) = blades
-            .equivalent(model, omega, a, Some(w_lin))
-            .map_err(|e| anyhow!("the damper's equivalent values at {a} m of stroke: {e:#}"))?;
-        let mut z = eq
-            .mode_state(omega)
-            .map_err(|e| anyhow!("the regressing lag mode at {omega} rad/s: {e:#}"))?;
-        for v in &mut z {
-            *v *= a / arm;
-        }
-        let mut dampers = Vec::with_capacity(nb);
-        for (b, d) in &blades.decks {
-            dampers.push(BladeDamper {
-                device: d.build(model, INTEGRATOR)?,
-                arm_m: b.spec.damper_attachment.arm_m,
-            });
-        }
-        let wf = (2.0 * PI * mode.frequency_hz).max(1e-6);
-        let period = 2.0 * PI / wf;
-        let t_end = o.cycles.max(2) as f64 * period;
-        let r = bare
-            .respond(omega, &mut dampers, &z, t_end, dt)
-            .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {omega} rad/s: {e}"))?;
-        let resp = &r.response;
-        let env: Vec<(f64, f64)> = resp
-            .time_s
-            .iter()
-            .enumerate()
-            .map(|(i, &t)| (t, arm * cyclic_amplitude(resp.state(i), nb, omega, t, wf)))
-            .collect();
-        let fit: Vec<(f64, f64)> = env
-            .iter()
-            .filter(|(t, v)| *t >= period && *v > 0.0)
-            .map(|&(t, v)| (t, v.ln()))
-            .collect();
-        if fit.len() < 16 {
-            bail!("the amplitude check at {a} m of stroke, {omega} rad/s: the response left the reduced model's range (lag beyond {:.0} deg) before a cycle was fitted", 2.0 * MAX_LAG_RAD.to_degrees());
-        }
-        let g = crate::analysis::compare::slope(&fit);
-        let mean_ln = fit.iter().map(|p| p.1).sum::<f64>() / fit.len() as f64;
-        let amp = mean_ln.exp();
-        let (_, at, kc) = blades.equivalent(model, omega, amp, Some(w_rot(&mode)))?;
-        let thin = (env.len() / 400).max(1);
-        Ok(AmplitudePoint {
-            start_m: a,
-            stroke_amplitude_m: amp,
-            growth_rate_per_s: g,
-            equivalent_growth_rate_per_s: at.growth_rate_per_s,
-            equivalent_damping_nms_per_rad: kc[0].1,
-            frequency_hz: at.frequency_hz,
-            max_force_n: r.force_n.iter().fold(0.0f64, |m, f| m.max(f.abs())),
-            max_iterations: r.max_iterations,
-            envelope: env.iter().step_by(thin).copied().collect(),
-        })
+    let ctx = Ctx {
+        blades: &blades,
+        bare: &bare,
+        model,
+        omega,
+        arm,
+        opts: o,
     };
+    // the mode continued from 0.1 mm through the starts, by MAC (in order: cheap)
+    let mut chain: Vec<(Reduced, TrackedMode)> = Vec::with_capacity(o.amplitudes_m.len());
+    let mut prev = first.clone();
+    for &a in &o.amplitudes_m {
+        let (r, t, _) = blades
+            .tracked(model, omega, a, w_rot(omega, &prev.mode), &prev.right)
+            .map_err(|e| anyhow!("the damper's equivalent values at {a} m of stroke: {e:#}"))?;
+        chain.push((r, t.clone()));
+        prev = t;
+    }
+    // the starts are independent: side by side on the cores
     let points = o
         .amplitudes_m
         .par_iter()
-        .map(|&a| start(a))
+        .zip(chain.par_iter())
+        .map(|(&a, (r, t))| ctx.start(a, r, t, false))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let limit_cycles: Vec<LimitCycle> = points
-        .windows(2)
-        .filter(|w| (w[0].growth_rate_per_s > 0.0) != (w[1].growth_rate_per_s > 0.0))
-        .map(|w| {
-            let (g0, g1) = (w[0].growth_rate_per_s, w[1].growth_rate_per_s);
-            let (l0, l1) = (w[0].stroke_amplitude_m.ln(), w[1].stroke_amplitude_m.ln());
-            LimitCycle {
-                stroke_amplitude_m: (l0 + (l1 - l0) * g0 / (g0 - g1)).exp(),
-                stable: g0 > 0.0,
-            }
-        })
-        .collect();
+    let mut limit_cycles = Vec::new();
+    let mut refinements = Vec::new();
+    for (k, w) in points.windows(2).enumerate() {
+        if (w[0].growth_rate_per_s > 0.0) == (w[1].growth_rate_per_s > 0.0) {
+            continue;
+        }
+        let coarse = interpolate(&w[0], &w[1]);
+        let (lo, hi, extra) = ctx.bisect(
+            w[0].clone(),
+            chain[k].1.clone(),
+            w[1].clone(),
+            chain[k + 1].1.clone(),
+        )?;
+        refinements.extend(extra);
+        limit_cycles.push(LimitCycle {
+            stroke_amplitude_m: interpolate(&lo, &hi),
+            stable: w[0].growth_rate_per_s > 0.0,
+            bracket_m: [lo.stroke_amplitude_m, hi.stroke_amplitude_m],
+            start_bracket_m: [lo.start_m, hi.start_m],
+            bracket_growth_rates_per_s: [lo.growth_rate_per_s, hi.growth_rate_per_s],
+            coarse_m: coarse,
+        });
+    }
+    refinements.sort_by(|p: &AmplitudePoint, q| p.start_m.total_cmp(&q.start_m));
     let relief_limits_n = (model == DamperModel::Physical)
         .then(|| crate::rotor::sim::relief_limits(&blades.decks[0].1))
         .flatten();
-    let statement = statement(omega, &linearised, &points, &limit_cycles, relief_limits_n);
+    let statement = statement(
+        omega,
+        &linearised,
+        &points,
+        &limit_cycles,
+        relief_limits_n,
+        o.cycles,
+    );
     Ok(AmplitudeCheck {
         omega_rad_s: omega,
         damper: model,
         linearised,
         points,
+        refinements,
         limit_cycles,
         relief_limits_n,
         steps_per_rev: o.steps_per_rev,
+        fit_cycles: o.cycles,
         statement,
     })
+}
+
+/// Most damper cycles a start may fit.
+pub const MAX_FIT_CYCLES: usize = 50;
+
+/// The mode's rotating-frame frequency at `omega` [rad/s] (what the damper strokes at).
+fn w_rot(omega: f64, m: &Mode) -> f64 {
+    (omega - m.eigenvalue.im.abs()).abs()
+}
+
+/// Log-linear interpolation of the zero of the growth rate between two points.
+fn interpolate(p: &AmplitudePoint, q: &AmplitudePoint) -> f64 {
+    let (g0, g1) = (p.growth_rate_per_s, q.growth_rate_per_s);
+    let (l0, l1) = (p.stroke_amplitude_m.ln(), q.stroke_amplitude_m.ln());
+    (l0 + (l1 - l0) * g0 / (g0 - g1)).exp()
+}
+
+/// What every start shares.
+struct Ctx<'a> {
+    blades: &'a Blades,
+    bare: &'a Reduced,
+    model: DamperModel,
+    omega: f64,
+    arm: f64,
+    opts: &'a AmplitudeOptions,
+}
+
+impl Ctx<'_> {
+    /// One start at stroke amplitude `a` on the mode `tm` of the equivalent rotor `eq`: the
+    /// devices pressurised on the mode's stroke, then the free response, its modal
+    /// coordinate sampled once a revolution and fitted after [`SKIP_CYCLES`] damper cycles.
+    fn start(
+        &self,
+        a: f64,
+        _eq: &Reduced,
+        tm: &TrackedMode,
+        bisection: bool,
+    ) -> anyhow::Result<AmplitudePoint> {
+        let (om, arm, o) = (self.omega, self.arm, self.opts);
+        let nb = self.bare.blades();
+        let dt = 2.0 * PI / om / o.steps_per_rev as f64;
+        let z: Vec<f64> = tm.unit_state().iter().map(|v| v * a / arm).collect();
+        let mut dampers = Vec::with_capacity(nb);
+        for (b, d) in &self.blades.decks {
+            dampers.push(BladeDamper {
+                device: d.build(self.model, INTEGRATOR)?,
+                arm_m: b.spec.damper_attachment.arm_m,
+            });
+        }
+        let wr = w_rot(om, &tm.mode).max(1e-3 * om);
+        let period = 2.0 * PI / wr;
+        let whirl = Whirl::of(tm, nb, om, a / arm);
+        let settled = settle(&mut dampers, &whirl, period, dt)
+            .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {om} rad/s: {e:#}"))?;
+        let rev = 2.0 * PI / om;
+        let fit_from = SKIP_CYCLES as f64 * period;
+        let revs = (((SKIP_CYCLES + o.cycles) as f64 * period) / rev).ceil() + 1.0;
+        let t_end = revs * rev;
+        let r = self
+            .bare
+            .respond(om, &mut dampers, &z, t_end, dt)
+            .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {om} rad/s: {e}"))?;
+        let resp = &r.response;
+        let wf = tm.mode.eigenvalue.im.abs().max(1e-6);
+        let env: Vec<(f64, f64)> = resp
+            .time_s
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| (t, arm * cyclic_amplitude(resp.state(i), nb, om, t, wf)))
+            .collect();
+        // the modal coordinate at the start of each revolution (where the left eigenvector
+        // of the monodromy applies)
+        let samples: Vec<(f64, f64)> = resp
+            .time_s
+            .iter()
+            .enumerate()
+            .filter(|(_, &t)| {
+                let k = (t / rev).round();
+                (t - k * rev).abs() < 0.25 * dt && t >= fit_from - 0.25 * dt
+            })
+            .map(|(i, &t)| (t, 2.0 * arm * tm.coordinate(resp.state(i)).norm()))
+            .filter(|&(_, v)| v > 0.0 && v.is_finite())
+            .collect();
+        if samples.len() < 4 {
+            bail!(
+                "the amplitude check at {a} m of stroke, {om} rad/s: {} revolutions of the response after {fit_from:.3} s (at least 4 are fitted); the response {}",
+                samples.len(),
+                if resp.time_s.last().copied().unwrap_or(0.0) < t_end - dt {
+                    format!("left the reduced model's range (lag beyond {:.0} deg)", 2.0 * MAX_LAG_RAD.to_degrees())
+                } else {
+                    "is too short: fit more damper cycles".to_string()
+                }
+            );
+        }
+        let (g, amp) = fit_log(&samples);
+        let fit_to = samples.last().map_or(fit_from, |s| s.0);
+        let (_, at, kc) = self
+            .blades
+            .tracked(self.model, om, amp, wr, &tm.right)
+            .map_err(|e| anyhow!("the damper's equivalent values at {amp} m of stroke: {e:#}"))?;
+        let thin = (env.len() / 400).max(1);
+        Ok(AmplitudePoint {
+            start_m: a,
+            stroke_amplitude_m: amp,
+            growth_rate_per_s: g,
+            equivalent_growth_rate_per_s: at.mode.growth_rate_per_s,
+            equivalent_damping_nms_per_rad: kc[0].1,
+            frequency_hz: tm.mode.frequency_hz,
+            max_force_n: r.force_n.iter().fold(0.0f64, |m, f| m.max(f.abs())),
+            max_iterations: r.max_iterations,
+            envelope: env.iter().step_by(thin).copied().collect(),
+            mac: tm.mac,
+            runner_up_mac: tm.runner_up_mac,
+            label: tm.mode.label,
+            fit_from_s: samples[0].0,
+            fit_to_s: fit_to,
+            fitted_revolutions: samples.len(),
+            settled,
+            bisection,
+        })
+    }
+
+    /// The bracket `(lo, hi)` of a sign change of the growth rate refined in log amplitude:
+    /// each round two starts side by side, either side of the zero interpolated in log
+    /// amplitude 0.8 of [`BRACKET_RATIO`] apart (after a round that did not straddle the
+    /// zero, at the bracket's thirds), until its start amplitudes are within
+    /// [`BRACKET_RATIO`]. Returns the final bracket and the refinement starts.
+    fn bisect(
+        &self,
+        mut lo: AmplitudePoint,
+        mut tlo: TrackedMode,
+        mut hi: AmplitudePoint,
+        mut thi: TrackedMode,
+    ) -> anyhow::Result<(AmplitudePoint, AmplitudePoint, Vec<AmplitudePoint>)> {
+        let mut extra = Vec::new();
+        let mut round = 0;
+        let mut secant = true;
+        while hi.start_m / lo.start_m > BRACKET_RATIO {
+            round += 1;
+            if round > MAX_REFINEMENTS {
+                bail!(
+                    "the neutral amplitude at {} rad/s: after {MAX_REFINEMENTS} rounds the bracket is {:.6e} to {:.6e} m of stroke (ratio {:.4}, {BRACKET_RATIO} sought)",
+                    self.omega, lo.start_m, hi.start_m, hi.start_m / lo.start_m
+                );
+            }
+            let r = (hi.start_m / lo.start_m).ln();
+            // the zero of the growth rate interpolated in log amplitude, tried just either
+            // side of it (the bracket's width apart); after a round that did not straddle
+            // it, the bracket's thirds
+            let (g0, g1) = (lo.growth_rate_per_s, hi.growth_rate_per_s);
+            let x = (g0 / (g0 - g1)).clamp(0.05, 0.95);
+            let half = 0.4 * BRACKET_RATIO.ln();
+            let amps = if secant && 2.0 * half < 0.9 * r {
+                let c = lo.start_m.ln() + x * r;
+                let (p, q) = (
+                    (c - half).max(lo.start_m.ln() + 0.02 * r),
+                    (c + half).min(hi.start_m.ln() - 0.02 * r),
+                );
+                [p.exp(), q.exp()]
+            } else {
+                [
+                    lo.start_m * (r / 3.0).exp(),
+                    lo.start_m * (2.0 * r / 3.0).exp(),
+                ]
+            };
+            let new = amps
+                .par_iter()
+                .map(|&a| -> anyhow::Result<(AmplitudePoint, TrackedMode)> {
+                    let (eq, t, _) = self
+                        .blades
+                        .tracked(
+                            self.model,
+                            self.omega,
+                            a,
+                            w_rot(self.omega, &tlo.mode),
+                            &tlo.right,
+                        )
+                        .map_err(|e| {
+                            anyhow!("the damper's equivalent values at {a} m of stroke: {e:#}")
+                        })?;
+                    let p = self.start(a, &eq, &t, true)?;
+                    Ok((p, t))
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let mut seq = vec![(lo.clone(), tlo.clone())];
+            seq.extend(new.iter().cloned());
+            seq.push((hi.clone(), thi.clone()));
+            extra.extend(new.into_iter().map(|p| p.0));
+            let pos = lo.growth_rate_per_s > 0.0;
+            let k = (0..3)
+                .find(|&k| (seq[k + 1].0.growth_rate_per_s > 0.0) != pos)
+                .unwrap_or(2);
+            // a round that straddled the zero with its two starts leaves their bracket
+            secant = k == 1 || !secant;
+            (lo, tlo) = seq[k].clone();
+            (hi, thi) = seq[k + 1].clone();
+            if (lo.growth_rate_per_s > 0.0) == (hi.growth_rate_per_s > 0.0) {
+                // the first sign change from the low end is the one continued
+                bail!("the neutral amplitude at {} rad/s: no sign change left in the bracket {:.6e} to {:.6e} m", self.omega, lo.start_m, hi.start_m);
+            }
+        }
+        Ok((lo, hi, extra))
+    }
 }
 
 fn statement(
@@ -432,6 +703,7 @@ fn statement(
     points: &[AmplitudePoint],
     cycles: &[LimitCycle],
     relief: Option<(f64, f64)>,
+    fit_cycles: usize,
 ) -> String {
     let mm = |v: f64| format!("{:.3} mm", v * 1e3);
     let (lo, hi) = (
@@ -460,17 +732,36 @@ fn statement(
             .iter()
             .map(|c| {
                 format!(
-                    "{} at {} of stroke",
+                    "{} at {} of stroke (bracketed by starts growing at {:+.5} and {:+.5} /s at {} and {})",
                     if c.stable {
                         "a stable limit cycle"
                     } else {
                         "an unstable limit cycle (larger motions grow)"
                     },
-                    mm(c.stroke_amplitude_m)
+                    mm(c.stroke_amplitude_m),
+                    c.bracket_growth_rates_per_s[0],
+                    c.bracket_growth_rates_per_s[1],
+                    mm(c.bracket_m[0]),
+                    mm(c.bracket_m[1])
                 )
             })
             .collect();
         s += &format!("the time domain finds {}", list.join(" and "));
+    }
+    s += &format!(
+        "; each start's dampers pressurised on the mode's stroke first, the growth rate fitted to the mode's coordinate once a revolution over {fit_cycles} damper cycles after the first"
+    );
+    let odd: Vec<String> = points
+        .iter()
+        .filter(|p| p.mac < super::tracking::AMBIGUOUS_MAC)
+        .map(|p| format!("{} (MAC {:.2})", mm(p.start_m), p.mac))
+        .collect();
+    if !odd.is_empty() {
+        s += &format!(
+            "; the mode's continuation is AMBIGUOUS at the starts {} (MAC below {})",
+            odd.join(", "),
+            super::tracking::AMBIGUOUS_MAC
+        );
     }
     if let Some((l, h)) = relief {
         let cap = h.min(-l);
@@ -493,10 +784,12 @@ fn statement(
 
 /// amplitude.csv: one row per start.
 pub fn csv(c: &AmplitudeCheck) -> String {
-    let mut s = String::from("rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N\n");
-    for p in &c.points {
+    let mut s = String::from("rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N,mac,runner_up_mac,fit_from_s,fit_to_s,fitted_revolutions,settle_cycles,settle_change,bisection\n");
+    let mut all: Vec<&AmplitudePoint> = c.points.iter().chain(&c.refinements).collect();
+    all.sort_by(|p, q| p.start_m.total_cmp(&q.start_m));
+    for p in all {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             c.omega_rad_s,
             p.start_m,
             p.stroke_amplitude_m,
@@ -505,7 +798,15 @@ pub fn csv(c: &AmplitudeCheck) -> String {
             c.linearised.growth_rate_per_s,
             p.equivalent_damping_nms_per_rad,
             p.frequency_hz,
-            p.max_force_n
+            p.max_force_n,
+            p.mac,
+            p.runner_up_mac,
+            p.fit_from_s,
+            p.fit_to_s,
+            p.fitted_revolutions,
+            p.settled.cycles,
+            p.settled.change,
+            u8::from(p.bisection)
         ));
     }
     s
@@ -519,7 +820,8 @@ pub fn json(c: &AmplitudeCheck) -> serde_json::Value {
         "steps_per_rev": c.steps_per_rev,
         "linearised_growth_rate_per_s": c.linearised.growth_rate_per_s,
         "linearisation_amplitude_m": LINEARISATION_AMPLITUDE_M,
-        "points": c.points.iter().map(|p| serde_json::json!({
+        "fit_damper_cycles": c.fit_cycles,
+        "points": c.points.iter().chain(&c.refinements).map(|p| serde_json::json!({
             "start_stroke_amplitude_m": p.start_m,
             "stroke_amplitude_m": p.stroke_amplitude_m,
             "growth_rate_per_s": p.growth_rate_per_s,
@@ -527,6 +829,15 @@ pub fn json(c: &AmplitudeCheck) -> serde_json::Value {
             "equivalent_damping_Nms_per_rad": p.equivalent_damping_nms_per_rad,
             "frequency_Hz": p.frequency_hz,
             "max_damper_force_N": p.max_force_n,
+            "mac": p.mac,
+            "runner_up_mac": p.runner_up_mac,
+            "mode_label": p.label.as_str(),
+            "fit_from_s": p.fit_from_s,
+            "fit_to_s": p.fit_to_s,
+            "fitted_revolutions": p.fitted_revolutions,
+            "settle_cycles": p.settled.cycles,
+            "settle_change": p.settled.change,
+            "bisection": p.bisection,
         })).collect::<Vec<_>>(),
         "limit_cycles": c.limit_cycles,
         "relief_limits_N": c.relief_limits_n.map(|(l, h)| [l, h]),
@@ -542,11 +853,13 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
     let mut rep = HtmlReport::new("");
     rep.heading(2, "Amplitude: where the linear analysis stops being true");
     rep.paragraph(&format!(
-        "The reduced rotor at {} rad/s with each blade's {} damper as a device (its valves live), started on the regressing lag mode at each stroke amplitude and integrated {} steps per revolution; the growth rate is the slope of the log of the cyclic lag amplitude after the first cycle, at the window's mean amplitude. Beside it: the growth rate from the damper's equivalent stiffness and damping at that amplitude (the bench's first harmonic), and the linearised map's at {} mm.",
+        "The reduced rotor at {} rad/s with each blade's {} damper as a device (its valves live), started on the regressing lag mode at each stroke amplitude and integrated {} steps per revolution. The mode is continued from the linearised map's regressing lag at {} mm through the amplitudes by the modal assurance criterion (MAC) of its Floquet eigenvector. Before each start the dampers run on the mode's stroke until their cycle-mean and RMS forces settle (the check valves' ratcheting); the growth rate is the slope of the log of the mode's coordinate (its left eigenvector on the state, once a revolution) over {} damper cycles after the first, at the window's mean amplitude. A sign change is refined in log amplitude until its starts are within {:.0}%. Beside each: the growth rate from the damper's equivalent stiffness and damping at that amplitude (the bench's first harmonic), and the linearised map's.",
         c.omega_rad_s,
         c.damper.name(),
         c.steps_per_rev,
-        LINEARISATION_AMPLITUDE_M * 1e3
+        LINEARISATION_AMPLITUDE_M * 1e3,
+        c.fit_cycles,
+        (BRACKET_RATIO - 1.0) * 100.0
     ));
     rep.paragraph(&c.statement);
     let lx: Vec<f64> = c
@@ -589,8 +902,9 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
         "Each start's cyclic lag amplitude times the damper arm.",
         &env.to_svg(900, 420)?,
     );
-    let rows: Vec<Vec<String>> = c
-        .points
+    let mut all: Vec<&AmplitudePoint> = c.points.iter().chain(&c.refinements).collect();
+    all.sort_by(|p, q| p.start_m.total_cmp(&q.start_m));
+    let rows: Vec<Vec<String>> = all
         .iter()
         .map(|p| {
             vec![
@@ -600,6 +914,9 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
                 format!("{:+.5}", p.equivalent_growth_rate_per_s),
                 format!("{:.1}", p.equivalent_damping_nms_per_rad),
                 format!("{:.0}", p.max_force_n),
+                format!("{:.3}", p.mac),
+                format!("{:.2} to {:.2}", p.fit_from_s, p.fit_to_s),
+                if p.bisection { "refinement" } else { "given" }.to_string(),
             ]
         })
         .collect();
@@ -611,6 +928,9 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
             "equivalent damper [1/s]",
             "equivalent damping [N m s/rad]",
             "largest damper force [N]",
+            "MAC with the previous amplitude's mode",
+            "fitted window [s]",
+            "start",
         ],
         &rows,
     );

@@ -13,6 +13,7 @@ mod ground;
 mod job;
 mod report;
 mod time;
+pub mod tracking;
 pub use ground::*;
 pub use job::*;
 pub use report::*;
