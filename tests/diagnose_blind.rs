@@ -12,11 +12,31 @@ use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::DamperDeck;
 use std::path::Path;
 
+/// flightdata/damper_nominal.toml as the truth models read it: the paper's orifice with its
+/// laminar band and no seal friction. The deck's viscous orifice and Dahl seal friction
+/// (`mu_Pa_s`, `orifice_length_m`, `seal_*`) are left out: the truth models do not have them
+/// (seal friction is one of their hidden effects, as LuGre), and the suite measures the
+/// diagnosis against the damper they simulate.
 fn nominal_deck() -> DamperDeck {
-    DamperDeck::from_file(Path::new(concat!(
+    let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/flightdata/damper_nominal.toml"
-    )))
+    ))
+    .unwrap();
+    let keys = [
+        "mu_Pa_s",
+        "orifice_length_m",
+        "seal_friction_N",
+        "seal_presliding_stiffness",
+    ];
+    let bare: Vec<&str> = text
+        .lines()
+        .filter(|l| !keys.iter().any(|k| l.trim_start().starts_with(k)))
+        .collect();
+    DamperDeck::from_toml_str(
+        &(bare.join("\n") + "\n"),
+        "damper_nominal.toml (truth models' reading)",
+    )
     .unwrap()
 }
 

@@ -57,7 +57,14 @@ fn peak_force_grows_with_velocity_and_saturates_under_the_relief_valves() {
         .unwrap();
     let runs = harmonic_sweep(dev.as_ref(), &SweepOptions::default(), false).unwrap();
     let pk: Vec<f64> = runs.iter().map(|r| r.peak_force_pos_n).collect();
-    assert!(pk.windows(2).all(|w| w[1] > w[0]), "{pk:?}");
+    // strictly growing below the relief valves' crack force; on the plateau above it the peak
+    // is the valve's and is read once a step (256 per cycle here), which under-reads the
+    // ringing poppet's peak by up to 1.2% (docs/hydraulics.md, "Output rate")
+    assert!(
+        pk.windows(2)
+            .all(|w| w[1] > w[0] || (w[0] > cap && w[1] > (1.0 - 0.012) * w[0])),
+        "{pk:?}"
+    );
     // Below the cap at low speed, quadratic-ish growth: doubling 1 -> 2 in/s more than triples it.
     assert!(pk[2] > 3.0 * pk[1]);
     // Saturation: 6 -> 10 in/s (+67% velocity) adds less than 5% force, and the plateau sits

@@ -87,6 +87,18 @@ fn modified_newton_reproduces_full_newton_on_every_channel() {
         revs,
     );
     let floor = differences(&full[2], &tight[0]);
+    for (name, d) in &floor {
+        eprintln!(
+            "full Newton, rtol {RTOL:e} vs {:e}: {name} moves by {d:.2e} of its peak-to-peak",
+            RTOL / 3.0
+        );
+        if !is_valve(name) && !is_load_channel(name) {
+            assert!(
+                *d < 1e-5,
+                "full Newton moves {name} by {d:e} between tolerances"
+            );
+        }
+    }
     for (f, m) in full.iter().zip(&modified) {
         let steps = (revs * f.steps_per_rev) as f64;
         // the point of the method: far fewer factorizations than iterations
@@ -114,7 +126,17 @@ fn modified_newton_reproduces_full_newton_on_every_channel() {
             // residual test fixes to ||r|| <= 1e-7 ||r_0|| (r_0, the predictor residual, ~1e6 N)
             // only: full Newton at a 3x tighter tolerance moves shear_chord_r0.05_N by 2.3e-5
             // of its peak-to-peak (`floor`), the small shears and hub loads most.
-            let bound = if is_valve(&name) || is_load_channel(&name) {
+            // A valve channel is held to twice what full Newton itself moves it by between
+            // the two tolerances where that is more than 1e-4 (with the viscous orifice the
+            // valve velocities' sub-step extremes move by up to 9.3e-5): the modified method
+            // cannot be asked to agree better than the solver's own tolerance fixes them.
+            let own = floor
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map_or(0.0, |(_, d)| *d);
+            let bound = if is_valve(&name) {
+                1e-4f64.max(2.0 * own)
+            } else if is_load_channel(&name) {
                 1e-4
             } else {
                 1e-5
@@ -126,18 +148,6 @@ fn modified_newton_reproduces_full_newton_on_every_channel() {
             );
         }
         assert!(moving >= 6, "{}: {moving} moving channels", m.model);
-    }
-    for (name, d) in &floor {
-        eprintln!(
-            "full Newton, rtol {RTOL:e} vs {:e}: {name} moves by {d:.2e} of its peak-to-peak",
-            RTOL / 3.0
-        );
-        if !is_valve(name) && !is_load_channel(name) {
-            assert!(
-                *d < 1e-5,
-                "full Newton moves {name} by {d:e} between tolerances"
-            );
-        }
     }
 }
 

@@ -8,8 +8,16 @@ use rotorsim::rotor::RotorDeck;
 use rotorsim::stability::ModeLabel;
 use std::path::Path;
 
+/// The oil alone: the deck's ASSUMED seal friction set to 0. These checks compare the time
+/// domain with the first-harmonic linearisation; the Dahl friction's first harmonic changes by
+/// a factor of several between 0.1 and 0.3 mm (its pre-sliding), so a decaying window does not
+/// sit at one amplitude long enough to compare at 1%.
+fn oil_alone() -> Vec<rotorsim::overrides::Override> {
+    vec![rotorsim::overrides::Override::parse("damper.physical.seal_friction_N=0").unwrap()]
+}
+
 fn deck() -> RotorDeck {
-    RotorDeck::from_file_with(Path::new("rotors/uh60a_airframe.toml"), &[]).unwrap()
+    RotorDeck::from_file_with(Path::new("rotors/uh60a_airframe.toml"), &oil_alone()).unwrap()
 }
 
 fn check(model: DamperModel, om: f64, amplitudes_m: &[f64]) -> AmplitudeCheck {
@@ -152,7 +160,8 @@ fn the_amplitude_check_finds_the_limit_cycle_and_the_relief_valves() {
 #[test]
 fn in_hover_the_devices_reproduce_the_air_resonance_map() {
     use rotorsim::resonance::air::{air_resonance_map, HoverOptions};
-    let deck = RotorDeck::from_file_with(Path::new("rotors/uh60a_hover.toml"), &[]).unwrap();
+    let deck =
+        RotorDeck::from_file_with(Path::new("rotors/uh60a_hover.toml"), &oil_alone()).unwrap();
     let om = 27.0;
     for (model, amps, tol, cycles) in [
         (DamperModel::Linear, vec![1e-4, 3e-3], 5e-5, 8),

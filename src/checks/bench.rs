@@ -1115,6 +1115,18 @@ pub fn replay(
         .zip(&cfg.measured)
         .map(|(t, p)| window(cfg, t, p))
         .collect::<anyhow::Result<Vec<_>>>()?;
+    // the model steps once per sample: a test sampled slower than any damper bench is a unit
+    // error (milliseconds in `time_s`) far more often than a test
+    for (t, p) in tests.iter().zip(&cfg.measured) {
+        if median_interval_s(t) >= MAX_SAMPLE_INTERVAL_S {
+            anyhow::bail!(
+                "bench file {}: column time_s: samples slower than {} Hz, where the model steps once per sample{}",
+                p.display(),
+                1.0 / MAX_SAMPLE_INTERVAL_S,
+                sampling_hint(t)
+            );
+        }
+    }
     if devices.iter().any(|(m, _)| *m == DamperModel::Physical) {
         for (t, p) in tests.iter().zip(&cfg.measured) {
             let d = t.stroke_m.iter().fold(0.0f64, |a, d| a.max(d.abs()));
@@ -1369,15 +1381,24 @@ fn replay_figures(
     Ok(())
 }
 
+/// Longest median sample interval of a measured test [s] (10 Hz; benches sample at 1 kHz or
+/// more).
+pub const MAX_SAMPLE_INTERVAL_S: f64 = 0.1;
+
+/// The median sample interval of a test [s] (0 for fewer than two samples).
+fn median_interval_s(test: &bench::BenchTest) -> f64 {
+    let mut dt: Vec<f64> = test.time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    if dt.is_empty() {
+        return 0.0;
+    }
+    dt.sort_by(f64::total_cmp);
+    dt[dt.len() / 2]
+}
+
 /// A hint when a test samples slower than a damper bench does (the model steps once per
 /// sample): the median interval, and the likely cause, a time column in milliseconds.
 fn sampling_hint(test: &bench::BenchTest) -> String {
-    let mut dt: Vec<f64> = test.time_s.windows(2).map(|w| w[1] - w[0]).collect();
-    if dt.is_empty() {
-        return String::new();
-    }
-    dt.sort_by(f64::total_cmp);
-    let med = dt[dt.len() / 2];
+    let med = median_interval_s(test);
     if med >= 0.01 {
         format!(
             "; the file samples every {med} s (median), where damper benches sample at 1 kHz or \
