@@ -10,7 +10,6 @@ use rotorsim::diagnose::rotor::flight_measurement;
 use rotorsim::diagnose::{diagnose, DiagnoseOptions, Measurement};
 use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::DamperDeck;
-use std::path::Path;
 
 /// flightdata/damper_nominal.toml as the truth models read it: the paper's orifice with its
 /// laminar band and no seal friction. The deck's viscous orifice and Dahl seal friction
