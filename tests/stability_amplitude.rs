@@ -182,14 +182,21 @@ fn in_hover_the_devices_reproduce_the_air_resonance_map() {
             .map(|m| m.growth_rate_per_s)
             .fold(f64::NEG_INFINITY, f64::max);
         for p in &c.points {
-            let e = (p.growth_rate_per_s / lin - 1.0).abs();
+            // the physical damper against its first harmonic at the window's amplitude (the
+            // viscous orifice's turbulent term makes its damping change between the start and
+            // the window); the dashpot against the map
+            let reference = match model {
+                DamperModel::Physical => p.equivalent_growth_rate_per_s,
+                _ => lin,
+            };
+            let e = (p.growth_rate_per_s / reference - 1.0).abs();
             println!(
                 "hover {model:?} {:.1e} m: {:+.7} against {lin:+.7}: {e:.1e}",
                 p.start_m, p.growth_rate_per_s
             );
             assert!(
                 e <= tol,
-                "{model:?} {:.1e} m: {:+.6} against the hover map's {lin:+.6} ({e:.1e})",
+                "{model:?} {:.1e} m: {:+.6} against {reference:+.6} ({e:.1e})",
                 p.start_m,
                 p.growth_rate_per_s
             );

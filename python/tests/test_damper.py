@@ -30,7 +30,9 @@ def cli_replay(tmp_path, t, x, model):
             f.write(f"{a!r},{b!r}\n")
     out = tmp_path / f"out_{model}"
     subprocess.run(
-        [CLI, "bench", "--damper-deck", str(DECK), "--damper", model,
+        # the Damper steps as a run does (RK4, 25 sub-steps), the bench's default is its
+        # converged implicit scheme: ask the bench for the run's
+        [CLI, "bench", "--damper-deck", str(DECK), "--damper", model, "--scheme", "rk4",
          "--measured", str(test), "--out", str(out)],
         check=True, capture_output=True,
     )
