@@ -288,17 +288,15 @@ impl Blades {
         }))
     }
 
-    /// The rotor with its dampers' equivalent values at stroke amplitude `a`, linearised at
-    /// the rotating-frame frequency `w` [rad/s], and its mode of largest MAC with `previous`
-    /// (a right eigenvector of [`TrackedMode`]).
-    fn tracked(
+    /// Each blade's damper linearised at stroke amplitude `a` and rotating-frame frequency `w`
+    /// (hinge stiffness and damping; a blade whose damper equals an earlier one's shares it).
+    fn dampers_at(
         &self,
         model: DamperModel,
         om: f64,
         a: f64,
         w: f64,
-        previous: &[c64],
-    ) -> anyhow::Result<Tracked> {
+    ) -> anyhow::Result<Vec<(f64, f64)>> {
         let w_lin = w.max(0.05 * om).max(0.1);
         let mut kc: Vec<(f64, f64)> = Vec::with_capacity(self.decks.len());
         for (k, (b, d)) in self.decks.iter().enumerate() {
@@ -316,6 +314,21 @@ impl Blades {
                 .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?,
             });
         }
+        Ok(kc)
+    }
+
+    /// The rotor with its dampers' equivalent values at stroke amplitude `a`, linearised at
+    /// the rotating-frame frequency `w` [rad/s], and its mode of largest MAC with `previous`
+    /// (a right eigenvector of [`TrackedMode`]).
+    fn tracked(
+        &self,
+        model: DamperModel,
+        om: f64,
+        a: f64,
+        w: f64,
+        previous: &[c64],
+    ) -> anyhow::Result<Tracked> {
+        let kc = self.dampers_at(model, om, a, w)?;
         let rotor = self.rotor(&kc, om)?;
         let t = rotor
             .tracked(om, Follow::Vector(previous))
@@ -344,23 +357,7 @@ impl Blades {
         };
         let mut out = None;
         for _ in 0..passes {
-            let w_lin = w.max(0.05 * om).max(0.1);
-            let mut kc: Vec<(f64, f64)> = Vec::with_capacity(self.decks.len());
-            for (k, (b, d)) in self.decks.iter().enumerate() {
-                let same = (0..k).find(|&j| super::rigid_blade::same_damper(&self.decks, j, k));
-                kc.push(match same {
-                    Some(j) => kc[j],
-                    None => linearise_at(
-                        d,
-                        model,
-                        b.spec.damper_attachment.arm_m,
-                        w_lin,
-                        a,
-                        INTEGRATOR,
-                    )
-                    .map_err(|e| anyhow!("blade {}: {e:#}", k + 1))?,
-                });
-            }
+            let kc = self.dampers_at(model, om, a, w)?;
             let rotor = self.rotor(&kc, om)?;
             let modes = rotor
                 .modes(om)
