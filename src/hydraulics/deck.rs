@@ -23,23 +23,29 @@ pub const DEFAULT_DP_LAMINAR_PA: f64 = 1.0e3;
 /// Default cavitation band when the deck omits `p_cav_Pa`.
 pub const DEFAULT_P_CAV_PA: f64 = 1.0e4;
 
-/// A deck error: the file, the key (a dotted path) and what was expected of it. One type for
-/// every deck read here and above (damper, actuator, model decks).
+/// A deck error: which deck, the file, the key (a dotted path) and what was expected of it.
+/// One type for every deck read here and above (rotor, damper, actuator, model decks).
 #[derive(Debug, thiserror::Error)]
 pub enum DeckError {
     /// The file cannot be read.
-    #[error("deck {file}: cannot read: {source}")]
+    #[error("{deck} {file}: cannot read: {source}")]
     Read {
+        deck: &'static str,
         file: String,
         #[source]
         source: std::io::Error,
     },
     /// The file as a whole: not TOML, or a model beyond the budget.
-    #[error("deck {file}: {message}")]
-    File { file: String, message: String },
+    #[error("{deck} {file}: {message}")]
+    File {
+        deck: &'static str,
+        file: String,
+        message: String,
+    },
     /// One key of the deck and what is wrong with it.
-    #[error("deck {file}{}", problem.describe(key))]
+    #[error("{deck} {file}{}", problem.describe(key))]
     Key {
+        deck: &'static str,
         file: String,
         key: String,
         problem: Problem,
@@ -76,9 +82,38 @@ impl Problem {
     }
 }
 
+/// How a deck is named in messages when the caller does not say which it is.
+const DECK: &str = "deck";
+
 impl DeckError {
+    /// The file cannot be read.
+    pub fn read(file: &str, source: std::io::Error) -> Self {
+        Self::Read {
+            deck: DECK,
+            file: file.into(),
+            source,
+        }
+    }
+    /// The file as a whole (`message` says what is wrong).
+    pub fn file(file: &str, message: impl Into<String>) -> Self {
+        Self::File {
+            deck: DECK,
+            file: file.into(),
+            message: message.into(),
+        }
+    }
+    /// The same error, the deck named as `deck` ("rotor deck"): what the user passed it as.
+    pub fn in_deck(mut self, name: &'static str) -> Self {
+        match &mut self {
+            Self::Read { deck, .. } | Self::File { deck, .. } | Self::Key { deck, .. } => {
+                *deck = name
+            }
+        }
+        self
+    }
     pub fn key(file: &str, key: impl Into<String>, problem: Problem) -> Self {
         Self::Key {
+            deck: DECK,
             file: file.into(),
             key: key.into(),
             problem,
@@ -97,10 +132,10 @@ impl DeckError {
     }
     /// TOML that does not parse (the message gives the line).
     pub fn syntax(file: &str, e: &toml::de::Error) -> Self {
-        Self::File {
-            file: file.into(),
-            message: format!("not valid TOML: {}", e.to_string().trim_end()),
-        }
+        Self::file(
+            file,
+            format!("not valid TOML: {}", e.to_string().trim_end()),
+        )
     }
     /// A serde error of the typed tables read from a parsed TOML table: the key path it names
     /// (the tables it sits in, then the field) and what serde expected.
@@ -513,10 +548,8 @@ impl DamperDeck {
     /// Reads a deck file.
     pub fn from_file(path: &Path) -> Result<Self, DeckError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| DeckError::Read {
-            file: file.clone(),
-            source,
-        })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| DeckError::read(&file, source))?;
         Self::from_toml_str(&text, &file)
     }
 

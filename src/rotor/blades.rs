@@ -3,7 +3,7 @@
 //! deck is the base deck (the deck without its `[blades]` table, what every single-blade command
 //! reads) with these applied as overrides, the deck's entries first, then the `--set` ones: each
 //! is validated exactly like a value written in the deck, and an error names the key as written.
-use super::deck::RotorSpec;
+use super::deck::{deck_error, RotorSpec};
 use super::RotorDeck;
 use crate::hydraulics::DamperDeck;
 use crate::overrides::{self, Override};
@@ -54,7 +54,7 @@ impl Entry {
 fn located(file: &str, set: Option<&Override>, key: &str, msg: &str) -> anyhow::Error {
     match set {
         Some(o) => anyhow!("--set {o}: rotor deck {file}, {key}: {msg}"),
-        None => anyhow!("rotor deck {file}, {key}: {msg}"),
+        None => deck_error(file, key, msg).into(),
     }
 }
 
@@ -113,24 +113,32 @@ fn check_path(path: &str) -> Result<(), String> {
 /// number, deck path); the values are checked when the blade's deck is built.
 fn deck_entries(file: &str, table: &Value, base: &Table, n: usize) -> anyhow::Result<Vec<Entry>> {
     let Value::Table(t) = table else {
-        bail!(
-            "rotor deck {file}, {KEY}: expected per-blade tables [{KEY}.K.<deck path>] (K = 1 to {n}), found {table}"
-        );
+        return Err(deck_error(
+            file,
+            KEY,
+            &format!(
+                "expected per-blade tables [{KEY}.K.<deck path>] (K = 1 to {n}), found {table}"
+            ),
+        )
+        .into());
     };
     let mut out = Vec::new();
     for (k, v) in t {
-        let b = blade_number(k, n).map_err(|e| anyhow!("rotor deck {file}, {KEY}.{k}: {e}"))?;
+        let b = blade_number(k, n).map_err(|e| deck_error(file, &format!("{KEY}.{k}"), &e))?;
         let Value::Table(bt) = v else {
-            bail!(
-                "rotor deck {file}, {KEY}.{k}: expected a table of blade {b}'s deck values ([{KEY}.{k}.<deck path>]), found {v}"
-            );
+            return Err(deck_error(
+                file,
+                &format!("{KEY}.{k}"),
+                &format!("expected a table of blade {b}'s deck values ([{KEY}.{k}.<deck path>]), found {v}"),
+            )
+            .into());
         };
         let mut leaves = Vec::new();
         flatten(bt, &mut Vec::new(), &mut leaves);
         for (parts, leaf) in leaves {
             let path = parts.join(".");
             let full = format!("{KEY}.{k}.{path}");
-            let bad = |msg: String| anyhow!("rotor deck {file}, {full}: {msg}");
+            let bad = |msg: String| anyhow::Error::from(deck_error(file, &full, &msg));
             if parts
                 .iter()
                 .any(|p| overrides::check_key(p).is_err() || p.contains('.'))
@@ -217,7 +225,8 @@ fn check_rotor(root: &Table, file: &str) -> anyhow::Result<()> {
     if let Err(e) = RotorSpec::schema(root) {
         bail!("{}", e.message().trim_end());
     }
-    RotorSpec::from_table(root, file).map(|_| ())
+    RotorSpec::from_table(root, file)?;
+    Ok(())
 }
 
 impl RotorDeck {

@@ -1,5 +1,6 @@
 //! Rotor deck schema (docs/rotor_deck.md). Unknown keys are errors naming the file, line and
 //! key; the `[damper]` table is read separately by [`crate::hydraulics::DamperDeck`].
+use crate::hydraulics::DeckError;
 use crate::structure::section::SectionProps;
 use serde::Deserialize;
 use std::path::Path;
@@ -485,6 +486,24 @@ pub struct RotorTable {
     pub blades: usize,
 }
 
+impl RotorTable {
+    /// The rules of `[rotor]` both kinds of deck share: the failing key and what was expected.
+    /// (The radius is checked by each kind against its blade.)
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        let w = self.omega_rad_s;
+        if !(w.is_finite() && w > 0.0) {
+            return Err((
+                "rotor.omega_rad_s",
+                format!("expected a positive number, found {w}"),
+            ));
+        }
+        if self.blades == 0 {
+            return Err(("rotor.blades", "expected at least 1 blade".into()));
+        }
+        Ok(())
+    }
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BladeTable {
@@ -823,10 +842,12 @@ pub struct LagMoments {
 }
 
 /// The error for a hinged-blade deck given where an elastomeric rotor is read.
-fn hinged_deck(file: &str) -> anyhow::Error {
-    anyhow::anyhow!(
-        "rotor deck {file}: a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it"
+fn hinged_deck(file: &str) -> DeckError {
+    DeckError::file(
+        file,
+        "a hinged-blade deck ([[hinge]] tables, docs/rotor_deck.md \"Hinged-blade decks\") has no pitch link or damper: only `rotorsim modes --rotor` reads it",
     )
+    .in_deck(ROTOR_DECK)
 }
 
 impl RotorSpec {
@@ -1030,30 +1051,30 @@ impl RotorSpec {
     }
 
     /// Parse deck text; `file` names it in errors (toml reports line and column).
-    pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
+    pub fn parse(text: &str, file: &str) -> Result<Self, DeckError> {
         if super::RotorKind::of_text(text) == super::RotorKind::Hinged {
             return Err(hinged_deck(file));
         }
         let spec: RotorSpec = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.to_string().trim_end()))?;
+            .map_err(|e| DeckError::file(file, e.to_string().trim_end()).in_deck(ROTOR_DECK))?;
         spec.validate(file)?;
         Ok(spec)
     }
 
-    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+    pub fn from_file(path: &Path) -> Result<Self, DeckError> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+            .map_err(|e| DeckError::read(&file, e).in_deck(ROTOR_DECK))?;
         Self::parse(&text, &file)
     }
 
     /// The deck of parsed (and possibly overridden) tables, validated like [`RotorSpec::parse`].
-    pub fn from_table(root: &toml::Table, file: &str) -> anyhow::Result<Self> {
+    pub fn from_table(root: &toml::Table, file: &str) -> Result<Self, DeckError> {
         if root.contains_key("hinge") {
             return Err(hinged_deck(file));
         }
         let spec = Self::schema(root)
-            .map_err(|e| anyhow::anyhow!("rotor deck {file}: {}", e.message().trim_end()))?;
+            .map_err(|e| DeckError::file(file, e.message().trim_end()).in_deck(ROTOR_DECK))?;
         spec.validate(file)?;
         Ok(spec)
     }
@@ -1063,7 +1084,7 @@ impl RotorSpec {
         toml::Value::Table(root.clone()).try_into()
     }
 
-    fn validate(&self, file: &str) -> anyhow::Result<()> {
+    fn validate(&self, file: &str) -> Result<(), DeckError> {
         self.check_parts(file)?;
         self.check_geometry(file)?;
         self.check_values(file)?;
@@ -1071,20 +1092,16 @@ impl RotorSpec {
     }
 
     /// Rotor speed, airframe, aerodynamics, blade count, sections and the finite values.
-    fn check_parts(&self, file: &str) -> anyhow::Result<()> {
+    fn check_parts(&self, file: &str) -> Result<(), DeckError> {
         let bad = |key: &str, msg: &str| deck_error(file, key, msg);
-        let pos = |key: &str, v: f64| check_positive(file, key, v);
         let nonneg = |key: &str, v: f64| check_non_negative(file, key, v);
-        pos("rotor.omega_rad_s", self.rotor.omega_rad_s)?;
+        self.rotor.check().map_err(|(k, what)| bad(k, &what))?;
         if let Some(a) = &self.airframe {
             a.check().map_err(|(k, what)| bad(&k, &what))?;
         }
         if let Some(a) = &self.aero {
             a.check(self.rotor.radius_m)
                 .map_err(|(k, what)| bad(&k, &what))?;
-        }
-        if self.rotor.blades == 0 {
-            return Err(bad("rotor.blades", "expected at least 1 blade"));
         }
         for (key, sec) in [
             (
@@ -1146,7 +1163,7 @@ impl RotorSpec {
     }
 
     /// Radii in order and element counts.
-    fn check_geometry(&self, file: &str) -> anyhow::Result<()> {
+    fn check_geometry(&self, file: &str) -> Result<(), DeckError> {
         let bad = |key: &str, msg: &str| deck_error(file, key, msg);
         let pos = |key: &str, v: f64| check_positive(file, key, v);
         pos("rotor.radius_m", self.rotor.radius_m)?;
@@ -1185,7 +1202,7 @@ impl RotorSpec {
     }
 
     /// Bearing, masses, lengths and the pitch horn and twist tables.
-    fn check_values(&self, file: &str) -> anyhow::Result<()> {
+    fn check_values(&self, file: &str) -> Result<(), DeckError> {
         let bad = |key: &str, msg: &str| deck_error(file, key, msg);
         let pos = |key: &str, v: f64| check_positive(file, key, v);
         let nonneg = |key: &str, v: f64| check_non_negative(file, key, v);
@@ -1248,7 +1265,7 @@ impl RotorSpec {
     }
 
     /// Output stations and section channels.
-    fn check_outputs(&self, file: &str) -> anyhow::Result<()> {
+    fn check_outputs(&self, file: &str) -> Result<(), DeckError> {
         let bad = |key: &str, msg: &str| deck_error(file, key, msg);
         let o = &self.outputs;
         let lo = self.retention.hinge_r_m / self.rotor.radius_m;
@@ -1292,11 +1309,14 @@ impl RotorSpec {
     }
 }
 
-fn deck_error(file: &str, key: &str, msg: &str) -> anyhow::Error {
-    anyhow::anyhow!("rotor deck {file}, {key}: {msg}")
+/// How a rotor deck is named in its errors.
+pub(crate) const ROTOR_DECK: &str = "rotor deck";
+
+pub(crate) fn deck_error(file: &str, key: &str, msg: &str) -> DeckError {
+    DeckError::invalid(file, key, msg).in_deck(ROTOR_DECK)
 }
 
-fn check_positive(file: &str, key: &str, v: f64) -> anyhow::Result<()> {
+fn check_positive(file: &str, key: &str, v: f64) -> Result<(), DeckError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -1308,7 +1328,7 @@ fn check_positive(file: &str, key: &str, v: f64) -> anyhow::Result<()> {
     }
 }
 
-fn check_non_negative(file: &str, key: &str, v: f64) -> anyhow::Result<()> {
+fn check_non_negative(file: &str, key: &str, v: f64) -> Result<(), DeckError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {

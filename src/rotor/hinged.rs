@@ -10,6 +10,7 @@
 //! by a static moment on the blade root, then ramped off) with its damped frequency and damping
 //! ratio from a least-squares fit of a damped sine.
 use super::deck::RotorTable;
+use crate::hydraulics::DeckError;
 use crate::solver::modal::{modes, ModalOptions, Mode, ModeKind};
 use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonMethod, State};
@@ -22,6 +23,9 @@ use crate::structure::model::{Element, Model};
 use crate::structure::section::SectionProps;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+
+/// How a hinged-blade deck is named in its errors.
+const HINGED_DECK: &str = "hinged-blade rotor deck";
 
 /// Rotation a hinge frees (hub frame; angle signs as the bearing of docs/rotor_deck.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -137,21 +141,17 @@ pub const TRACKED: [&str; 7] = [
 ];
 
 impl HingedSpec {
-    pub fn parse(text: &str, file: &str) -> anyhow::Result<Self> {
-        let spec: HingedSpec = toml::from_str(text).map_err(|e| {
-            anyhow::anyhow!(
-                "rotor deck {file} (hinged blade): {}",
-                e.to_string().trim_end()
-            )
-        })?;
+    pub fn parse(text: &str, file: &str) -> Result<Self, DeckError> {
+        let spec: HingedSpec = toml::from_str(text)
+            .map_err(|e| DeckError::file(file, e.to_string().trim_end()).in_deck(HINGED_DECK))?;
         spec.validate(file)?;
         Ok(spec)
     }
 
-    pub fn from_file(path: &Path) -> anyhow::Result<Self> {
+    pub fn from_file(path: &Path) -> Result<Self, DeckError> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+            .map_err(|e| DeckError::read(&file, e).in_deck(HINGED_DECK))?;
         Self::parse(&text, &file)
     }
 
@@ -160,21 +160,10 @@ impl HingedSpec {
         self.rotor.omega_rad_s * 60.0 / (2.0 * std::f64::consts::PI)
     }
 
-    fn validate(&self, file: &str) -> anyhow::Result<()> {
-        let bad = |key: &str, msg: String| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
+    fn validate(&self, file: &str) -> Result<(), DeckError> {
+        let bad = |key: &str, msg: String| DeckError::invalid(file, key, msg).in_deck(HINGED_DECK);
         let fin = |v: f64| v.is_finite();
-        if !(fin(self.rotor.omega_rad_s) && self.rotor.omega_rad_s > 0.0) {
-            return Err(bad(
-                "rotor.omega_rad_s",
-                format!(
-                    "expected a positive number, found {}",
-                    self.rotor.omega_rad_s
-                ),
-            ));
-        }
-        if self.rotor.blades == 0 {
-            return Err(bad("rotor.blades", "expected at least 1 blade".into()));
-        }
+        self.rotor.check().map_err(|(key, msg)| bad(key, msg))?;
         if self.hinges.is_empty() {
             return Err(bad("hinge", "expected at least one [[hinge]]".into()));
         }
@@ -272,8 +261,8 @@ impl HingedSpec {
     }
 
     /// The point masses: unique names, on the blade (root to `tip`), positive, finite.
-    fn validate_masses(&self, file: &str, tip: f64) -> anyhow::Result<()> {
-        let bad = |key: &str, msg: String| anyhow::anyhow!("rotor deck {file}, {key}: {msg}");
+    fn validate_masses(&self, file: &str, tip: f64) -> Result<(), DeckError> {
+        let bad = |key: &str, msg: String| DeckError::invalid(file, key, msg).in_deck(HINGED_DECK);
         let fin = |v: f64| v.is_finite();
         let b = &self.blade;
         let mut names: Vec<&str> = vec![];

@@ -352,7 +352,7 @@ impl RotorDeck {
     pub fn from_file_with(path: &Path, overrides: &[Override]) -> anyhow::Result<Self> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("rotor deck {file}: cannot read: {e}"))?;
+            .map_err(|e| crate::hydraulics::DeckError::read(&file, e).in_deck(deck::ROTOR_DECK))?;
         let spec = deck::RotorSpec::parse(&text, &file)?;
         let root = crate::overrides::parse_deck(&text, &file)?;
         let assumed = assumed::scan(&text, &root);
@@ -368,7 +368,7 @@ impl RotorDeck {
                 // command line, which the caller names
                 if let Err(e) = deck::RotorSpec::schema(t) {
                     let table = ov.key.rsplit_once('.').map_or("", |(t, _)| t);
-                    anyhow::bail!("rotor deck {file}, {table}: {}", e.message().trim_end());
+                    return Err(deck::deck_error(&file, table, e.message().trim_end()).into());
                 }
                 deck::RotorSpec::from_table(t, &file)?;
                 if ov.is_damper() {

@@ -522,16 +522,10 @@ pub fn load_deck_within(
     budget: impl FnOnce(&Deck) -> Result<(), String>,
 ) -> Result<(Deck, Model), DeckError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| DeckError::Read {
-        file: file.clone(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| DeckError::read(&file, source))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut deck = deserialize(&text, &file)?;
-    budget(&deck).map_err(|message| DeckError::File {
-        file: file.clone(),
-        message,
-    })?;
+    budget(&deck).map_err(|message| DeckError::file(&file, message))?;
     let (model, probes) = build(&deck, &file, &base)?;
     deck.hydraulic_probes = BuiltProbes(probes);
     Ok((deck, model))
@@ -541,10 +535,7 @@ fn deserialize(text: &str, file: &str) -> Result<Deck, DeckError> {
     let deck: Deck = toml::from_str(text).map_err(|e| {
         let msg = e.to_string().trim_end().to_string();
         let at = e.span().and_then(|sp| array_table_at(text, sp.start));
-        DeckError::File {
-            file: file.into(),
-            message: at.map(|t| format!("in {t}: {msg}")).unwrap_or(msg),
-        }
+        DeckError::file(file, at.map(|t| format!("in {t}: {msg}")).unwrap_or(msg))
     })?;
     validate(&deck).map_err(|(key, msg)| DeckError::invalid(file, key, msg))?;
     Ok(deck)
