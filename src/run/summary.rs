@@ -451,26 +451,51 @@ pub fn figures(run: &ModelRun, measured: Option<&Measured>) -> anyhow::Result<Mo
     })
 }
 
+/// A model reproduces the measured force when its correlation with it is at least this (it
+/// follows at least half the measurement's variance, r^2 >= 0.49) and its RMS error is below
+/// the measurement's RMS about its mean (it does better than the mean alone). Below either, a
+/// smallest RMS error ranks wrong shapes, and no model is named the closest.
+pub const REPRODUCES_CORRELATION: f64 = 0.7;
+
 /// The model that comes closest (smallest RMS error) and how it ranks against the others.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Ranking {
     /// (model, RMS error [N], correlation), best first.
     pub order: Vec<(String, f64, f64)>,
+    /// Whether the first reproduces the measurement ([`REPRODUCES_CORRELATION`]); when not,
+    /// no model is named the closest.
+    pub reproduces: bool,
     pub statement: String,
 }
 
+/// Whether `m` reproduces the measurement ([`REPRODUCES_CORRELATION`]).
+pub fn reproduces(m: &Metrics) -> bool {
+    m.correlation >= REPRODUCES_CORRELATION && m.rms_error_rel < 1.0
+}
+
 pub fn ranking(items: &[(String, &Metrics)]) -> Option<Ranking> {
-    let mut order: Vec<(String, f64, f64)> = items
+    let mut ranked: Vec<(String, f64, f64, bool)> = items
         .iter()
         .filter(|(_, m)| m.rms_error.is_finite())
-        .map(|(n, m)| (n.clone(), m.rms_error, m.correlation))
+        .map(|(n, m)| (n.clone(), m.rms_error, m.correlation, reproduces(m)))
         .collect();
-    if order.is_empty() {
+    if ranked.is_empty() {
         return None;
     }
-    order.sort_by(|a, b| a.1.total_cmp(&b.1));
+    ranked.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let reproduces = ranked[0].3;
+    let order: Vec<(String, f64, f64)> = ranked.into_iter().map(|(n, e, c, _)| (n, e, c)).collect();
     let best = &order[0];
-    let statement = if order.len() == 1 {
+    let statement = if !reproduces {
+        let top = order
+            .iter()
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .unwrap_or(best);
+        format!(
+            "no model reproduces the measured force (correlation at least {REPRODUCES_CORRELATION} and an RMS error below the measurement's own RMS): the best correlation is {:.3} ({} model); the smallest RMS error, {:.0} N, is the {} model's",
+            top.2, top.0, best.1, best.0
+        )
+    } else if order.len() == 1 {
         format!(
             "only the {} model was compared: RMS error {:.0} N, correlation {:.3}",
             best.0, best.1, best.2
@@ -488,7 +513,11 @@ pub fn ranking(items: &[(String, &Metrics)]) -> Option<Ranking> {
             next.2
         )
     };
-    Some(Ranking { order, statement })
+    Some(Ranking {
+        order,
+        reproduces,
+        statement,
+    })
 }
 
 /// Run-level facts written into summary.json.
@@ -581,7 +610,7 @@ pub fn summary_json(
         },
         "wall_time_s": info.wall_s,
         "measured": meas,
-        "closest": rank.map(|r| json!({"model": r.order[0].0, "statement": r.statement, "order": r.order})),
+        "closest": rank.map(|r| json!({"model": r.order[0].0, "reproduces": r.reproduces, "statement": r.statement, "order": r.order})),
         "models": models,
     })
 }
@@ -955,6 +984,48 @@ fn periodic_resample(from: &[f64], values: &[f64], to: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Metrics of `model(psi)` against a 1/rev measurement, on 72 azimuths.
+    fn metrics_of(model: impl Fn(f64) -> f64) -> Metrics {
+        use crate::analysis::compare::{compare, Periodic};
+        let psi: Vec<f64> = (0..72).map(|k| k as f64 * 5.0).collect();
+        let meas: Vec<f64> = psi.iter().map(|p| 1e3 * p.to_radians().sin()).collect();
+        let m: Vec<f64> = psi.iter().map(|p| model(p.to_radians())).collect();
+        let pm = Periodic {
+            psi_deg: &psi,
+            value: &m,
+        };
+        let pr = Periodic {
+            psi_deg: &psi,
+            value: &meas,
+        };
+        compare(pm, pr, 3).unwrap()
+    }
+
+    #[test]
+    fn a_model_is_named_closest_only_when_it_reproduces_the_measurement() {
+        // the right shape, 20% small: correlation 1, RMS error 0.2 of the measurement's
+        let good = metrics_of(|p| 800.0 * p.sin());
+        // the wrong shape (a 2/rev), however small its RMS error
+        let wrong = metrics_of(|p| 100.0 * (2.0 * p).sin());
+        let zero = metrics_of(|p| -200.0 * p.sin());
+        let r = ranking(&[("a".into(), &wrong), ("b".into(), &good)]).unwrap();
+        assert!(r.reproduces && r.order[0].0 == "b", "{r:?}");
+        assert!(
+            r.statement.starts_with("the b model comes closest"),
+            "{}",
+            r.statement
+        );
+        let r = ranking(&[("a".into(), &wrong), ("c".into(), &zero)]).unwrap();
+        assert!(!r.reproduces, "{r:?}");
+        assert!(
+            r.statement
+                .starts_with("no model reproduces the measured force"),
+            "{}",
+            r.statement
+        );
+        assert!(!r.statement.contains("comes closest"), "{}", r.statement);
+    }
 
     #[test]
     fn measured_values_are_exact_on_shared_azimuths_and_periodic_linear_between() {
