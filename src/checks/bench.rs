@@ -225,6 +225,38 @@ impl BenchJob {
         }
     }
 
+    /// The sweep's peak velocities (in `--velocity-unit`, `factor` to m/s): positive, finite,
+    /// and told apart by their history files' names.
+    fn check_peak_velocities(&self, factor: f64) -> anyhow::Result<()> {
+        if self.peak_velocity.is_empty()
+            || self
+                .peak_velocity
+                .iter()
+                .any(|v| !(*v > 0.0 && v.is_finite()))
+        {
+            bail!(
+                "--peak-velocity must be positive numbers (got {:?})",
+                self.peak_velocity
+            );
+        }
+        let names: Vec<String> = self
+            .peak_velocity
+            .iter()
+            .map(|&v| history_name(v * factor))
+            .collect();
+        for (i, a) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|b| b == a) {
+                bail!(
+                    "--peak-velocity {} and {} {} name the same history file {a} (peak velocities are told apart to 1 um/s)",
+                    self.peak_velocity[j],
+                    self.peak_velocity[i],
+                    self.velocity_unit
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Checks the options and the deck, builds the devices, and runs the harmonic sweep (or
     /// the replay of `measured`) into `out`. `on_model` gets each model's sweep (and the
     /// hydraulic sub-stepping of its samples and each run's error estimate) once its files are
@@ -340,33 +372,7 @@ impl BenchJob {
             replay(&cfg, &deck, &devices, note)?;
             return Ok(outcome);
         }
-        let factor = factor?;
-        if self.peak_velocity.is_empty()
-            || self
-                .peak_velocity
-                .iter()
-                .any(|v| !(*v > 0.0 && v.is_finite()))
-        {
-            bail!(
-                "--peak-velocity must be positive numbers (got {:?})",
-                self.peak_velocity
-            );
-        }
-        let names: Vec<String> = self
-            .peak_velocity
-            .iter()
-            .map(|&v| history_name(v * factor))
-            .collect();
-        for (i, a) in names.iter().enumerate() {
-            if let Some(j) = names[..i].iter().position(|b| b == a) {
-                bail!(
-                    "--peak-velocity {} and {} {} name the same history file {a} (peak velocities are told apart to 1 um/s)",
-                    self.peak_velocity[j],
-                    self.peak_velocity[i],
-                    self.velocity_unit
-                );
-            }
-        }
+        self.check_peak_velocities(factor?)?;
         sweep(
             &cfg,
             &deck,
@@ -1095,16 +1101,14 @@ fn is_synthetic(path: &std::path::Path) -> bool {
     })
 }
 
-/// Replays every measured test (`cfg.measured`) through every device and writes
-/// replay_*.csv, loop_*.svg, replay_summary.csv and bench.html into `cfg.out`; `note` gets one
-/// line per test and model (its error metrics).
-pub fn replay(
+/// The measured tests of `cfg` read, each with its metric window, and checked before any
+/// output is made: sampled fast enough for a model that steps once per sample, and (for the
+/// physical damper) within the deck's stroke.
+fn read_tests(
     cfg: &Config,
     deck: &DamperDeck,
     devices: &[(DamperModel, Box<dyn Device>)],
-    note: &mut dyn FnMut(&str),
-) -> anyhow::Result<()> {
-    // Read every test and find its cycles before creating any output.
+) -> anyhow::Result<(Vec<BenchTest>, Vec<Window>)> {
     let tests = cfg
         .measured
         .iter()
@@ -1134,6 +1138,20 @@ pub fn replay(
                 .map_err(anyhow::Error::msg)?;
         }
     }
+    Ok((tests, windows))
+}
+
+/// Replays every measured test (`cfg.measured`) through every device and writes
+/// replay_*.csv, loop_*.svg, replay_summary.csv and bench.html into `cfg.out`; `note` gets one
+/// line per test and model (its error metrics).
+pub fn replay(
+    cfg: &Config,
+    deck: &DamperDeck,
+    devices: &[(DamperModel, Box<dyn Device>)],
+    note: &mut dyn FnMut(&str),
+) -> anyhow::Result<()> {
+    // Read every test and find its cycles before creating any output.
+    let (tests, windows) = read_tests(cfg, deck, devices)?;
     let inputs: Vec<PathBuf> = std::iter::once(cfg.deck.clone())
         .chain(cfg.measured.iter().cloned())
         .collect();

@@ -499,6 +499,24 @@ impl Plot {
         (x, y)
     }
 
+    /// A series' points as drawn: the finite ones, scaled (`fy`: the y axis' map); a marker
+    /// outside a y range that was asked for is left out, not drawn over the axes (lines and
+    /// bands keep their points).
+    fn drawn_points(&self, s: &Series, fy: &dyn Fn(f64) -> f64) -> Vec<(f64, f64)> {
+        s.x.iter()
+            .zip(&s.y)
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .filter(|(_, &y)| {
+                !matches!(
+                    s.kind,
+                    SeriesKind::Points | SeriesKind::Dots | SeriesKind::Rings
+                ) || self.y_categories.is_some()
+                    || self.y_range.is_none_or(|(lo, hi)| (lo..=hi).contains(&y))
+            })
+            .map(|(&x, &y)| (x * self.x_scale, fy(y)))
+            .collect()
+    }
+
     fn draw_on<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, plotters::coord::Shift>,
@@ -558,21 +576,7 @@ impl Plot {
             }
         };
         for (s, &color) in self.series.iter().zip(&colours) {
-            let pts: Vec<(f64, f64)> =
-                s.x.iter()
-                    .zip(&s.y)
-                    .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    // a marker outside a y range that was asked for is left out, not drawn
-                    // over the axes (lines and bands keep their points)
-                    .filter(|(_, &y)| {
-                        !matches!(
-                            s.kind,
-                            SeriesKind::Points | SeriesKind::Dots | SeriesKind::Rings
-                        ) || self.y_categories.is_some()
-                            || self.y_range.is_none_or(|(lo, hi)| (lo..=hi).contains(&y))
-                    })
-                    .map(|(&x, &y)| (x * sx, fy(y)))
-                    .collect();
+            let pts = self.drawn_points(s, &fy);
             match s.kind {
                 SeriesKind::Line => {
                     chart
