@@ -29,9 +29,32 @@ pub struct ClampCounts {
     alpha_high: AtomicU64,
     mach_low: AtomicU64,
     mach_high: AtomicU64,
+    /// Every table query, clamped or not (the fraction's denominator); on a cache line of its
+    /// own, as it is written on every query by every blade's thread.
+    queries: Padded,
 }
 
+#[derive(Debug, Default)]
+#[repr(align(64))]
+struct Padded(AtomicU64);
+
 impl ClampCounts {
+    /// Counts one table query.
+    fn query(&self) {
+        self.queries.0.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Table queries so far, clamped or not.
+    pub fn queries(&self) -> u64 {
+        self.queries.0.load(Ordering::Relaxed)
+    }
+
+    /// Queries clamped at any edge (a query clamped in alpha and Mach counts once per edge, so
+    /// this may exceed [`Self::queries`] only by those).
+    pub fn fraction_clamped(&self) -> f64 {
+        self.total() as f64 / self.queries().max(1) as f64
+    }
+
     /// Counts the edges of `clamp` (does nothing, and does not allocate, when none clamped).
     pub fn record(&self, clamp: Clamp) {
         if clamp.alpha_low {
@@ -79,7 +102,8 @@ impl ClampCounts {
         self.summary_with(None)
     }
 
-    fn summary_with(&self, limits: Option<[f64; 4]>) -> String {
+    /// [`Self::summary`] with the tables' limits (see [`Airfoil::limits`]) in each part.
+    pub fn summary_with(&self, limits: Option<[f64; 4]>) -> String {
         let lim = |k: usize, unit: &str, name: &str| match limits {
             Some(l) => format!(" ({name}{} {unit})", l[k]).replace(" )", ")"),
             None => String::new(),
@@ -188,6 +212,7 @@ impl Airfoil {
                 let (cd, c2) = t.cd.eval(a, mach);
                 let (cm, c3) = t.cm.eval(a, mach);
                 let clamp = c1.or(c2).or(c3);
+                clamps.query();
                 if clamp.any() {
                     clamps.record(clamp);
                 }
@@ -228,6 +253,23 @@ impl Airfoil {
                 ])
             }
         }
+    }
+
+    /// The narrowest limits of `airfoils`' tables ([`Self::limits`]); `None` without a table.
+    pub fn narrowest_limits<'a>(
+        airfoils: impl IntoIterator<Item = &'a Airfoil>,
+    ) -> Option<[f64; 4]> {
+        airfoils
+            .into_iter()
+            .filter_map(Airfoil::limits)
+            .reduce(|a, b| {
+                [
+                    a[0].max(b[0]),
+                    a[1].min(b[1]),
+                    a[2].max(b[2]),
+                    a[3].min(b[3]),
+                ]
+            })
     }
 
     /// [`ClampCounts::summary`] with this aerofoil's limits, e.g. "3 queries above the table's

@@ -69,7 +69,71 @@ pub struct BladeAero {
     pub tip_loss_factor: f64,
 }
 
+/// The share of a load point's strip (`width` from `start` [m]) that lifts, inboard of the
+/// tip-loss radius `tip_r`: the lifting span then ends at B R exactly, wherever the points
+/// fall (a point at radius `r` with no strip: 1 inboard, 0 outboard).
+fn lift_inside(start: f64, width: f64, r: f64, tip_r: f64) -> f64 {
+    if width > 0.0 {
+        ((tip_r - start) / width).clamp(0.0, 1.0)
+    } else if r <= tip_r {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// The section airloads at radius `r_m` between two load points `p0` and `p1` (inboard
+/// first) of the last evaluation: the air's in-plane velocity interpolated linearly between
+/// them, then the blade element at `r_m` itself (its chord, its aerofoil, lift only inboard of
+/// the tip-loss radius). This is what an output station reports: the lifting line at the
+/// station's radius, not a blend of two points' loads (which, across the tip-loss radius,
+/// would blend a lifting point with one that does not lift). Table lookups here are not
+/// counted as the run's.
+pub fn section_at(
+    geometry: &BladeAero,
+    rotor: &RotorAir,
+    r_m: f64,
+    p0: &PointRecord,
+    p1: &PointRecord,
+) -> SectionAirloads {
+    let w = if p1.r_m > p0.r_m {
+        ((r_m - p0.r_m) / (p1.r_m - p0.r_m)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    // the in-plane velocity (toward the trailing edge, up) each point's section saw
+    let rho = rotor.air.density_kg_m3;
+    let vel = |p: &PointRecord| {
+        let speed = (2.0 * p.section.q_pa / rho).max(0.0).sqrt();
+        let (s, c) = p.section.alpha_rad.sin_cos();
+        [speed * c, speed * s]
+    };
+    let (v0, v1) = (vel(p0), vel(p1));
+    let ut = v0[0] + w * (v1[0] - v0[0]);
+    let up = v0[1] + w * (v1[1] - v0[1]);
+    if r_m < geometry.cutout_r_m {
+        return SectionAirloads::default();
+    }
+    let lift = if r_m <= geometry.tip_r_m(rotor.radius_m) {
+        1.0
+    } else {
+        0.0
+    };
+    blade_element(
+        [0.0, -ut, up],
+        geometry.chord_at(r_m),
+        &rotor.air,
+        &geometry.airfoils[geometry.airfoil_at(r_m)].1,
+        &ClampCounts::default(),
+        lift,
+    )
+}
+
 impl BladeAero {
+    /// The tip-loss radius B R [m] of a rotor of radius `radius_m`.
+    pub fn tip_r_m(&self, radius_m: f64) -> f64 {
+        self.tip_loss_factor * radius_m
+    }
     fn chord_at(&self, r: f64) -> f64 {
         let c = &self.chord_m;
         if c.is_empty() {
@@ -212,10 +276,12 @@ impl LiftingLine {
         let n_el = ids.iter().map(|i| i + 1).max().unwrap_or(0);
         let mut first = vec![usize::MAX; n_el];
         let mut stations = Vec::with_capacity(ids.len() * NPTS_M);
-        let tip_r = geometry.tip_loss_factor * rotor.radius_m;
+        let tip_r = geometry.tip_r_m(rotor.radius_m);
         for &id in ids {
             if let Element::Beam(b) = &model.elements[id] {
                 first[id] = stations.len();
+                // each point's strip of the element: its quadrature weight, in point order
+                let mut strip_start = geometry.root_r_m + b.s_range[0];
                 for g in &b.gm {
                     let r = geometry.root_r_m + g.s_m;
                     stations.push(Station {
@@ -223,10 +289,11 @@ impl LiftingLine {
                         r_m: r,
                         chord_m: geometry.chord_at(r),
                         airfoil: geometry.airfoil_at(r),
-                        lift_factor: if r <= tip_r { 1.0 } else { 0.0 },
+                        lift_factor: lift_inside(strip_start, g.wj, r, tip_r),
                         weight_m: g.wj,
                         active: r >= geometry.cutout_r_m,
                     });
+                    strip_start += g.wj;
                 }
             }
         }
@@ -387,5 +454,29 @@ impl LiftingLine {
 impl DistributedLoad for LiftingLine {
     fn eval(&mut self, p: &LoadPoint) -> SectionLoad {
         self.evaluate(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lift_inside;
+
+    /// Strips of a 3-point Gauss element from 7.6 m to 8.0 m and a tip-loss radius of 7.9 m:
+    /// the lifting span (weights times lift factors) ends at 7.9 m exactly.
+    #[test]
+    fn the_lifting_span_ends_at_the_tip_loss_radius() {
+        let (a, l) = (7.6, 0.4);
+        let w = [5.0 / 18.0 * l, 8.0 / 18.0 * l, 5.0 / 18.0 * l];
+        let x = [0.5 - 0.15f64.sqrt(), 0.5, 0.5 + 0.15f64.sqrt()];
+        let mut start = a;
+        let mut span = 0.0;
+        for (wi, xi) in w.iter().zip(x) {
+            span += wi * lift_inside(start, *wi, a + xi * l, 7.9);
+            start += wi;
+        }
+        assert!((span - 0.3).abs() < 1e-12, "{span}");
+        // a point without a strip: lifts inboard of the radius only
+        assert_eq!(lift_inside(7.0, 0.0, 7.8, 7.9), 1.0);
+        assert_eq!(lift_inside(7.0, 0.0, 7.95, 7.9), 0.0);
     }
 }

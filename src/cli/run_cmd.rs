@@ -76,6 +76,9 @@ fn print_summary(outcome: &RunOutcome) {
                     t.total_s - t.hydraulics_s,
                     t.hydraulics_s
                 );
+                for line in summary::blade_force_lines(r) {
+                    outln!("{:<22} {line}", "");
+                }
                 if let Some(c) = r.loads_check.as_ref().filter(|c| !c.passed) {
                     outln!(
                         "warning: {}: blade root loads differ from the resultant of the applied, inertial, damper and pitch-link loads by {:.2e} of {}'s peak-to-peak (above {:.1e}): the structural solution is not in equilibrium to the accuracy the loads need",
@@ -103,10 +106,7 @@ fn print_summary(outcome: &RunOutcome) {
                     );
                 }
                 if let Some(a) = r.airloads.as_ref().filter(|a| a.clamped_queries > 0) {
-                    outln!(
-                        "warning: {}: aerofoil tables clamped {} queries to their edges (not extrapolated): {}",
-                        r.label, a.clamped_queries, a.clamps
-                    );
+                    errln!("warning: {}: {}", r.label, a.clamp_statement());
                 }
                 if r.converged() && r.periodic.message.starts_with("warm start") {
                     outln!("note: {}: {}", r.label, r.periodic.message);

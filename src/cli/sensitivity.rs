@@ -103,13 +103,14 @@ pub fn run(args: SensitivityArgs) -> anyhow::Result<()> {
         let top: Vec<String> = t
             .top3(k)
             .iter()
-            .map(|(r, spread)| {
-                let swing = r.swing(k).unwrap_or(*spread);
-                format!("{} (swing {swing:+.4e})", r.param.name())
-            })
+            .map(|(r, spread)| format!("{} (spread {spread:.4e})", r.param.name()))
             .collect();
         match t.nominal.values[k] {
-            Some(v) => outln!("{}: nominal {v:.4e}; top: {}", o.title, top.join(", ")),
+            Some(v) => outln!(
+                "{}: nominal {v:.4e}; most sensitive to (spread over low, nominal and high): {}",
+                o.title,
+                top.join(", ")
+            ),
             None => outln!("{}: not available from the {} model", o.title, t.model),
         }
     }

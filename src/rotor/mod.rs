@@ -88,8 +88,10 @@ pub struct AirloadInfo {
     pub inflow: String,
     /// The aerofoils, inboard first.
     pub airfoils: Vec<String>,
-    /// Aerofoil-table queries clamped to a table's edge (never extrapolated), and where.
+    /// Aerofoil-table queries clamped to a table's edge (never extrapolated; once per edge),
+    /// of `table_queries` in all, and where (with the tables' limits).
     pub clamped_queries: u64,
+    pub table_queries: u64,
     pub clamps: String,
     /// The record's thrust coefficient over solidity (its metadata), for comparison.
     pub record_ct_over_sigma: Option<f64>,
@@ -98,6 +100,21 @@ pub struct AirloadInfo {
 }
 
 impl AirloadInfo {
+    /// The clamped queries in words: their share of the lookups, then where, e.g. "12.3% of
+    /// 310,000 aerofoil-table lookups clamped to the tables' edges (values at the edge, not
+    /// extrapolated): 38,000 queries below the table's Mach range (Mach 0.3)"; empty if none.
+    pub fn clamp_statement(&self) -> String {
+        if self.clamped_queries == 0 {
+            return String::new();
+        }
+        format!(
+            "{:.1}% of {} aerofoil-table lookups clamped to the tables' edges (the value at the edge, not extrapolated): {}",
+            100.0 * self.clamped_queries as f64 / self.table_queries.max(1) as f64,
+            self.table_queries,
+            self.clamps
+        )
+    }
+
     /// The source with the hybrid's reference, in words.
     pub fn source_text(&self) -> String {
         match self.reference.as_str() {

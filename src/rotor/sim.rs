@@ -400,8 +400,12 @@ struct AeroRun {
     /// is modelled or the steps per revolution are not a multiple of N.
     history: Vec<crate::aero::inflow::DiskLoads>,
     blades: usize,
+    /// Blade 1's aerodynamic geometry (the output stations' sections are evaluated with it).
+    geometry: crate::aero::lifting_line::BladeAero,
     /// Blade 1's aerofoils by segment, in words.
     airfoils: Vec<String>,
+    /// The narrowest alpha and Mach limits of its tables (None: the thin fallback only).
+    table_limits: Option<[f64; 4]>,
     record_ct_over_sigma: Option<f64>,
     record_synthetic: bool,
 }
@@ -986,46 +990,57 @@ fn aero_run(
     let (record, opts, source) = (ctx.record, ctx.opts, ctx.source);
     Ok(match aero_common {
         None => None,
-        Some((air, shared, clamps)) => Some(AeroRun {
-            source,
-            air,
-            shared,
-            clamps,
-            scale: spec.rotor.blades as f64 / blades.len() as f64,
-            solidity: spec.aero.as_ref().map_or(f64::NAN, |a| {
-                spec.rotor.blades as f64 * a.chord_m / (std::f64::consts::PI * spec.rotor.radius_m)
-            }),
-            coupled: source == super::aero::AirloadSource::Computed,
-            stations: record
-                .stations_r_over_r()
-                .iter()
-                .map(|r| (*r, r * spec.rotor.radius_m))
-                .collect(),
-            measured: AirloadReplay::new(record, ReplayMode::Average, ReplayOptions::default())?,
-            ahead_deg: blades[0].2,
-            history: if blades.len() == 1
-                && spec.rotor.blades > 1
-                && opts.steps_per_rev.is_multiple_of(spec.rotor.blades)
-            {
-                let nan = crate::aero::inflow::DiskLoads {
-                    ct: f64::NAN,
-                    cs: f64::NAN,
-                    cc: f64::NAN,
-                };
-                vec![nan; opts.steps_per_rev]
-            } else {
-                vec![]
-            },
-            blades: spec.rotor.blades,
-            airfoils: super::aero::blade_geometry(spec, ctx.file)?
-                .0
-                .airfoils
-                .iter()
-                .map(|(r, a)| format!("{} to r = {r} m", a.name()))
-                .collect(),
-            record_ct_over_sigma: record.meta.thrust_coefficient_over_solidity,
-            record_synthetic: record.meta.synthetic,
-        }),
+        Some((air, shared, clamps)) => {
+            let geometry = super::aero::blade_geometry(spec, ctx.file)?.0;
+            let foils = &geometry.airfoils;
+            Some(AeroRun {
+                source,
+                air,
+                shared,
+                clamps,
+                scale: spec.rotor.blades as f64 / blades.len() as f64,
+                solidity: spec.aero.as_ref().map_or(f64::NAN, |a| {
+                    spec.rotor.blades as f64 * a.chord_m
+                        / (std::f64::consts::PI * spec.rotor.radius_m)
+                }),
+                coupled: source == super::aero::AirloadSource::Computed,
+                stations: record
+                    .stations_r_over_r()
+                    .iter()
+                    .map(|r| (*r, r * spec.rotor.radius_m))
+                    .collect(),
+                measured: AirloadReplay::new(
+                    record,
+                    ReplayMode::Average,
+                    ReplayOptions::default(),
+                )?,
+                ahead_deg: blades[0].2,
+                history: if blades.len() == 1
+                    && spec.rotor.blades > 1
+                    && opts.steps_per_rev.is_multiple_of(spec.rotor.blades)
+                {
+                    let nan = crate::aero::inflow::DiskLoads {
+                        ct: f64::NAN,
+                        cs: f64::NAN,
+                        cc: f64::NAN,
+                    };
+                    vec![nan; opts.steps_per_rev]
+                } else {
+                    vec![]
+                },
+                blades: spec.rotor.blades,
+                airfoils: foils
+                    .iter()
+                    .map(|(r, a)| format!("{} to r = {r} m", a.name()))
+                    .collect(),
+                table_limits: crate::aero::airfoil::Airfoil::narrowest_limits(
+                    foils.iter().map(|(_, a)| a),
+                ),
+                geometry: geometry.clone(),
+                record_ct_over_sigma: record.meta.thrust_coefficient_over_solidity,
+                record_synthetic: record.meta.synthetic,
+            })
+        }
     })
 }
 
@@ -1269,7 +1284,7 @@ impl RotorSim {
     pub fn aero_clamps(&self) -> String {
         self.aero
             .as_ref()
-            .map_or(String::new(), |a| a.clamps.summary())
+            .map_or(String::new(), |a| a.clamps.summary_with(a.table_limits))
     }
 
     /// The rotor's channels, then per station of blade 1 (interpolated in radius between the
@@ -1305,16 +1320,15 @@ impl RotorSim {
             } else {
                 0.0
             };
-            let lerp = |f: &dyn Fn(&crate::aero::lifting_line::PointRecord) -> f64| {
-                f(p0) + w * (f(p1) - f(p0))
-            };
-            o[0] = lerp(&|p| p.section.alpha_rad.to_degrees());
-            o[1] = lerp(&|p| p.section.mach);
-            o[2] = lerp(&|p| p.section.coefficients.cl);
-            o[3] = lerp(&|p| p.section.coefficients.cd);
-            o[4] = lerp(&|p| p.section.coefficients.cm);
-            o[5] = lerp(&|p| p.lambda_i);
-            o[6] = lerp(&|p| p.section.normal_n_per_m());
+            // the lifting line at the station's own radius (not a blend of two points' loads)
+            let sec = crate::aero::lifting_line::section_at(&a.geometry, &a.air, *r_m, p0, p1);
+            o[0] = sec.alpha_rad.to_degrees();
+            o[1] = sec.mach;
+            o[2] = sec.coefficients.cl;
+            o[3] = sec.coefficients.cd;
+            o[4] = sec.coefficients.cm;
+            o[5] = p0.lambda_i + w * (p1.lambda_i - p0.lambda_i);
+            o[6] = sec.normal_n_per_m();
             let m = a.measured.section_loads_ahead(t, *r_m, a.ahead_deg);
             o[7] = o[6] - m.normal_N_per_m;
         }
@@ -1572,7 +1586,8 @@ impl ForcedResponse for RotorSim {
             inflow,
             airfoils: a.airfoils.clone(),
             clamped_queries: a.clamps.total(),
-            clamps: a.clamps.summary(),
+            table_queries: a.clamps.queries(),
+            clamps: a.clamps.summary_with(a.table_limits),
             record_ct_over_sigma: a.record_ct_over_sigma,
             record_synthetic: a.record_synthetic,
         })

@@ -22,15 +22,31 @@ pub const HUB_CHANNELS: [&str; 6] = [
 /// reported revolution.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct EquilibriumCheck {
-    /// Largest `|root - resultant| / peak-to-peak(root)` over samples and channels.
+    /// Largest `|root - resultant| / scale` over samples and channels, the scale of a channel
+    /// being its magnitude ([`load_scales`]).
     pub max_rel_error: f64,
     pub channel: String,
     pub tolerance: f64,
     pub passed: bool,
 }
 
-fn ptp(v: &[f64]) -> f64 {
-    super::summary::Stats::of(v).peak_to_peak
+/// The magnitude each root channel's error is measured against: the larger of its
+/// peak-to-peak and its largest absolute value (a steady load, as in hover, has no
+/// peak-to-peak to speak of), and at least 1e-3 of the largest such magnitude among the
+/// channels of its unit (forces, moments), so that a channel near zero is not judged by
+/// round-off.
+fn load_scales(channels: &[&[f64]; 6]) -> [f64; 6] {
+    let own = channels.map(|v| {
+        let st = super::summary::Stats::of(v);
+        st.peak_to_peak.max(st.min.abs()).max(st.max.abs())
+    });
+    let unit = |k: usize| {
+        own[3 * (k / 3)..3 * (k / 3) + 3]
+            .iter()
+            .cloned()
+            .fold(0.0, f64::max)
+    };
+    std::array::from_fn(|k| own[k].max(1e-3 * unit(k)).max(f64::MIN_POSITIVE))
 }
 
 /// Consumes the check channels (computing the equilibrium check) and adds the fixed-frame
@@ -44,8 +60,9 @@ pub fn finish(run: &mut ModelRun, blades: Option<usize>) {
         .collect();
     if let (Some(root), Some(check)) = (&root, &check) {
         let mut worst = (0.0f64, String::new());
+        let scales = load_scales(&std::array::from_fn(|k| run.last_rev[root[k]].as_slice()));
         for (k, (&i, &j)) in root.iter().zip(check).enumerate() {
-            let scale = ptp(&run.last_rev[i]).max(f64::MIN_POSITIVE);
+            let scale = scales[k];
             let e = run.last_rev[i]
                 .iter()
                 .zip(&run.last_rev[j])
@@ -165,4 +182,27 @@ pub fn loads_json(r: &ModelRun) -> serde_json::Value {
         "channels": channels,
         "equilibrium_check": r.loads_check,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::load_scales;
+
+    #[test]
+    fn a_steady_load_is_measured_by_its_magnitude_and_a_zero_one_by_its_units() {
+        let steady = [3.0e5; 8]; // centrifugal force in hover: no peak-to-peak
+        let cyclic: Vec<f64> = (0..8).map(|k| 2.0e3 * (k as f64).sin()).collect();
+        let zero = [1e-9; 8];
+        let moment = [1.0e4; 8];
+        let s = load_scales(&[&steady, &cyclic, &zero, &moment, &zero, &cyclic]);
+        assert_eq!(s[0], 3.0e5);
+        let ptp = cyclic.iter().cloned().fold(f64::MIN, f64::max)
+            - cyclic.iter().cloned().fold(f64::MAX, f64::min);
+        assert_eq!(s[1], ptp);
+        // a force channel near zero: 1e-3 of the largest force, not its round-off
+        assert_eq!(s[2], 3.0e2);
+        // moments are scaled among moments
+        assert_eq!(s[4], 1.0e1);
+        assert_eq!(s[5], ptp.max(1.0e1));
+    }
 }

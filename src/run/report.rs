@@ -247,6 +247,16 @@ fn verdict(
                 })
                 .collect();
             lines.extend(rotor_damper_split(ok, m));
+            // a whole rotor whose blades differ: the record is blade 1's; say what the others do
+            if !info.blade_differences.is_empty() {
+                for (r, _) in ok.iter().filter(|(r, _)| !r.blade_runs.is_empty()) {
+                    lines.push(format!(
+                        "{}, blade by blade (the comparison above is blade 1's): {}.",
+                        r.label,
+                        super::summary::blade_force_lines(r).join("; ")
+                    ));
+                }
+            }
             lines.push(format!(
                 "Measurement: the record's damper force averaged over {} revolutions, compared at its own {} azimuths.",
                 m.revolutions,
@@ -1410,10 +1420,7 @@ fn airloads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
         if a.record_synthetic { ", SYNTHETIC" } else { "" },
     ));
     if a.clamped_queries > 0 {
-        rep.paragraph(&format!(
-            "Aerofoil tables clamped {} queries to their edges (not extrapolated): {}.",
-            a.clamped_queries, a.clamps
-        ));
+        rep.paragraph(&format!("{}.", a.clamp_statement()));
     }
     // stations r/R of the normal-force channels
     let prefix = "aero_normal_N_per_m_r";

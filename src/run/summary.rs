@@ -694,6 +694,7 @@ fn airloads_json(r: &ModelRun) -> Value {
         "inflow": a.inflow,
         "airfoils": a.airfoils,
         "clamped_queries": a.clamped_queries,
+        "table_queries": a.table_queries,
         "clamps": a.clamps,
         "thrust_N_mean": mean("rotor_thrust_N"),
         "power_W_mean": mean("rotor_power_W"),
@@ -727,6 +728,40 @@ fn airframe_json(r: &ModelRun) -> Value {
         })
         .collect();
     json!({"channels": channels, "momentum_check": balance})
+}
+
+/// A whole-rotor run's damper force blade by blade, in words: one line per blade (peak-to-peak
+/// and mean), the blades whose force differs from blade 1's by more than 1% of its
+/// peak-to-peak marked; empty for a single-blade run.
+pub fn blade_force_lines(r: &ModelRun) -> Vec<String> {
+    let stats: Vec<(usize, Stats)> = r
+        .blade_runs
+        .iter()
+        .filter_map(|b| Some((b.blade?, Stats::of(b.channel("damper_force_N")?))))
+        .collect();
+    let Some((_, first)) = stats.first() else {
+        return vec![];
+    };
+    let tol = 0.01 * first.peak_to_peak;
+    stats
+        .iter()
+        .map(|(k, st)| {
+            let differs = (st.peak_to_peak - first.peak_to_peak).abs() > tol
+                || (st.mean - first.mean).abs() > tol;
+            format!(
+                "blade {k}: damper force {:.2} kN peak-to-peak, mean {:+.2} kN{}",
+                st.peak_to_peak * 1e-3,
+                st.mean * 1e-3,
+                if *k == 1 {
+                    " (the record's damper)"
+                } else if differs {
+                    " (differs from blade 1)"
+                } else {
+                    ""
+                }
+            )
+        })
+        .collect()
 }
 
 /// A whole-rotor run's blades: per blade its place, folder, periodicity, damper force and

@@ -178,6 +178,10 @@ fn case_with(base: &Table, id: &str, setting: Option<(&str, Value)>) -> sweep::C
     }
 }
 
+/// Why the deck's `[aero]` values are not varied: a study's runs replay the record's measured
+/// airloads, which do not read them (a swing of zero would rank them as mattering nothing).
+const UNUSED_AERO: &str = "an [aero] value: the study's runs replay the record's measured airloads, which do not use the lifting line (its values act only with --airloads computed or hybrid)";
+
 /// Finds the parameters (the deck's labelled values, then `--vary`), chooses and checks their
 /// ranges with `runner` (the deck's own validation, as the sweep checks its cases), and writes
 /// the plan text. Errors name the option or the key.
@@ -201,6 +205,15 @@ pub fn setup(o: &SensitivityOptions, runner: &dyn CaseRunner) -> anyhow::Result<
     let mut targets: Vec<Target> = Vec::new();
     if !o.only_vary {
         for l in &found.labelled {
+            if l.key == "aero" || l.key.starts_with("aero.") {
+                skipped.push(Skipped {
+                    line: l.line,
+                    key: Some(l.key.clone()),
+                    text: format!("{} = {}  # {}", l.key, l.value, l.comment),
+                    reason: UNUSED_AERO.into(),
+                });
+                continue;
+            }
             let (t, s) = scan::targets(l);
             targets.extend(t);
             skipped.extend(s);
