@@ -176,3 +176,159 @@ fn ground_resonance_limit_cycle_agrees_with_the_describing_function() {
         assert!(p.mac >= 0.8, "start {} m: MAC {}", p.start_m, p.mac);
     }
 }
+
+/// `rotorsim stability` with the amplitude check, into a fresh folder: (success, stdout and
+/// stderr, the folder).
+fn stability_command(name: &str, args: &[&str]) -> (bool, String, std::path::PathBuf) {
+    let out = std::env::temp_dir().join(format!(
+        "rotorsim-limit-cycle-{name}-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("stability")
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text, out)
+}
+
+/// The report's banners (their text).
+fn banners(html: &str) -> Vec<String> {
+    html.split("<div class=\"banner ")
+        .skip(1)
+        .map(|b| b.split("</div>").next().unwrap_or("").to_string())
+        .collect()
+}
+
+/// At 78 rad/s, inside the linearly unstable range, the shipped deck's regressing lag grows
+/// from the 1 mm start to the damper's end of travel (37.5 mm): the check reports it (the
+/// command, amplitude.csv, summary.json, the verdict and the report's banner) and succeeds.
+#[test]
+fn inside_the_unstable_range_the_start_grows_to_the_end_of_travel() {
+    let (ok, text, out) = stability_command(
+        "travel",
+        &[
+            "--rotor",
+            "rotors/uh60a_airframe.toml",
+            "--speeds",
+            "78",
+            "--damper",
+            "physical",
+            "--amplitudes-m",
+            "1e-3,1e-2",
+            "--amplitude-at-rad-s",
+            "78",
+        ],
+    );
+    println!("{text}");
+    assert!(ok, "{text}");
+    assert!(!out.join("INCOMPLETE").exists());
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("amplitude check: "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains("grows to the end of travel (")
+            && line.contains(" of 37.5 mm) within ")
+            && line.contains("no limit cycle below the stroke limit"),
+        "{line}"
+    );
+    let verdict = text
+        .lines()
+        .find(|l| l.starts_with("UNSTABLE: regressing lag"));
+    assert!(
+        verdict.is_some_and(|v| v.contains("no limit cycle below the stroke limit")),
+        "{text}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let a = &s["amplitude_check"];
+    assert!(a["limit_cycles"].as_array().unwrap().is_empty());
+    assert_eq!(a["travel_m"].as_f64().unwrap(), 0.0375);
+    for p in a["points"].as_array().unwrap() {
+        let e = &p["end_of_travel"];
+        assert!(e["stroke_m"].as_f64().unwrap() >= 0.95 * 0.0375, "{p}");
+        assert!(e["time_s"].as_f64().unwrap() > 0.0, "{p}");
+        assert!(p["growth_rate_per_s"].as_f64().unwrap() > 0.0, "{p}");
+    }
+    assert!(a["headline"]
+        .as_str()
+        .unwrap()
+        .contains("no limit cycle below the stroke limit"));
+    let csv = std::fs::read_to_string(out.join("amplitude.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    let col = rows[0]
+        .iter()
+        .position(|c| *c == "end_of_travel_s")
+        .unwrap();
+    assert_eq!(rows.len(), 3);
+    for r in &rows[1..] {
+        assert!(r[col].parse::<f64>().unwrap() > 0.0, "{r:?}");
+    }
+    let html = std::fs::read_to_string(out.join("stability.html")).unwrap();
+    assert!(
+        banners(&html)
+            .iter()
+            .any(|b| b.contains("grows to the end of travel")),
+        "{:?}",
+        banners(&html)
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The limit cycle in the report's banner: the oil alone at 70 rad/s, two starts either side
+/// of the neutral amplitude (0.69 mm).
+#[test]
+fn the_limit_cycle_is_in_the_report_banner() {
+    let (ok, text, out) = stability_command(
+        "banner",
+        &[
+            "--rotor",
+            "rotors/uh60a_airframe.toml",
+            "--speeds",
+            "70",
+            "--damper",
+            "physical",
+            "--set",
+            "damper.physical.seal_friction_N=0",
+            "--amplitudes-m",
+            "5e-4,1e-3",
+            "--amplitude-at-rad-s",
+            "70",
+        ],
+    );
+    println!("{text}");
+    assert!(ok, "{text}");
+    let html = std::fs::read_to_string(out.join("stability.html")).unwrap();
+    let b = banners(&html);
+    let banner = b
+        .iter()
+        .find(|b| b.contains("limit cycle at "))
+        .unwrap_or_else(|| panic!("{b:?}"));
+    let mm: f64 = banner
+        .split("limit cycle at ")
+        .nth(1)
+        .and_then(|r| r.split(" mm stroke").next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((0.67..=0.71).contains(&mm), "{banner}");
+    assert!(banner.contains("neutral amplitude bracketed"), "{banner}");
+    // the command prints the same text
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("amplitude check: "))
+        .unwrap();
+    let head = line.trim_start_matches("amplitude check: ");
+    assert!(html.contains(head), "{head}");
+    let _ = std::fs::remove_dir_all(&out);
+}

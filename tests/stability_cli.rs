@@ -225,7 +225,7 @@ fn the_amplitude_check_writes_its_table_section_and_statement() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N,mac,runner_up_mac,fit_from_s,fit_to_s,fitted_revolutions,settle_cycles,settle_change,bisection"
+        "rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N,mac,runner_up_mac,fit_from_s,fit_to_s,fitted_revolutions,settle_cycles,settle_change,bisection,end_of_travel_stroke_m,end_of_travel_s"
     );
     assert_eq!(lines.count(), 2);
     let html = std::fs::read_to_string(out.join("stability.html")).unwrap();

@@ -25,7 +25,8 @@ pub fn run(args: StabilityArgs) -> anyhow::Result<()> {
         amplitude: amp,
     } = job.execute(&mut |line| outln!("{line}"))?;
     if let Some(c) = &amp {
-        outln!("amplitude check: {}", c.statement);
+        outln!("amplitude check: {}", c.headline);
+        outln!("amplitude check in full: {}", c.statement);
     }
     for c in &time {
         outln!(

@@ -33,6 +33,36 @@ pub const INTEGRATOR: IntegratorOptions = super::BENCH_INTEGRATOR;
 pub const MAX_AMPLITUDES: usize = 200;
 /// Largest lag angle of a start [rad]: the reduced model is linear in the lag angle.
 pub const MAX_LAG_RAD: f64 = 0.35;
+/// A start's free response stops once a blade's stroke reaches this fraction of the damper's
+/// travel (the physical damper's `V/A`, its shortest chamber's): the start has grown to the
+/// end of travel, a result (no limit cycle below the stroke limit), not a failure. The margin
+/// keeps the devices' trial strokes inside the chambers.
+pub const END_OF_TRAVEL_FRACTION: f64 = 0.95;
+
+/// A start that grew to the damper's end of travel.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct EndOfTravel {
+    /// The stroke where the response stopped (the largest blade's) [m].
+    pub stroke_m: f64,
+    /// The damper's travel [m] (the response stops at [`END_OF_TRAVEL_FRACTION`] of it).
+    pub travel_m: f64,
+    /// Time from the start [s].
+    pub time_s: f64,
+    /// The blade whose stroke reached it (1-based).
+    pub blade: usize,
+}
+
+impl EndOfTravel {
+    /// "grows to the end of travel (35.6 of 37.5 mm) within 0.84 s"
+    pub fn text(&self) -> String {
+        format!(
+            "grows to the end of travel ({:.1} of {:.1} mm) within {:.2} s",
+            self.stroke_m * 1e3,
+            self.travel_m * 1e3,
+            self.time_s
+        )
+    }
+}
 
 /// How the amplitude check runs.
 #[derive(Clone, Debug)]
@@ -96,6 +126,10 @@ pub struct AmplitudePoint {
     pub settled: Settled,
     /// A start of the neutral amplitude's refinement (not one of the given amplitudes).
     pub bisection: bool,
+    /// The start grew to the damper's end of travel (its response stopped there). The growth
+    /// rate is then fitted over the revolutions it ran (from the start when fewer than four
+    /// follow the skipped damper cycle).
+    pub end_of_travel: Option<EndOfTravel>,
 }
 
 /// A limit cycle between two starts.
@@ -133,8 +167,25 @@ pub struct AmplitudeCheck {
     pub steps_per_rev: usize,
     /// Damper cycles fitted per start.
     pub fit_cycles: usize,
+    /// The damper's travel [m] (physical damper), where the starts stop.
+    pub travel_m: Option<f64>,
+    /// The outcome in a short line (the command's, the report banner's and the verdict's).
+    pub headline: String,
     /// The outcome in a sentence.
     pub statement: String,
+}
+
+impl AmplitudeCheck {
+    /// Whether the outcome is good news: a stable limit cycle (no unstable one) or decay at
+    /// every amplitude.
+    pub fn benign(&self) -> bool {
+        if self.limit_cycles.is_empty() {
+            self.points.iter().all(|p| p.growth_rate_per_s < 0.0)
+        } else {
+            self.limit_cycles.iter().all(|c| c.stable)
+                && self.points.iter().all(|p| p.end_of_travel.is_none())
+        }
+    }
 }
 
 /// Amplitudes: finite, positive, increasing, and a lag angle the reduced model holds.
@@ -201,14 +252,15 @@ impl Reduced {
         z: &[f64],
         t_end: f64,
         dt: f64,
+        stop_lag_rad: f64,
     ) -> anyhow::Result<crate::stability::DeviceResponse> {
         Ok(match self {
             Reduced::Lag(r) => {
-                free_response_with_dampers(r, om, dampers, z, t_end, dt, 2.0 * MAX_LAG_RAD)?
+                free_response_with_dampers(r, om, dampers, z, t_end, dt, stop_lag_rad)?
             }
             Reduced::Air(r, h) => {
                 let steps_per_rev = (2.0 * PI / om / dt).round() as usize;
-                r.response_with_dampers(h, dampers, z, t_end, steps_per_rev, 2.0 * MAX_LAG_RAD)?
+                r.response_with_dampers(h, dampers, z, t_end, steps_per_rev, stop_lag_rad)?
             }
         })
     }
@@ -250,6 +302,20 @@ impl Blades {
             y,
             hover: None,
         })
+    }
+
+    /// The physical damper's travel [m]: its shortest chamber's `V0 / A`, over the blades
+    /// (None for the other models).
+    fn travel_m(&self, model: DamperModel) -> Option<f64> {
+        if model != DamperModel::Physical {
+            return None;
+        }
+        self.decks
+            .iter()
+            .filter_map(|(_, d)| d.physical.as_ref())
+            .flat_map(|c| c.chambers.iter().map(|ch| ch.volume0 / ch.area))
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .min_by(f64::total_cmp)
     }
 
     /// The rotor with each blade's damper replaced by `kc(blade)` (stiffness, damping at the
@@ -411,6 +477,24 @@ pub fn amplitude_check(
     let blades = Blades::of(deck, model, o.hover)?;
     let arm = blades.decks[0].0.spec.damper_attachment.arm_m;
     check_amplitudes(&o.amplitudes_m, arm)?;
+    let travel_m = blades.travel_m(model);
+    let max_arm = blades
+        .decks
+        .iter()
+        .map(|(b, _)| b.spec.damper_attachment.arm_m)
+        .fold(arm, f64::max);
+    let mut stop_lag_rad = 2.0 * MAX_LAG_RAD;
+    if let Some(t) = travel_m {
+        let stop = END_OF_TRAVEL_FRACTION * t;
+        let top = o.amplitudes_m[o.amplitudes_m.len() - 1];
+        if top >= stop {
+            bail!(
+                "--amplitudes-m: {top} m of stroke is at the damper's end of travel ({t:.4e} m, its chambers' V/A; the starts stop at {:.0}% of it): start below {stop:.4e} m",
+                100.0 * END_OF_TRAVEL_FRACTION
+            );
+        }
+        stop_lag_rad = stop_lag_rad.min(stop / max_arm);
+    }
     let (lin_rotor, linearised, _) =
         blades.equivalent(model, omega, LINEARISATION_AMPLITUDE_M, None)?;
     let first = lin_rotor
@@ -424,6 +508,8 @@ pub fn amplitude_check(
         omega,
         arm,
         opts: o,
+        stop_lag_rad,
+        travel_m,
     };
     // the mode continued from 0.1 mm through the starts, by MAC (in order: cheap)
     let mut chain: Vec<(Reduced, TrackedMode)> = Vec::with_capacity(o.amplitudes_m.len());
@@ -469,10 +555,14 @@ pub fn amplitude_check(
     let relief_limits_n = (model == DamperModel::Physical)
         .then(|| crate::rotor::sim::relief_limits(&blades.decks[0].1))
         .flatten();
+    let mut all: Vec<&AmplitudePoint> = points.iter().chain(&refinements).collect();
+    all.sort_by(|p, q| p.start_m.total_cmp(&q.start_m));
+    let headline = headline(omega, model, &points, &all, &limit_cycles);
     let statement = statement(
         omega,
         &linearised,
         &points,
+        &all,
         &limit_cycles,
         relief_limits_n,
         o.cycles,
@@ -487,6 +577,8 @@ pub fn amplitude_check(
         relief_limits_n,
         steps_per_rev: o.steps_per_rev,
         fit_cycles: o.cycles,
+        travel_m,
+        headline,
         statement,
     })
 }
@@ -514,6 +606,10 @@ struct Ctx<'a> {
     omega: f64,
     arm: f64,
     opts: &'a AmplitudeOptions,
+    /// A response stops once a blade's lag angle exceeds this [rad] (the end of travel's, or
+    /// the reduced model's range).
+    stop_lag_rad: f64,
+    travel_m: Option<f64>,
 }
 
 impl Ctx<'_> {
@@ -549,9 +645,25 @@ impl Ctx<'_> {
         let t_end = revs * rev;
         let r = self
             .bare
-            .respond(om, &mut dampers, &z, t_end, dt)
+            .respond(om, &mut dampers, &z, t_end, dt, self.stop_lag_rad)
             .map_err(|e| anyhow!("the amplitude check at {a} m of stroke, {om} rad/s: {e}"))?;
         let resp = &r.response;
+        // a response that stopped at the end of travel: a result
+        let end_of_travel = self.travel_m.and_then(|travel| {
+            let n = resp.time_s.len();
+            let last = resp.state(n - 1);
+            let (blade, stroke) = dampers
+                .iter()
+                .enumerate()
+                .map(|(k, d)| (k, (d.arm_m * last[k]).abs()))
+                .max_by(|p, q| p.1.total_cmp(&q.1))?;
+            (stroke >= END_OF_TRAVEL_FRACTION * travel * (1.0 - 1e-12)).then_some(EndOfTravel {
+                stroke_m: stroke,
+                travel_m: travel,
+                time_s: resp.time_s[n - 1],
+                blade: blade + 1,
+            })
+        });
         let wf = tm.mode.eigenvalue.im.abs().max(1e-6);
         let env: Vec<(f64, f64)> = resp
             .time_s
@@ -561,18 +673,32 @@ impl Ctx<'_> {
             .collect();
         // the modal coordinate at the start of each revolution (where the left eigenvector
         // of the monodromy applies)
-        let samples: Vec<(f64, f64)> = resp
-            .time_s
-            .iter()
-            .enumerate()
-            .filter(|(_, &t)| {
-                let k = (t / rev).round();
-                (t - k * rev).abs() < 0.25 * dt && t >= fit_from - 0.25 * dt
-            })
-            .map(|(i, &t)| (t, 2.0 * arm * tm.coordinate(resp.state(i)).norm()))
-            .filter(|&(_, v)| v > 0.0 && v.is_finite())
-            .collect();
-        if samples.len() < 4 {
+        let sampled = |from: f64| -> Vec<(f64, f64)> {
+            resp.time_s
+                .iter()
+                .enumerate()
+                .filter(|(_, &t)| {
+                    let k = (t / rev).round();
+                    (t - k * rev).abs() < 0.25 * dt && t >= from - 0.25 * dt
+                })
+                .map(|(i, &t)| (t, 2.0 * arm * tm.coordinate(resp.state(i)).norm()))
+                .filter(|&(_, v)| v > 0.0 && v.is_finite())
+                .collect()
+        };
+        let mut samples = sampled(fit_from);
+        if samples.len() < 4 && end_of_travel.is_some() {
+            // it reached the end of travel before a window: the revolutions from the start
+            samples = sampled(0.0);
+            if samples.len() < 2 {
+                // under a revolution: from the start to the stop
+                samples = [env.first(), env.last()]
+                    .into_iter()
+                    .flatten()
+                    .copied()
+                    .collect();
+            }
+        }
+        if samples.len() < 2 || (samples.len() < 4 && end_of_travel.is_none()) {
             bail!(
                 "the amplitude check at {a} m of stroke, {om} rad/s: {} revolutions of the response after {fit_from:.3} s (at least 4 are fitted); the response {}",
                 samples.len(),
@@ -585,17 +711,23 @@ impl Ctx<'_> {
         }
         let (g, amp) = fit_log(&samples);
         let fit_to = samples.last().map_or(fit_from, |s| s.0);
-        let (_, at, kc) = self
+        let equivalent = self
             .blades
             .tracked(self.model, om, amp, wr, &tm.right)
-            .map_err(|e| anyhow!("the damper's equivalent values at {amp} m of stroke: {e:#}"))?;
+            .map_err(|e| anyhow!("the damper's equivalent values at {amp} m of stroke: {e:#}"));
+        let (eq_growth, eq_damping) = match equivalent {
+            Ok((_, at, kc)) => (at.mode.growth_rate_per_s, kc[0].1),
+            // near the end of travel the bench may not run: the start's own result stands
+            Err(_) if end_of_travel.is_some() => (f64::NAN, f64::NAN),
+            Err(e) => return Err(e),
+        };
         let thin = (env.len() / 400).max(1);
         Ok(AmplitudePoint {
             start_m: a,
             stroke_amplitude_m: amp,
             growth_rate_per_s: g,
-            equivalent_growth_rate_per_s: at.mode.growth_rate_per_s,
-            equivalent_damping_nms_per_rad: kc[0].1,
+            equivalent_growth_rate_per_s: eq_growth,
+            equivalent_damping_nms_per_rad: eq_damping,
             frequency_hz: tm.mode.frequency_hz,
             max_force_n: r.force_n.iter().fold(0.0f64, |m, f| m.max(f.abs())),
             max_iterations: r.max_iterations,
@@ -608,6 +740,7 @@ impl Ctx<'_> {
             fitted_revolutions: samples.len(),
             settled,
             bisection,
+            end_of_travel,
         })
     }
 
@@ -694,10 +827,77 @@ impl Ctx<'_> {
     }
 }
 
+/// The outcome in a line (`all`: the given and the refinement starts, by amplitude):
+/// "limit cycle at 0.691 mm of stroke (stable; neutral amplitude bracketed 0.688-0.692 mm)",
+/// "decays at every amplitude 0.1-30 mm: no limit cycle", or "grows to the end of travel
+/// ... : no limit cycle below the stroke limit".
+fn headline(
+    omega: f64,
+    model: DamperModel,
+    points: &[AmplitudePoint],
+    all: &[&AmplitudePoint],
+    cycles: &[LimitCycle],
+) -> String {
+    // millimetres, three decimals at most, trailing zeros dropped
+    let n = |v: f64| {
+        let t = format!("{:.3}", v * 1e3);
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let (lo, hi) = (
+        points.first().map_or(0.0, |p| p.start_m),
+        points.last().map_or(0.0, |p| p.start_m),
+    );
+    let travel = all.iter().find_map(|p| p.end_of_travel.map(|e| (p, e)));
+    let mut parts: Vec<String> = cycles
+        .iter()
+        .map(|c| {
+            format!(
+                "{} at {} mm stroke (neutral amplitude bracketed {}-{} mm)",
+                if c.stable {
+                    "limit cycle"
+                } else {
+                    "unstable limit cycle (larger motions grow)"
+                },
+                n(c.stroke_amplitude_m),
+                n(c.bracket_m[0]),
+                n(c.bracket_m[1]),
+            )
+        })
+        .collect();
+    if cycles.is_empty() {
+        let all_decay = points.iter().all(|p| p.growth_rate_per_s < 0.0);
+        let range = format!("{}-{} mm", n(lo), n(hi));
+        parts.push(match (all_decay, travel) {
+            (true, _) => format!("decays at every amplitude {range}: no limit cycle"),
+            (false, Some((p, e))) if p.start_m <= lo => format!(
+                "{} from the {} mm start: no limit cycle below the stroke limit",
+                e.text(),
+                n(p.start_m)
+            ),
+            (false, Some((p, e))) => format!(
+                "grows at every amplitude {range}, the {} mm start {}: no limit cycle below the stroke limit",
+                n(p.start_m),
+                e.text()
+            ),
+            (false, None) => {
+                format!("grows at every amplitude {range}: no limit cycle in that range")
+            }
+        });
+    } else if let Some((p, e)) = travel {
+        parts.push(format!("the {} mm start {}", n(p.start_m), e.text()));
+    }
+    format!(
+        "at {omega:.3} rad/s ({} damper), regressing lag: {}",
+        model.name(),
+        parts.join("; ")
+    )
+}
+
 fn statement(
     omega: f64,
     lin: &Mode,
     points: &[AmplitudePoint],
+    all: &[&AmplitudePoint],
     cycles: &[LimitCycle],
     relief: Option<(f64, f64)>,
     fit_cycles: usize,
@@ -745,6 +945,24 @@ fn statement(
             .collect();
         s += &format!("the time domain finds {}", list.join(" and "));
     }
+    let travel: Vec<String> = all
+        .iter()
+        .filter_map(|p| {
+            p.end_of_travel
+                .map(|e| format!("the {} start {}", mm(p.start_m), e.text()))
+        })
+        .collect();
+    if !travel.is_empty() {
+        s += &format!(
+            "; {} (its response stopped there, its growth rate fitted over what it ran){}",
+            travel.join(", "),
+            if cycles.iter().all(|c| c.stable) {
+                ": no limit cycle below the stroke limit"
+            } else {
+                ""
+            }
+        );
+    }
     s += &format!(
         "; each start's dampers pressurised on the mode's stroke first, the growth rate fitted to the mode's coordinate once a revolution over {fit_cycles} damper cycles after the first"
     );
@@ -781,12 +999,12 @@ fn statement(
 
 /// amplitude.csv: one row per start.
 pub fn csv(c: &AmplitudeCheck) -> String {
-    let mut s = String::from("rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N,mac,runner_up_mac,fit_from_s,fit_to_s,fitted_revolutions,settle_cycles,settle_change,bisection\n");
+    let mut s = String::from("rotor_speed_rad_s,start_stroke_amplitude_m,stroke_amplitude_m,growth_rate_per_s,equivalent_growth_rate_per_s,linearised_growth_rate_per_s,equivalent_damping_Nms_per_rad,frequency_Hz,max_damper_force_N,mac,runner_up_mac,fit_from_s,fit_to_s,fitted_revolutions,settle_cycles,settle_change,bisection,end_of_travel_stroke_m,end_of_travel_s\n");
     let mut all: Vec<&AmplitudePoint> = c.points.iter().chain(&c.refinements).collect();
     all.sort_by(|p, q| p.start_m.total_cmp(&q.start_m));
     for p in all {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             c.omega_rad_s,
             p.start_m,
             p.stroke_amplitude_m,
@@ -803,7 +1021,11 @@ pub fn csv(c: &AmplitudeCheck) -> String {
             p.fitted_revolutions,
             p.settled.cycles,
             p.settled.change,
-            u8::from(p.bisection)
+            u8::from(p.bisection),
+            p.end_of_travel
+                .map_or(String::new(), |e| e.stroke_m.to_string()),
+            p.end_of_travel
+                .map_or(String::new(), |e| e.time_s.to_string()),
         ));
     }
     s
@@ -835,9 +1057,12 @@ pub fn json(c: &AmplitudeCheck) -> serde_json::Value {
             "settle_cycles": p.settled.cycles,
             "settle_change": p.settled.change,
             "bisection": p.bisection,
+            "end_of_travel": p.end_of_travel,
         })).collect::<Vec<_>>(),
         "limit_cycles": c.limit_cycles,
         "relief_limits_N": c.relief_limits_n.map(|(l, h)| [l, h]),
+        "travel_m": c.travel_m,
+        "headline": c.headline,
         "statement": c.statement,
     })
 }
@@ -858,6 +1083,7 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
         c.fit_cycles,
         (BRACKET_RATIO - 1.0) * 100.0
     ));
+    rep.paragraph(&format!("Amplitude check {}.", c.headline));
     rep.paragraph(&c.statement);
     let lx: Vec<f64> = c
         .points
@@ -914,6 +1140,7 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
                 format!("{:.3}", p.mac),
                 format!("{:.2} to {:.2}", p.fit_from_s, p.fit_to_s),
                 if p.bisection { "refinement" } else { "given" }.to_string(),
+                p.end_of_travel.map_or(String::new(), |e| e.text()),
             ]
         })
         .collect();
@@ -928,6 +1155,7 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
             "MAC with the previous amplitude's mode",
             "fitted window [s]",
             "start",
+            "end of travel",
         ],
         &rows,
     );

@@ -81,6 +81,9 @@ pub struct Verdict {
     pub not_moved: Vec<(String, String)>,
     /// What the mode is when it is not a resonance (a free airframe's flight-dynamics mode).
     pub note: Option<String>,
+    /// The amplitude check's outcome, when it ran at this speed on this mode (its headline).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude_check: Option<String>,
 }
 
 impl Verdict {
@@ -120,7 +123,10 @@ impl Verdict {
             } else {
                 format!("; decided by {}", names.join("; "))
             }
-        )
+        ) + &self
+            .amplitude_check
+            .as_ref()
+            .map_or(String::new(), |a| format!("; amplitude check {a}"))
     }
 }
 
@@ -348,6 +354,7 @@ pub fn verdicts(
             moved: moved_n,
             not_moved,
             note: flight_mode(deck, &cond, m0.label.as_str(), m0.frequency_hz),
+            amplitude_check: None,
         });
     }
     Ok(out)

@@ -306,6 +306,17 @@ impl StabilityJob {
                 }
             }
         };
+        if let Some(c) = &amp {
+            // the verdict on the regressing lag at the check's speed says what the check found
+            for v in &mut map.verdicts {
+                if (v.omega_rad_s - c.omega_rad_s).abs() <= 1e-9 * c.omega_rad_s
+                    && v.mode
+                        .contains(crate::stability::ModeLabel::RegressingLag.as_str())
+                {
+                    v.amplitude_check = Some(c.headline.clone());
+                }
+            }
+        }
         write_all(&map, &time, amp.as_ref(), &deck, &out)?;
         out.finish()?;
         Ok(StabilityOutcome {

@@ -108,12 +108,21 @@ pub fn range_text(map: &StabilityMap, u: &UnstableRange) -> String {
 /// stability.html: the Coleman diagram, damping versus speed with the unstable ranges shaded,
 /// the reduced model and the ranges.
 pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
+    html_with(map, deck, None)
+}
+
+/// As [`html`], the amplitude check's outcome among the banners (unless a verdict carries it).
+pub fn html_with(
+    map: &StabilityMap,
+    deck: &RotorDeck,
+    amplitude: Option<&amplitude::AmplitudeCheck>,
+) -> anyhow::Result<String> {
     let mut rep = HtmlReport::new(if map.hover.is_some() {
         "Air resonance in hover"
     } else {
         "Ground resonance"
     });
-    html_intro(&mut rep, map, deck);
+    html_intro(&mut rep, map, deck, amplitude);
     html_figures(&mut rep, map)?;
     html_model(&mut rep, map);
     rep.list(&map.notes);
@@ -121,7 +130,12 @@ pub fn html(map: &StabilityMap, deck: &RotorDeck) -> anyhow::Result<String> {
 }
 
 /// The verdict banner and what was solved.
-fn html_intro(rep: &mut HtmlReport, map: &StabilityMap, deck: &RotorDeck) {
+fn html_intro(
+    rep: &mut HtmlReport,
+    map: &StabilityMap,
+    deck: &RotorDeck,
+    amplitude: Option<&amplitude::AmplitudeCheck>,
+) {
     let method = map
         .speeds
         .first()
@@ -154,6 +168,12 @@ fn html_intro(rep: &mut HtmlReport, map: &StabilityMap, deck: &RotorDeck) {
             _ => Banner::Bad,
         };
         rep.banner(kind, &format!("{}.", v.line()));
+    }
+    if let Some(a) = amplitude {
+        if map.verdicts.iter().all(|v| v.amplitude_check.is_none()) {
+            let kind = if a.benign() { Banner::Ok } else { Banner::Bad };
+            rep.banner(kind, &format!("Amplitude check {}.", a.headline));
+        }
     }
     if !map.verdicts.is_empty() {
         rep.paragraph(&format!(
@@ -451,7 +471,7 @@ pub fn write_all(
         ));
     }
     out.write("stability.csv", text.as_bytes())?;
-    let mut page = html(map, deck)?;
+    let mut page = html_with(map, deck, amplitude)?;
     if !time.is_empty() {
         let mut rep = HtmlReport::new("");
         rep.heading(2, "Time domain: the whole rotor");
