@@ -193,19 +193,73 @@ pub(crate) fn linearise_at(
             .ok_or_else(|| anyhow!("{}: no [damper.linear] table", damper.source))?;
         return Ok((0.0, a2 * c));
     }
-    let dev = damper.build(model, integrator)?;
-    let r = harmonic_run(
-        dev.as_ref(),
-        w,
-        w * amplitude_m,
-        BENCH_CYCLES,
-        BENCH_STEPS_PER_CYCLE,
-        false,
-    )?;
-    Ok((
-        a2 * r.storage_stiffness_n_per_m,
-        a2 * r.loss_stiffness_n_per_m / w,
-    ))
+    let (storage, loss) =
+        bench_cache::stiffnesses(damper, model, w, amplitude_m, integrator, || {
+            let dev = damper.build(model, integrator)?;
+            let r = harmonic_run(
+                dev.as_ref(),
+                w,
+                w * amplitude_m,
+                BENCH_CYCLES,
+                BENCH_STEPS_PER_CYCLE,
+                false,
+            )?;
+            Ok((r.storage_stiffness_n_per_m, r.loss_stiffness_n_per_m))
+        })?;
+    Ok((a2 * storage, a2 * loss / w))
+}
+
+/// The bench runs of [`linearise_at`] already made in this process, by everything that decides
+/// them: the damper deck's values (all of them, as `Debug` prints them: every `f64` in its
+/// shortest round-trip form, so two keys are equal exactly when the values are bit for bit,
+/// -0 and 0 apart), the model, the frequency and amplitude (bits) and the integrator. A hit
+/// returns what the run returned, so a map is bit for bit the one computed without it. The
+/// verdicts' bands recompute the map once per moved value and end: the values that do not
+/// touch the damper (the airframe's, the blade's) find their dampers' runs at the frequencies
+/// the nominal map met (docs/performance.md). Only successes are kept; a caller finding a run
+/// under way waits for it instead of repeating it.
+mod bench_cache {
+    use super::{DamperDeck, DamperModel, IntegratorOptions};
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, PoisonError};
+
+    /// Entries kept before the cache starts over (a few kB each).
+    const MAX_ENTRIES: usize = 4096;
+
+    type Slot = Arc<Mutex<Option<(f64, f64)>>>;
+    static RUNS: Mutex<Option<HashMap<String, Slot>>> = Mutex::new(None);
+
+    /// The bench's storage and loss stiffnesses [N/m] of `damper` as `model` at `w` [rad/s]
+    /// and stroke amplitude `amplitude_m`: from the cache, or `run` (kept when it succeeds).
+    pub(super) fn stiffnesses(
+        damper: &DamperDeck,
+        model: DamperModel,
+        w: f64,
+        amplitude_m: f64,
+        integrator: IntegratorOptions,
+        run: impl FnOnce() -> anyhow::Result<(f64, f64)>,
+    ) -> anyhow::Result<(f64, f64)> {
+        let key = format!(
+            "{model:?} {:016x} {:016x} {integrator:?} {damper:?}",
+            w.to_bits(),
+            amplitude_m.to_bits()
+        );
+        let slot = {
+            let mut runs = RUNS.lock().unwrap_or_else(PoisonError::into_inner);
+            let runs = runs.get_or_insert_with(HashMap::new);
+            if runs.len() >= MAX_ENTRIES && !runs.contains_key(&key) {
+                runs.clear();
+            }
+            runs.entry(key).or_default().clone()
+        };
+        let mut done = slot.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(kc) = *done {
+            return Ok(kc);
+        }
+        let kc = run()?;
+        *done = Some(kc);
+        Ok(kc)
+    }
 }
 
 /// One blade of `spec` with its damper linearised at `w`.
