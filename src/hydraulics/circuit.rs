@@ -217,6 +217,18 @@ impl CircuitParams {
         }
     }
 
+    /// How fast the chambers' pressure difference relaxes through the viscous orifice at zero
+    /// stroke and the initial pressures, `(B0/V0 + B1/V1) / R_lam` [1/s] (None: Eq. 4's law,
+    /// whose regularised slope is far gentler). An explicit sub-step longer than the stability
+    /// limit of its scheme over this rate amplifies instead of damping where the flow reverses.
+    pub fn orifice_rate_per_s(&self) -> Option<f64> {
+        let law = self.viscous_orifice()?;
+        let stiffness: f64 = (0..2)
+            .map(|k| self.bulk(k, self.p_init[k]).0 / self.chambers[k].volume0)
+            .sum();
+        Some(stiffness / law.r)
+    }
+
     /// Bulk modulus of the contents of chamber k at p: Eq. (3), or the oil/air mixture.
     #[inline(always)]
     pub fn bulk(&self, k: usize, p: f64) -> (f64, f64) {

@@ -104,18 +104,28 @@ impl FromStr for PeriodicMethod {
 }
 
 /// A hydraulic sub-step scheme with the name it was given: summary.json records that name
-/// (`sdirk3` stays `sdirk3`, an alias of `implicit`).
+/// (`sdirk3` stays `sdirk3`, an alias of `implicit`). `auto` (the default) is RK4, the paper's
+/// scheme, with more sub-steps where a physical damper's viscous orifice would make an RK4
+/// sub-step unstable ([`SchemeChoice::resolve`]); the run records the scheme and sub-steps
+/// it used.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SchemeChoice {
     pub scheme: Scheme,
     pub name: String,
+    /// Chosen by the run (`auto`), not by the user.
+    pub auto: bool,
 }
+
+/// The largest `h x rate` taken as stable for an RK4 sub-step: RK4's real-axis stability
+/// limit is 2.785; the rest is margin for the rate's growth as a chamber is compressed.
+pub const RK4_STABLE_H_RATE: f64 = 2.5;
 
 impl Default for SchemeChoice {
     fn default() -> Self {
         SchemeChoice {
             scheme: Scheme::Rk4,
-            name: "rk4".into(),
+            name: "auto".into(),
+            auto: true,
         }
     }
 }
@@ -123,10 +133,45 @@ impl Default for SchemeChoice {
 impl FromStr for SchemeChoice {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(Self::default());
+        }
         Ok(SchemeChoice {
-            scheme: s.parse()?,
+            scheme: s
+                .parse()
+                .map_err(|e: String| format!("{e}, or auto (the default)"))?,
             name: s.to_string(),
+            auto: false,
         })
+    }
+}
+
+impl SchemeChoice {
+    /// The scheme and sub-steps to run for dampers whose fastest rates are `rates` [1/s] at
+    /// hydraulic sub-steps of `h` [s] (`substeps` a structural step): `auto` is RK4 with the
+    /// sub-steps raised until `h x rate` is within [`RK4_STABLE_H_RATE`] for every damper (an
+    /// RK4 sub-step is far cheaper than an implicit one); an RK4 asked for by name at an
+    /// unstable sub-step is an error that says what to do.
+    pub fn resolve(&self, rates: &[f64], h: f64, substeps: usize) -> anyhow::Result<(Self, usize)> {
+        let fastest = rates.iter().cloned().fold(0.0, f64::max);
+        let unstable = self.scheme == Scheme::Rk4 && h * fastest > RK4_STABLE_H_RATE;
+        let need = (substeps as f64 * h * fastest / RK4_STABLE_H_RATE).ceil() as usize;
+        if self.auto {
+            let rk4 = SchemeChoice {
+                scheme: Scheme::Rk4,
+                name: "rk4".into(),
+                auto: false,
+            };
+            return Ok((rk4, if unstable { need } else { substeps }));
+        }
+        if unstable {
+            anyhow::bail!(
+                "--scheme {} --substeps {substeps}: the damper's viscous orifice relaxes the chambers' pressure difference at {fastest:.3e} 1/s, and an RK4 sub-step of {h:.3e} s (h x rate = {:.2}) is unstable above {RK4_STABLE_H_RATE}: use --substeps {need} or more, --scheme implicit (stable at any sub-step), or leave --scheme out (auto raises the sub-steps)",
+                self.name,
+                h * fastest
+            );
+        }
+        Ok((self.clone(), substeps))
     }
 }
 
@@ -150,7 +195,7 @@ impl Default for NamedOptions<'_> {
     fn default() -> Self {
         NamedOptions {
             damper: "all",
-            scheme: "rk4",
+            scheme: "auto",
             newton: "modified",
             periodic: "shooting",
             model: "uh60a",
@@ -208,8 +253,9 @@ pub struct RunSettings {
     /// Hydraulic sub-steps per structural step.
     #[arg(long, default_value_t = DEFAULT_SUBSTEPS)]
     pub substeps: usize,
-    /// Hydraulic sub-step scheme: rk4 or implicit.
-    #[arg(long, default_value = "rk4")]
+    /// Hydraulic sub-step scheme: auto (rk4, with the sub-steps raised where a physical
+    /// damper's viscous orifice would make an RK4 sub-step unstable), rk4 or implicit.
+    #[arg(long, default_value = "auto")]
     pub scheme: String,
     /// Rotor model: uh60a (the multibody model of the rotor deck), rigid (the rotor deck's blade
     /// rigid on its lag hinge, airloads projected with the control pitch: the reduced model of
@@ -868,6 +914,27 @@ impl RunJob {
         let record = FlightRecord::read(&self.flight)
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
         let (rotor, deck, blades) = self.decks_for(&models)?;
+        // the hydraulic scheme for these dampers (auto chosen, or rk4 checked), then the run
+        let rates: Vec<f64> = if models.contains(&DamperModel::Physical) {
+            std::iter::once(&deck)
+                .chain(blades.iter().map(|(_, d)| d))
+                .filter_map(|d| d.physical.as_ref()?.orifice_rate_per_s())
+                .collect()
+        } else {
+            vec![]
+        };
+        let h = 2.0 * std::f64::consts::PI
+            / record.meta.rotor_speed_rad_s
+            / (self.steps_per_rev * self.substeps.max(1)) as f64;
+        let (scheme, substeps) = self.scheme.resolve(&rates, h, self.substeps)?;
+        if scheme != self.scheme || substeps != self.substeps {
+            let job = RunJob {
+                scheme,
+                substeps,
+                ..self.clone()
+            };
+            return job.execute_until(observer, stop);
+        }
         // The dampers at the record's oil temperature where the deck has the oil's law.
         let deck = deck
             .at_known_oil_temperature(self.record_oil_temperature_k(&record, None))?
@@ -1173,5 +1240,40 @@ impl RunJob {
             })
             .collect();
         Some(format!("this run overrides {}", items.join(", ")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stability decks' viscous orifice relaxes at about 1.6e5 1/s; the run's default
+    /// sub-step is 2 pi / 27 / 256 / 25 = 3.6e-5 s, h x rate = 5.8, where an RK4 sub-step
+    /// amplifies 26-fold (1 + z + z^2/2 + z^3/6 + z^4/24 at z = -5.8).
+    #[test]
+    fn auto_raises_rk4_sub_steps_to_stability_and_a_named_rk4_is_refused() {
+        let h = 2.0 * std::f64::consts::PI / 27.0 / 256.0 / 25.0;
+        let rate = 5.8 / h;
+        let auto = SchemeChoice::default();
+        let (s, n) = auto.resolve(&[rate], h, 25).unwrap();
+        assert_eq!((s.scheme, s.name.as_str(), n), (Scheme::Rk4, "rk4", 58));
+        assert!(h * 25.0 / n as f64 * rate <= RK4_STABLE_H_RATE);
+        // a gentle damper (Eq. 4's law: no rate) keeps the sub-steps
+        assert_eq!(auto.resolve(&[], h, 25).unwrap().1, 25);
+        let rk4: SchemeChoice = "rk4".parse().unwrap();
+        let e = rk4.resolve(&[rate], h, 25).unwrap_err().to_string();
+        assert!(
+            e.contains("--substeps 58 or more") && e.contains("--scheme implicit"),
+            "{e}"
+        );
+        let implicit: SchemeChoice = "implicit".parse().unwrap();
+        assert_eq!(
+            implicit.resolve(&[rate], h, 25).unwrap(),
+            (implicit.clone(), 25)
+        );
+        // the RK4 amplification at the default sub-step, as the doc says
+        let z: f64 = -5.8;
+        let g = 1.0 + z + z * z / 2.0 + z.powi(3) / 6.0 + z.powi(4) / 24.0;
+        assert!(g > 20.0, "{g}");
     }
 }
