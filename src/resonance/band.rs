@@ -193,21 +193,15 @@ fn follow(map: &StabilityMap, k: usize, label: &str, lambda: faer::c64) -> Optio
         .map(|m| m.growth_rate_per_s)
 }
 
-/// The verdicts of `map`: at the deck's operating speed when it lies within the map's speeds
-/// (its least damped mode), and at the fastest growth of each unstable range. `path` and `set`
-/// are the deck file and the user's overrides the map was computed with.
-pub fn verdicts(
-    deck: &RotorDeck,
-    set: &[Override],
-    model: DamperModel,
-    map: &StabilityMap,
-    cond: Condition,
-) -> anyhow::Result<Vec<Verdict>> {
+/// Where verdicts are made on `map`, as (why, speed, mode label): the deck's operating speed
+/// when the map reaches it (its least damped mode: no label), and the fastest growth of each
+/// unstable range.
+fn verdict_asks(deck: &RotorDeck, map: &StabilityMap) -> Vec<(String, f64, Option<String>)> {
     // (why, speed, label) of each verdict
     let mut asks: Vec<(String, f64, Option<String>)> = vec![];
     let (first, last) = match (map.speeds.first(), map.speeds.last()) {
         (Some(a), Some(b)) => (a.omega_rad_s, b.omega_rad_s),
-        _ => return Ok(vec![]),
+        _ => return vec![],
     };
     let op = deck.spec.rotor.omega_rad_s;
     if (first..=last).contains(&op) {
@@ -240,6 +234,20 @@ pub fn verdicts(
             }
         }
     }
+    asks
+}
+
+/// The verdicts of `map`: at the deck's operating speed when it lies within the map's speeds
+/// (its least damped mode), and at the fastest growth of each unstable range. `path` and `set`
+/// are the deck file and the user's overrides the map was computed with.
+pub fn verdicts(
+    deck: &RotorDeck,
+    set: &[Override],
+    model: DamperModel,
+    map: &StabilityMap,
+    cond: Condition,
+) -> anyhow::Result<Vec<Verdict>> {
+    let mut asks = verdict_asks(deck, map);
     if asks.is_empty() {
         return Ok(vec![]);
     }

@@ -173,6 +173,35 @@ impl StabilityJob {
         }
     }
 
+    /// The amplitude check's speed and start amplitudes [m], read and checked (None: no check).
+    fn amplitude_starts(&self, deck: &RotorDeck) -> anyhow::Result<Option<(f64, Vec<f64>)>> {
+        let Some(a) = &self.amplitudes_m else {
+            if self.amplitude_at_rad_s.is_some() {
+                bail!("--amplitude-at-rad-s needs --amplitudes-m (the amplitudes to start from, or `default`)");
+            }
+            return Ok(None);
+        };
+        let amplitudes_m = if a.trim() == "default" {
+            amplitude::DEFAULT_AMPLITUDES_M.to_vec()
+        } else {
+            crate::run::ranges::parse_range(
+                "--amplitudes-m",
+                a,
+                "expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`",
+                amplitude::MAX_AMPLITUDES,
+                "an amplitude check may have",
+            )?
+        };
+        let w = self
+            .amplitude_at_rad_s
+            .unwrap_or(deck.spec.rotor.omega_rad_s);
+        if !(w.is_finite() && w > 0.0) {
+            bail!("--amplitude-at-rad-s {w}: expected a positive rotor speed in rad/s");
+        }
+        amplitude::check_amplitudes(&amplitudes_m, deck.spec.damper_attachment.arm_m)?;
+        Ok(Some((w, amplitudes_m)))
+    }
+
     /// Checks the options and the deck (before the result folder exists), then computes the
     /// map, the time-domain runs and the amplitude check and writes them. `say` gets a line as
     /// each slow part starts. A failure after the folder exists leaves it marked incomplete.
@@ -200,35 +229,7 @@ impl StabilityJob {
             }
         }
         // the amplitude check: read and checked before the result folder exists
-        let amplitude = match &self.amplitudes_m {
-            None => {
-                if self.amplitude_at_rad_s.is_some() {
-                    bail!("--amplitude-at-rad-s needs --amplitudes-m (the amplitudes to start from, or `default`)");
-                }
-                None
-            }
-            Some(a) => {
-                let amplitudes_m = if a.trim() == "default" {
-                    amplitude::DEFAULT_AMPLITUDES_M.to_vec()
-                } else {
-                    crate::run::ranges::parse_range(
-                        "--amplitudes-m",
-                        a,
-                        "expected stroke amplitudes in m, e.g. 1e-4,1e-3,1e-2, or `default`",
-                        amplitude::MAX_AMPLITUDES,
-                        "an amplitude check may have",
-                    )?
-                };
-                let w = self
-                    .amplitude_at_rad_s
-                    .unwrap_or(deck.spec.rotor.omega_rad_s);
-                if !(w.is_finite() && w > 0.0) {
-                    bail!("--amplitude-at-rad-s {w}: expected a positive rotor speed in rad/s");
-                }
-                amplitude::check_amplitudes(&amplitudes_m, deck.spec.damper_attachment.arm_m)?;
-                Some((w, amplitudes_m))
-            }
-        };
+        let amplitude = self.amplitude_starts(&deck)?;
         let hover = self.hover_options;
         if self.hover {
             hover.check()?;

@@ -886,6 +886,57 @@ impl RunJob {
         Ok(())
     }
 
+    /// The dampers at the record's oil temperature where the deck has the oil's law (the
+    /// run's damper deck, then each blade's).
+    fn at_record_oil_temperature(
+        &self,
+        record: &FlightRecord,
+        deck: DamperDeck,
+        blades: Vec<(RotorDeck, DamperDeck)>,
+    ) -> anyhow::Result<(DamperDeck, Vec<(RotorDeck, DamperDeck)>)> {
+        let deck = deck
+            .at_known_oil_temperature(self.record_oil_temperature_k(record, None))?
+            .into_owned();
+        let blades = (1..)
+            .zip(blades)
+            .map(|(k, (r, d))| {
+                let t = self.record_oil_temperature_k(record, Some(k));
+                Ok((r, d.at_known_oil_temperature(t)?.into_owned()))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok((deck, blades))
+    }
+
+    /// This job with the hydraulic scheme and sub-steps [`SchemeChoice::resolve`] gives for
+    /// its physical dampers (`deck`, and each blade's), or None when they are this job's.
+    fn with_stable_substeps(
+        &self,
+        models: &[DamperModel],
+        record: &FlightRecord,
+        deck: &DamperDeck,
+        blades: &[(RotorDeck, DamperDeck)],
+    ) -> anyhow::Result<Option<RunJob>> {
+        let rates: Vec<f64> = if models.contains(&DamperModel::Physical) {
+            std::iter::once(deck)
+                .chain(blades.iter().map(|(_, d)| d))
+                .filter_map(|d| d.physical.as_ref()?.orifice_rate_per_s())
+                .collect()
+        } else {
+            vec![]
+        };
+        let h = 2.0 * std::f64::consts::PI
+            / record.meta.rotor_speed_rad_s
+            / (self.steps_per_rev * self.substeps.max(1)) as f64;
+        let (scheme, substeps) = self.scheme.resolve(&rates, h, self.substeps)?;
+        Ok(
+            (scheme != self.scheme || substeps != self.substeps).then(|| RunJob {
+                scheme,
+                substeps,
+                ..self.clone()
+            }),
+        )
+    }
+
     /// Runs the models side by side into the result folder `out` and writes every output.
     /// A failed model (the folder is then published incomplete) or, with `require_periodic`,
     /// a model not periodic (published complete) is an error: a [`RunFailed`] carrying the
@@ -914,38 +965,11 @@ impl RunJob {
         let record = FlightRecord::read(&self.flight)
             .with_context(|| format!("reading flight record {}", self.flight.display()))?;
         let (rotor, deck, blades) = self.decks_for(&models)?;
+        let (deck, blades) = self.at_record_oil_temperature(&record, deck, blades)?;
         // the hydraulic scheme for these dampers (auto chosen, or rk4 checked), then the run
-        let rates: Vec<f64> = if models.contains(&DamperModel::Physical) {
-            std::iter::once(&deck)
-                .chain(blades.iter().map(|(_, d)| d))
-                .filter_map(|d| d.physical.as_ref()?.orifice_rate_per_s())
-                .collect()
-        } else {
-            vec![]
-        };
-        let h = 2.0 * std::f64::consts::PI
-            / record.meta.rotor_speed_rad_s
-            / (self.steps_per_rev * self.substeps.max(1)) as f64;
-        let (scheme, substeps) = self.scheme.resolve(&rates, h, self.substeps)?;
-        if scheme != self.scheme || substeps != self.substeps {
-            let job = RunJob {
-                scheme,
-                substeps,
-                ..self.clone()
-            };
+        if let Some(job) = self.with_stable_substeps(&models, &record, &deck, &blades)? {
             return job.execute_until(observer, stop);
         }
-        // The dampers at the record's oil temperature where the deck has the oil's law.
-        let deck = deck
-            .at_known_oil_temperature(self.record_oil_temperature_k(&record, None))?
-            .into_owned();
-        let blades = (1..)
-            .zip(blades)
-            .map(|(k, (r, d))| {
-                let t = self.record_oil_temperature_k(&record, Some(k));
-                Ok((r, d.at_known_oil_temperature(t)?.into_owned()))
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
         let nb = blades.len();
         // a rotor on an airframe is one model: its blades are coupled through the hub
         let coupled = nb > 0 && rotor.as_ref().is_some_and(|r| r.spec.airframe.is_some());
