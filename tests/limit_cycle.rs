@@ -75,7 +75,14 @@ fn df_growth(deck: &RotorDeck, om: f64, a: f64, w0: f64) -> (f64, f64) {
             .coleman_eigenvalues(om)
             .unwrap()
             .into_iter()
-            .filter(|m| m.label == ModeLabel::RegressingLag)
+            // the ground resonance: the least damped of the regressing lag and the airframe
+            // modes it meets (as the amplitude check takes it)
+            .filter(|m| {
+                matches!(
+                    m.label,
+                    ModeLabel::RegressingLag | ModeLabel::AirframeX | ModeLabel::AirframeY
+                )
+            })
             .max_by(|p, q| p.growth_rate_per_s.total_cmp(&q.growth_rate_per_s))
             .unwrap();
         g = m.growth_rate_per_s;

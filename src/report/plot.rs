@@ -77,9 +77,11 @@ pub const MODE_COLOURS: [(&str, RGBColor); 12] = [
     ("airframe pitch", RGBColor(0, 0, 128)),
 ];
 
-/// The fixed colour of a stability mode label, or None.
+/// The fixed colour of a stability mode label, or None: the family's colour whatever follows
+/// it in brackets ("airframe y (real root 2)" is drawn as "airframe y").
 pub fn mode_colour(label: &str) -> Option<RGBColor> {
-    MODE_COLOURS.iter().find(|m| m.0 == label).map(|m| m.1)
+    let family = label.split(" (").next().unwrap_or(label).trim_end();
+    MODE_COLOURS.iter().find(|m| m.0 == family).map(|m| m.1)
 }
 
 /// The colour as a CSS hex string (for HTML next to the plots).
@@ -831,6 +833,15 @@ mod tests {
             .line("nonlinear", &[0.0, 1.0], &[0.0, 1.0])
             .points("", &[0.0, 1.0], &[0.0, 1.0]);
         assert_eq!(p.colours()[1], MODEL_COLOURS[2].1);
+    }
+
+    #[test]
+    fn a_stability_mode_has_its_family_colour_whatever_the_suffix() {
+        let y = mode_colour("airframe y").unwrap();
+        assert_eq!(mode_colour("airframe y (real root 1)"), Some(y));
+        assert_eq!(mode_colour("airframe y (2)"), Some(y));
+        assert_ne!(mode_colour("airframe x"), Some(y));
+        assert_eq!(mode_colour("unresolved (1)"), None);
     }
 
     #[test]

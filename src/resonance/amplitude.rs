@@ -428,9 +428,10 @@ impl Blades {
             let modes = rotor
                 .modes(om)
                 .map_err(|e| anyhow!("the reduced model at {om} rad/s: {e:#}"))?;
+            let ground = matches!(rotor, Reduced::Lag(_));
             let mode = modes
                 .into_iter()
-                .filter(|m| m.label == ModeLabel::RegressingLag)
+                .filter(|m| ground_resonance_mode(m.label, ground))
                 .max_by(|p, q| p.growth_rate_per_s.total_cmp(&q.growth_rate_per_s))
                 .ok_or_else(|| anyhow!("no regressing lag mode at {om} rad/s"))?;
             w = (om - 2.0 * PI * mode.frequency_hz).abs();
@@ -438,6 +439,16 @@ impl Blades {
         }
         out.ok_or_else(|| anyhow!("no equivalent rotor"))
     }
+}
+
+/// The modes the amplitude check may start on: the regressing lag, and on the ground the
+/// airframe modes it meets. Each label names one mode, so where the regressing lag and the
+/// airframe coalesce the least damped of them (the ground resonance) may carry an airframe
+/// label; in hover the airframe's slow modes are the aircraft's flight dynamics, not the
+/// damper's.
+fn ground_resonance_mode(label: ModeLabel, ground: bool) -> bool {
+    label == ModeLabel::RegressingLag
+        || (ground && matches!(label, ModeLabel::AirframeX | ModeLabel::AirframeY))
 }
 
 /// Damper cycles of the free response left out of the fit: the coupled system's adjustment

@@ -12,6 +12,7 @@ use crate::hydraulics::DamperModel;
 use crate::overrides::Override;
 use crate::rotor::assumed::{targets, Target};
 use crate::rotor::RotorDeck;
+use crate::stability::ModeLabel;
 use rayon::prelude::*;
 
 /// The numerical floor of the flow laws and the factor it is moved by each way.
@@ -180,14 +181,16 @@ fn moved_values(deck: &RotorDeck, model: DamperModel, set: &[Override]) -> Vec<(
     out
 }
 
-/// The growth rate of the mode labelled `label` whose eigenvalue is nearest `lambda` in `map`
-/// at its speed `k` (of any label when none has it).
-fn follow(map: &StabilityMap, k: usize, label: &str, lambda: faer::c64) -> Option<f64> {
+/// The growth rate of the mode of `label`'s block ([`ModeLabel::block`]) whose eigenvalue is
+/// nearest `lambda` in `map` at its speed `k` (of any label when none has it). Not by label
+/// alone: each label names one mode, and where two modes coalesce a moved value may trade
+/// their labels.
+fn follow(map: &StabilityMap, k: usize, label: ModeLabel, lambda: faer::c64) -> Option<f64> {
     let modes = &map.speeds.get(k)?.modes;
     let near = |m: &&crate::stability::Mode| (m.eigenvalue - lambda).norm();
     modes
         .iter()
-        .filter(|m| m.label.as_str() == label)
+        .filter(|m| m.label.block() == label.block())
         .min_by(|a, b| near(a).total_cmp(&near(b)))
         .or_else(|| modes.iter().min_by(|a, b| near(a).total_cmp(&near(b))))
         .map(|m| m.growth_rate_per_s)
@@ -303,9 +306,7 @@ pub fn verdicts(
                 Ok(modes
                     .iter()
                     .enumerate()
-                    .map(|(k, m0)| {
-                        follow(&m, at[k], m0.label.as_str(), m0.eigenvalue).unwrap_or(f64::NAN)
-                    })
+                    .map(|(k, m0)| follow(&m, at[k], m0.label, m0.eigenvalue).unwrap_or(f64::NAN))
                     .collect())
             };
             Ok((lo, hi, at(lo)?, at(hi)?))

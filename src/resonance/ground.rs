@@ -107,7 +107,7 @@ impl StabilityMap {
             .flat_map(|s| {
                 s.modes
                     .iter()
-                    .map(move |m| (m.damping_ratio, m.label.to_string(), s.omega_rad_s))
+                    .map(move |m| (m.damping_ratio, m.name(), s.omega_rad_s))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }

@@ -17,7 +17,7 @@ pub fn csv(map: &StabilityMap) -> String {
             s.push_str(&format!(
                 "{},{},{},{},{},{}\n",
                 sp.omega_rad_s,
-                m.label,
+                m.name(),
                 m.frequency_hz,
                 m.damping_ratio,
                 m.growth_rate_per_s,

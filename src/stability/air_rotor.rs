@@ -37,6 +37,7 @@
 //! multipliers over one revolution (RK4), matched to the mean isotropic rotor's Coleman
 //! eigenvalues by the continuation of [`super::lag_rotor`].
 use super::dampers::{coupled_step, BladeDamper, DeviceResponse, StepForces};
+use super::labels::{self, Family};
 use super::lag_rotor::{
     continued_modes, eigen_pairs, floquet_multipliers, nearest, need_blades, out_of_range,
     unit_cyclic, upper_modes, Mode, ModeLabel, Result, StabilityError,
@@ -825,62 +826,106 @@ impl AirRotor {
             .collect()
     }
 
-    /// Label of an eigenvector in multi-blade coordinates: the largest kinetic-energy share
-    /// among the groups (cyclic lag and flap split into progressive and regressing by the
-    /// whirl rule of [`super::LagRotor::coleman_eigenvalues`]).
-    fn label(&self, lam: c64, v: &[c64], weight: &[f64], omega: f64) -> ModeLabel {
+    /// The families of the multi-blade coordinates `group` (solved together), each with as
+    /// many slots as coordinates it stands for: collective, cyclic (one regressing and one
+    /// progressive per cyclic pair), differential and higher cyclic ("differential"), lag then
+    /// flap, and the airframe's degrees of freedom.
+    fn families(&self, group: &[usize]) -> Vec<Family> {
+        let nb = self.blades.len();
+        let mut out: Vec<Family> = vec![];
+        let mut add = |label: ModeLabel, n: usize| {
+            if n == 0 {
+                return;
+            }
+            match out.iter_mut().find(|f| f.label == label) {
+                Some(f) => f.slots += n,
+                None => out.push(Family { label, slots: n }),
+            }
+        };
+        for d in 0..2 {
+            let has = |c: usize| group.contains(&(d * nb + c));
+            let [collective, regressing, progressive, reactionless] = Self::blade_families(d);
+            add(collective, usize::from(has(0)));
+            let cyclic = usize::from(has(1)) + usize::from(has(2));
+            add(regressing, cyclic / 2);
+            add(progressive, cyclic / 2);
+            add(reactionless, (3..nb).filter(|&c| has(c)).count());
+        }
+        for (i, dof) in self.body.iter().enumerate() {
+            add(
+                Self::body_family(dof.axis),
+                usize::from(group.contains(&(2 * nb + i))),
+            );
+        }
+        out
+    }
+
+    /// (collective, regressing, progressive, differential) of the lag (`d = 0`) or the flap.
+    fn blade_families(d: usize) -> [ModeLabel; 4] {
+        if d == 0 {
+            [
+                ModeLabel::CollectiveLag,
+                ModeLabel::RegressingLag,
+                ModeLabel::ProgressiveLag,
+                ModeLabel::DifferentialLag,
+            ]
+        } else {
+            [
+                ModeLabel::CollectiveFlap,
+                ModeLabel::RegressingFlap,
+                ModeLabel::ProgressiveFlap,
+                ModeLabel::DifferentialFlap,
+            ]
+        }
+    }
+
+    fn body_family(axis: BodyAxis) -> ModeLabel {
+        match axis {
+            BodyAxis::X => ModeLabel::AirframeX,
+            BodyAxis::Y => ModeLabel::AirframeY,
+            BodyAxis::Roll => ModeLabel::AirframeRoll,
+            BodyAxis::Pitch => ModeLabel::AirframePitch,
+        }
+    }
+
+    /// The share of the eigenvector `v` (multi-blade coordinates, eigenvalue `lam`) in each of
+    /// `families`, from the kinetic energy of its groups (cyclic lag and flap split into
+    /// regressing and progressive by the whirl rule of
+    /// [`super::LagRotor::coleman_eigenvalues`]).
+    fn shares(
+        &self,
+        lam: c64,
+        v: &[c64],
+        weight: &[f64],
+        omega: f64,
+        families: &[Family],
+    ) -> Vec<f64> {
         let nb = self.blades.len();
         let e = |i: usize| weight[i] * v[i].norm() * v[i].norm();
-        let mut best = (f64::MIN, ModeLabel::Unresolved);
-        let mut offer = |energy: f64, label: ModeLabel| {
-            if energy > best.0 {
-                best = (energy, label);
+        let mut energy = vec![0.0; families.len()];
+        let mut offer = |label: ModeLabel, x: f64| {
+            if let Some(f) = families.iter().position(|f| f.label == label) {
+                energy[f] += x;
             }
         };
         for d in 0..2 {
             let base = d * nb;
-            let (collective, cyclic_pro, cyclic_reg, reactionless) = if d == 0 {
-                (
-                    ModeLabel::CollectiveLag,
-                    ModeLabel::ProgressiveLag,
-                    ModeLabel::RegressingLag,
-                    ModeLabel::DifferentialLag,
-                )
-            } else {
-                (
-                    ModeLabel::CollectiveFlap,
-                    ModeLabel::ProgressiveFlap,
-                    ModeLabel::RegressingFlap,
-                    ModeLabel::DifferentialFlap,
-                )
-            };
-            offer(e(base), collective);
+            let [collective, regressing, progressive, reactionless] = Self::blade_families(d);
+            offer(collective, e(base));
             let (zc, zs) = if lam.im >= 0.0 {
                 (v[base + 1], v[base + 2])
             } else {
                 (v[base + 1].conj(), v[base + 2].conj())
             };
-            let iz = c64::new(-zs.im, zs.re);
-            let progressive = (zc + iz).norm() > (zc - iz).norm() && lam.im.abs() > omega;
-            offer(
-                e(base + 1) + e(base + 2),
-                if progressive { cyclic_pro } else { cyclic_reg },
-            );
-            let rest: f64 = (3..nb).map(|c| e(base + c)).sum();
-            offer(rest, reactionless);
+            let (reg, pro) = labels::whirl_split(lam, zc, zs, omega, e(base + 1) + e(base + 2));
+            offer(regressing, reg);
+            offer(progressive, pro);
+            offer(reactionless, (3..nb).map(|c| e(base + c)).sum());
         }
         for (i, dof) in self.body.iter().enumerate() {
-            offer(
-                e(2 * nb + i),
-                match dof.axis {
-                    BodyAxis::X => ModeLabel::AirframeX,
-                    BodyAxis::Y => ModeLabel::AirframeY,
-                    BodyAxis::Roll => ModeLabel::AirframeRoll,
-                    BodyAxis::Pitch => ModeLabel::AirframePitch,
-                },
-            );
+            offer(Self::body_family(dof.axis), e(2 * nb + i));
         }
-        best.1
+        labels::shares(&energy)
     }
 
     /// All Coleman eigenvalues (conjugates included) with their labels, about the hover `h`.
@@ -926,13 +971,20 @@ impl AirRotor {
         for g in &groups {
             let sub = |m: &Mat<f64>| Mat::<f64>::from_fn(g.len(), g.len(), |i, j| m[(g[i], g[j])]);
             let (lams, vecs) = eigen_pairs(&sub(&mm), &sub(&cm), &sub(&km))?;
-            for (j, &l) in lams.iter().enumerate() {
-                let mut v = vec![c64::new(0.0, 0.0); n];
-                for (i, &gi) in g.iter().enumerate() {
-                    v[gi] = vecs[(i, j)];
-                }
-                out.push((l, self.label(l, &v, &weight, h.omega_rad_s)));
-            }
+            let families = self.families(g);
+            let shares: Vec<Vec<f64>> = lams
+                .iter()
+                .enumerate()
+                .map(|(j, &l)| {
+                    let mut v = vec![c64::new(0.0, 0.0); n];
+                    for (i, &gi) in g.iter().enumerate() {
+                        v[gi] = vecs[(i, j)];
+                    }
+                    self.shares(l, &v, &weight, h.omega_rad_s, &families)
+                })
+                .collect();
+            let labels = labels::assign(&lams, &shares, &families);
+            out.extend(lams.iter().copied().zip(labels));
         }
         Ok(out)
     }

@@ -63,6 +63,7 @@
 //! puts the frequency nearest that Coleman frequency; for a non-isotropic rotor this matching
 //! is continued from the mean rotor to the actual one in [`CONTINUATION_STAGES`] equal steps
 //! of the blade properties, each stage matched to the previous one. The label is carried over.
+use super::labels::{self, Family};
 use crate::solver::ode::{self, NotFinite, OdeRhs, Rk4};
 use faer::{c64, Mat};
 use std::f64::consts::PI;
@@ -187,6 +188,21 @@ impl ModeLabel {
     }
 }
 
+impl ModeLabel {
+    /// The families labelled together ([`LagRotor::coleman_eigenvalues`]): the modes that
+    /// couple to the airframe (0), the collective (1), the differential and higher cyclic (2)
+    /// and the unresolved (3). A mode keeps its block when a value moves; within the coupled
+    /// block the labels may trade places where two modes coalesce.
+    pub fn block(self) -> u8 {
+        match self {
+            ModeLabel::CollectiveLag | ModeLabel::CollectiveFlap => 1,
+            ModeLabel::DifferentialLag | ModeLabel::DifferentialFlap => 2,
+            ModeLabel::Unresolved => 3,
+            _ => 0,
+        }
+    }
+}
+
 impl fmt::Display for ModeLabel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.as_str())
@@ -196,7 +212,12 @@ impl fmt::Display for ModeLabel {
 /// One eigenvalue (one per complex-conjugate pair, `Im >= 0`) in the fixed frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mode {
+    /// The mode's family.
     pub label: ModeLabel,
+    /// 0 when the mode is its family's only one at this speed; else its number within the
+    /// family, 1, 2, ... by decreasing growth rate (an overdamped pair split into two real
+    /// roots: root 1 the slower to decay). See [`Mode::name`].
+    pub root: usize,
     /// `|Im lambda| / 2 pi`, fixed frame.
     pub frequency_hz: f64,
     /// `-Re lambda / |lambda|` (negative when unstable).
@@ -211,6 +232,7 @@ impl Mode {
         let norm = eigenvalue.re.hypot(eigenvalue.im);
         Mode {
             label,
+            root: 0,
             frequency_hz: eigenvalue.im.abs() / (2.0 * PI),
             damping_ratio: if norm > 0.0 {
                 -eigenvalue.re / norm
@@ -219,6 +241,19 @@ impl Mode {
             },
             growth_rate_per_s: eigenvalue.re,
             eigenvalue,
+        }
+    }
+}
+
+impl Mode {
+    /// The name of the mode, unique at its speed: the family ("airframe y"), and when the
+    /// family has more than one mode at this speed, which: "airframe y (real root 1)" for a
+    /// real root, "differential lag (2)" for an oscillating one.
+    pub fn name(&self) -> String {
+        match self.root {
+            0 => self.label.as_str().to_string(),
+            k if self.eigenvalue.im == 0.0 => format!("{} (real root {k})", self.label),
+            k => format!("{} ({k})", self.label),
         }
     }
 }
@@ -498,13 +533,18 @@ impl LagRotor {
     ///
     /// Labels: the collective, differential and higher cyclic (reactionless, "differential
     /// lag") coordinates do not couple to the hub and are solved as separate blocks, labelled
-    /// by block. In the coupled block (cyclic n = 1 with the hub) a mode is labelled by the
-    /// largest kinetic-energy share of its eigenvector: cyclic lag
-    /// `N/2 I (|zeta_1c|^2 + |zeta_1s|^2)`, `M_x |x|^2`, `M_y |y|^2` (total masses). A
-    /// cyclic-lag mode is "progressive" when its whirl turns forward in the rotating frame:
-    /// forward whirl in the fixed frame (`|zeta_1c + i zeta_1s|` larger than
-    /// `|zeta_1c - i zeta_1s|`) at a fixed-frame frequency above `Omega`; otherwise it is
-    /// "regressing" (below `Omega`, or backward whirl in the fixed frame).
+    /// by block. In the coupled block (cyclic n = 1 with the hub) the labels are solved jointly
+    /// ([`super::labels`]): each mode offers each family its share of the eigenvector's kinetic
+    /// energy, cyclic lag `N/2 I (|zeta_1c|^2 + |zeta_1s|^2)`, `M_x |x|^2`, `M_y |y|^2` (total
+    /// masses), and the assignment with the largest total share gives each family (regressing
+    /// lag, progressive lag, airframe x, airframe y) to one conjugate pair, or to one pair of
+    /// real roots when the family is overdamped. The cyclic share is split between progressive
+    /// and regressing by the whirl: a cyclic-lag mode is "progressive" when its whirl turns
+    /// forward in the rotating frame, i.e. forward whirl in the fixed frame (`|zeta_1c + i
+    /// zeta_1s|` larger than `|zeta_1c - i zeta_1s|`) at a fixed-frame frequency above
+    /// `Omega`; otherwise it is "regressing" (below `Omega`, or backward whirl in the fixed
+    /// frame). The forward part of the whirl above `Omega` counts as progressive, the rest as
+    /// regressing. A family with two modes at one speed numbers them ([`Mode::name`]).
     pub fn coleman_eigenvalues(&self, omega_rad_s: f64) -> Result<Vec<Mode>> {
         Ok(upper_modes(self.coleman_all(omega_rad_s)?))
     }
@@ -556,39 +596,43 @@ impl LagRotor {
         // Cyclic n = 1 coupled to the hub: coordinates zeta_1c, zeta_1s, hubs.
         let (mm, cm, km, weight) = self.cyclic_block(omega);
         let (lams, u) = eigen_pairs(&mm, &cm, &km)?;
-        for (j, &l) in lams.iter().enumerate() {
-            let energy = |i: usize| weight[i] * u[(i, j)].norm() * u[(i, j)].norm();
-            // Whirl of (zeta_1c, zeta_1s) for the Im >= 0 member of the pair.
-            let (zc, zs) = if l.im >= 0.0 {
-                (u[(0, j)], u[(1, j)])
+        let mut families = vec![
+            Family {
+                label: ModeLabel::RegressingLag,
+                slots: 1,
+            },
+            Family {
+                label: ModeLabel::ProgressiveLag,
+                slots: 1,
+            },
+        ];
+        families.extend(hubs.iter().map(|hub| Family {
+            label: if hub.is_y {
+                ModeLabel::AirframeY
             } else {
-                (u[(0, j)].conj(), u[(1, j)].conj())
-            };
-            let iz = c64::new(-zs.im, zs.re);
-            let progressive = (zc + iz).norm() > (zc - iz).norm() && l.im.abs() > omega;
-            let mut best = (
-                energy(0) + energy(1),
-                if progressive {
-                    ModeLabel::ProgressiveLag
+                ModeLabel::AirframeX
+            },
+            slots: 1,
+        }));
+        let weights: Vec<Vec<f64>> = lams
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| {
+                let energy = |i: usize| weight[i] * u[(i, j)].norm() * u[(i, j)].norm();
+                // Whirl of (zeta_1c, zeta_1s) for the Im >= 0 member of the pair.
+                let (zc, zs) = if l.im >= 0.0 {
+                    (u[(0, j)], u[(1, j)])
                 } else {
-                    ModeLabel::RegressingLag
-                },
-            );
-            for (jh, hub) in hubs.iter().enumerate() {
-                let e = energy(2 + jh);
-                if e > best.0 {
-                    best = (
-                        e,
-                        if hub.is_y {
-                            ModeLabel::AirframeY
-                        } else {
-                            ModeLabel::AirframeX
-                        },
-                    );
-                }
-            }
-            out.push((l, best.1));
-        }
+                    (u[(0, j)].conj(), u[(1, j)].conj())
+                };
+                let (reg, pro) = labels::whirl_split(l, zc, zs, omega, energy(0) + energy(1));
+                let mut e = vec![reg, pro];
+                e.extend((0..hubs.len()).map(|jh| energy(2 + jh)));
+                labels::shares(&e)
+            })
+            .collect();
+        let labels = labels::assign(&lams, &weights, &families);
+        out.extend(lams.iter().copied().zip(labels));
         Ok(out)
     }
 
@@ -875,6 +919,10 @@ pub(super) fn upper_modes(all: Vec<(c64, ModeLabel)>) -> Vec<Mode> {
 fn modes_by_frequency(all: impl Iterator<Item = (c64, ModeLabel)>) -> Vec<Mode> {
     let mut modes: Vec<Mode> = all.map(|(l, label)| Mode::new(label, l)).collect();
     modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    let key: Vec<(ModeLabel, c64)> = modes.iter().map(|m| (m.label, m.eigenvalue)).collect();
+    for (m, root) in modes.iter_mut().zip(labels::roots_within_family(&key)) {
+        m.root = root;
+    }
     modes
 }
 
@@ -888,7 +936,7 @@ pub(super) fn floquet_multipliers(phi: &[f64], m: usize) -> Result<Vec<c64>> {
 /// of its mean isotropic rotor, continued as in the module documentation: `multipliers(None)`
 /// of the rotor itself when it is isotropic, else `multipliers(Some(s))` of the blend
 /// `mean + s (actual - mean)` for `s = k / CONTINUATION_STAGES`, `k = 1..=CONTINUATION_STAGES`.
-/// One mode per conjugate pair of the references, sorted by frequency.
+/// One mode per conjugate pair, sorted by frequency.
 pub(super) fn continued_modes(
     coleman: Vec<(c64, ModeLabel)>,
     period: f64,
@@ -896,20 +944,14 @@ pub(super) fn continued_modes(
     isotropic: bool,
     mut multipliers: impl FnMut(Option<f64>) -> Result<Vec<c64>>,
 ) -> Result<Vec<Mode>> {
-    // (exponent, (label, Im >= 0 in the mean rotor's Coleman set))
-    let refs = coleman
-        .into_iter()
-        .map(|(l, label)| (l, (label, l.im >= 0.0)))
-        .collect();
     let stages = if isotropic { 1 } else { CONTINUATION_STAGES };
-    let out = ode::continue_exponents(refs, stages, period, omega, |k| {
+    let out = ode::continue_exponents(coleman, stages, period, omega, |k| {
         multipliers((!isotropic).then(|| (k + 1) as f64 / CONTINUATION_STAGES as f64))
     })?;
-    Ok(modes_by_frequency(
-        out.into_iter()
-            .filter(|r| r.1 .1)
-            .map(|(l, (label, _))| (l, label)),
-    ))
+    // One mode per conjugate pair of the continued exponents (as of the Coleman ones): a pair
+    // of the mean rotor's real roots may continue to a conjugate pair, and a conjugate pair to
+    // two real roots.
+    Ok(upper_modes(out))
 }
 
 /// The periodic equations in individual blade coordinates, evaluated in place.

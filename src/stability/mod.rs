@@ -12,6 +12,7 @@
 //! resonance).
 pub mod air_rotor;
 pub mod dampers;
+mod labels;
 pub mod lag_rotor;
 
 pub use air_rotor::{AirBlade, AirRotor, BodyAxis, BodyDof, Hover, Strip};
