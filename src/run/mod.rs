@@ -45,8 +45,9 @@ pub const MONITORED: [(&str, f64); 4] = [
 
 /// Monitored as well when the simulation has it (computed airloads): the rotor's thrust [N],
 /// judged at the revolution's boundary like [`MONITORED`] and for content at the step rate
-/// (an every-step, alternating-sign component: a discrete instability that the blade's
-/// channels filter out), both on the scale `max(peak-to-peak, floor, 1% of the mean)`.
+/// (an every-step, alternating-sign component beyond 0.1% of the scale: a discrete
+/// instability that the blade's channels filter out), both on the scale `max(peak-to-peak,
+/// floor, 1% of the mean)`.
 pub const MONITORED_IF_PRESENT: [(&str, f64); 1] = [("rotor_thrust_N", 10.0)];
 
 /// Name of the step-rate entry of a monitored channel in the residuals (`NAME@step_rate`).
