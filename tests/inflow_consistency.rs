@@ -362,3 +362,20 @@ fn coupled_inflow_matches_blade_element_momentum_theory() {
     let _ = std::fs::remove_dir_all(&dir);
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The periodicity monitor's step-rate measure: an every-step alternation about a mean is 1/2
+/// of its peak-to-peak, a smooth periodic signal has none.
+#[test]
+fn step_rate_content_sees_the_alternation_only() {
+    use rotorsim::run::periodic::step_rate_content;
+    let n = 256;
+    let flip: Vec<f64> = (0..n)
+        .map(|j| 1000.0 + if j % 2 == 0 { 50.0 } else { -30.0 })
+        .collect();
+    assert!((step_rate_content(&flip, 10.0) - 0.5).abs() < 1e-12);
+    let smooth: Vec<f64> = (0..n)
+        .map(|j| 1000.0 + 40.0 * (4.0 * 2.0 * PI * j as f64 / n as f64).sin())
+        .collect();
+    assert!(step_rate_content(&smooth, 10.0) < 1e-12);
+    assert_eq!(step_rate_content(&[5.0; 8], 10.0), 0.0);
+}
