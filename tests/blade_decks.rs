@@ -131,14 +131,17 @@ fn a_blade_override_wins_over_the_deck_and_reaches_that_blade_only() {
     let only = RotorDeck::from_file_with(&p, &sets(&[])).unwrap();
     assert!(only.per_blade());
     let plain = deck(&dir, "plain.toml", "", "");
-    let s = RotorDeck::from_file_with(
-        &plain,
-        &sets(&["blades.4.bearing.pitch_damping_Nms_per_rad=1"]),
-    )
-    .unwrap();
+    let s = RotorDeck::from_file_with(&plain, &sets(&["blades.4.bearing.pitch_loss_factor=0.2"]))
+        .unwrap();
     assert!(s.per_blade());
-    assert_eq!(s.blade(4).unwrap().spec.bearing.pitch_c, 1.0);
-    assert_eq!(s.blade(3).unwrap().spec.bearing.pitch_c, 272.0);
+    assert_eq!(
+        s.blade(4).unwrap().spec.bearing.pitch_loss_factor,
+        Some(0.2)
+    );
+    assert_eq!(
+        s.blade(3).unwrap().spec.bearing.pitch_loss_factor,
+        Some(0.1)
+    );
     assert!(s.blade(5).is_err() && s.blade(0).is_err());
     let _ = std::fs::remove_dir_all(&dir);
 }

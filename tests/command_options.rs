@@ -21,7 +21,7 @@ fn other_value(key: &str, d: &Value) -> (Value, Vec<String>) {
     let text = |v: &str| (Value::from(v), vec![flag.clone(), v.to_string()]);
     let list = |v: &str| (json!([v]), vec![flag.clone(), v.to_string()]);
     match (key, d) {
-        ("vary", _) => list("bearing.lag_damping_Nms_per_rad=136:544"),
+        ("vary", _) => list("bearing.lag_loss_factor=0.05:0.2"),
         ("measured", _) => list("some/test.csv"),
         ("damper", _) => text("physical"),
         ("model", _) => text("rigid"),

@@ -214,7 +214,7 @@ fn a_warm_start_from_another_discretisation_or_deck_says_so() {
                 "--steps-per-rev",
                 "128",
                 "--set",
-                "bearing.lag_damping_Nms_per_rad=300.0",
+                "bearing.lag_loss_factor=0.11",
                 "--initial-state",
                 a.to_str().unwrap(),
                 "--out",

@@ -241,20 +241,28 @@ fn expand_prints_a_model_deck_that_loads_back() {
     // the damper as a [[hydraulic]] element reading the rotor deck's [damper] table
     assert_eq!(deck.hydraulic_probes.len(), 1);
     assert_eq!(model.step_elements.len(), 1);
-    // bearing: lag, flap, pitch revolute joints at the hinge with the deck's springs
+    // bearing: lag, flap, pitch revolute joints at the hinge, each an elastomer whose storage
+    // stiffness at its reference frequency is the deck's stiffness (no separate spring)
+    use rotorsim::rotor::deck::BearingAxis;
     let spec = RotorDeck::from_file(&repo("rotors/uh60a.toml"))
         .unwrap()
         .spec;
-    for (name, k) in [
-        ("lag", spec.bearing.lag_k),
-        ("flap", spec.bearing.flap_k),
-        ("pitch", spec.bearing.pitch_k),
+    let om = spec.rotor.omega_rad_s;
+    for (name, axis, k) in [
+        ("lag", BearingAxis::Lag, spec.bearing.lag_k),
+        ("flap", BearingAxis::Flap, spec.bearing.flap_k),
+        ("pitch", BearingAxis::Pitch, spec.bearing.pitch_k),
     ] {
         let id = model.element_id(name).unwrap();
         match &model.elements[id] {
             rotorsim::structure::Element::Joint(j) => {
                 assert_eq!(j.kind, rotorsim::structure::JointKind::Revolute);
-                assert_eq!(j.spring_nm_per_rad, k);
+                assert_eq!(j.spring_nm_per_rad, 0.0);
+                let w = spec.bearing.elastomer(axis, om).unwrap().reference_rad_s;
+                let e = j.elastomer.as_ref().expect("an elastomer");
+                let storage = e.chain.complex(w).0;
+                // the printed deck's numbers, read back
+                assert!((storage / k - 1.0).abs() < 1e-9, "{name}: {storage} vs {k}");
             }
             _ => panic!("{name} is not a joint"),
         }

@@ -67,7 +67,7 @@ fn the_shipped_deck_labels_sixteen_numbers_and_two_notes() {
         "blade.damping_mu_s",
         "retention.horn_r_m",
         "bearing.flap_stiffness_Nm_per_rad",
-        "bearing.pitch_damping_Nms_per_rad",
+        "bearing.pitch_loss_factor",
         "pitch_control.horn_tip_m[0]",
         "pitch_control.horn_tip_m[1]",
         "pitch_control.link_length_m",
@@ -105,15 +105,15 @@ fn ok(o: &Output) {
 }
 
 /// The shipped deck with its files by absolute path and one ASSUMED label kept: the bearing's
-/// lag damping.
+/// lag loss factor.
 fn one_label_deck(dir: &Path) {
     let r = root();
     let text = std::fs::read_to_string(r.join("rotors/uh60a.toml"))
         .unwrap()
         .replace("# ASSUMED", "# assumed")
         .replace(
-            "lag_damping_Nms_per_rad = 272.0        # assumed",
-            "lag_damping_Nms_per_rad = 272.0        # ASSUMED",
+            "lag_loss_factor = 0.1                  # assumed",
+            "lag_loss_factor = 0.1                  # ASSUMED",
         )
         .replace(
             "sections_csv = \"data/",
@@ -173,10 +173,10 @@ fn a_rigid_sensitivity_matches_plain_runs_and_its_swing_is_high_minus_low() {
     let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
     assert_eq!(rows.len(), 2);
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    assert_eq!(&rows[0][0], "bearing.lag_damping_Nms_per_rad");
-    assert_eq!(&rows[0][1], "Nms_per_rad");
-    assert_eq!(f(&rows[0][col("low_value")]), Some(136.0));
-    assert_eq!(f(&rows[0][col("high_value")]), Some(544.0));
+    assert_eq!(&rows[0][0], "bearing.lag_loss_factor");
+    assert_eq!(&rows[0][1], "-");
+    assert_eq!(f(&rows[0][col("low_value")]), Some(0.05));
+    assert_eq!(f(&rows[0][col("high_value")]), Some(0.2));
     assert_eq!(&rows[1][0], "bearing.lag_stiffness_Nm_per_rad");
     assert_eq!(&rows[1][col("range")], "--vary");
     assert_eq!(f(&rows[1][col("low_value")]), Some(15000.0));
@@ -237,7 +237,7 @@ fn a_rigid_sensitivity_matches_plain_runs_and_its_swing_is_high_minus_low() {
         assert_eq!(&row[col("pitch_link_force_half_p2p_swing_N")], "");
     }
     let low_case = read_json(
-        &out.join("cases/bearing.lag_damping_Nms_per_rad-low")
+        &out.join("cases/bearing.lag_loss_factor-low")
             .join("summary.json"),
     );
     assert_eq!(

@@ -72,13 +72,13 @@ fn hover_operating_speed_is_marginal_and_names_the_bearing_damping() {
     assert!(band[0] < 0.0 && band[1] > 0.0, "{band:?}");
     assert_eq!(v["call"], "marginal");
     let first = &v["deciding"][0];
-    assert_eq!(first["key"], "bearing.lag_damping_Nms_per_rad", "{v}");
+    assert_eq!(first["key"], "bearing.lag_loss_factor", "{v}");
     let line = text
         .lines()
         .find(|l| l.starts_with("marginal: regressing lag"))
         .unwrap();
     assert!(
-        line.contains("band") && line.contains("bearing.lag_damping_Nms_per_rad"),
+        line.contains("band") && line.contains("bearing.lag_loss_factor"),
         "{line}"
     );
     // the deciding value's ends are the maps a user gets by setting it
@@ -88,7 +88,7 @@ fn hover_operating_speed_is_marginal_and_names_the_bearing_damping() {
     ] {
         let x = first[end].as_f64().unwrap();
         let o = tmp(&format!("verdict_hover_{end}"));
-        let set = format!("bearing.lag_damping_Nms_per_rad={x}");
+        let set = format!("bearing.lag_loss_factor={x}");
         let mut a = base.to_vec();
         a.extend(["--set", &set]);
         stability(&a, &o);
