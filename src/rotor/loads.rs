@@ -43,6 +43,26 @@ pub const HINGE_MOMENT_CHANNELS: [&str; 3] = [
     "pitch_bearing_moment_Nm",
 ];
 
+/// The pitch-link load's contributors (docs/loads.md, "Pitch-link contributors"): the moment
+/// balance about the pitch axis of what is outboard of the pitch joint (retention segments 2
+/// and 3, blade, pitch horn), each moment as the link tension that balances it. The bearing
+/// (its spring, dashpot and elastomer together), the applied loads (airloads), the inertial
+/// loads (centrifugal and propeller moments included), gravity, and the pitch link's own
+/// part between its mid-length (where [`PITCH_LINK_CHANNEL`] is taken) and the horn: its
+/// shear's moment at the horn and its upper half's axial inertia and weight. They sum to the
+/// link load when the balance holds (the residual is checked, docs/loads.md).
+pub const PITCH_LINK_CONTRIBUTOR_CHANNELS: [&str; 5] = [
+    "pitch_link_from_bearing_N",
+    "pitch_link_from_airloads_N",
+    "pitch_link_from_inertia_N",
+    "pitch_link_from_gravity_N",
+    "pitch_link_from_link_N",
+];
+
+/// The link tension's arm about the pitch axis, signed: the tension's moment about the axis
+/// (nose up positive) per newton [m].
+pub const PITCH_LINK_ARM_CHANNEL: &str = "pitch_link_arm_m";
+
 /// Infix of the section channels in the unpitched blade frame
 /// (`flap_moment_unpitched_r0.05_Nm`, docs/loads.md).
 pub const UNPITCHED: &str = "unpitched";
@@ -117,6 +137,10 @@ pub struct LoadChannels {
     swash_drive: usize,
     /// The bearing's lag, flap and pitch joints ([`HINGE_CHANNELS`]).
     hinges: [usize; 3],
+    /// First element of `beams` outboard of the pitch joint (segment 2's first), and the
+    /// pitch link's node at the horn.
+    outboard_from: usize,
+    link_top: usize,
 }
 
 fn beam_ids<'a>(m: &'a Model, name: &str) -> anyhow::Result<&'a [usize]> {
@@ -209,6 +233,12 @@ impl LoadChannels {
                 names_v.push(section_channel(kind, unit, x, true));
             }
         }
+        names_v.extend(
+            PITCH_LINK_CONTRIBUTOR_CHANNELS
+                .iter()
+                .map(|s| s.to_string()),
+        );
+        names_v.push(PITCH_LINK_ARM_CHANNEL.to_string());
         let hinges = [
             element(m, names::LAG)?,
             element(m, names::FLAP)?,
@@ -224,6 +254,7 @@ impl LoadChannels {
         let hub = m.node_id(names::HUB)?;
         let hub_cut = vec![beam_ids(m, "seg1")?[0], element(m, "damper_hub_mount")?];
         let mut beams = vec![];
+        let outboard_from = beam_ids(m, "seg1")?.len();
         for b in ["seg1", "seg2", "seg3", names::BLADE] {
             beams.extend_from_slice(&beam_ids(m, b)?);
         }
@@ -249,6 +280,10 @@ impl LoadChannels {
                 .ok_or_else(|| anyhow::anyhow!("pitch_link_upper has no horn node"))?,
             _ => anyhow::bail!("pitch_link_upper is not a joint"),
         };
+        let link_top = match &m.elements[link_joint] {
+            Element::Joint(j) => j.node_b,
+            _ => anyhow::bail!("pitch_link_upper is not a joint"),
+        };
         Ok(LoadChannels {
             stations,
             kinds,
@@ -267,6 +302,8 @@ impl LoadChannels {
             frame: [[cs, -sn, 0.0], [sn, cs, 0.0], [0.0, 0.0, 1.0]],
             swash_drive,
             hinges,
+            outboard_from,
+            link_top,
         })
     }
 
@@ -363,8 +400,9 @@ impl LoadChannels {
         let rh = mm(&quat_to_arr(&st.q[self.hub]), &self.frame);
         // the shaft axis: the unpitched blade frame's second axis is normal to it
         let up = [rh[0][2], rh[1][2], rh[2][2]];
-        // the unpitched section channels come last
-        let mut iu = out.len() - self.stations.len() * self.unpitched_kinds.len();
+        // the unpitched section channels come last but for the pitch-link contributors
+        let n_link = PITCH_LINK_CONTRIBUTOR_CHANNELS.len() + 1;
+        let mut iu = out.len() - n_link - self.stations.len() * self.unpitched_kinds.len();
         let mut i = 0;
         let all = |c: &loads::SectionComponents| {
             [
@@ -393,9 +431,9 @@ impl LoadChannels {
                 iu += 1;
             }
         }
-        out[i] = loads::section(m, st, &ctx, self.link.elem, self.link.s_m)?
-            .components()
-            .axial_n;
+        let link_section = loads::section(m, st, &ctx, self.link.elem, self.link.s_m)?;
+        let link_tension = link_section.components().axial_n;
+        out[i] = link_tension;
         i += 1;
         // what the blade system exerts on the hub, about the hub centre, from this sample's
         // data of the retention's first element
@@ -438,6 +476,94 @@ impl LoadChannels {
             out[i + q] = j.angle(&a, &b);
             out[i + 3 + q] = j.axis_moment(&a, &b);
         }
+        let k = out.len() - n_link;
+        let link_axis = [
+            link_section.frame[0][0],
+            link_section.frame[1][0],
+            link_section.frame[2][0],
+        ];
+        self.pitch_link_contributors(
+            m,
+            st,
+            &ctx,
+            &data[self.outboard_from..],
+            link_tension,
+            link_axis,
+            &mut out[k..],
+        )
+    }
+
+    /// The pitch-link contributors and the link's arm ([`PITCH_LINK_CONTRIBUTOR_CHANNELS`],
+    /// [`PITCH_LINK_ARM_CHANNEL`]) into `out`, from the moment balance about the pitch joint's
+    /// axis of the parts outboard of it (`outboard`: their beams' data). `link_axis`: the
+    /// link's direction at mid-length, toward the horn (tension pulls the horn against it).
+    #[allow(clippy::too_many_arguments)]
+    fn pitch_link_contributors(
+        &self,
+        m: &Model,
+        st: &State,
+        ctx: &EvalCtx,
+        outboard: &[ElemData],
+        link_tension: f64,
+        link_axis: [f64; 3],
+        out: &mut [f64],
+    ) -> anyhow::Result<()> {
+        let kin = |n: Option<usize>| n.map_or_else(NodeKin::ground, |n| st.node_kin(n));
+        let Element::Joint(pj) = &m.elements[self.hinges[2]] else {
+            anyhow::bail!("element {} is not a joint", self.hinges[2]);
+        };
+        let (ka, kb) = (kin(pj.node_a), kin(Some(pj.node_b)));
+        // the pitch axis: the joint's z through its point, as node A carries them
+        let fa = mm(&ka.r, &pj.qa);
+        let z = [fa[0][2], fa[1][2], fa[2][2]];
+        let p = add(ka.x, mv(&ka.r, pj.da));
+        let about = |r: &Resultant| dot(r.moment, z);
+        // applied loads alone, then with gravity; the rest of the densities is inertia
+        let applied_ctx = EvalCtx {
+            inertia: false,
+            gravity: [0.0; 3],
+            ..*ctx
+        };
+        let with_gravity_ctx = EvalCtx {
+            inertia: false,
+            ..*ctx
+        };
+        let horn = &self.rigid[..1];
+        let mut full = loads::applied_and_inertial(m, st, ctx, horn, p)?;
+        let mut applied = loads::applied_and_inertial(m, st, &applied_ctx, horn, p)?;
+        let mut with_gravity = loads::applied_and_inertial(m, st, &with_gravity_ctx, horn, p)?;
+        let has_gravity = ctx.gravity != [0.0; 3];
+        for e in outboard {
+            let Element::Beam(b) = &m.elements[e.elem] else {
+                anyhow::bail!("element {} is not a beam", e.elem);
+            };
+            full = full.add(&loads::densities_resultant(&e.d, p));
+            let d = b.densities_with(&e.k, &e.ip.rg, &applied_ctx);
+            let a = loads::densities_resultant(&d, p);
+            applied = applied.add(&a);
+            with_gravity = with_gravity.add(&if has_gravity {
+                loads::densities_resultant(&b.densities_with(&e.k, &e.ip.rg, &with_gravity_ctx), p)
+            } else {
+                a
+            });
+        }
+        let m_air = about(&applied);
+        let m_grav = about(&with_gravity) - m_air;
+        let m_inertia = about(&full) - about(&with_gravity);
+        // the bearing's moment on the blade side resists the pitch angle
+        let m_bearing = -pj.axis_moment(&ka, &kb);
+        let horn_load =
+            loads::element_on_node(m, st, ctx, &self.lam_off, self.link_joint, self.horn_node)?
+                .moved(st.x[self.horn_node], p);
+        let arm = dot(cross(sub(st.x[self.link_top], p), fmul(-1.0, link_axis)), z);
+        // balance: tension x arm + the others' moments = 0 (the link's own part being the
+        // difference between its mid-length tension and its moment at the horn)
+        out[0] = -m_bearing / arm;
+        out[1] = -m_air / arm;
+        out[2] = -m_inertia / arm;
+        out[3] = -m_grav / arm;
+        out[4] = link_tension - about(&horn_load) / arm;
+        out[5] = arm;
         Ok(())
     }
 }

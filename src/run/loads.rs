@@ -137,6 +137,8 @@ pub fn is_load_channel(name: &str) -> bool {
         name.starts_with(&format!("{k}_r")) || name.starts_with(&format!("{k}_{UNPITCHED}_r"))
     }) || name == crate::rotor::loads::PITCH_LINK_CHANNEL
         || HINGE_MOMENT_CHANNELS.contains(&name)
+        || crate::rotor::loads::PITCH_LINK_CONTRIBUTOR_CHANNELS.contains(&name)
+        || name == crate::rotor::loads::PITCH_LINK_ARM_CHANNEL
         || ROOT_CHANNELS.contains(&name)
         || HUB_CHANNELS.contains(&name)
         || super::rotor::HUB_ROTATING_CHANNELS.contains(&name)
@@ -170,8 +172,135 @@ pub fn channels_json(
     channels
 }
 
+/// Largest difference accepted between the pitch-link load and the sum of its contributors, of
+/// the load's magnitude: the moment balance they come from holds to the structural solution's
+/// equilibrium, as the root loads' check ([`EQUILIBRIUM_TOL`]).
+pub const PITCH_LINK_BALANCE_TOL: f64 = EQUILIBRIUM_TOL;
+
+/// Harmonics of the pitch link's contributors shown (1 to this, per rev).
+pub const PITCH_LINK_HARMONICS: usize = 5;
+
+/// One row of the pitch-link breakdown: mean and harmonic amplitudes 1..=[`PITCH_LINK_HARMONICS`]/rev
+/// [N] over the reported revolution.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ContributorRow {
+    pub name: String,
+    /// The last_rev.csv column it comes from.
+    pub channel: String,
+    pub mean_n: f64,
+    pub amplitude_n: Vec<f64>,
+}
+
+/// The pitch-link load and its contributors (docs/loads.md, "Pitch-link contributors"), the
+/// bearing's split per harmonic by phase against the pitch-bearing angle (its moment's parts
+/// over the mean arm), and the balance check.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PitchLinkBreakdown {
+    pub rows: Vec<ContributorRow>,
+    pub balance_check: EquilibriumCheck,
+}
+
+/// The bearing moment's harmonic `b` split against the angle's harmonic `x` (both `a cos + b
+/// sin`): the part in phase with the angle (its storage, the spring) and the part a quarter
+/// period ahead (its loss, the damping), as amplitudes; None without pitch motion at that
+/// harmonic, where the split is undefined.
+fn phase_split(b: [f64; 2], x: [f64; 2]) -> Option<(f64, f64)> {
+    let nx = x[0].hypot(x[1]);
+    if nx.is_nan() || nx <= 1e-12 {
+        return None;
+    }
+    let (u, v) = (x[0] / nx, x[1] / nx);
+    Some(((b[0] * u + b[1] * v).abs(), (b[1] * u - b[0] * v).abs()))
+}
+
+/// The breakdown of a run with the pitch-link channels; None otherwise.
+pub fn pitch_link_breakdown(r: &ModelRun) -> Option<PitchLinkBreakdown> {
+    use crate::analysis::harmonics::harmonics;
+    use crate::rotor::loads::{
+        HINGE_CHANNELS, HINGE_MOMENT_CHANNELS, PITCH_LINK_ARM_CHANNEL, PITCH_LINK_CHANNEL as LINK,
+        PITCH_LINK_CONTRIBUTOR_CHANNELS as PARTS,
+    };
+    let link = r.channel(LINK)?;
+    let parts: Vec<&[f64]> = PARTS
+        .iter()
+        .map(|c| r.channel(c))
+        .collect::<Option<Vec<_>>>()?;
+    let angle = r.channel(HINGE_CHANNELS[2])?;
+    let n = PITCH_LINK_HARMONICS;
+    let fit = |v: &[f64]| harmonics(&r.azimuth_deg, v, n).ok();
+    let row = |name: &str, channel: &str, v: &[f64]| -> Option<ContributorRow> {
+        let h = fit(v)?;
+        Some(ContributorRow {
+            name: name.into(),
+            channel: channel.into(),
+            mean_n: h[0].cos,
+            amplitude_n: h[1..].iter().map(|x| x.amplitude).collect(),
+        })
+    };
+    let names = [
+        "bearing (spring, damping and elastomer)",
+        "airloads (applied loads)",
+        "inertia (centrifugal and propeller moments included)",
+        "gravity",
+        "pitch link's own (shear at the horn, upper half's inertia)",
+    ];
+    // the bearing's split: its moment's harmonics against the angle's, over the mean arm
+    let moment = r.channel(HINGE_MOMENT_CHANNELS[2])?;
+    let arm = r.channel(PITCH_LINK_ARM_CHANNEL)?;
+    let inv_arm = arm.iter().map(|a| 1.0 / a.abs()).sum::<f64>() / arm.len().max(1) as f64;
+    let (hm, hx) = (fit(moment)?, fit(angle)?);
+    let split: Vec<Option<(f64, f64)>> = (1..=n)
+        .map(|j| phase_split([hm[j].cos, hm[j].sin], [hx[j].cos, hx[j].sin]))
+        .collect();
+    let pick = |f: fn((f64, f64)) -> f64| -> Vec<f64> {
+        split
+            .iter()
+            .map(|s| s.map_or(f64::NAN, |s| f(s) * inv_arm))
+            .collect()
+    };
+    let mut rows = vec![row("pitch-link load", LINK, link)?];
+    for (k, (name, v)) in names.iter().zip(&parts).enumerate() {
+        rows.push(row(name, PARTS[k], v)?);
+        if k == 0 {
+            let mean = rows.last().map_or(0.0, |r| r.mean_n);
+            rows.push(ContributorRow {
+                name: "bearing in phase with the pitch angle (spring)".into(),
+                channel: HINGE_MOMENT_CHANNELS[2].into(),
+                mean_n: mean,
+                amplitude_n: pick(|s| s.0),
+            });
+            rows.push(ContributorRow {
+                name: "bearing in quadrature with the pitch angle (damping)".into(),
+                channel: HINGE_MOMENT_CHANNELS[2].into(),
+                mean_n: 0.0,
+                amplitude_n: pick(|s| s.1),
+            });
+        }
+    }
+    // the contributors' sum against the load, over the revolution
+    let st = super::summary::Stats::of(link);
+    let scale = st
+        .peak_to_peak
+        .max(st.min.abs())
+        .max(st.max.abs())
+        .max(f64::MIN_POSITIVE);
+    let worst = (0..link.len())
+        .map(|i| (link[i] - parts.iter().map(|p| p[i]).sum::<f64>()).abs() / scale)
+        .fold(0.0f64, |m, x| if x.is_nan() { f64::NAN } else { m.max(x) });
+    Some(PitchLinkBreakdown {
+        rows,
+        balance_check: EquilibriumCheck {
+            max_rel_error: worst,
+            channel: LINK.into(),
+            tolerance: PITCH_LINK_BALANCE_TOL,
+            passed: worst <= PITCH_LINK_BALANCE_TOL,
+        },
+    })
+}
+
 /// summary.json `loads`: per load channel mean, half peak-to-peak and harmonics 0-10/rev
-/// (amplitude, phase), and the equilibrium check. Null for a run without load channels.
+/// (amplitude, phase), the equilibrium check and the pitch-link breakdown. Null for a run
+/// without load channels.
 pub fn loads_json(r: &ModelRun) -> serde_json::Value {
     use serde_json::json;
     let channels = channels_json(r, is_load_channel);
@@ -181,6 +310,7 @@ pub fn loads_json(r: &ModelRun) -> serde_json::Value {
     json!({
         "channels": channels,
         "equilibrium_check": r.loads_check,
+        "pitch_link_contributors": pitch_link_breakdown(r),
     })
 }
 

@@ -1291,7 +1291,7 @@ pub fn report_html(
     metrics_section(&mut rep, &ok, measured, syn);
     damper_figures(&mut rep, &runs, measured);
     periodic_section(&mut rep, &runs);
-    blade_loads(&mut rep, &runs);
+    blade_loads(&mut rep, &runs, info.synthetic);
     airloads(&mut rep, &runs);
     whole_rotor(&mut rep, info, &runs);
     rep.heading(2, "Conventions");
@@ -1504,7 +1504,55 @@ fn airloads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     );
 }
 
-fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
+/// The pitch-link load's harmonics and its contributors' (docs/loads.md, "Pitch-link
+/// contributors").
+fn pitch_link_contributors(rep: &mut HtmlReport, runs: &[&ModelRun], synthetic: bool) {
+    use super::loads::{pitch_link_breakdown, PITCH_LINK_HARMONICS};
+    let mut rows = vec![];
+    let mut checks = vec![];
+    for r in runs {
+        let Some(b) = pitch_link_breakdown(r) else {
+            continue;
+        };
+        for c in &b.rows {
+            let mut row = vec![r.label.clone(), c.name.clone(), format!("{:.0}", c.mean_n)];
+            row.extend(c.amplitude_n.iter().map(|a| {
+                if a.is_finite() {
+                    format!("{a:.0}")
+                } else {
+                    "-".into()
+                }
+            }));
+            rows.push(row);
+        }
+        let c = &b.balance_check;
+        checks.push(format!(
+            "{}: largest difference between the load and its contributors' sum {:.1e} of its magnitude ({}, tolerance {:.1e})",
+            r.label,
+            c.max_rel_error,
+            if c.passed { "passed" } else { "FAILED" },
+            c.tolerance
+        ));
+    }
+    if rows.is_empty() {
+        return;
+    }
+    let source = if synthetic {
+        "the SYNTHETIC record's airloads"
+    } else {
+        "the airloads"
+    };
+    rep.paragraph(&format!(
+        "Pitch-link load and its contributors [N]: the moment balance about the pitch axis of the blade outboard of the pitch bearing, each moment as the link tension that balances it (its moment over the horn's arm). The bearing's row is split per harmonic by phase against the pitch-bearing angle: in phase, its spring (storage); a quarter period ahead, its damping (loss); '-' where the blade does not pitch at that harmonic. Airloads: {source}, their pitching moments and their forces' moments about the pitch axis. The pitch link's own: its shear at the horn and its upper half's inertia, between the horn and the mid-length where the load is taken."
+    ));
+    let mut head = vec!["model".to_string(), "contributor".into(), "mean".into()];
+    head.extend((1..=PITCH_LINK_HARMONICS).map(|n| format!("{n}/rev")));
+    let head: Vec<&str> = head.iter().map(|s| s.as_str()).collect();
+    rep.table(&head, &rows);
+    rep.paragraph(&format!("Balance check: {}.", checks.join("; ")));
+}
+
+fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun], synthetic: bool) {
     use crate::rotor::deck::SECTION_KINDS;
     let with: Vec<&ModelRun> = runs
         .iter()
@@ -1570,6 +1618,7 @@ fn blade_loads(rep: &mut HtmlReport, runs: &[&ModelRun]) {
             &[("pitch_link_force_N", "")],
         )],
     );
+    pitch_link_contributors(rep, &with, synthetic);
     // Grouped by magnitude: the centrifugal fx is ten times the shears and would flatten them.
     let mut root = root_groups(
         &with,
