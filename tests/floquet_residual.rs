@@ -34,8 +34,13 @@ fn march(sim: &mut dyn ForcedResponse, from: &SimState, steps: usize) -> Vec<Vec
 /// Roots of the order-`p` recurrence fitted by least squares to every coordinate of `d`
 /// from revolution `FIRST`, and the fit's relative residual.
 fn prony(d: &[Vec<f64>], p: usize) -> (Vec<(f64, f64)>, f64) {
+    prony_from(d, p, FIRST)
+}
+
+/// [`prony`] from revolution `first`.
+fn prony_from(d: &[Vec<f64>], p: usize, first: usize) -> (Vec<(f64, f64)>, f64) {
     let n = d[0].len();
-    let rows: Vec<(usize, usize)> = (FIRST..d.len() - p)
+    let rows: Vec<(usize, usize)> = (first..d.len() - p)
         .flat_map(|k| (0..n).map(move |c| (k, c)))
         .collect();
     let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r].0 + j][rows[r].1]);
@@ -165,4 +170,130 @@ fn flap_and_lag_multipliers_match_a_fit_of_the_perturbed_march_or_are_marked() {
             );
         }
     }
+}
+
+/// Marches `revs` revolutions from `from`, the tip flap channel at every step.
+fn tip_flap_march(
+    sim: &mut dyn ForcedResponse,
+    from: &SimState,
+    revs: usize,
+    steps: usize,
+) -> Vec<f64> {
+    sim.restore_state(from).unwrap();
+    sim.set_output_channels(true);
+    let names = sim.channel_names();
+    let k = names.iter().position(|c| c == "tip_flap_m").unwrap();
+    let mut buf = vec![0.0; names.len()];
+    let mut out = Vec::with_capacity(revs * steps);
+    for _ in 0..revs * steps {
+        sim.step().unwrap();
+        sim.channels(&mut buf);
+        out.push(buf[k]);
+    }
+    out
+}
+
+/// Hybrid-periodic airloads (physical damper, the run's defaults): the periodic state with
+/// the blade flapped rigidly about its hinge (1e-4 rad) is marched 12 revolutions beside the
+/// unperturbed one; the tip flap channel's deviation, revolution by revolution (every sample
+/// a row), is fitted by a linear recurrence (Prony, as above). The least damped root, the lag
+/// mode, must match the reported lag multiplier within 1%, and the reported multiplier must be
+/// resolved. The flap transient's decay (RMS of the deviation, revolution to revolution) is
+/// printed beside the flap-labelled multipliers: it falls by about 0.09 then 0.12 in the first
+/// two revolutions, faster than any resolved flap-labelled multiplier (0.38, 0.36 at
+/// 0.16/rev, 0.14 at 0.19/rev): the aerodynamically damped first flap mode is not among the
+/// reported multipliers (|mu| below the 0.1 the run resolves), and no comparison is asserted.
+#[test]
+fn hybrid_lag_multiplier_matches_a_fit_of_the_perturbed_tip_flap() {
+    use rotorsim::rotor::aero::AirloadSource;
+    let deck = RotorDeck::from_file(&root().join("rotors/uh60a.toml")).unwrap();
+    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    let damper = deck.damper().unwrap();
+    let model = DamperModel::Physical;
+    let opts = RunOptions {
+        airloads: AirloadSource::HybridPeriodic,
+        ..Default::default()
+    };
+    let mut sim = rotorsim::rotor::build(&deck, &damper, model, &rec, &opts).unwrap();
+    let run = drive_periodic(
+        sim.as_mut(),
+        model,
+        &PeriodicOptions::shooting(1e-6, 75),
+        &|_, _| {},
+    )
+    .unwrap();
+    assert!(run.converged(), "{:?}", run.periodic);
+    for m in &run.periodic.floquet_multipliers {
+        eprintln!(
+            "Floquet {:>8}: |mu| {:.5} f {:.4}/rev residual {:.2e} of |mu|",
+            m.mode,
+            m.magnitude,
+            m.frequency_per_rev,
+            m.residual / m.magnitude
+        );
+    }
+    let x0 = run.periodic_state.clone().unwrap();
+    // a rigid flap about the hinge: every blade node beyond it raised by delta (r - e)
+    const K: usize = 24;
+    let (e, delta, tip) = (0.381, 1e-4, 8.3);
+    let mut xp = x0.clone();
+    for i in 0..xp.coords.len() / K {
+        let r = xp.coords[K * i].hypot(xp.coords[K * i + 1]);
+        if r > e && r < tip {
+            xp.coords[K * i + 2] += delta * (r - e);
+        }
+    }
+    let steps = (sim.period_s() / sim.time_step_s()).round() as usize;
+    let revs = 12;
+    let base = tip_flap_march(sim.as_mut(), &x0, revs, steps);
+    let pert = tip_flap_march(sim.as_mut(), &xp, revs, steps);
+    let d: Vec<Vec<f64>> = (0..revs)
+        .map(|k| {
+            (k * steps..(k + 1) * steps)
+                .map(|i| pert[i] - base[i])
+                .collect()
+        })
+        .collect();
+    let rms: Vec<f64> = d
+        .iter()
+        .map(|v| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt())
+        .collect();
+    for k in 1..4 {
+        eprintln!(
+            "tip flap deviation, revolution {k}: RMS {:.3e}, {:.4} of the revolution before",
+            rms[k],
+            rms[k] / rms[k - 1]
+        );
+    }
+    let lag = run
+        .periodic
+        .floquet_multipliers
+        .iter()
+        .find(|m| m.mode == "lag")
+        .expect("no lag multiplier");
+    let least_damped = |p: usize| {
+        let (roots, rel) = prony_from(&d, p, 1);
+        let z = roots
+            .iter()
+            .copied()
+            .max_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)))
+            .unwrap();
+        eprintln!(
+            "fit of order {p}: least damped {:.5} at {:.4}/rev, relative residual {rel:.1e}",
+            z.0.hypot(z.1),
+            z.1.atan2(z.0).abs() / std::f64::consts::TAU
+        );
+        z
+    };
+    let (z6, z8) = (least_damped(6), least_damped(8));
+    let fit = z6.0.hypot(z6.1);
+    assert!(
+        (fit - z8.0.hypot(z8.1)).abs() < 5e-3 * fit,
+        "the fit has not settled"
+    );
+    assert!(lag.reliable, "lag not resolved: {lag:?}");
+    let dist = (lag.magnitude - fit).abs() / fit;
+    assert!(dist < 0.01, "lag |mu| {} vs fit {fit}", lag.magnitude);
+    let fdist = (lag.frequency_per_rev - z6.1.atan2(z6.0).abs() / std::f64::consts::TAU).abs();
+    assert!(fdist < 0.005, "lag frequency off by {fdist}/rev");
 }

@@ -245,7 +245,12 @@ pub fn drive_periodic(
         return drive_periodic_once(sim, model, o, progress);
     }
     let t_start = Instant::now();
-    let first = drive_periodic_once(sim, model, o, progress)?;
+    // the first stage's multipliers are not reported: no directions to resolve them
+    let first_opts = PeriodicOptions {
+        floquet_resolve_dirs: 0,
+        ..o.clone()
+    };
+    let first = drive_periodic_once(sim, model, &first_opts, progress)?;
     let (true, Some(start)) = (first.periodic.converged, first.periodic_state.as_ref()) else {
         anyhow::bail!(
             "{}: hybrid airloads need the periodic solution under the measured airloads as their reference, and it was not found: residual {:.2e} after {} revolutions, above the tolerance {:.0e} (more --revs, --periodic shooting)",
@@ -539,6 +544,7 @@ fn shoot_stage(
     s.info.iterations = out.iterations;
     s.info.directions = out.directions;
     s.info.rejected_trials = out.rejected_trials;
+    s.info.floquet_directions = out.resolve_directions;
     s.info.residual_history = out.residual_history.clone();
     s.info.residual_by_channel = map.residual_by_channel.clone();
     s.info.converged = out.converged();
@@ -656,6 +662,7 @@ fn new_info(o: &PeriodicOptions, monitored: usize) -> PeriodicInfo {
         iterations: 0,
         directions: 0,
         rejected_trials: 0,
+        floquet_directions: 0,
         floquet_multipliers: vec![],
         error_estimate: None,
         message: String::new(),

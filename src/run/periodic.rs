@@ -44,6 +44,9 @@ pub struct PeriodicOptions {
     pub initial_state: Option<PeriodicStateFile>,
     /// Directions of the shooting subspace at least (more Floquet multipliers).
     pub min_floquet_dirs: usize,
+    /// Shooting: after convergence, at most this many more directions (one revolution each)
+    /// to resolve the reported multipliers ([`FLOQUET_RESOLVE_DIRS`] by default).
+    pub floquet_resolve_dirs: usize,
     /// Keep every revolution along the way (marched ones and accepted shooting iterates).
     pub keep_all_revs: bool,
     /// Fingerprint of this run's inputs ([`crate::io::inputs_fingerprint`]): saved with the
@@ -64,6 +67,7 @@ impl PeriodicOptions {
             stop_early: false,
             initial_state: None,
             min_floquet_dirs: 0,
+            floquet_resolve_dirs: FLOQUET_RESOLVE_DIRS,
             keep_all_revs: false,
             inputs_sha256: None,
             stop: Default::default(),
@@ -78,6 +82,7 @@ impl PeriodicOptions {
             stop_early: true,
             initial_state: None,
             min_floquet_dirs: 0,
+            floquet_resolve_dirs: FLOQUET_RESOLVE_DIRS,
             keep_all_revs: false,
             inputs_sha256: None,
             stop: Default::default(),
@@ -90,6 +95,11 @@ pub const DEFAULT_TOL: f64 = 1e-4;
 
 /// Multipliers reported (least damped first, the lag mode at the top).
 pub const FLOQUET_REPORTED: usize = 8;
+/// After shooting converged, at most this many more directions (one revolution each) to
+/// resolve the reported multipliers (residual at most 1% of |mu|) of magnitude at least
+/// [`FLOQUET_RESOLVE_FLOOR`].
+pub const FLOQUET_RESOLVE_DIRS: usize = 12;
+pub const FLOQUET_RESOLVE_FLOOR: f64 = 0.1;
 
 /// What the periodic solver did for one model.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -113,6 +123,10 @@ pub struct PeriodicInfo {
     pub iterations: usize,
     pub directions: usize,
     pub rejected_trials: usize,
+    /// Of `directions`, those added after the periodic solution was found to resolve the
+    /// reported Floquet multipliers (one revolution each, in `revolutions_integrated`).
+    #[serde(default)]
+    pub floquet_directions: usize,
     /// Least-damped Floquet multipliers (shooting), lag mode first.
     pub floquet_multipliers: Vec<Multiplier>,
     /// `residual / (1 - |mu_1|)`: distance to the periodic solution implied by the
@@ -321,6 +335,9 @@ pub(super) fn shooting_options(o: &PeriodicOptions) -> ShootingOptions {
         tol: o.tol,
         max_periods: o.max_revs,
         min_dirs: o.min_floquet_dirs,
+        resolve_wanted: FLOQUET_REPORTED,
+        resolve_floor: FLOQUET_RESOLVE_FLOOR,
+        resolve_dirs: o.floquet_resolve_dirs,
         ..Default::default()
     }
 }
