@@ -129,12 +129,42 @@ const SKEW_COUPLING: f64 = 15.0 * PI / 64.0;
 /// (`-sqrt(|ct|/2)` in hover); the windmill-brake and vortex-ring states are not modelled.
 /// Where the equation has several roots (lambda_free < 0 at low mu) one of them is returned.
 pub fn momentum_inflow(ct: f64, cond: FlightCondition) -> f64 {
-    if ct == 0.0 || !ct.is_finite() {
-        return if ct.is_finite() { 0.0 } else { f64::NAN };
+    momentum_root(ct, 0.0, cond)
+}
+
+/// The momentum inflow of a rotor whose thrust depends on it: the l0 with
+/// `l0 = ct(l0) / (2 sqrt(mu^2 + (lambda_free + l0)^2))`, `ct(l) = ct_ref + dct_dl0 (l - l0_ref)`
+/// (the blades' thrust `ct_ref` at inflow `l0_ref` and its derivative with respect to a change
+/// of the inflow, negative: more inflow, less lift). `dct_dl0 = 0` is [`momentum_inflow`];
+/// a positive derivative is taken as 0.
+pub fn momentum_inflow_coupled(
+    ct_ref: f64,
+    dct_dl0: f64,
+    l0_ref: f64,
+    cond: FlightCondition,
+) -> f64 {
+    let d = if dct_dl0.is_finite() {
+        dct_dl0.min(0.0)
+    } else {
+        0.0
+    };
+    if d == 0.0 {
+        return momentum_inflow(ct_ref, cond);
     }
+    momentum_root(ct_ref - d * l0_ref, d, cond)
+}
+
+/// The root l of `2 l sqrt(mu^2 + (lambda_free + l)^2) - d l - c0` (`d <= 0`), see
+/// [`momentum_inflow`] (d = 0) and [`momentum_inflow_coupled`].
+fn momentum_root(c0: f64, d: f64, cond: FlightCondition) -> f64 {
+    if c0 == 0.0 || !c0.is_finite() {
+        return if c0.is_finite() { 0.0 } else { f64::NAN };
+    }
+    let ct = c0;
     let (mu, lf) = (cond.mu, cond.lambda_free);
-    // g(l) = 2 l sqrt(mu^2 + (lf + l)^2) - ct; g(0) = -ct, so a root lies on ct's side of 0.
-    let g = |l: f64| 2.0 * l * mu.hypot(lf + l) - ct;
+    // g(l) = 2 l sqrt(mu^2 + (lf + l)^2) - d l - ct; g(0) = -ct, so a root lies on ct's side
+    // of 0.
+    let g = |l: f64| 2.0 * l * mu.hypot(lf + l) - d * l - ct;
     let sign = ct.signum();
     let hover = sign * (0.5 * ct.abs()).sqrt();
     // bracket [a, b]: sign * g(a) < 0 (a = 0), sign * g(b) >= 0 (grown from the hover value)
@@ -147,13 +177,13 @@ pub fn momentum_inflow(ct: f64, cond: FlightCondition) -> f64 {
     }
     let mut a = 0.0_f64;
     // first guess: the hover value corrected for the free stream
-    let mut l = ct / (2.0 * mu.hypot(lf + hover));
+    let mut l = ct / (2.0 * mu.hypot(lf + hover) - d);
     if !(l.is_finite() && (l - a) * (l - b) < 0.0) {
         l = 0.5 * (a + b);
     }
     for _ in 0..200 {
         let s = mu.hypot(lf + l);
-        let gl = 2.0 * l * s - ct;
+        let gl = 2.0 * l * s - d * l - ct;
         if gl == 0.0 {
             break;
         }
@@ -163,9 +193,9 @@ pub fn momentum_inflow(ct: f64, cond: FlightCondition) -> f64 {
             b = l;
         }
         let dg = if s > 0.0 {
-            2.0 * s + 2.0 * l * (lf + l) / s
+            2.0 * s + 2.0 * l * (lf + l) / s - d
         } else {
-            0.0
+            -d
         };
         let mut next = l - gl / dg;
         if !(next.is_finite() && (next - a) * (next - b) <= 0.0) {
@@ -507,19 +537,43 @@ impl Inflow {
         self.state[0] + self.state[1] * y + self.state[2] * x
     }
 
-    /// Advances by `dpsi` (= Omega dt, >= 0) under loads `l` held over the step.
-    ///
-    /// Uniform and Drees are quasi-steady: the state becomes the steady one for `l`. Pitt-Peters
-    /// integrates `M dl/dpsi = F - V(l0) L(l0)^-1 l` with the exponential Rosenbrock-Euler
-    /// scheme, `l += dpsi phi1(dpsi J) f(l)` (J the Jacobian of the right-hand side at the start
-    /// of the step, phi1(z) = (e^z - 1)/z evaluated through the exponential of the 4x4
-    /// augmented matrix): exact for the linearised system, second order, its fixed points are
-    /// exactly the steady solutions, and as dpsi grows it tends to a Newton step on the steady
-    /// equation, so it is stable for any dpsi. Does not allocate.
+    /// Advances by `dpsi` (= Omega dt, >= 0) under loads `l` held over the step, lagged: the
+    /// loads do not respond to the new inflow ([`Inflow::advance_coupled`] with a zero
+    /// derivative). A quasi-steady model fed back this way is a fixed-point iteration whose
+    /// gain exceeds 1 at light loading (every-step oscillation): rotors use
+    /// [`Inflow::advance_coupled`].
     pub fn advance(&mut self, dpsi: f64, l: &DiskLoads) {
+        self.advance_coupled(dpsi, l, 0.0);
+    }
+
+    /// Advances by `dpsi` (= Omega dt, >= 0) under loads `l` (the blades' loads at the current
+    /// inflow) which respond to a change of the mean inflow l0 as `ct + dct_dl0 (l0' - l0)`
+    /// (`dct_dl0 <= 0`, the lifting line's derivative at the step).
+    ///
+    /// Uniform and Drees are quasi-steady: l0 solves the momentum equation together with the
+    /// linearised thrust ([`momentum_inflow_coupled`], Newton), Drees' shape at that l0; at
+    /// constant loads the state is the steady one for `l`. Pitt-Peters integrates
+    /// `M dl/dpsi = F(l0) - V(l0) L(l0)^-1 l` with the exponential Rosenbrock-Euler scheme,
+    /// `l += dpsi phi1(dpsi J) f(l)` (J the Jacobian of the right-hand side at the start of the
+    /// step, thrust derivative included, phi1(z) = (e^z - 1)/z evaluated through the
+    /// exponential of the 4x4 augmented matrix): exact for the linearised system, second order,
+    /// its fixed points are exactly the steady solutions, and as dpsi grows it tends to a
+    /// Newton step on the steady equation, so it is stable for any dpsi. Does not allocate.
+    pub fn advance_coupled(&mut self, dpsi: f64, l: &DiskLoads, dct_dl0: f64) {
+        let d = if dct_dl0.is_finite() {
+            dct_dl0.min(0.0)
+        } else {
+            0.0
+        };
         match self.model {
-            InflowModel::Uniform | InflowModel::Drees => {
-                self.state = Self::steady(self.model, self.cond, l);
+            InflowModel::Uniform => {
+                let l0 = momentum_inflow_coupled(l.ct, d, self.state[0], self.cond);
+                self.state = [l0, 0.0, 0.0];
+            }
+            InflowModel::Drees => {
+                let l0 = momentum_inflow_coupled(l.ct, d, self.state[0], self.cond);
+                let (kx, ky) = drees_shape(self.cond.mu, self.cond.lambda_free + l0);
+                self.state = [l0, ky * l0, kx * l0];
             }
             InflowModel::PittPeters => {
                 if dpsi <= 0.0 || !dpsi.is_finite() {
@@ -535,6 +589,7 @@ impl Inflow {
                     }
                     aug[i][3] = minv * (f[i] - g[i]);
                 }
+                aug[0][0] += dpsi / PITT_PETERS_M[0] * d;
                 let e = expm4(&aug);
                 for i in 0..3 {
                     self.state[i] += e[i][3];
@@ -663,6 +718,69 @@ mod tests {
         let want = 2.0 * ((-3.0f64).exp() - 1.0) / -3.0;
         assert!(rel(e[0][3], want) < 1e-13, "{} vs {want}", e[0][3]);
         assert_eq!(e[3][3], 1.0);
+    }
+
+    /// The coupled momentum inflow solves its equation, is the momentum inflow of its own
+    /// thrust, and the momentum inflow without a derivative.
+    #[test]
+    fn coupled_momentum_inflow_solves_with_the_linearised_thrust() {
+        for (mu, lf) in [(0.0, 0.0), (0.05, 0.0), (0.3, 0.01)] {
+            let c = cond(mu, lf);
+            let (ct, d, l_ref) = (0.004, -0.1, 0.02);
+            let l = momentum_inflow_coupled(ct, d, l_ref, c);
+            let ct_l = ct + d * (l - l_ref);
+            assert!((2.0 * l * mu.hypot(lf + l) - ct_l).abs() < 1e-15, "mu {mu}");
+            assert!((l - momentum_inflow(ct_l, c)).abs() < 1e-15);
+            assert_eq!(
+                momentum_inflow_coupled(ct, 0.0, l_ref, c),
+                momentum_inflow(ct, c)
+            );
+            // a positive derivative is taken as none
+            assert_eq!(
+                momentum_inflow_coupled(ct, 0.1, l_ref, c),
+                momentum_inflow(ct, c)
+            );
+        }
+    }
+
+    /// A thrust falling with the inflow (CT = c0 - G l0) in hover, fed back step after step:
+    /// lagged, the gain G / (4 l0) above 1 flips the inflow every step; coupled, the first step
+    /// lands on the consistent inflow.
+    #[test]
+    fn coupled_update_has_no_every_step_oscillation() {
+        let c = cond(0.0, 0.0);
+        let (c0, g) = (0.004, 0.3);
+        let consistent = momentum_inflow_coupled(c0, -g, 0.0, c);
+        assert!(g / (4.0 * consistent) > 1.0);
+        let mut lagged = Inflow::new(InflowModel::Uniform, c);
+        let mut coupled = lagged.clone();
+        let mut lag = vec![];
+        for _ in 0..20 {
+            let l = lagged.state()[0];
+            lagged.advance(
+                0.01,
+                &DiskLoads {
+                    ct: c0 - g * l,
+                    ..Default::default()
+                },
+            );
+            lag.push(lagged.state()[0]);
+            let l = coupled.state()[0];
+            coupled.advance_coupled(
+                0.01,
+                &DiskLoads {
+                    ct: c0 - g * l,
+                    ..Default::default()
+                },
+                -g,
+            );
+            assert!((coupled.state()[0] - consistent).abs() < 1e-14);
+        }
+        let flips = lag
+            .windows(2)
+            .filter(|w| (w[1] - w[0]).abs() > 0.1 * consistent)
+            .count();
+        assert!(flips > 10, "{lag:?}");
     }
 
     #[test]

@@ -174,6 +174,10 @@ pub struct PointRecord {
     /// Force per span in the hub frame of the air [N/m] and the arm from the disk centre [m].
     pub force_n_per_m: [f64; 3],
     pub arm_m: [f64; 3],
+    /// Derivative of the force per span along the shaft (+z) with respect to the inflow
+    /// ratio there [N/m] (the blade's kinematics held): the lifting line's part of the inflow's
+    /// feedback, for solving the inflow with the loads.
+    pub dfz_dlambda_n_per_m: f64,
 }
 
 /// State shared by the blades of a rotor: the inflow and every load point's last airloads.
@@ -218,6 +222,22 @@ impl AeroShared {
                 cc: scale * cc / n,
             },
         }
+    }
+
+    /// Derivative of the rotor's thrust coefficient with respect to the mean inflow l0, the
+    /// blades' kinematics held: the sum over the modelled blades times `scale` (blades of the
+    /// rotor per blade modelled). Drees' shape scales with l0 (`lambda_i / l0` at every point);
+    /// uniform and Pitt-Peters (whose first-harmonic states are separate) move uniformly.
+    /// Negative: more inflow, less lift.
+    pub fn thrust_slope(&self, air: &RotorAir, scale: f64) -> f64 {
+        let l0 = self.inflow.state()[0];
+        let scaled = self.inflow.model() == super::inflow::InflowModel::Drees && l0 != 0.0;
+        let mut d = 0.0;
+        for p in self.points.iter().flatten() {
+            let shape = if scaled { p.lambda_i / l0 } else { 1.0 };
+            d += p.weight_m * p.dfz_dlambda_n_per_m * shape;
+        }
+        scale * d / air.thrust_scale_n()
     }
 }
 
@@ -360,7 +380,7 @@ impl LiftingLine {
         inflow: &Inflow,
         i: usize,
         p: &LoadPoint,
-    ) -> (SectionAirloads, [[f64; 3]; 3], f64) {
+    ) -> (SectionAirloads, [[f64; 3]; 3], f64, [f64; 3]) {
         let st = &self.stations[i];
         let (x, rp, v, w) = match &self.turn {
             None => (p.x, p.r, p.v, p.w),
@@ -383,7 +403,7 @@ impl LiftingLine {
             &self.clamps,
             st.lift_factor,
         );
-        (a, r, li)
+        (a, r, li, u)
     }
 
     /// The airloads station `i` would see at the kinematics `p` (a reference motion), with
@@ -394,7 +414,7 @@ impl LiftingLine {
         }
         match self.shared.lock() {
             Ok(sh) => {
-                let (mut a, r, _) = self.airloads(&sh.inflow, i, p);
+                let (mut a, r, _, _) = self.airloads(&sh.inflow, i, p);
                 // from the (pitch-law) frame the airloads were computed in to the frame of p
                 let rp = match &self.turn {
                     None => p.r,
@@ -421,9 +441,26 @@ impl LiftingLine {
                 ..Default::default()
             };
         }
-        let (a, r, li) = self.airloads(&sh.inflow, i, p);
+        let (a, r, li, u) = self.airloads(&sh.inflow, i, p);
         // hub frame of the air
         let f_hub = mv(&r, a.force_n_per_m);
+        // the force's response to the inflow ratio (a forward difference): the inflow moves
+        // the air by -d lambda Omega R along the shaft (z)
+        let dfz = {
+            const EPS: f64 = 1e-5;
+            let st = &self.stations[i];
+            let dv = self.rotor.omega_rad_s * self.rotor.radius_m * EPS;
+            let du = mtv(&r, [0.0, 0.0, -dv]);
+            let b = blade_element(
+                add(u, du),
+                st.chord_m,
+                &self.rotor.air,
+                &self.airfoils[st.airfoil],
+                &ClampCounts::default(),
+                st.lift_factor,
+            );
+            (mv(&r, b.force_n_per_m)[2] - f_hub[2]) / EPS
+        };
         let x = match &self.turn {
             None => p.x,
             Some(t) => mv(t, p.x),
@@ -437,6 +474,7 @@ impl LiftingLine {
             rec.section = a;
             rec.force_n_per_m = f_hub;
             rec.arm_m = sub(x, self.rotor.center_m);
+            rec.dfz_dlambda_n_per_m = dfz;
         }
         // in the section frame of p (the pitch law's frame and the turn undone)
         let rp = match &self.turn {

@@ -308,11 +308,10 @@ impl StabilityJob {
             }
         };
         if let Some(c) = &amp {
-            // the verdict on the regressing lag at the check's speed says what the check found
+            // the verdict on the checked mode at the check's speed says what the check found
             for v in &mut map.verdicts {
                 if (v.omega_rad_s - c.omega_rad_s).abs() <= 1e-9 * c.omega_rad_s
-                    && v.mode
-                        .contains(crate::stability::ModeLabel::RegressingLag.as_str())
+                    && v.mode == c.linearised.label.as_str()
                 {
                     v.amplitude_check = Some(c.headline.clone());
                 }

@@ -1251,6 +1251,8 @@ impl RotorSim {
         }
         let Ok(mut sh) = a.shared.lock() else { return };
         let n = a.history.len();
+        // the thrust's response to the inflow (every blade of the rotor sees it)
+        let slope = sh.thrust_slope(&a.air, a.scale);
         let disk = if n == 0 {
             sh.rotor_airloads(&a.air, a.scale).disk
         } else {
@@ -1270,7 +1272,7 @@ impl RotorSim {
             }
             sum
         };
-        sh.inflow.advance(dpsi, &disk);
+        sh.inflow.advance_coupled(dpsi, &disk, slope);
     }
 
     /// Where the airloads come from.

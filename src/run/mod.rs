@@ -43,6 +43,16 @@ pub const MONITORED: [(&str, f64); 4] = [
     ("tip_twist_rad", 1e-5),
 ];
 
+/// Monitored as well when the simulation has it (computed airloads): the rotor's thrust [N],
+/// judged at the revolution's boundary like [`MONITORED`] and for content at the step rate
+/// (an every-step, alternating-sign component beyond 0.1% of the scale: a discrete
+/// instability that the blade's channels filter out), both on the scale `max(peak-to-peak,
+/// floor, 1% of the mean)`.
+pub const MONITORED_IF_PRESENT: [(&str, f64); 1] = [("rotor_thrust_N", 10.0)];
+
+/// Name of the step-rate entry of a monitored channel in the residuals (`NAME@step_rate`).
+pub const STEP_RATE_SUFFIX: &str = "@step_rate";
+
 /// Harmonics compared against the measurement: 0..=10/rev.
 pub const N_HARMONICS: usize = 10;
 
@@ -300,8 +310,8 @@ struct DriveCtx<'a> {
     model: DamperModel,
     o: &'a PeriodicOptions,
     progress: &'a dyn Fn(usize, Option<f64>),
-    /// Indices of the [`MONITORED`] channels.
-    mon: Vec<usize>,
+    /// The monitored channels ([`MONITORED`], [`MONITORED_IF_PRESENT`]).
+    mon: Vec<periodic::Monitor>,
     /// Indices of the sub-step envelope channels.
     env_channels: Vec<usize>,
     can_save: bool,
@@ -377,7 +387,7 @@ fn drive_periodic_once(
     }
     let can_save = sim.save_state().is_some();
     let shooting = o.method == PeriodicMethod::Shooting && can_save;
-    let mut info = new_info(o, mon.len());
+    let mut info = new_info(o, &mon);
     if o.method == PeriodicMethod::Shooting && !can_save {
         info.message = format!("{} cannot save its state: marched", sim.label());
     }
@@ -450,8 +460,12 @@ fn drive_periodic_once(
     Ok(run)
 }
 
-/// The indices of the [`MONITORED`] channels among `names` (an error naming a missing one).
-fn monitored_channels(sim: &dyn ForcedResponse, names: &[String]) -> anyhow::Result<Vec<usize>> {
+/// The [`MONITORED`] channels among `names` (an error naming a missing one), then those of
+/// [`MONITORED_IF_PRESENT`] that the simulation has, each at the boundary and at the step rate.
+fn monitored_channels(
+    sim: &dyn ForcedResponse,
+    names: &[String],
+) -> anyhow::Result<Vec<periodic::Monitor>> {
     let idx = |name: &str| -> anyhow::Result<usize> {
         names.iter().position(|n| n == name).ok_or_else(|| {
             anyhow::anyhow!(
@@ -461,10 +475,34 @@ fn monitored_channels(sim: &dyn ForcedResponse, names: &[String]) -> anyhow::Res
             )
         })
     };
-    MONITORED
+    let mut mon = MONITORED
         .iter()
-        .map(|(n, _)| idx(n))
-        .collect::<anyhow::Result<_>>()
+        .map(|(n, floor)| {
+            Ok(periodic::Monitor {
+                index: idx(n)?,
+                name: n.to_string(),
+                floor: *floor,
+                kind: periodic::MonitorKind::Boundary,
+            })
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    for (n, floor) in MONITORED_IF_PRESENT {
+        if let Some(index) = names.iter().position(|c| c == n) {
+            mon.push(periodic::Monitor {
+                index,
+                name: n.to_string(),
+                floor,
+                kind: periodic::MonitorKind::BoundaryOfMean,
+            });
+            mon.push(periodic::Monitor {
+                index,
+                name: format!("{n}{STEP_RATE_SUFFIX}"),
+                floor,
+                kind: periodic::MonitorKind::StepRate,
+            });
+        }
+    }
+    Ok(mon)
 }
 
 /// March revolution by revolution until periodic, out of revolutions, or time to shoot;
@@ -648,14 +686,18 @@ fn steps_per_period(sim: &dyn ForcedResponse) -> anyhow::Result<(f64, f64, usize
 }
 
 /// The periodic search before its first revolution.
-fn new_info(o: &PeriodicOptions, monitored: usize) -> PeriodicInfo {
+fn new_info(o: &PeriodicOptions, monitored: &[periodic::Monitor]) -> PeriodicInfo {
     PeriodicInfo {
+        monitored: monitored
+            .iter()
+            .map(|m| (m.name.clone(), m.floor))
+            .collect(),
         method: o.method,
         method_used: PeriodicMethod::March,
         converged: false,
         tolerance: o.tol,
         residual: f64::NAN,
-        residual_by_channel: vec![f64::NAN; monitored],
+        residual_by_channel: vec![f64::NAN; monitored.len()],
         residual_history: vec![],
         revolutions_integrated: 0,
         marched_revolutions: 0,

@@ -4,8 +4,8 @@
 //!
 //! Residual of a revolution started from state `x`: per monitored channel,
 //! `|c(Phi(x)) - c(x)| / max(peak-to-peak of c over the revolution, floor)`, the largest over
-//! channels: the channels seen at the end of the revolution against the start.
-use super::MONITORED;
+//! channels: the channels seen at the end of the revolution against the start. The rotor's
+//! thrust (computed airloads) is also judged for an every-step alternating component.
 pub(super) use crate::analysis::periodicity::max_nan_poisoned as max_nan;
 use crate::analysis::periodicity::{boundary_change, relative_change};
 use crate::periodic::{Multiplier, PeriodMap, ShootingOptions};
@@ -113,6 +113,9 @@ pub struct PeriodicInfo {
     pub residual: f64,
     /// Per monitored channel.
     pub residual_by_channel: Vec<f64>,
+    /// The monitored channels' names and floors, in the order of `residual_by_channel`.
+    #[serde(skip)]
+    pub monitored: Vec<(String, f64)>,
     /// Shooting: residual of each accepted iterate; marching: of each revolution.
     pub residual_history: Vec<f64>,
     /// Every revolution integrated (marched, perturbed and trial).
@@ -139,6 +142,71 @@ pub struct PeriodicInfo {
     pub start_t_s: f64,
 }
 
+/// How a monitored channel is judged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MonitorKind {
+    /// The change over the revolution (end against start) on the scale `max(peak-to-peak,
+    /// floor)`.
+    Boundary,
+    /// The same on the scale `max(peak-to-peak, floor, 1% of the mean's magnitude)` (a channel
+    /// that is nearly constant about a large mean, the thrust in hover).
+    BoundaryOfMean,
+    /// The amplitude of the alternating-sign (every-step, Nyquist-rate) component over the
+    /// revolution, `|sum (-1)^j c_j| / n`, on the scale of `BoundaryOfMean`, beyond an
+    /// allowance of [`STEP_RATE_ALLOWANCE`] (the round-off and iteration-tolerance level of a
+    /// sound run, ~1e-6, then counts 0): a discrete instability of the step-to-step coupling,
+    /// which a periodic solution does not have (it gives ~0.5).
+    StepRate,
+}
+
+/// A monitored channel: its index among the simulation's channels, its name (the residual's
+/// label) and its floor.
+#[derive(Clone, Debug)]
+pub struct Monitor {
+    pub index: usize,
+    pub name: String,
+    pub floor: f64,
+    pub kind: MonitorKind,
+}
+
+/// Alternating content (relative to its scale) that [`MonitorKind::StepRate`] allows: a sound
+/// run has ~1e-6, an every-step instability ~0.5.
+pub const STEP_RATE_ALLOWANCE: f64 = 1e-3;
+
+/// Fraction of the mean's magnitude in the scale of [`MonitorKind::BoundaryOfMean`] and
+/// [`MonitorKind::StepRate`].
+const MEAN_FRACTION: f64 = 0.01;
+
+fn mean_scaled_floor(samples: &[f64], floor: f64) -> f64 {
+    let n = samples.len().max(1) as f64;
+    let mean = samples.iter().sum::<f64>() / n;
+    floor.max(MEAN_FRACTION * mean.abs())
+}
+
+/// The amplitude of the alternating-sign component of `samples`, `|sum (-1)^j c_j| / n` (0 for
+/// an odd count's last sample left out, so that a constant has none), relative to
+/// `max(peak-to-peak, floor)`; NaN if a sample is.
+pub fn step_rate_content(samples: &[f64], floor: f64) -> f64 {
+    let m = samples.len() - samples.len() % 2;
+    if m == 0 {
+        return 0.0;
+    }
+    let s: f64 = samples[..m]
+        .iter()
+        .enumerate()
+        .map(|(j, v)| if j % 2 == 0 { *v } else { -*v })
+        .sum();
+    let (lo, hi) = samples
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+            (l.min(*x), h.max(*x))
+        });
+    if s.is_nan() || lo.is_nan() || hi.is_nan() {
+        return f64::NAN;
+    }
+    (s / m as f64).abs() / (hi - lo).max(floor)
+}
+
 /// Samples of one revolution: channel values at the start of every step, and at its end.
 #[derive(Clone)]
 pub(super) struct Revolution {
@@ -158,20 +226,42 @@ impl Revolution {
         }
     }
 
-    /// Per monitored channel (indices `mon`, floors of [`MONITORED`]): the residual.
-    pub fn residual(&self, mon: &[usize]) -> Vec<f64> {
+    /// Per monitored channel: the residual.
+    pub fn residual(&self, mon: &[Monitor]) -> Vec<f64> {
         mon.iter()
-            .zip(MONITORED.iter())
-            .map(|(&c, (_, floor))| boundary_change(&self.samples[c], self.end[c], *floor))
+            .map(|m| {
+                let s = &self.samples[m.index];
+                match m.kind {
+                    MonitorKind::Boundary => boundary_change(s, self.end[m.index], m.floor),
+                    MonitorKind::BoundaryOfMean => {
+                        boundary_change(s, self.end[m.index], mean_scaled_floor(s, m.floor))
+                    }
+                    MonitorKind::StepRate => {
+                        let c = step_rate_content(s, mean_scaled_floor(s, m.floor));
+                        if c.is_nan() {
+                            c
+                        } else {
+                            (c - STEP_RATE_ALLOWANCE).max(0.0)
+                        }
+                    }
+                }
+            })
             .collect()
     }
 
     /// Per monitored channel: the largest change of any sample from `prev`, relative to this
     /// revolution's peak-to-peak.
-    pub fn change_from(&self, prev: &Revolution, mon: &[usize]) -> Vec<f64> {
+    pub fn change_from(&self, prev: &Revolution, mon: &[Monitor]) -> Vec<f64> {
         mon.iter()
-            .zip(MONITORED.iter())
-            .map(|(&c, (_, floor))| relative_change(&prev.samples[c], &self.samples[c], *floor))
+            .map(|m| {
+                let (a, b) = (&prev.samples[m.index], &self.samples[m.index]);
+                match m.kind {
+                    MonitorKind::Boundary => relative_change(a, b, m.floor),
+                    MonitorKind::BoundaryOfMean | MonitorKind::StepRate => {
+                        relative_change(a, b, mean_scaled_floor(b, m.floor))
+                    }
+                }
+            })
             .collect()
     }
 }
@@ -220,7 +310,7 @@ pub(super) fn integrate(
 /// The revolution map of a simulation, for [`crate::periodic::shoot`].
 pub(super) struct SimMap<'a> {
     pub sim: &'a mut dyn ForcedResponse,
-    pub mon: Vec<usize>,
+    pub mon: Vec<Monitor>,
     pub start: SimState,
     pub end: SimState,
     pub rev: Revolution,
@@ -241,7 +331,7 @@ impl<'a> SimMap<'a> {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         sim: &'a mut dyn ForcedResponse,
-        mon: Vec<usize>,
+        mon: Vec<Monitor>,
         start: SimState,
         end: SimState,
         rev: Revolution,

@@ -1,7 +1,7 @@
 //! Per-model figures of a run: damper force statistics, relief-valve limit check, comparison
 //! with the measured damper force (metrics of `crate::analysis::compare` on the measurement's
 //! own azimuths) and a residual analysis; written as DIR/summary.json and DIR/<model>/last_rev.csv.
-use super::{ModelOutcome, ModelRun, MONITORED, N_HARMONICS};
+use super::{ModelOutcome, ModelRun, N_HARMONICS};
 use crate::analysis::compare::{compare, Metrics, Periodic, PeriodicInterp};
 use crate::analysis::harmonics::{harmonics, Harmonic};
 use crate::flight::FlightRecord;
@@ -636,8 +636,8 @@ fn model_json(r: &ModelRun, f: &ModelFigures, measured: &Result<Measured, String
         "steps_per_rev": r.steps_per_rev,
         "period_s": r.period_s,
         "periodicity": {
-            "channels": MONITORED.iter().map(|c| c.0).collect::<Vec<_>>(),
-            "floors": MONITORED.iter().map(|c| c.1).collect::<Vec<_>>(),
+            "channels": r.periodic.monitored.iter().map(|c| c.0.as_str()).collect::<Vec<_>>(),
+            "floors": r.periodic.monitored.iter().map(|c| c.1).collect::<Vec<_>>(),
             "last_by_channel": r.periodic.residual_by_channel,
             "history": r.measure_history(),
             "last": last,
@@ -837,9 +837,10 @@ pub fn periodic_json(r: &ModelRun) -> Value {
         "method_requested": p.method.name(),
         "converged": p.converged,
         "residual": p.residual,
-        "residual_by_channel": MONITORED
+        "residual_by_channel": p
+            .monitored
             .iter()
-            .map(|c| c.0)
+            .map(|c| c.0.as_str())
             .zip(&p.residual_by_channel)
             .map(|(c, v)| (c.to_string(), json!(v)))
             .collect::<serde_json::Map<_, _>>(),
@@ -906,7 +907,7 @@ pub fn periodicity_statement(r: &ModelRun) -> String {
             "NOT periodic: residual {:.2e} above the {:.0e} tolerance (largest: {} {:.2e}) after {how}{}; run more revolutions (--revs) or check the transient damping of the rotor deck",
             p.residual,
             p.tolerance,
-            MONITORED.get(iw).map_or("", |c| c.0),
+            p.monitored.get(iw).map_or("", |c| c.0.as_str()),
             p.residual_by_channel.get(iw).copied().unwrap_or(f64::NAN),
             if p.message.is_empty() { String::new() } else { format!(" ({})", p.message) }
         )
