@@ -257,7 +257,7 @@ pub fn drive_periodic(
     let t_start = Instant::now();
     // the first stage's multipliers are not reported: no directions to resolve them
     let first_opts = PeriodicOptions {
-        floquet_resolve_dirs: 0,
+        floquet_resolve: false,
         ..o.clone()
     };
     let first = drive_periodic_once(sim, model, &first_opts, progress)?;
@@ -562,6 +562,7 @@ fn shoot_stage(
         .save_state()
         .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
     let label = format!("{} model", model.name());
+    let plan = periodic::FloquetPlan::of(o, sim.airload_info().is_some());
     let mut map = SimMap::new(
         sim,
         c.mon.clone(),
@@ -577,7 +578,7 @@ fn shoot_stage(
         map.kept = Some(vec![]);
     }
     s.info.residual_history = vec![max_nan(&map.residual_by_channel)];
-    let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
+    let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o, &plan));
     s.periods = map.periods;
     s.info.iterations = out.iterations;
     s.info.directions = out.directions;
@@ -600,7 +601,7 @@ fn shoot_stage(
         &format!("{} model, revolution {periods} (shooting)", model.name()),
     )?;
     s.start_state = Some(start);
-    let mult = reported_multipliers(sim, &out.ritz);
+    let mult = reported_multipliers(sim, &out.ritz, plan.reported);
     s.slowest = out
         .ritz
         .first()
@@ -718,6 +719,7 @@ fn new_info(o: &PeriodicOptions, monitored: &[periodic::Monitor]) -> PeriodicInf
 fn reported_multipliers(
     sim: &dyn ForcedResponse,
     ritz: &[crate::periodic::floquet::RitzPair],
+    reported: usize,
 ) -> Vec<crate::periodic::Multiplier> {
     let mut mult: Vec<_> = ritz
         .iter()
@@ -734,7 +736,7 @@ fn reported_multipliers(
         let lag = mult.remove(i);
         mult.insert(0, lag);
     }
-    mult.truncate(FLOQUET_REPORTED);
+    mult.truncate(reported);
     mult
 }
 
