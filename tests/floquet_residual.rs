@@ -45,9 +45,16 @@ fn prony_from(d: &[Vec<f64>], p: usize, first: usize) -> (Vec<(f64, f64)>, f64) 
         .collect();
     let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r].0 + j][rows[r].1]);
     let b = DVector::from_fn(rows.len(), |r, _| d[rows[r].0 + p][rows[r].1]);
-    let x = a.clone().svd(true, true).solve(&b, 1e-14).unwrap();
-    let rel = (&a * &x - &b).norm() / b.norm();
-    // companion matrix of z^p - sum x_j z^j
+    recurrence_roots(&a, &b)
+}
+
+/// Least-squares coefficients of `a x = b` (the recurrence's rows), the roots of its
+/// characteristic polynomial `z^p - sum x_j z^j` (companion matrix) and the fit's relative
+/// residual.
+fn recurrence_roots(a: &DMatrix<f64>, b: &DVector<f64>) -> (Vec<(f64, f64)>, f64) {
+    let p = a.ncols();
+    let x = a.clone().svd(true, true).solve(b, 1e-14).unwrap();
+    let rel = (a * &x - b).norm() / b.norm();
     let mut cm = DMatrix::<f64>::zeros(p, p);
     for j in 0..p {
         cm[(0, j)] = x[p - 1 - j];
@@ -217,21 +224,7 @@ fn prony_steps(d: &[f64], p: usize, steps: usize, t0: usize) -> (Vec<(f64, f64)>
     let rows: Vec<usize> = (t0..d.len() - p * steps).collect();
     let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r] + j * steps]);
     let b = DVector::from_fn(rows.len(), |r, _| d[rows[r] + p * steps]);
-    let x = a.clone().svd(true, true).solve(&b, 1e-14).unwrap();
-    let rel = (&a * &x - &b).norm() / b.norm();
-    let mut cm = DMatrix::<f64>::zeros(p, p);
-    for j in 0..p {
-        cm[(0, j)] = x[p - 1 - j];
-        if j + 1 < p {
-            cm[(j + 1, j)] = 1.0;
-        }
-    }
-    let roots = cm
-        .complex_eigenvalues()
-        .iter()
-        .map(|z| (z.re, z.im))
-        .collect();
-    (roots, rel)
+    recurrence_roots(&a, &b)
 }
 
 /// The hybrid-periodic case: the run (physical damper, tolerance 1e-6) and the fits of the

@@ -270,17 +270,8 @@ impl Blade {
     /// stream through the disk), by bisection; returns CT.
     fn ct_uniform(&self, mu: f64, th0: f64) -> f64 {
         let resid = |l: f64| self.ct(l, mu, th0) - 2.0 * l * mu.hypot(l);
-        let (mut a, mut b) = (0.0, 0.3);
-        assert!(resid(a) > 0.0 && resid(b) < 0.0);
-        for _ in 0..60 {
-            let m = 0.5 * (a + b);
-            if resid(m) > 0.0 {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        self.ct(0.5 * (a + b), mu, th0)
+        assert!(resid(0.0) > 0.0 && resid(0.3) < 0.0);
+        self.ct(bisect(resid, 0.0, 0.3), mu, th0)
     }
 
     /// Annulus BEMT: per annulus, lambda(r) with `dT = rho 4 pi r V_T lambda_i Omega R dr`
@@ -292,22 +283,26 @@ impl Blade {
             let resid = |l: f64| {
                 self.dthrust(r, l, mu, th0) - self.rho * 4.0 * PI * r * mu.hypot(l) * vt * l * vt
             };
-            let (mut a, mut b) = (0.0, 0.5);
-            if resid(a) <= 0.0 {
+            if resid(0.0) <= 0.0 {
                 continue;
             }
-            for _ in 0..60 {
-                let m = 0.5 * (a + b);
-                if resid(m) > 0.0 {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            t += self.dthrust(r, 0.5 * (a + b), mu, th0) * dr;
+            t += self.dthrust(r, bisect(resid, 0.0, 0.5), mu, th0) * dr;
         }
         t / self.scale()
     }
+}
+
+/// The root of `f` in `[a, b]` (`f(a) > 0`) by 60 bisections.
+fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        if f(m) > 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
 }
 
 /// Largest step-to-step change of the inflow over the last revolution relative to its mean.

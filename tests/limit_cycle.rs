@@ -5,6 +5,8 @@
 //! lag's growth rate is zero found by bisection. Computed here from the public bench and
 //! reduced-rotor APIs, not from the amplitude check's own linearisation: whatever damper the
 //! deck gives, the time domain's neutral amplitude must agree with it.
+mod support;
+
 use rotorsim::hydraulics::bench::harmonic_run;
 use rotorsim::hydraulics::{DamperModel, IntegratorOptions, Scheme};
 use rotorsim::overrides::Override;
@@ -225,25 +227,11 @@ fn with_the_seal_friction_neither_finds_a_limit_cycle_at_70_rad_s() {
 /// `rotorsim stability` with the amplitude check, into a fresh folder: (success, stdout and
 /// stderr, the folder).
 fn stability_command(name: &str, args: &[&str]) -> (bool, String, std::path::PathBuf) {
-    let out = std::env::temp_dir().join(format!(
-        "rotorsim-limit-cycle-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&out);
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .arg("stability")
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text, out)
+    let out = support::tmp(&format!("limit-cycle-{name}"));
+    let mut all = vec!["stability"];
+    all.extend_from_slice(args);
+    let (ok, text) = support::rotorsim_out(&all, &out);
+    (ok, text, out)
 }
 
 /// The report's banners (their text).
