@@ -101,6 +101,7 @@ fn soft_airframe_changes_the_answer_and_balances_momentum() {
         );
     }
     // the whole model's Floquet multipliers, labelled by what dominates each mode
+    assert!(!soft.periodic.floquet_multipliers.is_empty());
     assert!(soft
         .periodic
         .floquet_multipliers

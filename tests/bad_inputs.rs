@@ -414,6 +414,7 @@ const CASES: &[Case] = &[
     case("run steps-per-rev zero", &[], &["run", "--model", "rigid", "--steps-per-rev", "0", "--out", "{T}/out"], &["--steps-per-rev"]),
     case("run substeps zero", &[], &["run", "--model", "rigid", "--substeps", "0", "--out", "{T}/out"], &["--substeps"]),
     case("run scheme unknown", &[], &["run", "--scheme", "euler", "--out", "{T}/out"], &["--scheme", "euler"]),
+    case("run rk4 at an unstable sub-step (viscous orifice)", &[], &["run", "--rotor", "rotors/uh60a_hover.toml", "--scheme", "rk4", "--out", "{T}/out"], &["--scheme rk4", "--substeps 59"]),
     case("run model unknown", &[], &["run", "--model", "stiff", "--out", "{T}/out"], &["--model", "stiff"]),
     case("run newton unknown", &[], &["run", "--newton", "half", "--out", "{T}/out"], &["--newton", "half"]),
     case("run periodic unknown", &[], &["run", "--periodic", "guess", "--out", "{T}/out"], &["--periodic", "guess"]),

@@ -34,15 +34,27 @@ fn march(sim: &mut dyn ForcedResponse, from: &SimState, steps: usize) -> Vec<Vec
 /// Roots of the order-`p` recurrence fitted by least squares to every coordinate of `d`
 /// from revolution `FIRST`, and the fit's relative residual.
 fn prony(d: &[Vec<f64>], p: usize) -> (Vec<(f64, f64)>, f64) {
+    prony_from(d, p, FIRST)
+}
+
+/// [`prony`] from revolution `first`.
+fn prony_from(d: &[Vec<f64>], p: usize, first: usize) -> (Vec<(f64, f64)>, f64) {
     let n = d[0].len();
-    let rows: Vec<(usize, usize)> = (FIRST..d.len() - p)
+    let rows: Vec<(usize, usize)> = (first..d.len() - p)
         .flat_map(|k| (0..n).map(move |c| (k, c)))
         .collect();
     let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r].0 + j][rows[r].1]);
     let b = DVector::from_fn(rows.len(), |r, _| d[rows[r].0 + p][rows[r].1]);
-    let x = a.clone().svd(true, true).solve(&b, 1e-14).unwrap();
-    let rel = (&a * &x - &b).norm() / b.norm();
-    // companion matrix of z^p - sum x_j z^j
+    recurrence_roots(&a, &b)
+}
+
+/// Least-squares coefficients of `a x = b` (the recurrence's rows), the roots of its
+/// characteristic polynomial `z^p - sum x_j z^j` (companion matrix) and the fit's relative
+/// residual.
+fn recurrence_roots(a: &DMatrix<f64>, b: &DVector<f64>) -> (Vec<(f64, f64)>, f64) {
+    let p = a.ncols();
+    let x = a.clone().svd(true, true).solve(b, 1e-14).unwrap();
+    let rel = (a * &x - b).norm() / b.norm();
     let mut cm = DMatrix::<f64>::zeros(p, p);
     for j in 0..p {
         cm[(0, j)] = x[p - 1 - j];
@@ -165,4 +177,276 @@ fn flap_and_lag_multipliers_match_a_fit_of_the_perturbed_march_or_are_marked() {
             );
         }
     }
+}
+
+/// Marches `revs` revolutions from `from`, the tip flap channel at every step.
+fn tip_flap_march(
+    sim: &mut dyn ForcedResponse,
+    from: &SimState,
+    revs: usize,
+    steps: usize,
+) -> Vec<f64> {
+    sim.restore_state(from).unwrap();
+    sim.set_output_channels(true);
+    let names = sim.channel_names();
+    let k = names.iter().position(|c| c == "tip_flap_m").unwrap();
+    let mut buf = vec![0.0; names.len()];
+    let mut out = Vec::with_capacity(revs * steps);
+    for _ in 0..revs * steps {
+        sim.step().unwrap();
+        sim.channels(&mut buf);
+        out.push(buf[k]);
+    }
+    out
+}
+
+/// The blade flapped rigidly about its hinge (0.381 m): every node between it and the tip
+/// raised by `delta (r - e)`.
+fn rigidly_flapped(x: &SimState, delta: f64) -> SimState {
+    const K: usize = 24;
+    let (e, tip) = (0.381, 8.3);
+    let mut xp = x.clone();
+    for i in 0..xp.coords.len() / K {
+        let r = xp.coords[K * i].hypot(xp.coords[K * i + 1]);
+        if r > e && r < tip {
+            xp.coords[K * i + 2] += delta * (r - e);
+        }
+    }
+    xp
+}
+
+/// Roots of the per-revolution recurrence `d(t + p T) = sum_j a_j d(t + j T)` fitted by least
+/// squares at every step `t >= t0` of `d` (`steps` samples per revolution `T`), and the fit's
+/// relative residual. Unlike [`prony_from`], whose rows start at whole revolutions, the rows
+/// start at every step: a mode that decays tenfold in a revolution is fitted from where the
+/// faster ones have died, half a revolution after the perturbation if need be.
+fn prony_steps(d: &[f64], p: usize, steps: usize, t0: usize) -> (Vec<(f64, f64)>, f64) {
+    let rows: Vec<usize> = (t0..d.len() - p * steps).collect();
+    let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r] + j * steps]);
+    let b = DVector::from_fn(rows.len(), |r, _| d[rows[r] + p * steps]);
+    recurrence_roots(&a, &b)
+}
+
+/// The hybrid-periodic case: the run (physical damper, tolerance 1e-6) and the fits of the
+/// perturbed tip flap.
+struct HybridCase {
+    run: rotorsim::run::ModelRun,
+    /// Per-revolution deviation of the tip flap (a rigid flap of 1e-4 rad, 12 revolutions).
+    per_rev: Vec<Vec<f64>>,
+    /// The same at every step, central difference of flaps of +-1e-4 rad.
+    central: Vec<f64>,
+    steps: usize,
+}
+
+fn hybrid_case() -> HybridCase {
+    use rotorsim::rotor::aero::AirloadSource;
+    let deck = RotorDeck::from_file(&root().join("rotors/uh60a.toml")).unwrap();
+    let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
+    let damper = deck.damper().unwrap();
+    let model = DamperModel::Physical;
+    let opts = RunOptions {
+        airloads: AirloadSource::HybridPeriodic,
+        ..Default::default()
+    };
+    let mut sim = rotorsim::rotor::build(&deck, &damper, model, &rec, &opts).unwrap();
+    let run = drive_periodic(
+        sim.as_mut(),
+        model,
+        &PeriodicOptions::shooting(1e-6, 75),
+        &|_, _| {},
+    )
+    .unwrap();
+    assert!(run.converged(), "{:?}", run.periodic);
+    eprintln!(
+        "{} revolutions, {} of them resolving Floquet multipliers",
+        run.periodic.revolutions_integrated, run.periodic.floquet_directions
+    );
+    for m in &run.periodic.floquet_multipliers {
+        eprintln!(
+            "Floquet {:>8}: |mu| {:.5} f {:.4}/rev residual {:.2e} of |mu|",
+            m.mode,
+            m.magnitude,
+            m.frequency_per_rev,
+            m.residual / m.magnitude
+        );
+    }
+    let x0 = run.periodic_state.clone().unwrap();
+    let steps = (sim.period_s() / sim.time_step_s()).round() as usize;
+    let revs = 12;
+    let delta = 1e-4;
+    let base = tip_flap_march(sim.as_mut(), &x0, revs, steps);
+    let up = tip_flap_march(sim.as_mut(), &rigidly_flapped(&x0, delta), revs, steps);
+    let down = tip_flap_march(sim.as_mut(), &rigidly_flapped(&x0, -delta), revs, steps);
+    let per_rev = (0..revs)
+        .map(|k| {
+            (k * steps..(k + 1) * steps)
+                .map(|i| up[i] - base[i])
+                .collect()
+        })
+        .collect();
+    let central = up.iter().zip(&down).map(|(a, b)| (a - b) / 2.0).collect();
+    HybridCase {
+        run,
+        per_rev,
+        central,
+        steps,
+    }
+}
+
+/// The aerodynamically damped first flap mode among the reported multipliers: labelled flap,
+/// |mu| below 0.5 (the lifting line's damping: ~exp(-2 pi gamma/16) per revolution), at a
+/// frequency within 0.1/rev of a whole multiple of 1/rev (the rotating flap frequency of an
+/// articulated blade is near 1/rev; the modes of the second flap frequency, near 2.8/rev, show
+/// at 0.15-0.2/rev). Exactly one, or the test fails.
+fn first_flap(run: &rotorsim::run::ModelRun) -> rotorsim::periodic::Multiplier {
+    let found: Vec<_> = run
+        .periodic
+        .floquet_multipliers
+        .iter()
+        .filter(|m| m.mode == "flap" && m.magnitude < 0.5 && m.frequency_per_rev < 0.1)
+        .collect();
+    assert!(
+        found.len() == 1,
+        "the first flap mode is not found (or not alone): {found:?} among {:?}",
+        run.periodic.floquet_multipliers
+    );
+    found[0].clone()
+}
+
+/// The fitted roots of the first flap mode: for each order and window, the root nearest the
+/// reported multiplier `m` (complex conjugates folded), other than the lag mode (|z| < 0.5).
+fn flap_fits(c: &HybridCase, m: &rotorsim::periodic::Multiplier) -> Vec<(usize, usize, f64, f64)> {
+    let mut out = vec![];
+    for t0 in [c.steps, 3 * c.steps / 2] {
+        for p in [4, 6] {
+            let (roots, rel) = prony_steps(&c.central, p, c.steps, t0);
+            let z = roots
+                .iter()
+                .filter(|z| z.0.hypot(z.1) < 0.5)
+                .min_by(|a, b| {
+                    let d = |z: &&(f64, f64)| (z.0 - m.re).hypot(z.1.abs() - m.im.abs());
+                    d(a).total_cmp(&d(b))
+                })
+                .copied()
+                .unwrap_or_else(|| panic!("order {p} from step {t0}: no fast root: {roots:?}"));
+            let (mu, f) = (z.0.hypot(z.1), z.1.atan2(z.0).abs() / std::f64::consts::TAU);
+            eprintln!(
+                "flap fit, order {p}, rows from {:.1} revolutions: |mu| {mu:.4} at {f:.3}/rev (relative residual {rel:.1e})",
+                t0 as f64 / c.steps as f64
+            );
+            out.push((p, t0, mu, f));
+        }
+    }
+    out
+}
+
+/// Hybrid-periodic airloads (physical damper, the run's defaults): the periodic state with
+/// the blade flapped rigidly about its hinge (1e-4 rad) is marched 12 revolutions beside the
+/// unperturbed one; the tip flap channel's deviation, revolution by revolution (every sample
+/// a row), is fitted by a linear recurrence (Prony, as above). The least damped root, the lag
+/// mode, must match the reported lag multiplier within 1%, and the reported multiplier must be
+/// resolved. The first flap mode, damped by the lifting line to |mu| ~ 0.1, must be reported
+/// and resolved; the recurrence fitted at every step from one revolution after the
+/// perturbation (orders 4 and 6, from 1 and 1.5 revolutions) must bracket it: those fits do
+/// not agree to 5% among themselves (see the ignored test below).
+#[test]
+fn hybrid_lag_multiplier_matches_a_fit_of_the_perturbed_tip_flap() {
+    let c = hybrid_case();
+    let d = &c.per_rev;
+    let rms: Vec<f64> = d
+        .iter()
+        .map(|v| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt())
+        .collect();
+    for k in 1..4 {
+        eprintln!(
+            "tip flap deviation, revolution {k}: RMS {:.3e}, {:.4} of the revolution before",
+            rms[k],
+            rms[k] / rms[k - 1]
+        );
+    }
+    let lag = c
+        .run
+        .periodic
+        .floquet_multipliers
+        .iter()
+        .find(|m| m.mode == "lag")
+        .expect("no lag multiplier");
+    let least_damped = |p: usize| {
+        let (roots, rel) = prony_from(d, p, 1);
+        let z = roots
+            .iter()
+            .copied()
+            .max_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)))
+            .unwrap();
+        eprintln!(
+            "fit of order {p}: least damped {:.5} at {:.4}/rev, relative residual {rel:.1e}",
+            z.0.hypot(z.1),
+            z.1.atan2(z.0).abs() / std::f64::consts::TAU
+        );
+        z
+    };
+    let (z6, z8) = (least_damped(6), least_damped(8));
+    let fit = z6.0.hypot(z6.1);
+    assert!(
+        (fit - z8.0.hypot(z8.1)).abs() < 5e-3 * fit,
+        "the fit has not settled"
+    );
+    assert!(lag.reliable, "lag not resolved: {lag:?}");
+    let dist = (lag.magnitude - fit).abs() / fit;
+    assert!(dist < 0.01, "lag |mu| {} vs fit {fit}", lag.magnitude);
+    let fdist = (lag.frequency_per_rev - z6.1.atan2(z6.0).abs() / std::f64::consts::TAU).abs();
+    assert!(fdist < 0.005, "lag frequency off by {fdist}/rev");
+    // the first flap mode: found, resolved, within the spread of the decay fits
+    let flap = first_flap(&c.run);
+    eprintln!(
+        "first flap mode: |mu| {:.5} at {:.4}/rev, residual {:.1e} of |mu|",
+        flap.magnitude,
+        flap.frequency_per_rev,
+        flap.residual / flap.magnitude
+    );
+    assert!(
+        flap.reliable,
+        "the first flap mode is not resolved: {flap:?}"
+    );
+    let fits = flap_fits(&c, &flap);
+    let lo = fits.iter().map(|f| f.2).fold(f64::INFINITY, f64::min);
+    let hi = fits.iter().map(|f| f.2).fold(0.0, f64::max);
+    assert!(
+        (lo..=hi).contains(&flap.magnitude),
+        "flap |mu| {} outside the fits {lo:.4}..{hi:.4}",
+        flap.magnitude
+    );
+}
+
+/// What the scope asks and does not hold: the first flap multiplier within 5% of a decay fit
+/// that has itself settled (orders 4 and 6, rows from 1 and 1.5 revolutions, within 2.5% of
+/// one another: half the tolerance). The mode decays tenfold a revolution beside the second
+/// flap, torsion and flap modes of |mu| 0.08-0.4 and the lag mode (0.72); from the tip flap
+/// alone these four fits give 0.095 to 0.155, other orders and windows 0.08 to 0.14
+/// (docs/periodic.md). Run with `--ignored` to see the figures.
+#[test]
+#[ignore = "the decay fit of the tip flap does not settle to 5% (docs/periodic.md)"]
+fn hybrid_flap_multiplier_within_5_percent_of_a_settled_decay_fit() {
+    let c = hybrid_case();
+    let flap = first_flap(&c.run);
+    assert!(
+        flap.reliable,
+        "the first flap mode is not resolved: {flap:?}"
+    );
+    let fits = flap_fits(&c, &flap);
+    let reference = fits[0].2;
+    for f in &fits {
+        assert!(
+            (f.2 - reference).abs() <= 0.025 * reference,
+            "the fit has not settled: order {} from step {}: {:.4} against {reference:.4}",
+            f.0,
+            f.1,
+            f.2
+        );
+    }
+    assert!(
+        (flap.magnitude - reference).abs() <= 0.05 * reference,
+        "flap |mu| {} against the fit {reference}",
+        flap.magnitude
+    );
 }

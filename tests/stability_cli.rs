@@ -4,7 +4,6 @@
 //! outputs hold what the docs say.
 use rotorsim::stability::LagRotor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 mod support;
 
@@ -13,19 +12,9 @@ fn repo(p: &str) -> PathBuf {
 }
 
 fn stability(args: &[&str], out: &Path) -> (bool, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_rotorsim"))
-        .arg("stability")
-        .args(args)
-        .arg("--out")
-        .arg(out)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    let mut all = vec!["stability"];
+    all.extend_from_slice(args);
+    support::rotorsim_out(&all, out)
 }
 
 /// The source's rotor (data/stability/hammond1974.md), blade `out` (0-based) without its damper.

@@ -82,6 +82,10 @@ pub struct RitzPair {
     pub multiplier: Multiplier,
     pub vector_re: Vec<f64>,
     pub vector_im: Vec<f64>,
+    /// `M v - mu v` (real and imaginary parts): its part outside span(S) is the direction that
+    /// would resolve the pair next (the Arnoldi/Davidson expansion).
+    pub residual_re: Vec<f64>,
+    pub residual_im: Vec<f64>,
 }
 
 /// Ritz pairs of `M` on span(`s`) from `y = M s` (`s` orthonormal), least damped first (largest
@@ -113,18 +117,20 @@ pub fn ritz_pairs(s: &[Vec<f64>], y: &[Vec<f64>]) -> Vec<RitzPair> {
                 }
             }
             // M v - mu v, complex
-            let r2: f64 = (0..n)
-                .map(|p| {
-                    let dr = mr[p] - (l.re * vr[p] - l.im * vi[p]);
-                    let di = mi[p] - (l.re * vi[p] + l.im * vr[p]);
-                    dr * dr + di * di
-                })
-                .sum();
+            let rr: Vec<f64> = (0..n)
+                .map(|p| mr[p] - (l.re * vr[p] - l.im * vi[p]))
+                .collect();
+            let ri: Vec<f64> = (0..n)
+                .map(|p| mi[p] - (l.re * vi[p] + l.im * vr[p]))
+                .collect();
+            let r2 = dot(&rr, &rr) + dot(&ri, &ri);
             let v2 = dot(&vr, &vr) + dot(&vi, &vi);
             RitzPair {
                 multiplier: Multiplier::new(l.re, l.im).with_residual((r2 / v2).sqrt()),
                 vector_re: vr,
                 vector_im: vi,
+                residual_re: rr,
+                residual_im: ri,
             }
         })
         .collect();

@@ -46,6 +46,14 @@ pub struct ShootingOptions {
     /// Directions the subspace has at least when the solver stops converged (more Floquet
     /// multipliers, one period each).
     pub min_dirs: usize,
+    /// After convergence, the Ritz pairs to resolve: the first `resolve_wanted` (least
+    /// damped first) with |mu| at least `resolve_floor` get new directions (each the
+    /// residual `M v - mu v` of the least damped one not resolved, one period each) until their
+    /// residuals are at most [`super::floquet::RELIABLE_RESIDUAL`] of |mu|, at most
+    /// `resolve_dirs` of them (0: none).
+    pub resolve_wanted: usize,
+    pub resolve_floor: f64,
+    pub resolve_dirs: usize,
 }
 
 impl Default for ShootingOptions {
@@ -59,6 +67,9 @@ impl Default for ShootingOptions {
             max_halvings: 3,
             picard_rate: 0.2,
             min_dirs: 0,
+            resolve_wanted: 0,
+            resolve_floor: 0.0,
+            resolve_dirs: 0,
         }
     }
 }
@@ -85,6 +96,9 @@ pub struct ShootingOutcome {
     /// Periods spent on subspace directions and on rejected trials.
     pub directions: usize,
     pub rejected_trials: usize,
+    /// Of `directions`, those added after convergence to resolve the wanted Ritz pairs
+    /// ([`ShootingOptions::resolve_dirs`]).
+    pub resolve_directions: usize,
     /// Ritz pairs of the subspace, least damped first.
     pub ritz: Vec<RitzPair>,
     /// Estimated distance of the accepted point to the periodic solution, over the whole
@@ -170,6 +184,41 @@ fn add_direction(
     Ok(())
 }
 
+/// Directions added about the periodic solution until the wanted Ritz pairs are resolved
+/// ([`ShootingOptions::resolve_wanted`]): each the residual `M v - mu v` of the least damped
+/// pair not yet resolved (its real part, or its imaginary part when that has
+/// more left outside span(S)), orthogonalised; its image costs one period. Returns how many.
+fn resolve(
+    map: &mut dyn PeriodMap,
+    o: &ShootingOptions,
+    s: &mut Vec<Vec<f64>>,
+    y: &mut Vec<Vec<f64>>,
+) -> anyhow::Result<usize> {
+    let mut added = 0;
+    while added < o.resolve_dirs && map.periods() < o.max_periods {
+        let pairs = ritz_pairs(s, y);
+        // the least damped first: the slow modes matter most and converge first
+        let Some(worst) = pairs
+            .iter()
+            .take(o.resolve_wanted)
+            .find(|p| p.multiplier.magnitude >= o.resolve_floor && !p.multiplier.reliable)
+        else {
+            break;
+        };
+        let d = [&worst.residual_re, &worst.residual_im]
+            .into_iter()
+            .filter_map(|r| new_direction(s, r).map(|d| (norm(r), d)))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|x| x.1);
+        let Some(d) = d else {
+            break;
+        };
+        add_direction(map, o, s, y, d)?;
+        added += 1;
+    }
+    Ok(added)
+}
+
 /// Drive `map` to a periodic solution (see the module documentation); the map reports its
 /// own progress.
 pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
@@ -181,6 +230,7 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
         iterations: 0,
         directions: 0,
         rejected_trials: 0,
+        resolve_directions: 0,
         ritz: vec![],
         error_estimate: None,
     };
@@ -202,6 +252,8 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
                     add_direction(map, o, &mut s, &mut y, d)?;
                     out.directions += 1;
                 }
+                out.resolve_directions = resolve(map, o, &mut s, &mut y)?;
+                out.directions += out.resolve_directions;
                 return Ok(Stop::Converged);
             }
             if map.periods() >= o.max_periods {

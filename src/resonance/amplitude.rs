@@ -568,7 +568,14 @@ pub fn amplitude_check(
         .flatten();
     let mut all: Vec<&AmplitudePoint> = points.iter().chain(&refinements).collect();
     all.sort_by(|p, q| p.start_m.total_cmp(&q.start_m));
-    let headline = headline(omega, model, &points, &all, &limit_cycles);
+    let headline = headline(
+        omega,
+        model,
+        linearised.label.as_str(),
+        &points,
+        &all,
+        &limit_cycles,
+    );
     let statement = statement(
         omega,
         &linearised,
@@ -845,6 +852,7 @@ impl Ctx<'_> {
 fn headline(
     omega: f64,
     model: DamperModel,
+    mode: &str,
     points: &[AmplitudePoint],
     all: &[&AmplitudePoint],
     cycles: &[LimitCycle],
@@ -898,7 +906,7 @@ fn headline(
         parts.push(format!("the {} mm start {}", n(p.start_m), e.text()));
     }
     format!(
-        "at {omega:.3} rad/s ({} damper), regressing lag: {}",
+        "at {omega:.3} rad/s ({} damper), {mode}: {}",
         model.name(),
         parts.join("; ")
     )
@@ -930,9 +938,10 @@ fn statement(
     if cycles.is_empty() {
         let all_decay = points.iter().all(|p| p.growth_rate_per_s < 0.0);
         s += &format!(
-            "the time domain finds no limit cycle between {} and {} of stroke: the regressing lag {} at every amplitude tried",
+            "the time domain finds no limit cycle between {} and {} of stroke: the {} {} at every amplitude tried",
             mm(lo),
             mm(hi),
+            lin.label.as_str(),
             if all_decay { "decays" } else { "grows" }
         );
     } else {
@@ -1086,10 +1095,12 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
     let mut rep = HtmlReport::new("");
     rep.heading(2, "Amplitude: where the linear analysis stops being true");
     rep.paragraph(&format!(
-        "The reduced rotor at {} rad/s with each blade's {} damper as a device (its valves live), started on the regressing lag mode at each stroke amplitude and integrated {} steps per revolution. The mode is continued from the linearised map's regressing lag at {} mm through the amplitudes by the modal assurance criterion (MAC) of its Floquet eigenvector. Before each start the dampers run on the mode's stroke until their cycle-mean and RMS forces settle (the check valves' ratcheting); the growth rate is the slope of the log of the mode's coordinate (its left eigenvector on the state, once a revolution) over {} damper cycles after the first, at the window's mean amplitude. A sign change is refined in log amplitude until its starts are within {:.0}%. Beside each: the growth rate from the damper's equivalent stiffness and damping at that amplitude (the bench's first harmonic), and the linearised map's.",
+        "The reduced rotor at {} rad/s with each blade's {} damper as a device (its valves live), started on the {} mode (the least damped of the regressing lag and, on the ground, the airframe modes it meets) at each stroke amplitude and integrated {} steps per revolution. The mode is continued from the linearised map's {} at {} mm through the amplitudes by the modal assurance criterion (MAC) of its Floquet eigenvector. Before each start the dampers run on the mode's stroke until their cycle-mean and RMS forces settle (the check valves' ratcheting); the growth rate is the slope of the log of the mode's coordinate (its left eigenvector on the state, once a revolution) over {} damper cycles after the first, at the window's mean amplitude. A sign change is refined in log amplitude until its starts are within {:.0}%. Beside each: the growth rate from the damper's equivalent stiffness and damping at that amplitude (the bench's first harmonic), and the linearised map's.",
         c.omega_rad_s,
         c.damper.name(),
+        c.linearised.label.as_str(),
         c.steps_per_rev,
+        c.linearised.label.as_str(),
         LINEARISATION_AMPLITUDE_M * 1e3,
         c.fit_cycles,
         (BRACKET_RATIO - 1.0) * 100.0
@@ -1109,8 +1120,12 @@ pub fn html_section(c: &AmplitudeCheck) -> anyhow::Result<String> {
         .collect();
     let lin = vec![c.linearised.growth_rate_per_s; lx.len()];
     let zero = vec![0.0; lx.len()];
+    let title = format!(
+        "Growth rate of the {} against stroke amplitude",
+        c.linearised.label.as_str()
+    );
     let plot = Plot::new(
-        "Growth rate of the regressing lag against stroke amplitude",
+        &title,
         "log10 of the stroke amplitude [mm]",
         "growth rate [1/s]",
     )

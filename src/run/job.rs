@@ -1139,6 +1139,7 @@ impl RunJob {
                 stop_early: true,
                 initial_state: init,
                 min_floquet_dirs: 0,
+                floquet_resolve: true,
                 keep_all_revs: self.write_all_revs,
                 inputs_sha256: Some(inputs_sha256.to_string()),
                 stop: stop.clone(),

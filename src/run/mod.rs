@@ -255,7 +255,12 @@ pub fn drive_periodic(
         return drive_periodic_once(sim, model, o, progress);
     }
     let t_start = Instant::now();
-    let first = drive_periodic_once(sim, model, o, progress)?;
+    // the first stage's multipliers are not reported: no directions to resolve them
+    let first_opts = PeriodicOptions {
+        floquet_resolve: false,
+        ..o.clone()
+    };
+    let first = drive_periodic_once(sim, model, &first_opts, progress)?;
     let (true, Some(start)) = (first.periodic.converged, first.periodic_state.as_ref()) else {
         anyhow::bail!(
             "{}: hybrid airloads need the periodic solution under the measured airloads as their reference, and it was not found: residual {:.2e} after {} revolutions, above the tolerance {:.0e} (more --revs, --periodic shooting)",
@@ -557,6 +562,7 @@ fn shoot_stage(
         .save_state()
         .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
     let label = format!("{} model", model.name());
+    let plan = periodic::FloquetPlan::of(o, sim.airload_info().is_some());
     let mut map = SimMap::new(
         sim,
         c.mon.clone(),
@@ -572,11 +578,12 @@ fn shoot_stage(
         map.kept = Some(vec![]);
     }
     s.info.residual_history = vec![max_nan(&map.residual_by_channel)];
-    let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o));
+    let out = crate::periodic::shoot(&mut map, &periodic::shooting_options(o, &plan));
     s.periods = map.periods;
     s.info.iterations = out.iterations;
     s.info.directions = out.directions;
     s.info.rejected_trials = out.rejected_trials;
+    s.info.floquet_directions = out.resolve_directions;
     s.info.residual_history = out.residual_history.clone();
     s.info.residual_by_channel = map.residual_by_channel.clone();
     s.info.converged = out.converged();
@@ -594,7 +601,7 @@ fn shoot_stage(
         &format!("{} model, revolution {periods} (shooting)", model.name()),
     )?;
     s.start_state = Some(start);
-    let mult = reported_multipliers(sim, &out.ritz);
+    let mult = reported_multipliers(sim, &out.ritz, plan.reported);
     s.slowest = out
         .ritz
         .first()
@@ -698,6 +705,7 @@ fn new_info(o: &PeriodicOptions, monitored: &[periodic::Monitor]) -> PeriodicInf
         iterations: 0,
         directions: 0,
         rejected_trials: 0,
+        floquet_directions: 0,
         floquet_multipliers: vec![],
         error_estimate: None,
         message: String::new(),
@@ -711,6 +719,7 @@ fn new_info(o: &PeriodicOptions, monitored: &[periodic::Monitor]) -> PeriodicInf
 fn reported_multipliers(
     sim: &dyn ForcedResponse,
     ritz: &[crate::periodic::floquet::RitzPair],
+    reported: usize,
 ) -> Vec<crate::periodic::Multiplier> {
     let mut mult: Vec<_> = ritz
         .iter()
@@ -727,7 +736,7 @@ fn reported_multipliers(
         let lag = mult.remove(i);
         mult.insert(0, lag);
     }
-    mult.truncate(FLOQUET_REPORTED);
+    mult.truncate(reported);
     mult
 }
 

@@ -44,6 +44,9 @@ pub struct PeriodicOptions {
     pub initial_state: Option<PeriodicStateFile>,
     /// Directions of the shooting subspace at least (more Floquet multipliers).
     pub min_floquet_dirs: usize,
+    /// Shooting: after convergence, more directions (one revolution each) to resolve the
+    /// reported multipliers, as [`FloquetPlan::of`] sets them (on by default).
+    pub floquet_resolve: bool,
     /// Keep every revolution along the way (marched ones and accepted shooting iterates).
     pub keep_all_revs: bool,
     /// Fingerprint of this run's inputs ([`crate::io::inputs_fingerprint`]): saved with the
@@ -64,6 +67,7 @@ impl PeriodicOptions {
             stop_early: false,
             initial_state: None,
             min_floquet_dirs: 0,
+            floquet_resolve: true,
             keep_all_revs: false,
             inputs_sha256: None,
             stop: Default::default(),
@@ -78,6 +82,7 @@ impl PeriodicOptions {
             stop_early: true,
             initial_state: None,
             min_floquet_dirs: 0,
+            floquet_resolve: true,
             keep_all_revs: false,
             inputs_sha256: None,
             stop: Default::default(),
@@ -90,6 +95,56 @@ pub const DEFAULT_TOL: f64 = 1e-4;
 
 /// Multipliers reported (least damped first, the lag mode at the top).
 pub const FLOQUET_REPORTED: usize = 8;
+/// After shooting converged, at most this many more directions (one revolution each) to
+/// resolve the reported multipliers (residual at most 1% of |mu|) of magnitude at least
+/// [`FLOQUET_RESOLVE_FLOOR`].
+pub const FLOQUET_RESOLVE_DIRS: usize = 12;
+pub const FLOQUET_RESOLVE_FLOOR: f64 = 0.1;
+/// With the lifting line acting (computed and hybrid airloads) the first flap mode is
+/// damped aerodynamically to |mu| ~ 0.1 per revolution, below modes the structure damps
+/// less: the run reports more multipliers, resolves them down to a lower magnitude and
+/// allows more directions for it.
+pub const FLOQUET_REPORTED_AERO: usize = 10;
+pub const FLOQUET_RESOLVE_DIRS_AERO: usize = 20;
+pub const FLOQUET_RESOLVE_FLOOR_AERO: f64 = 0.05;
+
+/// The Floquet multipliers a run reports and resolves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FloquetPlan {
+    /// Multipliers reported, least damped first (the lag mode at the top).
+    pub reported: usize,
+    /// Of those, the ones of |mu| at least this are resolved (residual at most 1% of |mu|)...
+    pub floor: f64,
+    /// ...with at most this many directions after convergence (one revolution each).
+    pub dirs: usize,
+}
+
+impl FloquetPlan {
+    /// The plan of a run: with the lifting line acting (`aerodynamic`) the
+    /// [`FLOQUET_REPORTED_AERO`] least damped multipliers, resolved down to
+    /// [`FLOQUET_RESOLVE_FLOOR_AERO`] with up to [`FLOQUET_RESOLVE_DIRS_AERO`] directions;
+    /// otherwise [`FLOQUET_REPORTED`], [`FLOQUET_RESOLVE_FLOOR`], [`FLOQUET_RESOLVE_DIRS`]. No
+    /// directions when `o` does not resolve.
+    pub fn of(o: &PeriodicOptions, aerodynamic: bool) -> Self {
+        let mut p = if aerodynamic {
+            FloquetPlan {
+                reported: FLOQUET_REPORTED_AERO,
+                floor: FLOQUET_RESOLVE_FLOOR_AERO,
+                dirs: FLOQUET_RESOLVE_DIRS_AERO,
+            }
+        } else {
+            FloquetPlan {
+                reported: FLOQUET_REPORTED,
+                floor: FLOQUET_RESOLVE_FLOOR,
+                dirs: FLOQUET_RESOLVE_DIRS,
+            }
+        };
+        if !o.floquet_resolve {
+            p.dirs = 0;
+        }
+        p
+    }
+}
 
 /// What the periodic solver did for one model.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -116,6 +171,10 @@ pub struct PeriodicInfo {
     pub iterations: usize,
     pub directions: usize,
     pub rejected_trials: usize,
+    /// Of `directions`, those added after the periodic solution was found to resolve the
+    /// reported Floquet multipliers (one revolution each, in `revolutions_integrated`).
+    #[serde(default)]
+    pub floquet_directions: usize,
     /// Least-damped Floquet multipliers (shooting), lag mode first.
     pub floquet_multipliers: Vec<Multiplier>,
     /// `residual / (1 - |mu_1|)`: distance to the periodic solution implied by the
@@ -405,12 +464,16 @@ impl PeriodMap for SimMap<'_> {
     }
 }
 
-/// Shooting options of a run (the tolerance and budget from `o`).
-pub(super) fn shooting_options(o: &PeriodicOptions) -> ShootingOptions {
+/// Shooting options of a run (the tolerance and budget from `o`, the multipliers to resolve
+/// from `plan`).
+pub(super) fn shooting_options(o: &PeriodicOptions, plan: &FloquetPlan) -> ShootingOptions {
     ShootingOptions {
         tol: o.tol,
         max_periods: o.max_revs,
         min_dirs: o.min_floquet_dirs,
+        resolve_wanted: plan.reported,
+        resolve_floor: plan.floor,
+        resolve_dirs: plan.dirs,
         ..Default::default()
     }
 }

@@ -1215,8 +1215,10 @@ fn periodic_section(rep: &mut HtmlReport, runs: &[&ModelRun]) {
     );
     let frows = floquet_rows(runs);
     if !frows.is_empty() {
-        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode. A multiplier is the eigenvalue of a subspace of the monodromy matrix; its residual ||M v - mu v|| / ||v|| says how far the subspace holds the mode, and one above 1% of |mu| is marked not reliable: the subspace does not guarantee it to 1% (its value is often closer than its residual, but nothing says so).");
-        rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
+        rep.paragraph("Floquet multipliers of the periodic solution (Ritz values of the shooting subspace, least damped first, the lag mode at the top). |mu| is the decay of the mode per revolution; for a complex pair the frequency is known modulo 1/rev (shown in 0..0.5 /rev) and the damping ratio is computed with that frequency. A real positive multiplier is a motion that decays without oscillating: it has no frequency and no damping ratio, only its decay per revolution; a real negative one changes sign every revolution (1/2 /rev). The mode label is the largest of tip lag, flap and twist in the mode. A multiplier is the eigenvalue of a subspace of the monodromy matrix; its residual ||M v - mu v|| / ||v|| says how far the subspace holds the mode, and a mode whose residual is above 1% of |mu| is shown as not resolved, with its residual and no value (the subspace does not hold it to 1%). After the periodic solution is found, shooting adds directions (one revolution each) to resolve the reported modes: under prescribed airloads up to 12 for the eight least damped modes of |mu| at least 0.1; with the lifting line acting (computed and hybrid airloads), whose damping brings the first flap mode to |mu| ~ 0.1, ten modes are reported and up to 20 directions resolve those of |mu| at least 0.05.");
+        if runs.iter().all(|r| r.airloads.is_none()) {
+            rep.paragraph("Why the flap modes are so lightly damped: the run replays prescribed airloads, so the flap motion gets no aerodynamic damping, only the structure's. In the words of docs/rotor_model.md: \"prescribed airloads carry no aerodynamic damping (in flight the flap mode has a damping ratio of order Lock number / 16 ~ 0.5; here only the bearing damper, ~0.2%)\".");
+        }
         rep.table(
             &[
                 "model",
@@ -1347,12 +1349,40 @@ fn root_groups(
         .collect()
 }
 
-/// Rows of the Floquet table: a real multiplier is named as such, with no damping ratio (the
+/// How a multiplier whose residual is above 1% of |mu| is shown instead of its value.
+pub fn unresolved_text(m: &crate::periodic::Multiplier) -> String {
+    format!(
+        "not resolved (residual {:.0}% of |mu|)",
+        100.0 * m.residual / m.magnitude
+    )
+}
+
+/// Rows of the Floquet table: a multiplier not resolved to 1% shows no value; a real multiplier is named as such, with no damping ratio (the
 /// formula's 1 for a real positive one is not a damping).
 pub fn floquet_rows(runs: &[&ModelRun]) -> Vec<Vec<String>> {
     let mut rows = Vec::new();
     for r in runs {
         for m in &r.periodic.floquet_multipliers {
+            let mode = if m.mode.is_empty() {
+                "-".to_string()
+            } else {
+                m.mode.clone()
+            };
+            if !m.reliable {
+                // no number for a mode the subspace does not hold to 1%
+                rows.push(vec![
+                    r.label.clone(),
+                    mode,
+                    "-".into(),
+                    unresolved_text(m),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    format!("{:.1e}", m.residual),
+                    "NO".into(),
+                ]);
+                continue;
+            }
             let (kind, freq, zeta) = if m.im != 0.0 {
                 (
                     "complex pair",
@@ -1370,18 +1400,14 @@ pub fn floquet_rows(runs: &[&ModelRun]) -> Vec<Vec<String>> {
             };
             rows.push(vec![
                 r.label.clone(),
-                if m.mode.is_empty() {
-                    "-".into()
-                } else {
-                    m.mode.clone()
-                },
+                mode,
                 kind.into(),
                 format!("{:.6} {:+.6}i", m.re, m.im),
                 format!("{:.4}", m.magnitude),
                 freq,
                 zeta,
                 format!("{:.1e}", m.residual),
-                if m.reliable { "yes" } else { "NO" }.into(),
+                "yes".into(),
             ]);
         }
     }

@@ -851,10 +851,29 @@ pub fn periodic_json(r: &ModelRun) -> Value {
         "iterations": p.iterations,
         "directions": p.directions,
         "rejected_trials": p.rejected_trials,
-        "floquet_multipliers": p.floquet_multipliers,
+        "floquet_directions": p.floquet_directions,
+        "floquet_multipliers": p
+            .floquet_multipliers
+            .iter()
+            .map(floquet_entry)
+            .collect::<Vec<_>>(),
         "error_estimate": p.error_estimate,
         "message": p.message,
     })
+}
+
+/// One multiplier of summary.json: its fields, `resolved` (its residual at most 1% of
+/// |mu|: only then are its values to be used) and `shown` (the value as the report shows it,
+/// or that the mode is not resolved, with its residual).
+fn floquet_entry(m: &crate::periodic::Multiplier) -> serde_json::Value {
+    let mut v = json!(m);
+    v["resolved"] = json!(m.reliable);
+    v["shown"] = json!(if m.reliable {
+        format!("|mu| {:.4}", m.magnitude)
+    } else {
+        super::report::unresolved_text(m)
+    });
+    v
 }
 
 /// Plain statement of the periodicity of the reported revolution.

@@ -103,7 +103,9 @@ pub fn extract(m: &Value) -> (Vec<Option<f64>>, Option<bool>) {
             one_rev,
             hp("root_mz_Nm"),
             hp("root_my_Nm"),
-            lag.and_then(|x| x["damping_ratio"].as_f64()),
+            // only a resolved multiplier (residual at most 1% of |mu|) has a damping ratio
+            lag.filter(|x| x["reliable"].as_bool() == Some(true))
+                .and_then(|x| x["damping_ratio"].as_f64()),
         ],
         lag.and_then(|x| x["reliable"].as_bool()),
     )
@@ -555,7 +557,7 @@ pub fn html(t: &Sensitivity) -> String {
     }
     h.verdict("Outputs and the parameters that move them most", &lines);
     if t.nominal.lag_reliable == Some(false) {
-        h.notice("The nominal case's Floquet lag multiplier is marked not reliable by the run (its residual is above 1% of its magnitude: the shooting subspace does not guarantee it to 1%); read the lag damping's changes with that in mind (report.html of the case, Floquet table).");
+        h.notice("The nominal case's Floquet lag mode is not resolved by the run (its residual is above 1% of its magnitude: the shooting subspace does not hold it to 1%); its lag damping ratio is not shown (report.html of the case, Floquet table).");
     }
     h.contents();
     for (k, o) in OUTPUTS.iter().enumerate() {

@@ -17,6 +17,23 @@ pub fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// `rotorsim <args> --out <out>` from the package root: (success, stdout then stderr).
+pub fn rotorsim_out(args: &[&str], out: &Path) -> (bool, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rotorsim"))
+        .current_dir(root())
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
 /// A JSON file, parsed.
 pub fn read_json(path: &Path) -> serde_json::Value {
     let text =
