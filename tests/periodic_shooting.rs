@@ -107,7 +107,13 @@ fn floquet_multipliers_of_a_rigid_lag_hinge_match_the_analytic_roots() {
     assert_eq!(mu.mode, "lag");
 }
 
-fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn ForcedResponse>) {
+/// Shooting at tolerance `tol` against a 200-revolution march (perturbation damping on):
+/// within 1e-4 of every monitored channel's peak-to-peak.
+fn check_against_march(
+    name: &str,
+    tol: f64,
+    build: &dyn Fn(DamperModel, bool) -> Box<dyn ForcedResponse>,
+) {
     for model in MODELS {
         let mut sim = build(model, true);
         let march = drive_periodic(
@@ -121,16 +127,17 @@ fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn 
         let shot = drive_periodic(
             sim.as_mut(),
             model,
-            &PeriodicOptions::shooting(1e-4, 75),
+            &PeriodicOptions::shooting(tol, 75),
             &|_, _| {},
         )
         .unwrap();
         let (d, worst) = shot.difference_from(&march).unwrap();
         eprintln!(
-            "{name} {}: shooting {} revolutions, residual {:.2e}; march residual {:.2e}; difference {d:.2e} ({worst})",
+            "{name} {}: shooting {} revolutions, residual {:.2e}, estimated distance {:.2e}; march residual {:.2e}; difference {d:.2e} ({worst})",
             model.name(),
             shot.periodic.revolutions_integrated,
             shot.periodic.residual,
+            shot.periodic.error_estimate.unwrap_or(f64::NAN),
             march.periodic.residual
         );
         assert!(
@@ -139,7 +146,7 @@ fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn 
             model.name(),
             shot.periodic
         );
-        assert!(shot.periodic.residual < 1e-4);
+        assert!(shot.periodic.residual < tol);
         assert!(
             d < 1e-4,
             "{name} {}: shooting differs from the 200-revolution march by {d:.2e} of the peak-to-peak ({worst})",
@@ -152,7 +159,7 @@ fn check_against_march(name: &str, build: &dyn Fn(DamperModel, bool) -> Box<dyn 
 fn shooting_matches_a_200_revolution_march_rigid_reduction() {
     let (deck, rec) = setup();
     let damper = deck.damper().unwrap();
-    check_against_march("rigid", &|m, _| {
+    check_against_march("rigid", 1e-4, &|m, _| {
         let opts = RunOptions {
             steps_per_rev: 64,
             hydraulics: IntegratorOptions {
@@ -169,7 +176,11 @@ fn shooting_matches_a_200_revolution_march_rigid_reduction() {
 fn shooting_matches_a_200_revolution_march_elastic_model() {
     let (deck, rec) = setup();
     let damper = deck.damper().unwrap();
-    check_against_march("elastic", &|m, damping| {
+    // the first flap mode is nearly neutral under prescribed airloads (|mu| 0.997: no
+    // aerodynamic damping, and the bearing's loss factor acts on the 1.3% of the flap
+    // stiffness its spring gives), so a residual of 1e-4 leaves up to 1.2e-4 of tip flap:
+    // the solver is held to the march at a tenth of the run's tolerance (docs/periodic.md)
+    check_against_march("elastic", 1e-5, &|m, damping| {
         rotorsim::rotor::build(&deck, &damper, m, &rec, &elastic_opts(damping)).unwrap()
     });
 }

@@ -162,6 +162,20 @@ fn new_direction(s: &[Vec<f64>], d: &[f64]) -> Option<Vec<f64>> {
     Some(d)
 }
 
+/// Size of the Newton-Picard step `S c + rho` from the accepted point on the subspace as it
+/// is (no period integrated).
+fn next_step_norm(map: &dyn PeriodMap, s: &[Vec<f64>], y: &[Vec<f64>]) -> f64 {
+    let (x, f) = map.accepted();
+    let r: Vec<f64> = f.iter().zip(x).map(|(a, b)| a - b).collect();
+    let (c, mut dx) = project(s, y, &r);
+    for (cj, sj) in c.iter().zip(s) {
+        for (d, v) in dx.iter_mut().zip(sj) {
+            *d += cj * v;
+        }
+    }
+    norm(&dx)
+}
+
 /// Adds one direction `d` (unit) and its image `M d` about the accepted point.
 fn add_direction(
     map: &mut dyn PeriodMap,
@@ -308,11 +322,17 @@ pub fn shoot(map: &mut dyn PeriodMap, o: &ShootingOptions) -> ShootingOutcome {
             }
             out.iterations += 1;
             out.residual_history.push(map.residual());
+            let taken = lam * norm(&dx);
+            let next = next_step_norm(map, &s, &y);
             out.error_estimate = map.step_change().map(|d| {
                 let h = &out.residual_history;
                 // a contraction slower than 0.9 per step is taken as 0.9
                 let q = (h[h.len() - 1] / h[h.len() - 2]).min(MAX_CONTRACTION);
-                d * q / (1.0 - q)
+                // the residual can contract faster than the distance along a slow mode
+                // (distance r_j / (1 - mu_j)): the next Newton-Picard step on the subspace,
+                // scaled as the step just taken moved the channels, estimates it
+                let newton = if taken > 0.0 { d * next / taken } else { 0.0 };
+                (d * q / (1.0 - q)).max(newton)
             });
         }
     })();
