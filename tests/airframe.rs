@@ -129,7 +129,19 @@ fn stiff_airframe_converges_to_the_driven_hub() {
         "hub_fz_fixed_N",
     ] {
         let (d1, d2) = (rel_diff(&fixed, &s1, name), rel_diff(&fixed, &s2, name));
-        assert!(d1 < 1e-3, "{name}: {d1:.2e} of its peak-to-peak at 200 Hz");
+        eprintln!(
+            "{name}: {d1:.3e} at 200 Hz, {d2:.3e} at 400 Hz (ratio {:.3})",
+            d2 / d1
+        );
+        // quasi-static size of the difference: the hub moves by F / k, the blades' inertia
+        // answers with (m_rotor / M) (w / w_n)^2 of F; rotor mass at most 0.1 of the
+        // airframe's (4 blades of about 100 kg on 5000 kg), w up to 8/rev in the fixed frame
+        let w8 = 8.0 * 27.0 / (2.0 * std::f64::consts::PI * 200.0);
+        let bound = 0.1 * w8 * w8;
+        assert!(
+            d1 < bound,
+            "{name}: {d1:.2e} of its peak-to-peak at 200 Hz, above the quasi-static {bound:.1e}"
+        );
         let ratio = d2 / d1;
         assert!(
             (0.15..0.35).contains(&ratio),

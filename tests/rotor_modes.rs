@@ -4,7 +4,8 @@
 //! What holds (docs/rotor_model.md, "Fan plot"): at 100% speed lag1, flap1 and flap2 within 5%;
 //! flap3 within 5% up to 80% speed; near 100% the third flap and first torsion modes veer (the
 //! reference's torsion jumps from 21.2 to 22.4 Hz between 90% and 100%): compared branch by
-//! branch (lower and upper of the pair) they are within 5%; the model's first torsion is 7-9%
+//! branch, the upper within 5%, the lower (torsion-dominated) within the torsion gap, below
+//! the reference by less than 10%; the model's first torsion is 7-9%
 //! below the reference's below the veering (documented gap: blade GJ and I1 of the Yeo table
 //! limit it to ~19.7 Hz even with a rigid control system).
 use rotorsim::rotor::fan::{fan, read_reference, FanPoint};
@@ -71,7 +72,14 @@ fn uh60a_fan_plot_against_digitized_reference() {
     // the veering pair at 100%, branch by branch
     let (lo, hi) = (flap3.min(tor1), flap3.max(tor1));
     let (rlo, rhi) = (rr[3].min(rr[4]), rr[3].max(rr[4]));
-    assert!(err(lo, rlo).abs() < 0.05, "lower branch {lo} vs {rlo}");
+    // the lower branch is the model's torsion-dominated one and carries the torsion gap
+    // checked below (without the pitch bearing's former dashpot, 272 N m s/rad, which stiffened
+    // torsion by 0.1-0.2 Hz, it is -5.7%)
+    let e_lo = err(lo, rlo);
+    assert!(
+        e_lo < 0.0 && e_lo > -0.10,
+        "lower branch {lo} vs {rlo} ({e_lo:+.3})"
+    );
     assert!(err(hi, rhi).abs() < 0.05, "upper branch {hi} vs {rhi}");
     // documented torsion gap below the veering: 7-9% low
     for x in [0.5, 0.8] {
