@@ -20,6 +20,12 @@
 //! tan(alpha_s)` (alpha_s = 0 here: the free stream in the disk plane). The annulus-wise
 //! BEMT (momentum per annulus, `dCT = 4 lambda_i sqrt(mu^2 + lambda^2) r dr`) is printed
 //! beside it.
+//!
+//! What the BEMT's rigid, unconed blade does not have and the run keeps: the flow curvature a
+//! coned or bent blade's three-quarter-chord point sees (a pitch rate `Omega` times the local
+//! flap slope about the span). At 3 deg in hover the blade droops outboard (slope -1 deg
+//! there, +0.7 deg at the root) and it moves the run's CT/sigma by -0.8%; at 6 to 12 deg,
+//! coned up, by +1.2% to +2.1% (measured by dropping the three-quarter-chord arm).
 mod support;
 
 use rotorsim::aero::airfoil::{Airfoil, ClampCounts};
@@ -315,8 +321,9 @@ fn every_step_change(inflow: &[f64]) -> f64 {
     d / mean.abs()
 }
 
-/// The cases checked to 2% (advance ratio, collective [deg]); hover at 3 deg has its own test.
-const CASES: [(f64, f64); 7] = [
+/// The cases checked to 2% (advance ratio, collective [deg]).
+const CASES: [(f64, f64); 8] = [
+    (0.0, 3.0),
     (0.0, 6.0),
     (0.0, 9.0),
     (0.0, 12.0),
@@ -340,22 +347,6 @@ fn coupled_inflow_matches_blade_element_momentum_theory() {
             failures.push(format!("{name}: inflow step change {step:.2e} of its mean"));
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(failures.is_empty(), "{failures:#?}");
-}
-
-/// Hover at 3 deg of collective, the lightest loading: the run's CT/sigma is 2.6% below the
-/// BEMT's (0.01767 against 0.01814; 3.7% below with no tip loss in either, and the same with
-/// 24 revolutions, 256 steps per revolution or the blade's torsion 100 times stiffer again),
-/// so the difference is not the tip loss, the transient, the step or the twist under load.
-/// At this loading the thrust is the difference of the inboard lift and the outboard sections'
-/// negative lift, so a small difference in the lift distribution moves it by percents; where
-/// it comes from is open, and this check fails until it is found.
-#[test]
-#[ignore = "open: hover at 3 deg is 2.6% below the BEMT (see the doc comment)"]
-fn hover_at_3_deg_matches_blade_element_momentum_theory() {
-    let dir = support::tmp("inflow_consistency_hover3");
-    let failures = check_cases(&dir, &[(0.0, 3.0)]);
     let _ = std::fs::remove_dir_all(&dir);
     assert!(failures.is_empty(), "{failures:#?}");
 }

@@ -67,6 +67,86 @@ pub struct BladeAero {
     pub cutout_r_m: f64,
     /// Tip-loss factor B: no lift outboard of B R (1: none).
     pub tip_loss_factor: f64,
+    /// Built-in twist the blade's beam was built with, `(r_m, rad)` points, linear between and
+    /// constant outside (empty: the beam's section frames as they are). The beam carries the
+    /// table through its nodes (cubic interpolation over each element); the lifting line turns
+    /// each load point's section to the element's cubic projection of the table instead
+    /// ([`twist_offsets`]).
+    pub twist_rad: Vec<(f64, f64)>,
+}
+
+/// The table `t` (`(x, y)` points) at `x`: linear between its points, constant outside.
+fn table_at(t: &[(f64, f64)], x: f64) -> f64 {
+    match t {
+        [] => 0.0,
+        [first, ..] if x <= first.0 => first.1,
+        [.., last] if x >= last.0 => last.1,
+        _ => {
+            let k = t.partition_point(|p| p.0 <= x) - 1;
+            let w = (x - t[k].0) / (t[k + 1].0 - t[k].0);
+            t[k].1 + w * (t[k + 1].1 - t[k].1)
+        }
+    }
+}
+
+/// Legendre polynomials P0..P3 at xi.
+fn legendre(xi: f64) -> [f64; 4] {
+    [
+        1.0,
+        xi,
+        0.5 * (3.0 * xi * xi - 1.0),
+        0.5 * (5.0 * xi * xi - 3.0) * xi,
+    ]
+}
+
+/// The piecewise-linear twist table `t` over the element from `ra` to `rb` [m] projected onto
+/// cubics (least squares over the element): its Legendre coefficients in xi in [-1, 1]. Exact:
+/// the integrals are split at the table's points, 3-point Gauss on each piece.
+fn cubic_projection(t: &[(f64, f64)], ra: f64, rb: f64) -> [f64; 4] {
+    let xi_of = |r: f64| 2.0 * (r - ra) / (rb - ra) - 1.0;
+    let mut cuts = vec![-1.0];
+    cuts.extend(
+        t.iter()
+            .map(|p| xi_of(p.0))
+            .filter(|x| *x > -1.0 && *x < 1.0),
+    );
+    cuts.push(1.0);
+    let g = [-(0.6f64.sqrt()), 0.0, 0.6f64.sqrt()];
+    let gw = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let mut c = [0.0; 4];
+    for w in cuts.windows(2) {
+        let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+        for (x, wq) in g.iter().zip(gw) {
+            let xi = m + h * x;
+            let y = table_at(t, ra + 0.5 * (xi + 1.0) * (rb - ra));
+            for (k, pk) in legendre(xi).iter().enumerate() {
+                c[k] += wq * h * y * pk;
+            }
+        }
+    }
+    std::array::from_fn(|k| c[k] * (2 * k + 1) as f64 / 2.0)
+}
+
+/// Per load point of a cubic beam element from `ra` to `rb` [m] (nodes at its thirds, shape
+/// functions `n` at the points, the points at `xi` in [-1, 1]): the turn about the section
+/// axis from the beam's built-in twist there (the table through the nodes, interpolated) to
+/// the element's cubic projection of the table [rad]. With it the element's quadrature
+/// integrates the twist's part of the airloads times any cubic in r (thrust, flap moment,
+/// torque) exactly, also where the table has a kink or a step inside the element; where the
+/// table is linear over the element both are the table and the turn is zero.
+fn twist_offsets(t: &[(f64, f64)], ra: f64, rb: f64, pts: &[(f64, [f64; 4])]) -> Vec<f64> {
+    if t.is_empty() {
+        return vec![0.0; pts.len()];
+    }
+    let c = cubic_projection(t, ra, rb);
+    let nodal: [f64; 4] = std::array::from_fn(|i| table_at(t, ra + (rb - ra) * i as f64 / 3.0));
+    pts.iter()
+        .map(|(xi, n)| {
+            let projected: f64 = legendre(*xi).iter().zip(c).map(|(p, ck)| p * ck).sum();
+            let beam: f64 = n.iter().zip(nodal).map(|(ni, ti)| ni * ti).sum();
+            projected - beam
+        })
+        .collect()
 }
 
 /// The share of a load point's strip (`width` from `start` [m]) that lifts, inboard of the
@@ -254,6 +334,8 @@ struct Station {
     airfoil: usize,
     lift_factor: f64,
     weight_m: f64,
+    /// Turn about the section axis from the beam's built-in twist to the lifting line's [rad].
+    pitch_offset_rad: f64,
     /// Outside the aerofoil (inboard of the cut-out): no airloads.
     active: bool,
 }
@@ -300,9 +382,23 @@ impl LiftingLine {
         for &id in ids {
             if let Element::Beam(b) = &model.elements[id] {
                 first[id] = stations.len();
+                let (ra, rb) = (
+                    geometry.root_r_m + b.s_range[0],
+                    geometry.root_r_m + b.s_range[1],
+                );
+                let pts: Vec<(f64, [f64; 4])> =
+                    b.gm.iter()
+                        .map(|g| {
+                            (
+                                2.0 * (g.s_m - b.s_range[0]) / (b.s_range[1] - b.s_range[0]) - 1.0,
+                                g.n,
+                            )
+                        })
+                        .collect();
+                let offsets = twist_offsets(&geometry.twist_rad, ra, rb, &pts);
                 // each point's strip of the element: its quadrature weight, in point order
-                let mut strip_start = geometry.root_r_m + b.s_range[0];
-                for g in &b.gm {
+                let mut strip_start = ra;
+                for (g, offset) in b.gm.iter().zip(offsets) {
                     let r = geometry.root_r_m + g.s_m;
                     stations.push(Station {
                         s_m: g.s_m,
@@ -311,6 +407,7 @@ impl LiftingLine {
                         airfoil: geometry.airfoil_at(r),
                         lift_factor: lift_inside(strip_start, g.wj, r, tip_r),
                         weight_m: g.wj,
+                        pitch_offset_rad: offset,
                         active: r >= geometry.cutout_r_m,
                     });
                     strip_start += g.wj;
@@ -386,9 +483,11 @@ impl LiftingLine {
             None => (p.x, p.r, p.v, p.w),
             Some(t) => (mv(t, p.x), mm(t, &p.r), mv(t, p.v), mv(t, p.w)),
         };
-        let r = match &self.pitch_law {
-            None => rp,
-            Some(law) => mm(&rp, &exp_map([law(p.t), 0.0, 0.0])),
+        let pitch = st.pitch_offset_rad + self.pitch_law.as_ref().map_or(0.0, |law| law(p.t));
+        let r = if pitch == 0.0 {
+            rp
+        } else {
+            mm(&rp, &exp_map([pitch, 0.0, 0.0]))
         };
         // three-quarter chord: c/2 behind the quarter-chord reference line
         let arm = mv(&r, [0.0, -0.5 * st.chord_m, 0.0]);
@@ -497,7 +596,78 @@ impl DistributedLoad for LiftingLine {
 
 #[cfg(test)]
 mod tests {
-    use super::lift_inside;
+    use super::{lift_inside, twist_offsets};
+    use crate::structure::beam::{gauss, shape};
+
+    /// The twist each load point of an element from `ra` to `rb` meets the air with: the
+    /// table through the nodes, interpolated, plus the offset; and the points' radii and weights.
+    fn element(t: &[(f64, f64)], ra: f64, rb: f64) -> Vec<(f64, f64, f64)> {
+        let (xi, w) = gauss(4);
+        let pts: Vec<_> = xi.iter().map(|&x| (x, shape(x).0)).collect();
+        let off = twist_offsets(t, ra, rb, &pts);
+        let nodal: Vec<f64> = (0..4)
+            .map(|i| super::table_at(t, ra + (rb - ra) * i as f64 / 3.0))
+            .collect();
+        pts.iter()
+            .zip(&w)
+            .zip(off)
+            .map(|(((x, n), wq), o)| {
+                let beam: f64 = n.iter().zip(&nodal).map(|(a, b)| a * b).sum();
+                (
+                    ra + 0.5 * (x + 1.0) * (rb - ra),
+                    0.5 * wq * (rb - ra),
+                    beam + o,
+                )
+            })
+            .collect()
+    }
+
+    /// Where the table is linear over the element, the beam already carries it: no offset.
+    #[test]
+    fn a_linear_twist_needs_no_offset() {
+        let t = [(1.0, 0.2), (6.0, 0.0), (9.0, -0.1)];
+        let (xi, _) = gauss(4);
+        let pts: Vec<_> = xi.iter().map(|&x| (x, shape(x).0)).collect();
+        for o in twist_offsets(&t, 2.0, 2.6, &pts) {
+            assert!(o.abs() < 1e-14, "{o}");
+        }
+        assert!(twist_offsets(&[], 2.0, 2.6, &pts).iter().all(|o| *o == 0.0));
+    }
+
+    /// The shipped UH-60A table's step (-1.28 deg between 7.192 and 7.211 m) inside an element:
+    /// the load points' twist integrates the table times any cubic in r exactly.
+    #[test]
+    fn the_element_integrates_a_stepped_twist_exactly() {
+        let deg = std::f64::consts::PI / 180.0;
+        let t: Vec<(f64, f64)> = [
+            (6.0524, 0.2548),
+            (7.19226, -1.2799),
+            (7.21062, -2.5648),
+            (7.56167, -3.5369),
+            (7.87122, -3.5464),
+        ]
+        .iter()
+        .map(|p| (p.0, p.1 * deg))
+        .collect();
+        let (ra, rb) = (7.0462, 7.6124);
+        let pts = element(&t, ra, rb);
+        for k in 0..4 {
+            let got: f64 = pts.iter().map(|(r, w, th)| w * r.powi(k) * th).sum();
+            // the integral by fine midpoints
+            let n = 200_000;
+            let h = (rb - ra) / n as f64;
+            let want: f64 = (0..n)
+                .map(|i| {
+                    let r = ra + (i as f64 + 0.5) * h;
+                    h * r.powi(k) * super::table_at(&t, r)
+                })
+                .sum();
+            assert!(
+                (got - want).abs() < 1e-9 * want.abs().max(1e-3),
+                "r^{k}: {got} vs {want}"
+            );
+        }
+    }
 
     /// Strips of a 3-point Gauss element from 7.6 m to 8.0 m and a tip-loss radius of 7.9 m:
     /// the lifting span (weights times lift factors) ends at 7.9 m exactly.

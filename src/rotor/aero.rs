@@ -151,6 +151,12 @@ pub fn blade_geometry(spec: &RotorSpec, file: &Path) -> anyhow::Result<(BladeAer
             airfoils,
             cutout_r_m: a.cutout_r_m,
             tip_loss_factor: a.tip_loss_factor,
+            twist_rad: spec
+                .blade
+                .twist_deg
+                .iter()
+                .map(|p| (p[0], p[1].to_radians()))
+                .collect(),
         },
         model,
     ))
