@@ -1629,6 +1629,18 @@ impl ForcedResponse for RotorSim {
             parts.push((format!("{who}flap"), mag(t + 2)));
             parts.push((format!("{who}torsion"), twist * radius / 10.0));
         }
+        // the bearing elastomers' branch moments (the last coordinates, as angles): a mode
+        // made of them with little motion is a relaxation of the elastomer (real multiplier
+        // `exp(-T / tau)` of a Maxwell branch), not a blade mode
+        let n_el =
+            elastomer_scales(&self.solver.model).len() * crate::structure::elastomer::BRANCHES;
+        if n_el > 0 && n_el <= re.len() {
+            let el = (re.len() - n_el..re.len())
+                .map(|i| mag(i).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            parts.push(("bearing elastomer".to_string(), el * radius));
+        }
         if let Some(a) = &self.airframe {
             let i = K * a.mount;
             for d in &a.dofs {
