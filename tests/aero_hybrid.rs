@@ -87,7 +87,7 @@ fn run(flight: &Path, airloads: AirloadSource, out: &Path) -> ModelRun {
         flight: flight.to_path_buf(),
         damper: DamperChoice::One(DamperModel::Physical),
         periodic_tol: 1e-6,
-        revs: 75,
+        revs: 100,
         airloads,
         ..RunJob::new(out)
     };

@@ -200,6 +200,12 @@ pub trait ForcedResponse: Send {
     fn mode_label(&self, _re: &[f64], _im: &[f64]) -> String {
         String::new()
     }
+    /// Relaxation times of the model's internal relaxation states (the bearing elastomers'
+    /// Maxwell branches) [s]: each adds a real Floquet multiplier near `exp(-T / tau)` to the
+    /// structure's modes (empty: none).
+    fn relaxation_times_s(&self) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// A saved state of a [`ForcedResponse`]: the perturbable coordinates (periodic solvers work

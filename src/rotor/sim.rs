@@ -1629,17 +1629,19 @@ impl ForcedResponse for RotorSim {
             parts.push((format!("{who}flap"), mag(t + 2)));
             parts.push((format!("{who}torsion"), twist * radius / 10.0));
         }
-        // the bearing elastomers' branch moments (the last coordinates, as angles): a mode
-        // made of them with little motion is a relaxation of the elastomer (real multiplier
-        // `exp(-T / tau)` of a Maxwell branch), not a blade mode
+        // the bearing elastomers' branch moments (the last coordinates, as angles): a real
+        // mode made of them with little motion is a relaxation of the elastomer (multiplier
+        // near `exp(-T / tau)` of a Maxwell branch), not a blade mode; an oscillatory mode is
+        // the blade's, whatever the branches do in it
         let n_el =
             elastomer_scales(&self.solver.model).len() * crate::structure::elastomer::BRANCHES;
-        if n_el > 0 && n_el <= re.len() {
+        let real_mode = im.iter().all(|x| *x == 0.0);
+        if real_mode && n_el > 0 && n_el <= re.len() {
             let el = (re.len() - n_el..re.len())
                 .map(|i| mag(i).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            parts.push(("bearing elastomer".to_string(), el * radius));
+            parts.push(("elastomer relaxation".to_string(), el * radius));
         }
         if let Some(a) = &self.airframe {
             let i = K * a.mount;
@@ -1654,6 +1656,18 @@ impl ForcedResponse for RotorSim {
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .map(|p| p.0)
             .unwrap_or_default()
+    }
+    fn relaxation_times_s(&self) -> Vec<f64> {
+        self.solver
+            .model
+            .elements
+            .iter()
+            .filter_map(|e| match e {
+                Element::Joint(j) => j.elastomer.map(|el| el.chain.tau_s),
+                _ => None,
+            })
+            .flatten()
+            .collect()
     }
     fn timing(&self) -> Timing {
         Timing {

@@ -22,7 +22,7 @@ use std::time::Instant;
 /// Defaults of a run (those of `rotorsim run`'s options).
 pub const DEFAULT_ROTOR: &str = "rotors/uh60a.toml";
 pub const DEFAULT_FLIGHT: &str = "flightdata/c8534like";
-pub const DEFAULT_REVS: usize = 75;
+pub const DEFAULT_REVS: usize = 100;
 pub const DEFAULT_STEPS_PER_REV: usize = 256;
 pub const DEFAULT_SUBSTEPS: usize = 25;
 

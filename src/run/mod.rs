@@ -562,7 +562,12 @@ fn shoot_stage(
         .save_state()
         .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
     let label = format!("{} model", model.name());
-    let plan = periodic::FloquetPlan::of(o, sim.airload_info().is_some());
+    let aerodynamic = sim.airload_info().is_some();
+    let plan = periodic::FloquetPlan::of(o, aerodynamic).with_relaxations(
+        aerodynamic,
+        sim.period_s(),
+        &sim.relaxation_times_s(),
+    );
     let mut map = SimMap::new(
         sim,
         c.mon.clone(),
