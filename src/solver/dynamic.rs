@@ -282,15 +282,6 @@ impl DynamicSolver {
         Ok(s)
     }
 
-    /// Forgets modified Newton's stored factorization and whether the last step made one
-    /// (neither is part of a saved state): the first step after [`DynamicSolver::restore`]
-    /// factors the iteration matrix at its own iterate, so that a march from a restored state
-    /// does not depend on what was integrated before the restore.
-    pub(super) fn forget_factorization(&mut self) {
-        self.have_factor = false;
-        self.refreshed = false;
-    }
-
     fn coeffs(&self) -> (f64, f64) {
         let p = &self.params;
         let ca = (1.0 - p.alpha_m) / ((1.0 - p.alpha_f) * self.h * p.beta);

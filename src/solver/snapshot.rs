@@ -280,7 +280,6 @@ impl DynamicSolver {
         }
         self.r_ref = s.residual_scale;
         self.r_scale = s.force_scale;
-        self.forget_factorization();
         self.state.kin(&mut self.kin);
         Ok(())
     }
