@@ -140,7 +140,7 @@ fn build(c: &Case) -> Run {
         airfoils: vec![(RADIUS, Airfoil::Thin(ThinAirfoil::default()))],
         cutout_r_m: 0.0,
         tip_loss_factor: 1.0,
-        twist_rad: vec![],
+        twist_rad: rotorsim::structure::kin::TimeTable { points: vec![] },
     };
     let (th0, th1c, th1s) = (c.th0, c.th1c, c.th1s);
     let law = Arc::new(move |t: f64| {

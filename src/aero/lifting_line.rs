@@ -11,7 +11,8 @@
 use super::airfoil::{Airfoil, ClampCounts};
 use super::inflow::{DiskLoads, Inflow};
 use super::section::{blade_element, Air, SectionAirloads};
-use crate::structure::beam::{SectionLoad, NPTS_M};
+use crate::structure::beam::{gauss, SectionLoad, NPTS_M};
+use crate::structure::kin::TimeTable;
 use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
 use crate::structure::rotation::*;
 use std::sync::{Arc, Mutex};
@@ -68,25 +69,11 @@ pub struct BladeAero {
     /// Tip-loss factor B: no lift outboard of B R (1: none).
     pub tip_loss_factor: f64,
     /// Built-in twist the blade's beam was built with, `(r_m, rad)` points, linear between and
-    /// constant outside (empty: the beam's section frames as they are). The beam carries the
+    /// constant outside (no points: the beam's section frames as they are). The beam carries the
     /// table through its nodes (cubic interpolation over each element); the lifting line turns
     /// each load point's section to the element's cubic projection of the table instead
     /// ([`twist_offsets`]).
-    pub twist_rad: Vec<(f64, f64)>,
-}
-
-/// The table `t` (`(x, y)` points) at `x`: linear between its points, constant outside.
-fn table_at(t: &[(f64, f64)], x: f64) -> f64 {
-    match t {
-        [] => 0.0,
-        [first, ..] if x <= first.0 => first.1,
-        [.., last] if x >= last.0 => last.1,
-        _ => {
-            let k = t.partition_point(|p| p.0 <= x) - 1;
-            let w = (x - t[k].0) / (t[k + 1].0 - t[k].0);
-            t[k].1 + w * (t[k + 1].1 - t[k].1)
-        }
-    }
+    pub twist_rad: TimeTable,
 }
 
 /// Legendre polynomials P0..P3 at xi.
@@ -102,23 +89,23 @@ fn legendre(xi: f64) -> [f64; 4] {
 /// The piecewise-linear twist table `t` over the element from `ra` to `rb` [m] projected onto
 /// cubics (least squares over the element): its Legendre coefficients in xi in [-1, 1]. Exact:
 /// the integrals are split at the table's points, 3-point Gauss on each piece.
-fn cubic_projection(t: &[(f64, f64)], ra: f64, rb: f64) -> [f64; 4] {
+fn cubic_projection(t: &TimeTable, ra: f64, rb: f64) -> [f64; 4] {
     let xi_of = |r: f64| 2.0 * (r - ra) / (rb - ra) - 1.0;
     let mut cuts = vec![-1.0];
     cuts.extend(
-        t.iter()
+        t.points
+            .iter()
             .map(|p| xi_of(p.0))
             .filter(|x| *x > -1.0 && *x < 1.0),
     );
     cuts.push(1.0);
-    let g = [-(0.6f64.sqrt()), 0.0, 0.6f64.sqrt()];
-    let gw = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let (g, gw) = gauss(3);
     let mut c = [0.0; 4];
     for w in cuts.windows(2) {
         let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-        for (x, wq) in g.iter().zip(gw) {
+        for (x, wq) in g.iter().zip(&gw) {
             let xi = m + h * x;
-            let y = table_at(t, ra + 0.5 * (xi + 1.0) * (rb - ra));
+            let y = t.eval(ra + 0.5 * (xi + 1.0) * (rb - ra));
             for (k, pk) in legendre(xi).iter().enumerate() {
                 c[k] += wq * h * y * pk;
             }
@@ -134,12 +121,12 @@ fn cubic_projection(t: &[(f64, f64)], ra: f64, rb: f64) -> [f64; 4] {
 /// integrates the twist's part of the airloads times any cubic in r (thrust, flap moment,
 /// torque) exactly, also where the table has a kink or a step inside the element; where the
 /// table is linear over the element both are the table and the turn is zero.
-fn twist_offsets(t: &[(f64, f64)], ra: f64, rb: f64, pts: &[(f64, [f64; 4])]) -> Vec<f64> {
-    if t.is_empty() {
+fn twist_offsets(t: &TimeTable, ra: f64, rb: f64, pts: &[(f64, [f64; 4])]) -> Vec<f64> {
+    if t.points.is_empty() {
         return vec![0.0; pts.len()];
     }
     let c = cubic_projection(t, ra, rb);
-    let nodal: [f64; 4] = std::array::from_fn(|i| table_at(t, ra + (rb - ra) * i as f64 / 3.0));
+    let nodal: [f64; 4] = std::array::from_fn(|i| t.eval(ra + (rb - ra) * i as f64 / 3.0));
     pts.iter()
         .map(|(xi, n)| {
             let projected: f64 = legendre(*xi).iter().zip(c).map(|(p, ck)| p * ck).sum();
@@ -598,15 +585,16 @@ impl DistributedLoad for LiftingLine {
 mod tests {
     use super::{lift_inside, twist_offsets};
     use crate::structure::beam::{gauss, shape};
+    use crate::structure::kin::TimeTable;
 
     /// The twist each load point of an element from `ra` to `rb` meets the air with: the
     /// table through the nodes, interpolated, plus the offset; and the points' radii and weights.
-    fn element(t: &[(f64, f64)], ra: f64, rb: f64) -> Vec<(f64, f64, f64)> {
+    fn element(t: &TimeTable, ra: f64, rb: f64) -> Vec<(f64, f64, f64)> {
         let (xi, w) = gauss(4);
         let pts: Vec<_> = xi.iter().map(|&x| (x, shape(x).0)).collect();
         let off = twist_offsets(t, ra, rb, &pts);
         let nodal: Vec<f64> = (0..4)
-            .map(|i| super::table_at(t, ra + (rb - ra) * i as f64 / 3.0))
+            .map(|i| t.eval(ra + (rb - ra) * i as f64 / 3.0))
             .collect();
         pts.iter()
             .zip(&w)
@@ -625,13 +613,18 @@ mod tests {
     /// Where the table is linear over the element, the beam already carries it: no offset.
     #[test]
     fn a_linear_twist_needs_no_offset() {
-        let t = [(1.0, 0.2), (6.0, 0.0), (9.0, -0.1)];
+        let t = TimeTable {
+            points: vec![(1.0, 0.2), (6.0, 0.0), (9.0, -0.1)],
+        };
         let (xi, _) = gauss(4);
         let pts: Vec<_> = xi.iter().map(|&x| (x, shape(x).0)).collect();
         for o in twist_offsets(&t, 2.0, 2.6, &pts) {
             assert!(o.abs() < 1e-14, "{o}");
         }
-        assert!(twist_offsets(&[], 2.0, 2.6, &pts).iter().all(|o| *o == 0.0));
+        let none = TimeTable { points: vec![] };
+        assert!(twist_offsets(&none, 2.0, 2.6, &pts)
+            .iter()
+            .all(|o| *o == 0.0));
     }
 
     /// The shipped UH-60A table's step (-1.28 deg between 7.192 and 7.211 m) inside an element:
@@ -639,7 +632,7 @@ mod tests {
     #[test]
     fn the_element_integrates_a_stepped_twist_exactly() {
         let deg = std::f64::consts::PI / 180.0;
-        let t: Vec<(f64, f64)> = [
+        let points = [
             (6.0524, 0.2548),
             (7.19226, -1.2799),
             (7.21062, -2.5648),
@@ -649,6 +642,7 @@ mod tests {
         .iter()
         .map(|p| (p.0, p.1 * deg))
         .collect();
+        let t = TimeTable { points };
         let (ra, rb) = (7.0462, 7.6124);
         let pts = element(&t, ra, rb);
         for k in 0..4 {
@@ -659,7 +653,7 @@ mod tests {
             let want: f64 = (0..n)
                 .map(|i| {
                     let r = ra + (i as f64 + 0.5) * h;
-                    h * r.powi(k) * super::table_at(&t, r)
+                    h * r.powi(k) * t.eval(r)
                 })
                 .sum();
             assert!(

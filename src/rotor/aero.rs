@@ -12,6 +12,7 @@ use crate::aero::lifting_line::{BladeAero, LiftingLine, RotorAir};
 use crate::aero::section::Air;
 use crate::flight::FlightRecord;
 use crate::structure::beam::SectionLoad;
+use crate::structure::kin::TimeTable;
 use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
 use crate::structure::rotation::*;
 use std::path::Path;
@@ -151,12 +152,14 @@ pub fn blade_geometry(spec: &RotorSpec, file: &Path) -> anyhow::Result<(BladeAer
             airfoils,
             cutout_r_m: a.cutout_r_m,
             tip_loss_factor: a.tip_loss_factor,
-            twist_rad: spec
-                .blade
-                .twist_deg
-                .iter()
-                .map(|p| (p[0], p[1].to_radians()))
-                .collect(),
+            twist_rad: TimeTable {
+                points: spec
+                    .blade
+                    .twist_deg
+                    .iter()
+                    .map(|p| (p[0], p[1].to_radians()))
+                    .collect(),
+            },
         },
         model,
     ))
