@@ -234,3 +234,54 @@ fn a_snapshot_restores_the_elastomer_history() {
         "the branch history made no difference ({without:.2e})"
     );
 }
+
+/// A state is at the angle of its own configuration: restoring the configuration of one
+/// instant with the joint angles recorded at another (shooting moves a state's coordinates and
+/// keeps the rest of the snapshot it came from) marches exactly as restoring the instant
+/// itself. The record only picks the turn; read as the angle, the difference would be a strain
+/// of the elastomer within one step, `k_i` times it in every branch.
+#[test]
+fn a_restored_state_is_at_the_angle_of_its_configuration() {
+    let (_, model) = parse_deck(&good(), "e.toml", Path::new(".")).unwrap();
+    let mut st = State::from_model(&model);
+    st.w[0] = [0.0, 0.0, 0.1];
+    let h = 2.0 * std::f64::consts::PI / W / 200.0;
+    let mut s = DynamicSolver::new(model, st, h, 0.8).unwrap();
+    for _ in 0..137 {
+        s.step().unwrap();
+    }
+    let earlier = s.snapshot();
+    for _ in 0..50 {
+        s.step().unwrap();
+    }
+    let now = s.snapshot();
+    let moved = |a: &rotorsim::solver::snapshot::SolverSnapshot| {
+        a.joint_angles_rad.iter().flatten().copied().next().unwrap()
+    };
+    let apart = (moved(&now) - moved(&earlier)).abs();
+    assert!(apart > 1e-3, "the two records are {apart:.1e} rad apart");
+    let mut mixed = now.clone();
+    mixed.joint_angles_rad.clone_from(&earlier.joint_angles_rad);
+    let march = |s: &mut DynamicSolver, from: &rotorsim::solver::snapshot::SolverSnapshot| {
+        s.restore(from).unwrap();
+        (0..50)
+            .map(|_| {
+                s.step().unwrap();
+                s.sensor_values()
+            })
+            .collect::<Vec<_>>()
+    };
+    let a = march(&mut s, &now);
+    let b = march(&mut s, &mixed);
+    let scale = a.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let worst = a
+        .iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    println!("records {apart:.2e} rad apart: the marches differ by {worst:.1e} of {scale:.2e}");
+    assert!(
+        worst <= 1e-14 * scale,
+        "the record's angle changed the march by {worst:.2e} (of {scale:.2e})"
+    );
+}

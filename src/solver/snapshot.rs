@@ -3,6 +3,7 @@
 //! [`SolverSnapshot::set_coords`]) and a run writes the periodic one to disk for warm starts.
 use super::DynamicSolver;
 use crate::structure::joint::Joint;
+use crate::structure::kin::NodeKin;
 use crate::structure::model::Element;
 use crate::structure::rotation::*;
 use nalgebra::UnitQuaternion;
@@ -281,6 +282,22 @@ impl DynamicSolver {
         self.r_ref = s.residual_scale;
         self.r_scale = s.force_scale;
         self.state.kin(&mut self.kin);
+        // each joint's angle, and its elastomer's committed angle, from the configuration just
+        // restored (the snapshot's record only picks the turn): a state whose coordinates were
+        // moved (shooting's perturbed and trial states) is at that angle, with the branch
+        // moments it carries; with the recorded angle the first step would read the move as
+        // a strain of the bearing within one step (`k_i` times it in every branch)
+        let kin = &self.kin;
+        for e in self.model.elements.iter_mut() {
+            if let Element::Joint(j) = e {
+                let a = j.node_a.map(|i| kin[i]).unwrap_or_else(NodeKin::ground);
+                let psi = j.angle(&a, &kin[j.node_b]);
+                j.angle_prev = psi;
+                if let Some(el) = &mut j.elastomer {
+                    el.committed.angle_rad = psi;
+                }
+            }
+        }
         Ok(())
     }
 }
