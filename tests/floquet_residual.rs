@@ -1,55 +1,19 @@
-//! Floquet multipliers of the UH-60A run against a fit of the perturbed periodic march
-//! (docs/periodic.md): the periodic state is perturbed, both it and the unperturbed state are
-//! marched, and the per-revolution deviation `d_k` (every perturbable coordinate) is fitted by
-//! a linear recurrence `d_{k+p} = sum_j a_j d_{k+j}` (Prony's method: the roots of
-//! `z^p - sum a_j z^j` are the multipliers of the modes left in the deviation). The reported
-//! flap and lag multipliers must lie within 1% of the fitted ones or be marked unreliable.
-//! Under hybrid-periodic airloads the first flap mode decays tenfold a revolution and no fit of
-//! a march settles for it; it is checked against exact DMD on one-revolution pairs of the whole
-//! state (`dmd_first_flap`), from two perturbation sets that must agree.
+//! Floquet multipliers of the UH-60A run against independent references (docs/periodic.md).
+//! The settled reference: the simulation's own periodic solution at a tight Newton tolerance,
+//! then exact DMD on one-revolution pairs of the whole state (`dmd_until`), grown from two
+//! perturbation sets that must agree. Under measured airloads the reported flap and lag
+//! multipliers must lie within 1% of it or be marked unreliable; under hybrid-periodic airloads
+//! the lag within 1% and the first flap mode (it decays tenfold a revolution) within 5%. A fit
+//! of the perturbed tip flap (Prony's method) brackets the first flap mode.
 use nalgebra::{Complex, DMatrix, DVector};
 use rotorsim::flight::FlightRecord;
 use rotorsim::hydraulics::{DamperModel, IntegratorOptions};
+use rotorsim::periodic::Multiplier;
 use rotorsim::rotor::{ForcedResponse, RotorDeck, RunOptions, SimState};
+use rotorsim::run::job::DEFAULT_REVS;
 use rotorsim::run::{drive_periodic, PeriodicOptions};
 mod support;
 use support::root;
-
-/// Revolutions marched after the perturbation, and the first one fitted (the fast modes,
-/// |mu| < 0.5, have decayed below 1e-3 of their start by then).
-const REVS: usize = 40;
-const FIRST: usize = 10;
-/// Size of the perturbation in the map's coordinates (that of shooting's finite differences).
-const PERTURBATION: f64 = 1e-4;
-
-fn march(sim: &mut dyn ForcedResponse, from: &SimState, steps: usize) -> Vec<Vec<f64>> {
-    sim.restore_state(from).unwrap();
-    let mut out = vec![from.coords.clone()];
-    for _ in 0..REVS {
-        for _ in 0..steps {
-            sim.step().unwrap();
-        }
-        out.push(sim.save_state().unwrap().coords);
-    }
-    out
-}
-
-/// Roots of the order-`p` recurrence fitted by least squares to every coordinate of `d`
-/// from revolution `FIRST`, and the fit's relative residual.
-fn prony(d: &[Vec<f64>], p: usize) -> (Vec<(f64, f64)>, f64) {
-    prony_from(d, p, FIRST)
-}
-
-/// [`prony`] from revolution `first`.
-fn prony_from(d: &[Vec<f64>], p: usize, first: usize) -> (Vec<(f64, f64)>, f64) {
-    let n = d[0].len();
-    let rows: Vec<(usize, usize)> = (first..d.len() - p)
-        .flat_map(|k| (0..n).map(move |c| (k, c)))
-        .collect();
-    let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r].0 + j][rows[r].1]);
-    let b = DVector::from_fn(rows.len(), |r, _| d[rows[r].0 + p][rows[r].1]);
-    recurrence_roots(&a, &b)
-}
 
 /// Least-squares coefficients of `a x = b` (the recurrence's rows), the roots of its
 /// characteristic polynomial `z^p - sum x_j z^j` (companion matrix) and the fit's relative
@@ -73,18 +37,17 @@ fn recurrence_roots(a: &DMatrix<f64>, b: &DVector<f64>) -> (Vec<(f64, f64)>, f64
     (roots, rel)
 }
 
-/// Multiplier of the fitted roots nearest in frequency (mod 1/rev) to `f`, among the slow ones.
-fn nearest(roots: &[(f64, f64)], f: f64) -> (f64, f64) {
-    let freq = |z: &(f64, f64)| z.1.atan2(z.0).abs() / (2.0 * std::f64::consts::PI);
-    *roots
-        .iter()
-        .filter(|z| z.1 >= 0.0 && z.0.hypot(z.1) > 0.5)
-        .min_by(|a, b| (freq(a) - f).abs().total_cmp(&(freq(b) - f).abs()))
-        .unwrap()
-}
-
+/// Measured airloads (linear damper, 128 steps per revolution): the reported flap and lag
+/// multipliers, at the run's default tolerance and at a tight one started from the first's end
+/// (another subspace), within 1% of a settled reference or marked unreliable. The reference:
+/// the same model at the Newton tolerance [`REFERENCE_RTOL`] driven to its own periodic
+/// solution, then exact DMD ([`dmd_until`]) from two perturbation sets, A six random directions
+/// by 1e-5 and B six others by 2e-5, each grown until the eigenvalues nearest the reported flap
+/// and lag have residuals at most 1e-3 of |mu|; the two sets must agree within half the
+/// tolerance. (On the elastomeric bearing the lag mode at 0.29/rev has neighbours at 0.31 and
+/// 0.32/rev; a fit of a 40-revolution march of the perturbed state blends them, 1% low.)
 #[test]
-fn flap_and_lag_multipliers_match_a_fit_of_the_perturbed_march_or_are_marked() {
+fn flap_and_lag_multipliers_match_a_settled_reference_or_are_marked() {
     let deck = RotorDeck::from_file(&root().join("rotors/uh60a.toml")).unwrap();
     let rec = FlightRecord::read(&root().join("flightdata/c8534like")).unwrap();
     let damper = deck.damper().unwrap();
@@ -99,15 +62,13 @@ fn flap_and_lag_multipliers_match_a_fit_of_the_perturbed_march_or_are_marked() {
         ..Default::default()
     };
     let mut sim = rotorsim::rotor::build(&deck, &damper, model, &rec, &opts).unwrap();
-    // the run's default tolerance, then a tight one started from the first's end (another
-    // subspace: on it the lag multiplier is 1.6% off and its residual 24% of |mu|)
     let runs: Vec<_> = [1e-4, 1e-6]
         .iter()
         .map(|&tol| {
             let run = drive_periodic(
                 sim.as_mut(),
                 model,
-                &PeriodicOptions::shooting(tol, 75),
+                &PeriodicOptions::shooting(tol, DEFAULT_REVS),
                 &|_, _| {},
             )
             .unwrap();
@@ -115,71 +76,82 @@ fn flap_and_lag_multipliers_match_a_fit_of_the_perturbed_march_or_are_marked() {
             (tol, run)
         })
         .collect();
-    let x0 = runs[1].1.periodic_state.clone().unwrap();
-    let mut xp = x0.clone();
-    let v: Vec<f64> = (0..xp.coords.len())
-        .map(|i| (1.3 * i as f64 + 0.7).sin())
-        .collect();
-    let nv = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    for (c, vi) in xp.coords.iter_mut().zip(&v) {
-        *c += PERTURBATION * vi / nv;
-    }
-    let steps = opts.steps_per_rev;
-    let base = march(sim.as_mut(), &x0, steps);
-    let pert = march(sim.as_mut(), &xp, steps);
-    let d: Vec<Vec<f64>> = base
+    let reported = |run: &rotorsim::run::ModelRun, mode: &str| {
+        run.periodic
+            .floquet_multipliers
+            .iter()
+            .find(|m| m.mode == mode)
+            .unwrap_or_else(|| panic!("no {mode} multiplier"))
+            .clone()
+    };
+    let targets: Vec<Multiplier> = runs
         .iter()
-        .zip(&pert)
-        .map(|(b, p)| p.iter().zip(b).map(|(x, y)| x - y).collect())
+        .flat_map(|(_, r)| ["flap", "lag"].map(|m| reported(r, m)))
         .collect();
-    // the deviation holds about six slow modes (lag, flap, their second modes, torsion):
-    // order 12; order 10 tells how well the fit has settled
-    let (roots, rel) = prony(&d, 12);
-    let (roots10, _) = prony(&d, 10);
-    eprintln!("fit of order 12: relative residual {rel:.2e}");
-    assert!(rel < 2e-2, "the order-12 recurrence leaves {rel:.2e}");
+    let ref_opts = RunOptions {
+        newton_rtol: REFERENCE_RTOL,
+        ..opts
+    };
+    let mut rsim = rotorsim::rotor::build(&deck, &damper, model, &rec, &ref_opts).unwrap();
+    let mut po = PeriodicOptions::shooting(1e-6, DEFAULT_REVS);
+    po.floquet_resolve = false;
+    let rr = drive_periodic(rsim.as_mut(), model, &po, &|_, _| {}).unwrap();
+    assert!(rr.converged(), "reference: {:?}", rr.periodic);
+    let x0 = rr.periodic_state.clone().unwrap();
+    let n = x0.coords.len();
+    rsim.set_output_channels(false);
+    let resolved = |eigs: &[(Complex<f64>, f64)]| {
+        targets
+            .iter()
+            .all(|m| nearest_eig(eigs, m).is_some_and(|(_, r)| r <= 1e-3))
+    };
+    let set_a: Vec<Vec<f64>> = (1..=6).map(|s| random_direction(n, s)).collect();
+    let set_b: Vec<Vec<f64>> = (101..=106).map(|s| random_direction(n, s)).collect();
+    let steps = opts.steps_per_rev;
+    let (ea, na) = dmd_until(rsim.as_mut(), &x0, set_a, 1e-5, steps, &resolved);
+    let (eb, nb) = dmd_until(rsim.as_mut(), &x0, set_b, 2e-5, steps, &resolved);
+    eprintln!("reference: set A {na} pairs, set B {nb} pairs");
     for (tol, run) in &runs {
-        for m in &run.periodic.floquet_multipliers {
-            eprintln!(
-                "tol {tol:.0e}: Floquet {:>8}: {:.6} {:+.6}i |mu| {:.5} f {:.4}/rev residual {:.2e} reliable {}",
-                m.mode, m.re, m.im, m.magnitude, m.frequency_per_rev, m.residual, m.reliable
-            );
-        }
         for mode in ["flap", "lag"] {
-            // the least damped multiplier of that label
-            let m = run
-                .periodic
-                .floquet_multipliers
-                .iter()
-                .find(|m| m.mode == mode)
-                .unwrap_or_else(|| panic!("no {mode} multiplier"));
-            let (fr, fi) = nearest(&roots, m.frequency_per_rev);
-            let (gr, gi) = nearest(&roots10, m.frequency_per_rev);
-            let fit = fr.hypot(fi);
-            // the reference has settled: the decays per revolution of orders 10 and 12 agree
-            // within half the tolerance (the lag's frequency settles only to ~0.002/rev)
-            assert!(
-                (fit - gr.hypot(gi)).abs() < 5e-3 * fit,
-                "{mode}: fits of order 10 and 12 differ: {fit} vs {}",
-                gr.hypot(gi)
-            );
-            let dist = (m.magnitude - fit).abs() / fit;
-            let cdist = (m.re - fr).hypot(m.im.abs() - fi) / fit;
-            let decay = m.magnitude.ln() / fit.ln();
+            let m = reported(run, mode);
+            let (za, ra) = nearest_eig(&ea, &m).unwrap();
+            let (zb, rb) = nearest_eig(&eb, &m).unwrap();
+            let (ma, mb) = (za.norm(), zb.norm());
+            let dist = (m.magnitude - ma).abs() / ma;
             eprintln!(
-                "tol {tol:.0e} {mode}: Floquet |mu| {:.5}, fit {fit:.5} (order 10: {:.5}): |mu| off by {dist:.2e}, complex distance {cdist:.2e}, decay rate x{decay:.3}; residual {:.2e} of |mu|, reliable {}",
+                "tol {tol:.0e} {mode}: Floquet |mu| {:.5} at {:.4}/rev (residual {:.1e} of |mu|, reliable {}); reference A {ma:.5} at {:.4}/rev (residual {ra:.1e}), B {mb:.5} (residual {rb:.1e}): off by {dist:.2e}",
                 m.magnitude,
-                gr.hypot(gi),
+                m.frequency_per_rev,
                 m.residual / m.magnitude,
-                m.reliable
+                m.reliable,
+                za.im.atan2(za.re) / std::f64::consts::TAU,
+            );
+            assert!(
+                ra <= 1e-3 && rb <= 1e-3,
+                "{mode}: the reference is not resolved ({ra:.1e}, {rb:.1e})"
+            );
+            assert!(
+                (ma - mb).abs() <= 5e-3 * ma,
+                "{mode}: the reference has not settled: set A {ma:.5}, set B {mb:.5}"
             );
             assert!(
                 dist <= 0.01 || !m.reliable,
-                "{mode}: |mu| is {dist:.2e} from the fit yet marked reliable (residual {:.2e})",
+                "{mode}: |mu| is {dist:.2e} from the reference yet marked reliable (residual {:.2e})",
                 m.residual
             );
         }
     }
+}
+
+/// The DMD eigenvalue nearest the multiplier `m` in the complex plane (conjugates folded), and
+/// its residual.
+fn nearest_eig(eigs: &[(Complex<f64>, f64)], m: &Multiplier) -> Option<(Complex<f64>, f64)> {
+    eigs.iter()
+        .min_by(|a, b| {
+            let d = |z: &Complex<f64>| (z.re - m.re).hypot(z.im - m.im.abs());
+            d(&a.0).total_cmp(&d(&b.0))
+        })
+        .copied()
 }
 
 /// Marches `revs` revolutions from `from`, the tip flap channel at every step.
@@ -220,9 +192,9 @@ fn rigidly_flapped(x: &SimState, delta: f64) -> SimState {
 
 /// Roots of the per-revolution recurrence `d(t + p T) = sum_j a_j d(t + j T)` fitted by least
 /// squares at every step `t >= t0` of `d` (`steps` samples per revolution `T`), and the fit's
-/// relative residual. Unlike [`prony_from`], whose rows start at whole revolutions, the rows
-/// start at every step: a mode that decays tenfold in a revolution is fitted from where the
-/// faster ones have died, half a revolution after the perturbation if need be.
+/// relative residual. The rows start at every step, not at whole revolutions: a mode that
+/// decays tenfold in a revolution is fitted from where the faster ones have died, half a
+/// revolution after the perturbation if need be.
 fn prony_steps(d: &[f64], p: usize, steps: usize, t0: usize) -> (Vec<(f64, f64)>, f64) {
     let rows: Vec<usize> = (t0..d.len() - p * steps).collect();
     let a = DMatrix::from_fn(rows.len(), p, |r, j| d[rows[r] + j * steps]);
@@ -234,8 +206,6 @@ fn prony_steps(d: &[f64], p: usize, steps: usize, t0: usize) -> (Vec<(f64, f64)>
 /// perturbed tip flap.
 struct HybridCase {
     run: rotorsim::run::ModelRun,
-    /// Per-revolution deviation of the tip flap (a rigid flap of 1e-4 rad, 12 revolutions).
-    per_rev: Vec<Vec<f64>>,
     /// The same at every step, central difference of flaps of +-1e-4 rad.
     central: Vec<f64>,
     steps: usize,
@@ -259,7 +229,7 @@ fn hybrid_run(
         ..Default::default()
     };
     let mut sim = rotorsim::rotor::build(&deck, &damper, model, &rec, &opts).unwrap();
-    let mut po = PeriodicOptions::shooting(1e-6, 75);
+    let mut po = PeriodicOptions::shooting(1e-6, DEFAULT_REVS);
     po.floquet_resolve = resolve;
     let run = drive_periodic(sim.as_mut(), model, &po, &|_, _| {}).unwrap();
     assert!(run.converged(), "{:?}", run.periodic);
@@ -285,20 +255,11 @@ fn hybrid_case() -> HybridCase {
     let steps = (sim.period_s() / sim.time_step_s()).round() as usize;
     let revs = 12;
     let delta = 1e-4;
-    let base = tip_flap_march(sim.as_mut(), &x0, revs, steps);
     let up = tip_flap_march(sim.as_mut(), &rigidly_flapped(&x0, delta), revs, steps);
     let down = tip_flap_march(sim.as_mut(), &rigidly_flapped(&x0, -delta), revs, steps);
-    let per_rev = (0..revs)
-        .map(|k| {
-            (k * steps..(k + 1) * steps)
-                .map(|i| up[i] - base[i])
-                .collect()
-        })
-        .collect();
     let central = up.iter().zip(&down).map(|(a, b)| (a - b) / 2.0).collect();
     HybridCase {
         run,
-        per_rev,
         central,
         steps,
     }
@@ -351,63 +312,17 @@ fn flap_fits(c: &HybridCase, m: &rotorsim::periodic::Multiplier) -> Vec<(usize, 
     out
 }
 
-/// Hybrid-periodic airloads (physical damper, the run's defaults): the periodic state with
-/// the blade flapped rigidly about its hinge (1e-4 rad) is marched 12 revolutions beside the
-/// unperturbed one; the tip flap channel's deviation, revolution by revolution (every sample
-/// a row), is fitted by a linear recurrence (Prony, as above). The least damped root, the lag
-/// mode, must match the reported lag multiplier within 1%, and the reported multiplier must be
-/// resolved. The first flap mode, damped by the lifting line to |mu| ~ 0.1, must be reported
-/// and resolved; the recurrence fitted at every step from one revolution after the
-/// perturbation (orders 4 and 6, from 1 and 1.5 revolutions) must bracket it: those fits do
-/// not agree to 5% among themselves: the 5% check is against the settled reference of
-/// `hybrid_flap_multiplier_within_5_percent_of_a_settled_reference` below.
+/// Hybrid-periodic airloads (physical damper, the run's defaults): the first flap mode, damped
+/// by the lifting line to |mu| ~ 0.1, must be reported and resolved, and a fit of the perturbed
+/// march must bracket it: the periodic state with the blade flapped rigidly about its hinge
+/// (+-1e-4 rad) is marched 12 revolutions, and the tip flap's central difference is fitted by a
+/// linear recurrence at every step from one revolution after the perturbation (orders 4 and 6,
+/// from 1 and 1.5 revolutions). Those fits do not agree to 5% among themselves: the 5% check is
+/// against the settled reference of
+/// `hybrid_flap_and_lag_multipliers_match_a_settled_reference` below.
 #[test]
-fn hybrid_lag_multiplier_matches_a_fit_of_the_perturbed_tip_flap() {
+fn hybrid_first_flap_mode_is_resolved_within_the_decay_fits() {
     let c = hybrid_case();
-    let d = &c.per_rev;
-    let rms: Vec<f64> = d
-        .iter()
-        .map(|v| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt())
-        .collect();
-    for k in 1..4 {
-        eprintln!(
-            "tip flap deviation, revolution {k}: RMS {:.3e}, {:.4} of the revolution before",
-            rms[k],
-            rms[k] / rms[k - 1]
-        );
-    }
-    let lag = c
-        .run
-        .periodic
-        .floquet_multipliers
-        .iter()
-        .find(|m| m.mode == "lag")
-        .expect("no lag multiplier");
-    let least_damped = |p: usize| {
-        let (roots, rel) = prony_from(d, p, 1);
-        let z = roots
-            .iter()
-            .copied()
-            .max_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)))
-            .unwrap();
-        eprintln!(
-            "fit of order {p}: least damped {:.5} at {:.4}/rev, relative residual {rel:.1e}",
-            z.0.hypot(z.1),
-            z.1.atan2(z.0).abs() / std::f64::consts::TAU
-        );
-        z
-    };
-    let (z6, z8) = (least_damped(6), least_damped(8));
-    let fit = z6.0.hypot(z6.1);
-    assert!(
-        (fit - z8.0.hypot(z8.1)).abs() < 5e-3 * fit,
-        "the fit has not settled"
-    );
-    assert!(lag.reliable, "lag not resolved: {lag:?}");
-    let dist = (lag.magnitude - fit).abs() / fit;
-    assert!(dist < 0.01, "lag |mu| {} vs fit {fit}", lag.magnitude);
-    let fdist = (lag.frequency_per_rev - z6.1.atan2(z6.0).abs() / std::f64::consts::TAU).abs();
-    assert!(fdist < 0.005, "lag frequency off by {fdist}/rev");
     // the first flap mode: found, resolved, within the spread of the decay fits
     let flap = first_flap(&c.run);
     eprintln!(
@@ -527,25 +442,27 @@ fn first_flap_of(eigs: &[(Complex<f64>, f64)]) -> Option<(Complex<f64>, f64)> {
         .copied()
 }
 
-/// An independent estimate of the first flap multiplier: exact DMD on one-revolution pairs
-/// from the periodic state `x0`, the pairs a block Krylov sequence. The first block is
-/// `starts`; each revolution's images (`M q`, central differences of `delta`), orthogonalised
-/// against every start so far, are the next block's starts: every pair starts at the full
-/// perturbation, so a mode that decays tenfold a revolution stays as far above the
-/// integration's noise as the slow ones (a march would bury it within three revolutions). The
-/// blocks grow until the first flap mode's residual is below 1e-3 of `|mu|` (or 96 pairs).
-/// Returns it, its residual and the number of pairs.
-fn dmd_first_flap(
+/// A DMD eigenvalue (a multiplier) and its mode's relative residual.
+type Eig = (Complex<f64>, f64);
+
+/// Exact DMD on one-revolution pairs from the periodic state `x0`, the pairs a block Krylov
+/// sequence: the first block is `starts`; each revolution's images (`M q`, central differences
+/// of `delta`), orthogonalised against every start so far, are the next block's starts: every
+/// pair starts at the full perturbation, so a mode that decays tenfold a revolution stays as
+/// far above the integration's noise as the slow ones (a march would bury it within three
+/// revolutions). The blocks grow until `done` holds for the eigenvalues (or 96 pairs). Returns
+/// the eigenvalues with their residuals and the number of pairs.
+fn dmd_until(
     sim: &mut dyn ForcedResponse,
     x0: &SimState,
     starts: Vec<Vec<f64>>,
     delta: f64,
     steps: usize,
-    name: &str,
-) -> (Complex<f64>, f64, usize) {
+    done: &dyn Fn(&[Eig]) -> bool,
+) -> (Vec<Eig>, usize) {
     let (mut q, mut w): (Vec<Vec<f64>>, Vec<Vec<f64>>) = (vec![], vec![]);
     let mut block = starts;
-    while q.len() < 96 {
+    while q.len() < 96 && !block.is_empty() {
         let mut next = vec![];
         for mut v in block {
             let n0 = dot(&v, &v).sqrt();
@@ -567,23 +484,11 @@ fn dmd_first_flap(
         }
         block = next;
         let eigs = dmd_pairs(&q, &w);
-        let found = first_flap_of(&eigs);
-        if let Some((z, r)) = found {
-            eprintln!(
-                "{name}: {} pairs: first flap |mu| {:.5} at {:.4}/rev, residual {r:.1e} of |mu|",
-                q.len(),
-                z.norm(),
-                z.im.atan2(z.re) / std::f64::consts::TAU
-            );
-            if r <= 1e-3 {
-                return (z, r, q.len());
-            }
+        if done(&eigs) {
+            return (eigs, q.len());
         }
     }
-    let eigs = dmd_pairs(&q, &w);
-    let (z, r) = first_flap_of(&eigs)
-        .unwrap_or_else(|| panic!("{name}: the first flap mode is not found among {eigs:?}"));
-    (z, r, q.len())
+    (dmd_pairs(&q, &w), q.len())
 }
 
 /// Directions of a perturbation: uniform random (seeded) on the displacements, rotations and
@@ -609,15 +514,19 @@ fn random_direction(n: usize, seed: u64) -> Vec<f64> {
 }
 
 /// Hybrid-periodic airloads (physical damper, the run's defaults): the reported first flap
-/// multiplier, resolved, within 5% of an independent reference that has itself settled. The
-/// reference uses the simulation's stepping only (`save_state`, `restore_state`, `step`): its
-/// own periodic solution at the Newton tolerance [`REFERENCE_RTOL`], then exact DMD on
-/// one-revolution pairs of the whole state ([`dmd_first_flap`]) from two perturbation sets: A
-/// the rigid flap about the hinge, its rate and four random directions, perturbed by 1e-5; B
-/// six other random directions, perturbed by 2e-5. The central differences are checked to be
-/// linear (1e-5 against 2e-5) and the two sets must agree within 2.5% (half the tolerance).
+/// multiplier, resolved, within 5% of an independent reference that has itself settled, and the
+/// reported lag multiplier, resolved, within 1% of it. The reference uses the simulation's
+/// stepping only (`save_state`, `restore_state`, `step`): its own periodic solution at the
+/// Newton tolerance [`REFERENCE_RTOL`], then exact DMD on one-revolution pairs of the whole
+/// state ([`dmd_until`], until the first flap mode and the eigenvalue nearest the reported lag
+/// have residuals at most 1e-3 of |mu|) from two perturbation sets: A the rigid flap about the
+/// hinge, its rate and four random directions, perturbed by 1e-5; B six other random
+/// directions, perturbed by 2e-5. The central differences are checked to be linear (1e-5
+/// against 2e-5) and the two sets must agree within half the tolerance (2.5% for the flap,
+/// 0.5% for the lag). (On the elastomeric bearing the lag mode at 0.29/rev has neighbours at
+/// 0.31 and 0.32/rev, which a fit of the perturbed tip flap over 12 revolutions blends.)
 #[test]
-fn hybrid_flap_multiplier_within_5_percent_of_a_settled_reference() {
+fn hybrid_flap_and_lag_multipliers_match_a_settled_reference() {
     let (_, run) = hybrid_run(RunOptions::default().newton_rtol, true);
     let flap = first_flap(&run);
     eprintln!(
@@ -630,6 +539,14 @@ fn hybrid_flap_multiplier_within_5_percent_of_a_settled_reference() {
         flap.reliable,
         "the first flap mode is not resolved: {flap:?}"
     );
+    let lag = run
+        .periodic
+        .floquet_multipliers
+        .iter()
+        .find(|m| m.mode == "lag")
+        .expect("no lag multiplier")
+        .clone();
+    assert!(lag.reliable, "lag not resolved: {lag:?}");
     let (mut sim, reference_run) = hybrid_run(REFERENCE_RTOL, false);
     let x0 = reference_run.periodic_state.clone().unwrap();
     let steps = (sim.period_s() / sim.time_step_s()).round() as usize;
@@ -665,8 +582,17 @@ fn hybrid_flap_multiplier_within_5_percent_of_a_settled_reference() {
         .chain((1..=4).map(|s| random_direction(n, s)))
         .collect();
     let set_b: Vec<Vec<f64>> = (101..=106).map(|s| random_direction(n, s)).collect();
-    let (za, ra, na) = dmd_first_flap(sim.as_mut(), &x0, set_a, 1e-5, steps, "set A");
-    let (zb, rb, nb) = dmd_first_flap(sim.as_mut(), &x0, set_b, 2e-5, steps, "set B");
+    let resolved = |eigs: &[(Complex<f64>, f64)]| {
+        first_flap_of(eigs).is_some_and(|(_, r)| r <= 1e-3)
+            && nearest_eig(eigs, &lag).is_some_and(|(_, r)| r <= 1e-3)
+    };
+    let (ea, na) = dmd_until(sim.as_mut(), &x0, set_a, 1e-5, steps, &resolved);
+    let (eb, nb) = dmd_until(sim.as_mut(), &x0, set_b, 2e-5, steps, &resolved);
+    let flap_of = |e: &[(Complex<f64>, f64)], set: &str| {
+        first_flap_of(e)
+            .unwrap_or_else(|| panic!("set {set}: the first flap mode is not found among {e:?}"))
+    };
+    let ((za, ra), (zb, rb)) = (flap_of(&ea, "A"), flap_of(&eb, "B"));
     let (ma, mb) = (za.norm(), zb.norm());
     eprintln!(
         "reference: set A {ma:.5} ({na} pairs, residual {ra:.1e}), set B {mb:.5} ({nb} pairs, residual {rb:.1e}): {:.2}% apart",
@@ -687,6 +613,32 @@ fn hybrid_flap_multiplier_within_5_percent_of_a_settled_reference() {
         dist <= 0.05,
         "flap |mu| {} is {:.1}% from the reference {ma:.5}",
         flap.magnitude,
+        100.0 * dist
+    );
+    // the lag: the DMD eigenvalue nearest the reported one, resolved in both sets
+    let (la, lra) = nearest_eig(&ea, &lag).unwrap();
+    let (lb, lrb) = nearest_eig(&eb, &lag).unwrap();
+    let (ma, mb) = (la.norm(), lb.norm());
+    let dist = (lag.magnitude - ma).abs() / ma;
+    eprintln!(
+        "lag: reported {:.5} at {:.4}/rev (residual {:.1e} of |mu|); reference A {ma:.5} at {:.4}/rev (residual {lra:.1e}), B {mb:.5} (residual {lrb:.1e}): off by {dist:.2e}",
+        lag.magnitude,
+        lag.frequency_per_rev,
+        lag.residual / lag.magnitude,
+        la.im.atan2(la.re) / std::f64::consts::TAU
+    );
+    assert!(
+        lra <= 1e-3 && lrb <= 1e-3,
+        "lag: the reference is not resolved ({lra:.1e}, {lrb:.1e})"
+    );
+    assert!(
+        (ma - mb).abs() <= 5e-3 * ma,
+        "lag: the reference has not settled: set A {ma:.5}, set B {mb:.5}"
+    );
+    assert!(
+        dist <= 0.01,
+        "lag |mu| {} is {:.2}% from the reference {ma:.5}",
+        lag.magnitude,
         100.0 * dist
     );
 }
