@@ -157,7 +157,7 @@ fn progress_is_plain_lines_when_stderr_is_not_a_terminal() {
     let e = String::from_utf8_lossy(&r.stderr);
     // the first revolution is reported at once, the end always; no terminal control codes
     assert!(
-        e.contains("linear: revolution 1 of at most 75, periodicity"),
+        e.contains("linear: revolution 1 of at most 100, periodicity"),
         "{e}"
     );
     assert!(e.contains("linear: done after"), "{e}");
