@@ -45,7 +45,7 @@ def test_default_run_is_the_clis_bit_for_bit(tmp_path):
     assert r.floquet() == cli_summary["models"]["physical"]["periodic"]["floquet_multipliers"]
     assert r.loads() == cli_summary["models"]["physical"]["loads"]
     # progress: the start, one event per revolution, the end
-    assert events[0] == {"event": "start", "units": ["physical"], "revs": 75}
+    assert events[0] == {"event": "start", "units": ["physical"], "revs": 100}
     revs = [e for e in events if e["event"] == "revolution"]
     assert [e["revolution"] for e in revs] == list(range(1, len(revs) + 1))
     assert events[-1]["event"] == "finished" and events[-1]["ok"]
@@ -75,7 +75,7 @@ def test_errors_name_the_file_and_the_key(tmp_path):
     with pytest.raises(ValueError, match="--airloads"):
         rotorsim.run(damper="linear", airloads="guessed", progress=False)
     with pytest.raises(ValueError, match="did not run"):
-        rotorsim.run(damper="linear", steps_per_rev=64, progress=False).last_rev("physical")
+        rotorsim.run(damper="linear", model="rigid", progress=False).last_rev("physical")
 
 
 def test_the_rigid_reduction_is_the_clis_and_reads_back(tmp_path):
