@@ -471,27 +471,6 @@ fn subst(s: &str, t: &Path) -> String {
         .replace("{R}", &root().display().to_string())
 }
 
-/// Copies of shipped decks refer to shipped files by absolute path.
-fn absolutize(text: String) -> String {
-    let r = root();
-    text.replace(
-        "sections_csv = \"data/",
-        &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
-    )
-    .replace(
-        "csv = \"data/",
-        &format!("csv = \"{}/", r.join("rotors/data").display()),
-    )
-    .replace(
-        "deck = \"../../rotors/",
-        &format!("deck = \"{}/", r.join("rotors").display()),
-    )
-    .replace(
-        "c81 = \"../data/",
-        &format!("c81 = \"{}/", r.join("data").display()),
-    )
-}
-
 /// Writes a case's files; Err names an edit that matched nothing.
 fn write_files(dir: &Path, files: &[F]) -> Result<(), String> {
     for &(dst, src, edits) in files {
@@ -529,7 +508,7 @@ fn write_files(dir: &Path, files: &[F]) -> Result<(), String> {
             t.1 = t.1.replacen(from, to, 1);
         }
         for (p, t) in texts {
-            std::fs::write(p, absolutize(t)).unwrap();
+            std::fs::write(p, support::absolutize(t)).unwrap();
         }
     }
     Ok(())

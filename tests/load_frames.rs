@@ -499,21 +499,7 @@ fn the_bearing_moments_are_the_elastomers_frequency_response() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut rd = csv::Reader::from_path(out.join("linear/last_rev.csv")).unwrap();
-    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
-    let rows: Vec<Vec<f64>> = rd
-        .records()
-        .map(|r| {
-            r.unwrap()
-                .iter()
-                .map(|x| x.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    let col = |name: &str| -> Vec<f64> {
-        let i = header.iter().position(|h| h == name).unwrap();
-        rows.iter().map(|r| r[i]).collect()
-    };
+    let col = support::csv_columns(&out.join("linear/last_rev.csv"));
     // complex harmonic n of a sampled revolution
     let harmonic = |x: &[f64], n: usize| -> (f64, f64) {
         let len = x.len() as f64;

@@ -10,28 +10,6 @@ use rotorsim::rotor::RotorDeck;
 use rotorsim::structure::elastomer::MaxwellChain;
 use std::path::Path;
 
-/// last_rev.csv as named columns.
-fn columns(path: &Path) -> impl Fn(&str) -> Vec<f64> {
-    let mut rd = csv::Reader::from_path(path).unwrap();
-    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
-    let rows: Vec<Vec<f64>> = rd
-        .records()
-        .map(|r| {
-            r.unwrap()
-                .iter()
-                .map(|x| x.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    move |name: &str| {
-        let i = header
-            .iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name}"));
-        rows.iter().map(|r| r[i]).collect()
-    }
-}
-
 /// Harmonic n of a uniformly sampled revolution, `(a, b)` of `a cos + b sin`.
 fn harmonic(x: &[f64], n: usize) -> (f64, f64) {
     let len = x.len() as f64;
@@ -73,7 +51,7 @@ fn row(summary: &serde_json::Value, name: &str) -> Vec<f64> {
 /// Checks one run: the balance, the arm, and the bearing's split against `stiffness(n)`, the
 /// bearing's storage and loss stiffness (K', K'') at n/rev [N m/rad].
 fn check(out: &Path, stiffness: impl Fn(usize) -> (f64, f64)) {
-    let col = columns(&out.join("linear/last_rev.csv"));
+    let col = support::csv_columns(&out.join("linear/last_rev.csv"));
     let link = col("pitch_link_force_N");
     let parts: Vec<Vec<f64>> = PITCH_LINK_CONTRIBUTOR_CHANNELS
         .iter()
@@ -165,20 +143,14 @@ fn a_dashpot_bearing_damps_as_c_psi_dot() {
     let dir = support::tmp("pitch_link_dashpot");
     std::fs::create_dir_all(&dir).unwrap();
     let r = support::root();
-    let text = std::fs::read_to_string(r.join("rotors/uh60a.toml"))
-        .unwrap()
-        .replace(
-            "pitch_loss_factor = 0.1 ",
-            "pitch_damping_Nms_per_rad = 272.0 ",
-        )
-        .replace(
-            "sections_csv = \"data/",
-            &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
-        )
-        .replace(
-            "c81 = \"../data/",
-            &format!("c81 = \"{}/", r.join("data").display()),
-        );
+    let text = support::absolutize(
+        std::fs::read_to_string(r.join("rotors/uh60a.toml"))
+            .unwrap()
+            .replace(
+                "pitch_loss_factor = 0.1 ",
+                "pitch_damping_Nms_per_rad = 272.0 ",
+            ),
+    );
     assert!(text.contains("pitch_damping_Nms_per_rad = 272.0"));
     let rotor = dir.join("r.toml");
     std::fs::write(&rotor, text).unwrap();

@@ -108,21 +108,15 @@ fn ok(o: &Output) {
 /// lag loss factor.
 fn one_label_deck(dir: &Path) {
     let r = root();
-    let text = std::fs::read_to_string(r.join("rotors/uh60a.toml"))
-        .unwrap()
-        .replace("# ASSUMED", "# assumed")
-        .replace(
-            "lag_loss_factor = 0.1                  # assumed",
-            "lag_loss_factor = 0.1                  # ASSUMED",
-        )
-        .replace(
-            "sections_csv = \"data/",
-            &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
-        )
-        .replace(
-            "c81 = \"../data/",
-            &format!("c81 = \"{}/", r.join("data").display()),
-        );
+    let text = support::absolutize(
+        std::fs::read_to_string(r.join("rotors/uh60a.toml"))
+            .unwrap()
+            .replace("# ASSUMED", "# assumed")
+            .replace(
+                "lag_loss_factor = 0.1                  # assumed",
+                "lag_loss_factor = 0.1                  # ASSUMED",
+            ),
+    );
     std::fs::write(dir.join("r.toml"), text).unwrap();
 }
 

@@ -188,16 +188,23 @@ fn bad_elastomer_keys_are_refused_with_the_key() {
     assert!(err.contains("stiffness_Nm_per_rad"), "{err}");
 }
 
-#[test]
-fn a_snapshot_restores_the_elastomer_history() {
+/// The body on its elastomeric hinge released with 0.1 rad/s and stepped `steps` times (200
+/// steps per undamped period, rho_inf 0.8).
+fn released_for(steps: usize) -> DynamicSolver {
     let (_, model) = parse_deck(&good(), "e.toml", Path::new(".")).unwrap();
     let mut st = State::from_model(&model);
     st.w[0] = [0.0, 0.0, 0.1];
     let h = 2.0 * std::f64::consts::PI / W / 200.0;
     let mut s = DynamicSolver::new(model, st, h, 0.8).unwrap();
-    for _ in 0..137 {
+    for _ in 0..steps {
         s.step().unwrap();
     }
+    s
+}
+
+#[test]
+fn a_snapshot_restores_the_elastomer_history() {
+    let mut s = released_for(137);
     let snap = s.snapshot();
     assert!(snap
         .joint_elastomers_nm
@@ -242,14 +249,7 @@ fn a_snapshot_restores_the_elastomer_history() {
 /// of the elastomer within one step, `k_i` times it in every branch.
 #[test]
 fn a_restored_state_is_at_the_angle_of_its_configuration() {
-    let (_, model) = parse_deck(&good(), "e.toml", Path::new(".")).unwrap();
-    let mut st = State::from_model(&model);
-    st.w[0] = [0.0, 0.0, 0.1];
-    let h = 2.0 * std::f64::consts::PI / W / 200.0;
-    let mut s = DynamicSolver::new(model, st, h, 0.8).unwrap();
-    for _ in 0..137 {
-        s.step().unwrap();
-    }
+    let mut s = released_for(137);
     let earlier = s.snapshot();
     for _ in 0..50 {
         s.step().unwrap();

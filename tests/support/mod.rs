@@ -113,3 +113,46 @@ pub fn upward_crossings(h: &[(f64, f64)]) -> Vec<f64> {
         .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1))
         .collect()
 }
+
+/// Copies of shipped decks refer to shipped files by absolute path.
+pub fn absolutize(text: String) -> String {
+    let r = root();
+    text.replace(
+        "sections_csv = \"data/",
+        &format!("sections_csv = \"{}/", r.join("rotors/data").display()),
+    )
+    .replace(
+        "csv = \"data/",
+        &format!("csv = \"{}/", r.join("rotors/data").display()),
+    )
+    .replace(
+        "deck = \"../../rotors/",
+        &format!("deck = \"{}/", r.join("rotors").display()),
+    )
+    .replace(
+        "c81 = \"../data/",
+        &format!("c81 = \"{}/", r.join("data").display()),
+    )
+}
+
+/// The columns of a CSV file with a header, by name (a cell that is not a number reads NaN).
+pub fn csv_columns(path: &Path) -> impl Fn(&str) -> Vec<f64> {
+    let mut rd = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
+    let rows: Vec<Vec<f64>> = rd
+        .records()
+        .map(|r| {
+            r.unwrap()
+                .iter()
+                .map(|x| x.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    move |name: &str| {
+        let i = header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"));
+        rows.iter().map(|r| r[i]).collect()
+    }
+}
