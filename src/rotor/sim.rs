@@ -13,6 +13,7 @@ use crate::solver::statics::{static_solve, StaticOptions};
 use crate::solver::{DynamicSolver, NewtonError, State};
 use crate::structure::beam::{SectionLoad, NPTS_M};
 use crate::structure::deck::{build_deck_ids, Built, BuiltIds, Deck};
+use crate::structure::elastomer::Elastomer;
 use crate::structure::hydraulic::{HydraulicForceElement, HydraulicProbe};
 use crate::structure::kin::TimeTable;
 use crate::structure::model::{DistributedLoad, Element, LoadPoint, Model};
@@ -1633,8 +1634,7 @@ impl ForcedResponse for RotorSim {
         // mode made of them with little motion is a relaxation of the elastomer (multiplier
         // near `exp(-T / tau)` of a Maxwell branch), not a blade mode; an oscillatory mode is
         // the blade's, whatever the branches do in it
-        let n_el =
-            elastomer_scales(&self.solver.model).len() * crate::structure::elastomer::BRANCHES;
+        let n_el = elastomers(&self.solver.model).count() * crate::structure::elastomer::BRANCHES;
         let real_mode = im.iter().all(|x| *x == 0.0);
         if real_mode && n_el > 0 && n_el <= re.len() {
             let el = (re.len() - n_el..re.len())
@@ -1658,15 +1658,8 @@ impl ForcedResponse for RotorSim {
             .unwrap_or_default()
     }
     fn relaxation_times_s(&self) -> Vec<f64> {
-        self.solver
-            .model
-            .elements
-            .iter()
-            .filter_map(|e| match e {
-                Element::Joint(j) => j.elastomer.map(|el| el.chain.tau_s),
-                _ => None,
-            })
-            .flatten()
+        elastomers(&self.solver.model)
+            .flat_map(|(_, el)| el.chain.tau_s)
             .collect()
     }
     fn timing(&self) -> Timing {
@@ -1685,18 +1678,19 @@ impl ForcedResponse for RotorSim {
     }
 }
 
+/// The model's joints with an elastomer: element index and the elastomer.
+fn elastomers(m: &Model) -> impl Iterator<Item = (usize, &Elastomer)> {
+    m.elements.iter().enumerate().filter_map(|(i, e)| match e {
+        Element::Joint(j) => j.elastomer.as_ref().map(|el| (i, el)),
+        _ => None,
+    })
+}
+
 /// The model's joints with an elastomer: element index and the chain's stiffness scale
 /// (`K_inf + sum k_i`, N m/rad) that turns its branch moments into angles.
 fn elastomer_scales(m: &Model) -> Vec<(usize, f64)> {
-    m.elements
-        .iter()
-        .enumerate()
-        .filter_map(|(i, e)| match e {
-            Element::Joint(j) => j
-                .elastomer
-                .map(|el| (i, el.chain.k_inf + el.chain.k.iter().sum::<f64>())),
-            _ => None,
-        })
+    elastomers(m)
+        .map(|(i, el)| (i, el.chain.k_inf + el.chain.k.iter().sum::<f64>()))
         .collect()
 }
 

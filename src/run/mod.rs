@@ -562,9 +562,9 @@ fn shoot_stage(
         .save_state()
         .ok_or_else(|| anyhow::anyhow!("{}: cannot save its state", sim.label()))?;
     let label = format!("{} model", model.name());
-    let aerodynamic = sim.airload_info().is_some();
-    let plan = periodic::FloquetPlan::of(o, aerodynamic).with_relaxations(
-        aerodynamic,
+    let plan = periodic::FloquetPlan::of(
+        o,
+        sim.airload_info().is_some(),
         sim.period_s(),
         &sim.relaxation_times_s(),
     );

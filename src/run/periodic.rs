@@ -125,12 +125,25 @@ impl FloquetPlan {
     /// [`FLOQUET_RESOLVE_FLOOR_AERO`] with up to [`FLOQUET_RESOLVE_DIRS_AERO`] directions;
     /// otherwise [`FLOQUET_REPORTED`], [`FLOQUET_RESOLVE_FLOOR`], [`FLOQUET_RESOLVE_DIRS`]. No
     /// directions when `o` does not resolve.
-    pub fn of(o: &PeriodicOptions, aerodynamic: bool) -> Self {
+    ///
+    /// The lifting line's plan is widened for a model with relaxation states of times `tau_s`
+    /// [s] (the bearing elastomers' Maxwell branches) over a period `period_s`: each whose free
+    /// multiplier `exp(-T / tau)` is at least half the floor (coupled to the blade it sits
+    /// higher: 0.59 against 0.53 on the shipped bearing) takes one more reported place and two
+    /// more directions, so that the aerodynamically damped first flap mode (|mu| ~ 0.1, below
+    /// the relaxations) keeps its place (the README's hybrid-periodic run, physical damper, uses
+    /// 29 of its 32 directions). The measured-airload plan is left as it is: its reported modes
+    /// sit above the relaxations (the slowest, 0.59, would be ninth on the shipped deck).
+    pub fn of(o: &PeriodicOptions, aerodynamic: bool, period_s: f64, tau_s: &[f64]) -> Self {
         let mut p = if aerodynamic {
+            let n = tau_s
+                .iter()
+                .filter(|t| (-period_s / **t).exp() >= 0.5 * FLOQUET_RESOLVE_FLOOR_AERO)
+                .count();
             FloquetPlan {
-                reported: FLOQUET_REPORTED_AERO,
+                reported: FLOQUET_REPORTED_AERO + n,
                 floor: FLOQUET_RESOLVE_FLOOR_AERO,
-                dirs: FLOQUET_RESOLVE_DIRS_AERO,
+                dirs: FLOQUET_RESOLVE_DIRS_AERO + 2 * n,
             }
         } else {
             FloquetPlan {
@@ -143,29 +156,6 @@ impl FloquetPlan {
             p.dirs = 0;
         }
         p
-    }
-
-    /// The lifting line's plan widened for a model with relaxation states of times `tau_s`
-    /// [s] (the bearing elastomers' Maxwell branches) over a period `period_s`: each whose
-    /// free multiplier `exp(-T / tau)` is at least half the floor (coupled to the blade it sits
-    /// higher: 0.59 against 0.53 on the shipped bearing) takes one more reported place and two
-    /// more directions, so that the aerodynamically damped flap mode (|mu| ~ 0.1, below the
-    /// relaxations) keeps its place (measured on the shipped deck: 28 directions with 6 such
-    /// relaxations, 20 without). The measured-airload plan is left as it is: its reported
-    /// modes sit above the relaxations (the slowest, 0.59, is 8th on the shipped deck).
-    pub fn with_relaxations(mut self, aerodynamic: bool, period_s: f64, tau_s: &[f64]) -> Self {
-        if !aerodynamic {
-            return self;
-        }
-        let n = tau_s
-            .iter()
-            .filter(|t| (-period_s / **t).exp() >= 0.5 * self.floor)
-            .count();
-        self.reported += n;
-        if self.dirs > 0 {
-            self.dirs += 2 * n;
-        }
-        self
     }
 }
 

@@ -240,9 +240,8 @@ impl DynamicSolver {
         }
         for (k, e) in self.model.elements.iter_mut().enumerate() {
             if let Element::Joint(j) = e {
-                let angle = j.angle_prev;
+                // the committed angle is set below, from the restored configuration
                 if let Some(el) = &mut j.elastomer {
-                    el.committed.angle_rad = angle;
                     if let Some(v) = s.joint_elastomers_nm.get(k) {
                         if v.len() != el.committed.branch_nm.len()
                             || v.iter().any(|x| !x.is_finite())
